@@ -1,0 +1,75 @@
+// sfx render SCENE: renders a scene and writes a PNG and a float image (PFM) beside it.
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "kernels/bvh.h"
+#include "kernels/reference/reference_tracer.h"
+#include "workloads/input_error.h"
+#include "workloads/scene_loader.h"
+
+namespace sfx {
+
+void add_render_command(CLI::App& app) {
+    struct Options {
+        std::string scene;
+        std::string output = "render.png";
+        std::string tracer = "reference";
+        bool json = false;
+        WorkloadFlags workload;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand("render", "render a scene to PNG and PFM");
+    c->add_option("scene", options->scene, "scene file or built-in scene name")->required();
+    c->add_option("-o,--output", options->output, "output PNG; the PFM goes beside it")
+        ->capture_default_str();
+    c->add_option("--tracer", options->tracer, "reference")
+        ->check(CLI::IsMember({"reference"}))
+        ->capture_default_str();
+    c->add_flag("--json", options->json, "print one JSON document");
+    options->workload.add_to(c);
+    c->callback([options] {
+        const Scene scene = load_scene(options->scene);
+        const RenderSettings settings = options->workload.resolve(scene);
+        if (options->output.size() < 5 || options->output.substr(options->output.size() - 4) != ".png")
+            throw InputError("command line", 0, "--output", "expected a .png path, got '" + options->output + "'");
+        const Bvh bvh(scene);
+        const RenderResult result = render_reference(scene, bvh, settings);
+        const std::string pfm = options->output.substr(0, options->output.size() - 4) + ".pfm";
+        write_png(result.image, options->output);
+        write_pfm(result.image, pfm);
+        const Vec3 mean = result.image.mean();
+        if (options->json) {
+            nlohmann::json j;
+            j["scene"] = scene.name;
+            j["tracer"] = options->tracer;
+            j["width"] = settings.width;
+            j["height"] = settings.height;
+            j["spp"] = settings.spp;
+            j["rays"] = result.stats.rays();
+            j["rays.camera"] = result.stats.camera_rays;
+            j["rays.extension"] = result.stats.extension_rays;
+            j["rays.shadow"] = result.stats.shadow_rays;
+            j["nonfinite_paths"] = result.stats.nonfinite_paths;
+            j["host_seconds"] = result.stats.host_seconds;
+            j["mean_radiance"] = {mean.x, mean.y, mean.z};
+            j["png"] = options->output;
+            j["pfm"] = pfm;
+            std::cout << j.dump(2) << "\n";
+        } else {
+            std::cout << "scene            " << scene.name << "\n"
+                      << "image            " << settings.width << "x" << settings.height << " x "
+                      << settings.spp << " spp, depth " << settings.max_depth << "\n"
+                      << "rays             " << result.stats.rays() << " (camera "
+                      << result.stats.camera_rays << ", extension " << result.stats.extension_rays
+                      << ", shadow " << result.stats.shadow_rays << ")\n"
+                      << "nonfinite paths  " << result.stats.nonfinite_paths << "\n"
+                      << "host seconds     " << result.stats.host_seconds << "\n"
+                      << "mrays/s          " << result.stats.rays() / result.stats.host_seconds * 1e-6 << "\n"
+                      << "wrote            " << options->output << ", " << pfm << "\n";
+        }
+    });
+}
+
+}  // namespace sfx

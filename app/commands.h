@@ -1,0 +1,29 @@
+#pragma once
+// The sfx subcommands. Each add_*_command registers one subcommand; main.cpp lists them.
+// Commands print a human table by default and one JSON document with --json.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "kernels/render.h"
+#include "workloads/scene.h"
+
+namespace sfx {
+
+// Workload flags shared by every command that renders or simulates a scene.
+struct WorkloadFlags {
+    std::string res = "256x256";
+    uint32_t spp = 4;
+    int depth = -1;  // -1: the scene's own max_depth
+    std::string tile = "32";
+    uint64_t seed = 0;
+    uint32_t threads = 0;
+
+    void add_to(CLI::App* command);
+    // Resolves against the scene; throws InputError (key = the flag) on a bad value.
+    RenderSettings resolve(const Scene& scene) const;
+};
+
+void add_render_command(CLI::App& app);
+
+}  // namespace sfx

@@ -1,0 +1,30 @@
+// sfx: a design-space explorer for stream-filtering ray-tracing hardware.
+// Thin: parses, calls the libraries, prints. Bad input exits 2 with file, line and key.
+
+#include <iostream>
+
+#include "app/commands.h"
+#include "workloads/input_error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"sfx: hardware design-space explorer for stream-filtering ray tracing"};
+    app.require_subcommand(1);
+    sfx::add_render_command(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    } catch (const sfx::InputError& e) {
+        std::cerr << "sfx: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "sfx: failed: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}

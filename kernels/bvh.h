@@ -1,0 +1,76 @@
+#pragma once
+// Binned-SAH bounding volume hierarchy over a scene's primitives (triangles and spheres).
+// The build is single-threaded and deterministic: the same scene gives the same tree, byte
+// for byte, so traces and images never depend on the machine.
+
+#include <cstdint>
+#include <vector>
+
+#include "kernels/intersect.h"
+#include "kernels/ray.h"
+#include "workloads/scene.h"
+
+namespace sfx {
+
+struct BvhNode {
+    Bounds3 bounds;
+    uint32_t first = 0;  // leaf: first index into Bvh::prim_ids; interior: left child index
+    uint32_t count = 0;  // leaf: primitive count (> 0); interior: 0
+    uint32_t right = 0;  // interior: right child index
+    uint8_t axis = 0;    // interior: split axis, for front-to-back order
+
+    bool is_leaf() const { return count > 0; }
+};
+
+struct BvhBuildOptions {
+    uint32_t max_leaf_size = 4;
+    uint32_t bins = 16;
+    float traversal_cost = 1.f;     // SAH cost of one box test, relative to one primitive test
+    float intersection_cost = 1.f;
+};
+
+struct BvhStats {
+    uint64_t nodes = 0;
+    uint64_t leaves = 0;
+    uint32_t max_depth = 0;
+    double average_leaf_depth = 0.0;
+    double average_leaf_size = 0.0;
+    uint32_t max_leaf_size = 0;
+    double sah_cost = 0.0;
+    uint64_t bytes = 0;
+};
+
+class Bvh {
+public:
+    static constexpr uint32_t k_sah_depth_limit = 64;
+    static constexpr uint32_t k_max_depth = k_sah_depth_limit + 33;  // + log2(2^32) median levels
+
+    Bvh() = default;
+    Bvh(const Scene& scene, const BvhBuildOptions& options = {});
+
+    const std::vector<BvhNode>& nodes() const { return m_nodes; }
+    const std::vector<uint32_t>& prim_ids() const { return m_prim_ids; }
+    const Scene& scene() const { return *m_scene; }
+    BvhStats stats() const;
+
+    // Depth-first, one ray at a time: the reference tracer's traversal.
+    Hit intersect(const Ray& ray) const;
+    bool occluded(const Ray& ray) const;
+
+    // One primitive test (used by both tracers, so both compute the same bits).
+    bool intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const;
+
+private:
+    uint32_t build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& prim_bounds,
+                   const std::vector<Vec3>& centroids, const BvhBuildOptions& options,
+                   uint32_t depth);
+
+    const Scene* m_scene = nullptr;
+    std::vector<BvhNode> m_nodes;
+    std::vector<uint32_t> m_prim_ids;
+};
+
+// Front child first: the child on the side the direction comes from.
+inline bool visit_right_first(const BvhNode& node, const Vec3& dir) { return dir[node.axis] < 0.f; }
+
+}  // namespace sfx

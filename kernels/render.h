@@ -1,0 +1,66 @@
+#pragma once
+// What every tracer takes and gives: render settings, the film, and per-render statistics.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "kernels/vec.h"
+
+namespace sfx {
+
+struct RenderSettings {
+    uint32_t width = 256;
+    uint32_t height = 256;
+    uint32_t spp = 4;
+    uint32_t max_depth = 3;  // bounces after the camera ray (the scene's value unless overridden)
+    uint32_t tile = 32;      // tile edge in pixels; the stream tracer's stream is tile^2 rays
+    uint32_t threads = 0;    // 0: all hardware threads
+    uint64_t seed = 0;
+};
+
+// One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
+// order, so neither thread count nor tile order changes a bit.
+struct Image {
+    uint32_t width = 0, height = 0;
+    std::vector<Vec3> pixels;
+
+    Image() = default;
+    Image(uint32_t w, uint32_t h) : width(w), height(h), pixels(size_t(w) * h) {}
+    Vec3& at(uint32_t x, uint32_t y) { return pixels[size_t(y) * width + x]; }
+    const Vec3& at(uint32_t x, uint32_t y) const { return pixels[size_t(y) * width + x]; }
+    Vec3 mean() const;
+};
+
+void write_pfm(const Image& image, const std::string& path);
+void write_png(const Image& image, const std::string& path);  // sRGB, clamped
+Image read_pfm(const std::string& path);
+
+struct RenderStats {
+    uint64_t camera_rays = 0;
+    uint64_t extension_rays = 0;
+    uint64_t shadow_rays = 0;
+    uint64_t nonfinite_paths = 0;  // paths whose radiance was NaN/Inf: zeroed, counted
+    double host_seconds = 0.0;
+
+    uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
+    RenderStats& operator+=(const RenderStats& o);
+};
+
+struct RenderResult {
+    Image image;
+    RenderStats stats;
+};
+
+// Tiles of the image in row-major order, each tile_size^2 pixels (clipped at the border).
+struct TileRect {
+    uint32_t x0, y0, x1, y1;
+};
+std::vector<TileRect> make_tiles(uint32_t width, uint32_t height, uint32_t tile_size);
+
+// Runs job(i) for i in [0, count) on `threads` threads (0: hardware concurrency), each index
+// exactly once; which thread runs which index never matters to callers.
+void parallel_for(uint32_t count, uint32_t threads, const std::function<void(uint32_t)>& job);
+
+}  // namespace sfx

@@ -1,0 +1,117 @@
+#include "workloads/scene.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace sfx {
+
+const char* to_string(MaterialKind kind) {
+    switch (kind) {
+        case MaterialKind::lambertian: return "lambertian";
+        case MaterialKind::dielectric: return "dielectric";
+        case MaterialKind::glossy: return "glossy";
+    }
+    return "?";
+}
+
+std::string FeatureSet::describe() const {
+    std::ostringstream s;
+    const char* sep = "";
+    auto item = [&](bool on, const char* name) {
+        if (on) { s << sep << name; sep = ", "; }
+    };
+    item(triangles, "triangles");
+    item(spheres, "spheres");
+    item(lambertian, "lambertian");
+    item(dielectric, "dielectric");
+    item(glossy, "glossy");
+    item(thin_lens, "thin-lens");
+    item(ambient, "ambient");
+    item(environment, "environment");
+    s << sep << light_count << " light" << (light_count == 1 ? "" : "s") << ", depth " << max_depth;
+    return s.str();
+}
+
+float Scene::primitive_area(uint32_t prim) const {
+    if (is_sphere(prim)) {
+        const float r = sphere(prim).radius;
+        return 4.f * float(M_PI) * r * r;
+    }
+    const Triangle& t = triangles[prim];
+    return 0.5f * length(cross(positions[t.v1] - positions[t.v0], positions[t.v2] - positions[t.v0]));
+}
+
+Bounds3 Scene::primitive_bounds(uint32_t prim) const {
+    Bounds3 b;
+    if (is_sphere(prim)) {
+        const Sphere& s = sphere(prim);
+        b.extend(s.center - Vec3(s.radius));
+        b.extend(s.center + Vec3(s.radius));
+    } else {
+        const Triangle& t = triangles[prim];
+        b.extend(positions[t.v0]);
+        b.extend(positions[t.v1]);
+        b.extend(positions[t.v2]);
+    }
+    return b;
+}
+
+Bounds3 Scene::bounds() const {
+    Bounds3 b;
+    for (uint32_t p = 0; p < primitive_count(); ++p) b.extend(primitive_bounds(p));
+    return b;
+}
+
+FeatureSet Scene::features() const {
+    FeatureSet f;
+    f.triangles = !triangles.empty();
+    f.spheres = !spheres.empty();
+    std::vector<bool> used(materials.size(), false);
+    for (const Triangle& t : triangles) used[t.material] = true;
+    for (const Sphere& s : spheres) used[s.material] = true;
+    for (size_t m = 0; m < materials.size(); ++m) {
+        if (!used[m]) continue;
+        f.lambertian |= materials[m].kind == MaterialKind::lambertian;
+        f.dielectric |= materials[m].kind == MaterialKind::dielectric;
+        f.glossy |= materials[m].kind == MaterialKind::glossy;
+    }
+    f.thin_lens = camera.aperture_radius > 0.f;
+    f.ambient = !is_black(ambient);
+    f.environment = !is_black(environment);
+    f.light_count = uint32_t(lights.size());
+    f.max_depth = max_depth;
+    return f;
+}
+
+void Scene::finalize(const std::vector<uint32_t>& light_groups) {
+    lights.clear();
+    std::map<uint32_t, size_t> light_of_group;
+    for (uint32_t p = 0; p < primitive_count(); ++p) {
+        const Material& m = materials[material_of(p)];
+        if (!m.emissive()) continue;
+        const float a = primitive_area(p);
+        if (!(a > 0.f)) continue;  // degenerate emitters can be neither hit nor sampled
+        size_t index;
+        if (light_groups.empty()) {
+            index = lights.size();
+            lights.emplace_back();
+        } else {
+            auto [it, inserted] = light_of_group.emplace(light_groups[p], lights.size());
+            if (inserted) lights.emplace_back();
+            index = it->second;
+        }
+        AreaLight& light = lights[index];
+        light.primitives.push_back(p);
+        light.area += a;
+        light.area_cdf.push_back(light.area);
+        light.emission = m.emission;
+    }
+}
+
+uint64_t Scene::geometry_bytes() const {
+    return positions.size() * sizeof(Vec3) + triangles.size() * sizeof(Triangle) +
+           spheres.size() * sizeof(Sphere) + materials.size() * sizeof(Material);
+}
+
+}  // namespace sfx
