@@ -74,4 +74,16 @@ inline Vec3 glossy_sample_spec(float exponent, const Vec3& n, const Vec3& wo, fl
     return reflect(wo, h);
 }
 
+// The coupled model's sampling: the glossy lobe or the cosine lobe, each with probability 1/2.
+// Returns the direction; its density is glossy_pdf (the mixture), so f cos / pdf is unbiased.
+inline Vec3 glossy_sample(float exponent, const Vec3& n, const Vec3& wo, float u_lobe, float u,
+                          float v) {
+    return u_lobe < 0.5f ? glossy_sample_spec(exponent, n, wo, u, v)
+                         : to_world(sample_cosine_hemisphere(u, v), n);
+}
+
+inline float glossy_pdf(float exponent, const Vec3& n, const Vec3& wo, const Vec3& wi) {
+    return 0.5f * glossy_spec_pdf(exponent, n, wo, wi) + 0.5f * cosine_hemisphere_pdf(dot(n, wi));
+}
+
 }  // namespace sfx

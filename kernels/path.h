@@ -142,13 +142,11 @@ inline bool glossy_scatter(PathState& p, const Material& m, const SurfaceHit& s,
     const Vec3 wo = -normalize(ray.dir);
     const float u = p.key.uniform(b, RngDim::direction_u);
     const float v = p.key.uniform(b, RngDim::direction_v);
-    const Vec3 wi = p.key.uniform(b, RngDim::lobe_choice) < 0.5f
-                        ? glossy_sample_spec(m.exponent, s.normal, wo, u, v)
-                        : to_world(sample_cosine_hemisphere(u, v), s.normal);
+    const Vec3 wi =
+        glossy_sample(m.exponent, s.normal, wo, p.key.uniform(b, RngDim::lobe_choice), u, v);
     const float cos_i = dot(s.normal, wi);
     if (!(cos_i > 0.f)) return false;
-    const float pdf = 0.5f * glossy_spec_pdf(m.exponent, s.normal, wo, wi) +
-                      0.5f * cosine_hemisphere_pdf(cos_i);
+    const float pdf = glossy_pdf(m.exponent, s.normal, wo, wi);
     if (!(pdf > 0.f)) return false;
     const Vec3 f = glossy_eval(m.diffuse, m.specular, m.exponent, s.normal, wo, wi);
     p.throughput *= f * (cos_i / pdf);
