@@ -13,9 +13,11 @@ namespace sfx {
 // incident side, eta = n_transmitted / n_incident. Returns 1 under total internal reflection.
 inline float fresnel_dielectric(float cos_i, float eta) {
     cos_i = std::min(1.f, std::max(0.f, cos_i));
-    const float sin2_t = (1.f - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= 1.f) return 1.f;
-    const float cos_t = std::sqrt(1.f - sin2_t);
+    // cos_t = sqrt(eta^2 - 1 + cos_i^2) / eta: exact for eta = 1 (sqrt(fl(c^2)) == c), so an
+    // index-matched interface reflects exactly nothing.
+    const float eta2_cos2_t = eta * eta - 1.f + cos_i * cos_i;
+    if (eta2_cos2_t <= 0.f) return 1.f;
+    const float cos_t = std::sqrt(eta2_cos2_t) / eta;
     const float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     const float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     return 0.5f * (r_par * r_par + r_perp * r_perp);
