@@ -1,0 +1,369 @@
+#include "hw_model/hw_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "workloads/input_error.h"
+
+namespace sfx {
+namespace {
+
+// Scalar text <-> typed values, strictly: "16x", "-1" for unsigned, "1e999" are errors.
+bool parse_scalar(const std::string& s, uint32_t& out) {
+    if (s.empty() || s[0] == '-' || s[0] == '+') return false;
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+    if (errno || *end != '\0' || v > 0xffffffffull) return false;
+    out = uint32_t(v);
+    return true;
+}
+bool parse_scalar(const std::string& s, double& out) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s.c_str(), &end);
+    if (errno || *end != '\0' || !std::isfinite(v)) return false;
+    out = v;
+    return true;
+}
+bool parse_scalar(const std::string& s, bool& out) {
+    if (s == "true") { out = true; return true; }
+    if (s == "false") { out = false; return true; }
+    return false;
+}
+bool parse_scalar(const std::string& s, std::string& out) {
+    out = s;
+    return true;
+}
+const char* type_name(uint32_t) { return "a non-negative integer"; }
+const char* type_name(double) { return "a finite number"; }
+const char* type_name(bool) { return "true or false"; }
+const char* type_name(const std::string&) { return "a string"; }
+
+std::string to_text(uint32_t v) { return std::to_string(v); }
+std::string to_text(bool v) { return v ? "true" : "false"; }
+std::string to_text(const std::string& v) { return v; }
+std::string to_text(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+template <class T> bool in_range(const T& v, const T& lo, const T& hi) { return v >= lo && v <= hi; }
+
+int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+
+std::string join(const std::string& prefix, const std::string& name) {
+    return prefix.empty() ? name : prefix + "." + name;
+}
+
+// Reads a YAML map into a config: every key must be visited, every value must parse and lie
+// in range. Absent keys keep their defaults.
+class YamlReader {
+public:
+    YamlReader(const YAML::Node& node, std::string file, std::string prefix, HwLineMap& lines)
+        : m_node(node), m_file(std::move(file)), m_prefix(std::move(prefix)), m_lines(lines) {
+        if (!m_node.IsMap())
+            throw InputError(m_file, line_of(m_node), m_prefix.empty() ? "(top level)" : m_prefix,
+                             "expected a mapping of keys to values");
+    }
+
+    template <class T, class B> void param(const char* name, T& value, const char*, const char*,
+                                           B lo, B hi) {
+        if (read(name, value) && !in_range(value, T(lo), T(hi)))
+            throw InputError(m_file, line_of(m_node[name]), join(m_prefix, name),
+                             "value " + to_text(value) + " is outside [" + to_text(T(lo)) + ", " +
+                                 to_text(T(hi)) + "]");
+    }
+    template <class T> void param(const char* name, T& value, const char*, const char*) {
+        read(name, value);
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*> allowed,
+                const char*) {
+        if (!read(name, value)) return;
+        std::string list;
+        for (const char* a : allowed) {
+            if (value == a) return;
+            list += list.empty() ? a : std::string(", ") + a;
+        }
+        throw InputError(m_file, line_of(m_node[name]), join(m_prefix, name),
+                         "'" + value + "' is not one of: " + list);
+    }
+    template <class G> void group(const char* name, G& g) {
+        m_seen.insert(name);
+        const YAML::Node child = m_node[name];
+        if (!child) return;
+        m_lines[join(m_prefix, name)] = line_of(child);
+        YamlReader r(child, m_file, join(m_prefix, name), m_lines);
+        g.visit(r);
+        r.finish();
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        m_seen.insert(name);
+        const YAML::Node child = m_node[name];
+        if (!child) return;
+        if (!child.IsSequence())
+            throw InputError(m_file, line_of(child), join(m_prefix, name), "expected a list");
+        m_lines[join(m_prefix, name)] = line_of(child);
+        items.assign(child.size(), G{});
+        for (size_t i = 0; i < child.size(); ++i) {
+            const std::string item = join(m_prefix, name) + "[" + std::to_string(i) + "]";
+            m_lines[item] = line_of(child[i]);
+            YamlReader r(child[i], m_file, item, m_lines);
+            items[i].visit(r);
+            r.finish();
+        }
+    }
+    void finish() const {
+        std::set<std::string> keys;
+        for (const auto& kv : m_node) {
+            const std::string key = kv.first.as<std::string>();
+            if (!m_seen.count(key))
+                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "unknown key");
+            if (!keys.insert(key).second)
+                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "duplicate key");
+        }
+    }
+
+private:
+    template <class T> bool read(const char* name, T& value) {
+        m_seen.insert(name);
+        const YAML::Node child = m_node[name];
+        if (!child) return false;
+        if (!child.IsScalar() || !parse_scalar(child.Scalar(), value))
+            throw InputError(m_file, line_of(child), join(m_prefix, name),
+                             std::string("expected ") + type_name(value));
+        m_lines[join(m_prefix, name)] = line_of(child);
+        return true;
+    }
+
+    const YAML::Node& m_node;
+    std::string m_file, m_prefix;
+    HwLineMap& m_lines;
+    std::set<std::string> m_seen;
+};
+
+class YamlWriter {
+public:
+    explicit YamlWriter(YAML::Emitter& out) : m_out(out) {}
+    template <class T, class B> void param(const char* name, T& value, const char* unit,
+                                           const char* description, B, B) {
+        param(name, value, unit, description);
+    }
+    template <class T> void param(const char* name, T& value, const char* unit, const char* description) {
+        m_out << YAML::Key << name << YAML::Value;
+        write(value);
+        std::string comment = description;
+        if (*unit) comment += std::string(" [") + unit + "]";
+        m_out << YAML::Comment(comment);
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*>,
+                const char* description) {
+        param(name, value, "", description);
+    }
+    template <class G> void group(const char* name, G& g) {
+        m_out << YAML::Key << name << YAML::Value << YAML::BeginMap;
+        g.visit(*this);
+        m_out << YAML::EndMap;
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        m_out << YAML::Key << name << YAML::Value << YAML::BeginSeq;
+        for (G& item : items) {
+            m_out << YAML::BeginMap;
+            item.visit(*this);
+            m_out << YAML::EndMap;
+        }
+        m_out << YAML::EndSeq;
+    }
+
+private:
+    void write(uint32_t v) { m_out << v; }
+    void write(bool v) { m_out << (v ? "true" : "false"); }
+    void write(const std::string& v) { m_out << YAML::DoubleQuoted << v; }
+    void write(double v) { m_out << to_text(v); }
+    YAML::Emitter& m_out;
+};
+
+class Flattener {
+public:
+    explicit Flattener(std::vector<HwParamInfo>& out, std::string prefix = "")
+        : m_out(out), m_prefix(std::move(prefix)) {}
+    template <class T, class B> void param(const char* name, T& value, const char* unit,
+                                           const char* description, B, B) {
+        param(name, value, unit, description);
+    }
+    template <class T> void param(const char* name, T& value, const char* unit, const char* description) {
+        m_out.push_back({join(m_prefix, name), to_text(value), unit, description});
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*>,
+                const char* description) {
+        param(name, value, "", description);
+    }
+    template <class G> void group(const char* name, G& g) {
+        Flattener f(m_out, join(m_prefix, name));
+        g.visit(f);
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        for (size_t i = 0; i < items.size(); ++i) {
+            Flattener f(m_out, join(m_prefix, name) + "[" + std::to_string(i) + "]");
+            items[i].visit(f);
+        }
+    }
+
+private:
+    std::vector<HwParamInfo>& m_out;
+    std::string m_prefix;
+};
+
+// Finds one parameter by dotted path and assigns it through the same range checks as YAML.
+class Setter {
+public:
+    Setter(const std::string& target, const std::string& value, const std::string& file, int line,
+           std::string prefix = "")
+        : m_target(target), m_value(value), m_file(file), m_line(line), m_prefix(std::move(prefix)) {}
+    bool found() const { return m_found; }
+
+    template <class T, class B> void param(const char* name, T& value, const char*, const char*,
+                                           B lo, B hi) {
+        if (!assign(name, value)) return;
+        if (!in_range(value, T(lo), T(hi)))
+            throw InputError(m_file, m_line, m_target,
+                             "value " + m_value + " is outside [" + to_text(T(lo)) + ", " +
+                                 to_text(T(hi)) + "]");
+    }
+    template <class T> void param(const char* name, T& value, const char*, const char*) {
+        assign(name, value);
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*> allowed,
+                const char*) {
+        if (join(m_prefix, name) != m_target) return;
+        for (const char* a : allowed)
+            if (m_value == a) {
+                value = m_value;
+                m_found = true;
+                return;
+            }
+        throw InputError(m_file, m_line, m_target, "'" + m_value + "' is not an allowed value");
+    }
+    template <class G> void group(const char* name, G& g) {
+        Setter s(m_target, m_value, m_file, m_line, join(m_prefix, name));
+        g.visit(s);
+        m_found |= s.m_found;
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        for (size_t i = 0; i < items.size(); ++i) {
+            Setter s(m_target, m_value, m_file, m_line,
+                     join(m_prefix, name) + "[" + std::to_string(i) + "]");
+            items[i].visit(s);
+            m_found |= s.m_found;
+        }
+    }
+
+private:
+    template <class T> bool assign(const char* name, T& value) {
+        if (join(m_prefix, name) != m_target) return false;
+        T parsed{};
+        if (!parse_scalar(m_value, parsed))
+            throw InputError(m_file, m_line, m_target, std::string("expected ") + type_name(parsed));
+        value = parsed;
+        m_found = true;
+        return true;
+    }
+    const std::string& m_target;
+    const std::string& m_value;
+    const std::string& m_file;
+    int m_line;
+    std::string m_prefix;
+    bool m_found = false;
+};
+
+bool is_power_of_two(uint32_t v) { return v && !(v & (v - 1)); }
+
+}  // namespace
+
+void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap& lines) {
+    auto fail = [&](const std::string& key, const std::string& what) {
+        // The line of the key itself, else of the nearest enclosing key that was written.
+        for (std::string k = key;; k = k.substr(0, k.find_last_of(".["))) {
+            auto it = lines.find(k);
+            if (it != lines.end()) throw InputError(file, it->second, key, what);
+            if (k.find_first_of(".[") == std::string::npos) break;
+        }
+        throw InputError(file, 0, key, what);
+    };
+    if (c.ray_buffer.kib % c.ray_buffer.banks != 0)
+        fail("ray_buffer.banks", std::to_string(c.ray_buffer.banks) + " banks do not divide " +
+                                     std::to_string(c.ray_buffer.kib) + " KiB");
+    if ((uint64_t(c.ray_buffer.bank_kib()) * 1024) % (4ull * c.ray_buffer.line_words) != 0)
+        fail("ray_buffer.line_words", "a bank does not hold a whole number of lines");
+    if (c.scene_memory.caches.size() > 8) fail("scene_memory.caches", "at most 8 cache levels");
+    std::set<std::string> names;
+    for (size_t i = 0; i < c.scene_memory.caches.size(); ++i) {
+        const CacheLevelConfig& l = c.scene_memory.caches[i];
+        const std::string key = "scene_memory.caches[" + std::to_string(i) + "]";
+        if (!is_power_of_two(l.line_bytes)) fail(key + ".line_bytes", "must be a power of two");
+        const uint64_t lines = uint64_t(l.kib) * 1024 / l.line_bytes;
+        if (lines == 0 || lines % l.ways != 0 || (uint64_t(l.kib) * 1024) % l.line_bytes != 0)
+            fail(key + ".ways", "capacity must be a whole number of sets of " +
+                                    std::to_string(l.ways) + " lines");
+        if (l.name.empty() || !names.insert(l.name).second)
+            fail(key + ".name", "cache level names must be unique and non-empty");
+    }
+}
+
+HwConfig parse_hw_config(const std::string& text, const std::string& file) {
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", e.msg);
+    }
+    HwConfig config;
+    HwLineMap lines;
+    YamlReader reader(root, file, "", lines);
+    config.visit(reader);
+    reader.finish();
+    check_hw_config(config, file, lines);
+    return config;
+}
+
+HwConfig load_hw_config(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "", "cannot read hardware configuration");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_hw_config(text.str(), path);
+}
+
+std::string dump_hw_config(const HwConfig& config) {
+    YAML::Emitter out;
+    out << YAML::BeginMap;
+    YamlWriter writer(out);
+    const_cast<HwConfig&>(config).visit(writer);  // the writer only reads
+    out << YAML::EndMap;
+    return std::string(out.c_str()) + "\n";
+}
+
+std::vector<HwParamInfo> flatten_hw_config(const HwConfig& config) {
+    std::vector<HwParamInfo> out;
+    Flattener f(out);
+    const_cast<HwConfig&>(config).visit(f);  // the flattener only reads
+    return out;
+}
+
+void set_hw_param(HwConfig& config, const std::string& path, const std::string& value,
+                  const std::string& file, int line) {
+    Setter s(path, value, file, line);
+    config.visit(s);
+    if (!s.found()) throw InputError(file, line, path, "no such hardware parameter");
+}
+
+}  // namespace sfx

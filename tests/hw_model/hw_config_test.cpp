@@ -1,0 +1,101 @@
+// The hardware configuration: strict parsing with file, line and key; one source of truth.
+
+#include <catch2/catch.hpp>
+
+#include "hw_model/hw_config.h"
+#include "workloads/input_error.h"
+
+using namespace sfx;
+
+namespace {
+// Parses and returns the InputError it throws (failing the test if none).
+InputError parse_error(const std::string& text) {
+    try {
+        parse_hw_config(text, "bad.hw.yaml");
+    } catch (const InputError& e) {
+        return e;
+    }
+    FAIL("no InputError for:\n" << text);
+    return InputError("", 0, "", "");
+}
+}  // namespace
+
+TEST_CASE("The gr08 preset parses and is the in-class default", "[hw_config]") {
+    const HwConfig preset = load_hw_config(SFX_SOURCE_DIR "/hw_model/presets/gr08.hw.yaml");
+    const HwConfig defaults;
+    CHECK(dump_hw_config(preset) == dump_hw_config(defaults));
+    CHECK(preset.ray_buffer.bank_kib() == 16);
+    CHECK(preset.simd.width == 16);
+    CHECK(preset.scene_memory.caches.size() == 3);
+    CHECK(preset.scene_memory.caches[2].ways == 16);
+}
+
+TEST_CASE("dump then parse gives the same configuration", "[hw_config]") {
+    HwConfig c;
+    c.simd.width = 12;
+    c.ray_buffer.kib = 256;
+    c.scene_memory.caches.pop_back();
+    c.clock.core_mhz = 812.5;
+    const std::string text = dump_hw_config(c);
+    const HwConfig back = parse_hw_config(text, "dumped.hw.yaml");
+    CHECK(dump_hw_config(back) == text);
+    CHECK(back.simd.width == 12);
+    CHECK(back.clock.core_mhz == 812.5);
+    CHECK(back.scene_memory.caches.size() == 2);
+}
+
+TEST_CASE("Bad hardware values name file, line and dotted key", "[hw_config]") {
+    const InputError width0 = parse_error("simd:\n  width: 0\n");
+    CHECK(width0.file() == "bad.hw.yaml");
+    CHECK(width0.line() == 2);
+    CHECK(width0.key() == "simd.width");
+
+    const InputError unknown = parse_error("ray_buffer:\n  kib: 512\n  bankz: 32\n");
+    CHECK(unknown.line() == 3);
+    CHECK(unknown.key() == "ray_buffer.bankz");
+
+    const InputError banks = parse_error("ray_buffer:\n  kib: 512\n  banks: 24\n");
+    CHECK(banks.line() == 3);
+    CHECK(banks.key() == "ray_buffer.banks");
+
+    const InputError type = parse_error("clock:\n  core_mhz: fast\n");
+    CHECK(type.key() == "clock.core_mhz");
+
+    const InputError negative = parse_error("agu:\n  count: -1\n");
+    CHECK(negative.key() == "agu.count");
+
+    const InputError ways = parse_error(
+        "scene_memory:\n  caches:\n    - {name: l1, kib: 32, line_bytes: 64, ways: 7}\n");
+    CHECK(ways.line() == 3);
+    CHECK(ways.key() == "scene_memory.caches[0].ways");
+
+    const InputError choice = parse_error("partition:\n  kind: bubble_sort\n");
+    CHECK(choice.key() == "partition.kind");
+
+    CHECK(parse_error("simd: [1, 2]\n").key() == "simd");
+    CHECK(parse_error("simd:\n  width: 16\n  width: 8\n").line() > 0);
+}
+
+TEST_CASE("Parameters are flattened to dotted names and set by path", "[hw_config]") {
+    HwConfig c;
+    const std::vector<HwParamInfo> params = flatten_hw_config(c);
+    bool saw_width = false, saw_cache = false;
+    for (const HwParamInfo& p : params) {
+        CHECK_FALSE(p.description.empty());
+        if (p.path == "simd.width") {
+            saw_width = true;
+            CHECK(p.value == "16");
+            CHECK(p.unit == "lanes");
+        }
+        if (p.path == "scene_memory.caches[1].kib") saw_cache = p.value == "256";
+    }
+    CHECK(saw_width);
+    CHECK(saw_cache);
+    set_hw_param(c, "simd.width", "12");
+    CHECK(c.simd.width == 12);
+    set_hw_param(c, "scene_memory.caches[0].ways", "4");
+    CHECK(c.scene_memory.caches[0].ways == 4);
+    CHECK_THROWS_AS(set_hw_param(c, "simd.widht", "12"), InputError);
+    CHECK_THROWS_AS(set_hw_param(c, "simd.width", "65"), InputError);
+    CHECK_THROWS_AS(set_hw_param(c, "ray_buffer.pipelined", "yes"), InputError);
+}
