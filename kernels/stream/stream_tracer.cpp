@@ -1,0 +1,444 @@
+#include "kernels/stream/stream_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include "kernels/camera.h"
+#include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/stream_filter.h"
+
+namespace sfx {
+
+namespace {
+
+// The ray buffers of one stream, one array per field group (structure of arrays). A slot is a
+// path: a path carries one ray at a time, so its next ray goes to the same slot of the
+// next-generation buffer, and streams are lists of slots.
+struct RayBuffers {
+    uint32_t capacity = 0;
+    std::vector<PathState> path;
+    std::vector<Ray> ray[2];          // current and next generation
+    std::vector<RayPrecomp> pre;      // per-ray constants of the box and triangle tests
+    std::vector<float> t;             // box-test t_max: the closest hit so far, or the ray's
+    std::vector<Hit> hit;
+    std::vector<uint8_t> any_hit;     // shadow ray: any hit in (0, t_max) occludes it
+    std::vector<SurfaceHit> surf;
+    std::vector<uint32_t> ids, next_ids, trav_ids, scratch;
+    std::vector<uint8_t> mask;
+    std::vector<std::pair<uint32_t, uint32_t>> stack;  // (node, stream length)
+
+    void ensure(uint32_t n) {
+        if (n <= capacity) return;
+        capacity = n;
+        path.resize(n);
+        ray[0].resize(n);
+        ray[1].resize(n);
+        Ray unit;
+        unit.dir = {0.f, 0.f, 1.f};
+        pre.resize(n, RayPrecomp(unit));
+        t.resize(n);
+        hit.resize(n);
+        any_hit.resize(n);
+        surf.resize(n);
+        ids.resize(n);
+        next_ids.resize(n);
+        trav_ids.resize(n);
+        scratch.resize(n);
+        mask.resize(n);
+    }
+};
+
+// Fig. 3: test the stream against the node's box, filter, stop on empty; at a leaf intersect
+// each primitive with the sub-stream; else the front child, then the back child. Closest-hit
+// rays tighten their t as they find hits; shadow rays leave the stream once occluded.
+// The front child is chosen by a majority of the passing rays' direction signs on the split
+// axis: independent of the order of the stream, and for one ray the reference's choice.
+template <class Trace>
+void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Trace& trace) {
+    if (n == 0) return;
+    const std::vector<BvhNode>& nodes = bvh.nodes();
+    const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
+    const Scene& scene = bvh.scene();
+    uint32_t* ids = b.trav_ids.data();
+    uint8_t* mask = b.mask.data();
+    uint32_t* scratch = b.scratch.data();
+    const RayPrecomp* pre = b.pre.data();
+    float* t = b.t.data();
+    Hit* hit = b.hit.data();
+    const uint8_t* any_hit = b.any_hit.data();
+    auto& stack = b.stack;
+    stack.clear();
+    stack.push_back({0u, n});
+    // Every stream on the stack is a prefix of the traversal stream: filters move passing ids
+    // to the front and only permute inside a prefix, so (node, length) names a stream.
+    while (!stack.empty()) {
+        const auto [node_index, len] = stack.back();
+        stack.pop_back();
+        const BvhNode& node = nodes[node_index];
+        const int axis = node.axis;
+        uint32_t negative = 0;
+        const uint32_t k = filter<k_host_width>(
+            trace, OpKind::box_test, generation, node_index, ids, len, mask, scratch,
+            [&](uint32_t id) {
+                if (any_hit[id] && hit[id].valid()) return false;  // occluded already
+                const bool in = intersect_box(pre[id], node.bounds, t[id]) != INFINITY;
+                negative += in && pre[id].dir[axis] < 0.f;
+                return in;
+            });
+        if (k == 0) continue;
+        if (node.is_leaf()) {
+            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                const uint32_t prim = prim_ids[i];
+                const uint32_t passed = evaluate<k_host_width>(ids, k, mask, [&](uint32_t id) {
+                    if (any_hit[id])
+                        return !hit[id].valid() &&
+                               bvh.intersect_primitive(pre[id], prim, t[id], hit[id]);
+                    if (!bvh.intersect_primitive(pre[id], prim, t[id], hit[id])) return false;
+                    t[id] = hit[id].t;
+                    return true;
+                });
+                trace.op(scene.is_sphere(prim) ? OpKind::sphere_test : OpKind::triangle_test,
+                         generation, prim, ids, k, mask, passed);
+            }
+        } else {
+            const bool right_first = 2 * negative > k;
+            stack.push_back({right_first ? node.first : node.right, k});  // back: popped last
+            stack.push_back({right_first ? node.right : node.first, k});
+        }
+    }
+}
+
+// Loads rays[ids[i]] for traversal; invalid rays (NaN/Inf, zero direction) stay out of the
+// stream and miss, as in Bvh::intersect. Returns the traversal stream length.
+uint32_t load_rays(RayBuffers& b, const Ray* rays, uint32_t n) {
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t id = b.ids[i];
+        const Ray& r = rays[id];
+        b.hit[id] = Hit{};
+        if (!ray_is_valid(r)) continue;
+        b.pre[id] = RayPrecomp(r);
+        b.t[id] = r.t_max;
+        b.trav_ids[m++] = id;
+    }
+    return m;
+}
+
+}  // namespace
+
+struct StreamTracer::Impl {
+    const Scene& scene;
+    const Bvh& bvh;
+    RenderSettings settings;
+    CameraFrame camera;
+    std::vector<MaterialKind> kinds;  // material kinds present, in filter order
+    RayBuffers b;
+
+    Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
+        : scene(s), bvh(h), settings(r), camera(s.camera, r.width, r.height) {
+        for (MaterialKind k :
+             {MaterialKind::lambertian, MaterialKind::dielectric, MaterialKind::glossy})
+            if (std::any_of(s.materials.begin(), s.materials.end(),
+                            [&](const Material& m) { return m.kind == k; }))
+                kinds.push_back(k);
+    }
+
+    template <class Trace>
+    void run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
+             RenderStats& stats, Trace& trace, TraceSink* sink, RayObserver* observer);
+};
+
+template <class Trace>
+void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t sample,
+                             Vec3* sums, RenderStats& stats, Trace& trace, TraceSink* sink,
+                             RayObserver* observer) {
+    const uint32_t w = rect.x1 - rect.x0, h = rect.y1 - rect.y0, count = w * h;
+    b.ensure(count);
+    TilePass info;
+    info.tile = tile_index;
+    info.x0 = rect.x0; info.y0 = rect.y0; info.x1 = rect.x1; info.y1 = rect.y1;
+    info.sample = sample;
+    info.slot_count = count;
+    if constexpr (Trace::k_enabled) sink->begin_pass(info);
+
+    uint32_t* ids = b.ids.data();
+    uint8_t* mask = b.mask.data();
+    uint32_t* scratch = b.scratch.data();
+    PathState* path = b.path.data();
+    const SurfaceHit* surf = b.surf.data();
+    const Hit* hit = b.hit.data();
+    const uint8_t* any_hit = b.any_hit.data();
+    const uint32_t max_depth = settings.max_depth;
+
+    // Camera: the input buffer gets one primary ray per pixel of the tile.
+    int cur = 0;
+    for (uint32_t slot = 0; slot < count; ++slot) {
+        const uint32_t x = rect.x0 + slot % w, y = rect.y0 + slot / w;
+        PathState& p = path[slot];
+        p = PathState{};
+        p.key = {settings.seed, y * settings.width + x, sample};
+        b.ray[cur][slot] = camera.generate(p.key);
+        ids[slot] = slot;
+        mask[slot] = 1;
+    }
+    stats.camera_rays += count;
+    trace.op(OpKind::camera, 0, k_no_object, ids, count, mask, count);
+
+    uint32_t n = count;
+    uint16_t generation = 0;
+    while (n > 0) {
+        const Ray* rays = b.ray[cur].data();
+        Ray* next = b.ray[cur ^ 1].data();
+        for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
+        traverse(bvh, b, load_rays(b, rays, n), generation, trace);
+        if (observer)
+            for (uint32_t i = 0; i < n; ++i) {
+                const uint32_t id = ids[i];
+                observer->ray(path[id], rays[id], hit[id], any_hit[id] && hit[id].valid());
+            }
+
+        // The shading filter stack (Fig. 4) over the generation's stream.
+        uint32_t pushed = 0;
+        uint32_t* next_ids = b.next_ids.data();
+        auto run_filter = [&](OpKind kind, uint32_t object, uint32_t* s, uint32_t len,
+                              auto&& test) {
+            return filter<k_host_width>(trace, kind, generation, object, s, len, mask, scratch,
+                                        test);
+        };
+        uint32_t* s = ids;
+        uint32_t len = n;
+        const uint32_t shadows = run_filter(OpKind::shadow_filter, k_no_object, s, len,
+                                            [&](uint32_t id) {
+            if (!any_hit[id]) return false;
+            finish_shadow(path[id], hit[id].valid());
+            return true;
+        });
+        s += shadows;
+        len -= shadows;
+        const uint32_t misses = run_filter(OpKind::miss_filter, k_no_object, s, len,
+                                           [&](uint32_t id) {
+            if (hit[id].valid()) return false;
+            shade_miss(path[id], scene);
+            return true;
+        });
+        s += misses;
+        len -= misses;
+        run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
+            b.surf[id] = surface_at(scene, rays[id], hit[id]);
+            const Material& m = scene.materials[b.surf[id].material];
+            if (!m.emissive()) return false;
+            shade_emission(path[id], m);
+            return true;
+        });  // light hits reflect too: every hit goes on
+        len = run_filter(OpKind::depth_filter, k_no_object, s, len,
+                         [&](uint32_t id) { return may_scatter(path[id], max_depth); });
+
+        auto material = [&](uint32_t id) -> const Material& {
+            return scene.materials[surf[id].material];
+        };
+        auto push = [&](uint32_t id, bool shadow) {
+            next_ids[pushed++] = id;
+            ++(shadow ? stats.shadow_rays : stats.extension_rays);
+        };
+        for (size_t j = 0; j < kinds.size() && len > 0; ++j) {
+            const MaterialKind kind = kinds[j];
+            // The last kind present is what is left: it needs no test.
+            const uint32_t g =
+                j + 1 == kinds.size()
+                    ? len
+                    : run_filter(OpKind::material_filter, uint32_t(kind), s, len,
+                                 [&](uint32_t id) { return material(id).kind == kind; });
+            if (kind == MaterialKind::lambertian) {
+                const bool ambient = !is_black(scene.ambient);
+                if (ambient)
+                    run_filter(OpKind::ambient, k_no_object, s, g, [&](uint32_t id) {
+                        add_ambient(path[id], material(id), scene);
+                        return true;
+                    });
+                const uint32_t direct = run_filter(
+                    OpKind::lambertian_choice, k_no_object, s, g,
+                    [&](uint32_t id) { return lambertian_takes_direct(path[id], scene); });
+                run_filter(OpKind::lambertian_direct, k_no_object, s, direct, [&](uint32_t id) {
+                    if (!lambertian_direct(path[id], scene, material(id), surf[id], next[id]))
+                        return false;
+                    push(id, true);
+                    return true;
+                });
+                if (!ambient)  // with ambient light, the indirect group ends here
+                    run_filter(OpKind::lambertian_indirect, k_no_object, s + direct, g - direct,
+                               [&](uint32_t id) {
+                                   if (!lambertian_indirect(path[id], scene, material(id),
+                                                            surf[id], next[id]))
+                                       return false;
+                                   push(id, false);
+                                   return true;
+                               });
+            } else if (kind == MaterialKind::dielectric) {
+                run_filter(OpKind::dielectric, k_no_object, s, g, [&](uint32_t id) {
+                    if (!dielectric_scatter(path[id], material(id), surf[id], rays[id], next[id]))
+                        return false;
+                    push(id, false);
+                    return true;
+                });
+            } else {
+                run_filter(OpKind::glossy, k_no_object, s, g, [&](uint32_t id) {
+                    if (!glossy_scatter(path[id], material(id), surf[id], rays[id], next[id]))
+                        return false;
+                    push(id, false);
+                    return true;
+                });
+            }
+            s += g;
+            len -= g;
+        }
+
+        std::swap(b.ids, b.next_ids);
+        ids = b.ids.data();
+        n = pushed;
+        cur ^= 1;
+        ++generation;
+    }
+
+    // Each path ends exactly once per pass; passes come in sample order, so each pixel sums
+    // its samples in the reference tracer's order.
+    for (uint32_t slot = 0; slot < count; ++slot)
+        sums[slot] += sanitize_radiance(path[slot].radiance, stats);
+    info.generations = generation;
+    if constexpr (Trace::k_enabled) sink->end_pass(info);
+}
+
+StreamTracer::StreamTracer(const Scene& scene, const Bvh& bvh, const RenderSettings& settings)
+    : m_impl(std::make_unique<Impl>(scene, bvh, settings)) {}
+
+StreamTracer::~StreamTracer() = default;
+
+void StreamTracer::trace_pass(const TileRect& rect, uint32_t tile_index, uint32_t sample,
+                              Vec3* sums, RenderStats& stats, TraceSink* sink,
+                              RayObserver* observer) {
+    if (sink) {
+        SinkTrace trace{sink};
+        m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
+    } else {
+        NoTrace trace;
+        m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
+    }
+}
+
+RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
+                           TraceSink* sink) {
+    const auto start = std::chrono::steady_clock::now();
+    RenderResult result;
+    result.image = Image(settings.width, settings.height);
+    const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
+    uint32_t threads = settings.threads ? settings.threads
+                                        : std::max(1u, std::thread::hardware_concurrency());
+    threads = std::min<uint32_t>(threads, uint32_t(tiles.size()));
+    if (sink) {
+        TraceHeader header;
+        header.scene_hash = scene_hash(scene);
+        header.width = settings.width;
+        header.height = settings.height;
+        header.spp = settings.spp;
+        header.tile = settings.tile;
+        header.max_depth = settings.max_depth;
+        header.seed = settings.seed;
+        sink->begin_frame(header);
+    }
+
+    std::mutex mutex;  // guards the tracer pool and the stats
+    std::vector<std::unique_ptr<StreamTracer>> pool;
+    // With a sink and several threads, each pass is recorded, then replayed when every
+    // earlier tile has been replayed: the trace comes in tile order whatever the threads.
+    // Tiles are handed out in increasing order, so the tile waited for is always running.
+    std::mutex order_mutex;
+    std::condition_variable order_cv;
+    uint32_t turn = 0;
+    const bool ordered = sink && threads > 1;
+
+    parallel_for(uint32_t(tiles.size()), threads, [&](uint32_t t) {
+        std::unique_ptr<StreamTracer> tracer;
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            if (!pool.empty()) {
+                tracer = std::move(pool.back());
+                pool.pop_back();
+            }
+        }
+        if (!tracer) tracer = std::make_unique<StreamTracer>(scene, bvh, settings);
+        // Hands the turn on even if this tile throws, so no other tile waits forever.
+        struct TurnGuard {
+            bool active;
+            uint32_t tile;
+            std::mutex& m;
+            std::condition_variable& cv;
+            uint32_t& turn;
+            ~TurnGuard() {
+                if (!active) return;
+                std::unique_lock<std::mutex> lock(m);
+                cv.wait(lock, [&] { return turn == tile; });
+                turn = tile + 1;
+                cv.notify_all();
+            }
+        } guard{ordered, t, order_mutex, order_cv, turn};
+
+        const TileRect& r = tiles[t];
+        const uint32_t w = r.x1 - r.x0, count = w * (r.y1 - r.y0);
+        std::vector<Vec3> sums(count, Vec3(0.f));
+        RenderStats local;
+        TraceRecorder recorder;
+        for (uint32_t s = 0; s < settings.spp; ++s) {
+            if (!ordered) {
+                tracer->trace_pass(r, t, s, sums.data(), local, sink);
+                continue;
+            }
+            tracer->trace_pass(r, t, s, sums.data(), local, &recorder);
+            std::unique_lock<std::mutex> lock(order_mutex);
+            order_cv.wait(lock, [&] { return turn == t; });
+            recorder.replay(*sink);
+        }
+        for (uint32_t slot = 0; slot < count; ++slot)
+            result.image.at(r.x0 + slot % w, r.y0 + slot / w) = sums[slot] / float(settings.spp);
+        std::lock_guard<std::mutex> lock(mutex);
+        result.stats += local;
+        pool.push_back(std::move(tracer));
+    });
+    if (sink) sink->end_frame();
+    result.stats.host_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<Hit>& hits,
+                      TraceSink* sink) {
+    constexpr uint32_t k_stream = 4096;  // the paper's largest stream (64 x 64)
+    RayBuffers b;
+    b.ensure(k_stream);
+    hits.resize(rays.size());
+    for (size_t begin = 0; begin < rays.size(); begin += k_stream) {
+        const uint32_t n = uint32_t(std::min<size_t>(k_stream, rays.size() - begin));
+        for (uint32_t i = 0; i < n; ++i) {
+            b.ids[i] = i;
+            b.any_hit[i] = 0;
+        }
+        const uint32_t m = load_rays(b, rays.data() + begin, n);
+        TilePass info;
+        info.tile = uint32_t(begin / k_stream);
+        info.slot_count = n;
+        info.generations = 1;
+        if (sink) {
+            SinkTrace trace{sink};
+            sink->begin_pass(info);
+            traverse(bvh, b, m, 0, trace);
+            sink->end_pass(info);
+        } else {
+            NoTrace trace;
+            traverse(bvh, b, m, 0, trace);
+        }
+        std::copy(b.hit.begin(), b.hit.begin() + n, hits.begin() + begin);
+    }
+}
+
+}  // namespace sfx

@@ -1,0 +1,342 @@
+#include "kernels/trace.h"
+
+#include <cstring>
+#include <stdexcept>
+
+#include "workloads/scene.h"
+
+namespace sfx {
+
+const char* to_string(OpStage stage) {
+    switch (stage) {
+        case OpStage::traversal: return "traversal";
+        case OpStage::intersection: return "intersection";
+        case OpStage::shading: return "shading";
+    }
+    return "?";
+}
+
+const char* to_string(OpKind kind) {
+    switch (kind) {
+        case OpKind::camera: return "camera";
+        case OpKind::box_test: return "box_test";
+        case OpKind::triangle_test: return "triangle_test";
+        case OpKind::sphere_test: return "sphere_test";
+        case OpKind::shadow_filter: return "shadow_filter";
+        case OpKind::miss_filter: return "miss_filter";
+        case OpKind::emission_filter: return "emission_filter";
+        case OpKind::depth_filter: return "depth_filter";
+        case OpKind::material_filter: return "material_filter";
+        case OpKind::ambient: return "ambient";
+        case OpKind::lambertian_choice: return "lambertian_choice";
+        case OpKind::lambertian_direct: return "lambertian_direct";
+        case OpKind::lambertian_indirect: return "lambertian_indirect";
+        case OpKind::dielectric: return "dielectric";
+        case OpKind::glossy: return "glossy";
+        case OpKind::count: break;
+    }
+    return "?";
+}
+
+OpStage stage_of(OpKind kind) {
+    switch (kind) {
+        case OpKind::box_test: return OpStage::traversal;
+        case OpKind::triangle_test:
+        case OpKind::sphere_test: return OpStage::intersection;
+        default: return OpStage::shading;
+    }
+}
+
+// FNV-1a over the bytes that decide a trace.
+namespace {
+struct Fnv {
+    uint64_t h = 0xcbf29ce484222325ull;
+    void bytes(const void* p, size_t n) {
+        const auto* b = static_cast<const uint8_t*>(p);
+        for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
+    }
+    void f(float v) { bytes(&v, 4); }
+    void u(uint32_t v) { bytes(&v, 4); }
+    void v3(const Vec3& v) { f(v.x); f(v.y); f(v.z); }
+};
+}  // namespace
+
+uint64_t scene_hash(const Scene& s) {
+    Fnv h;
+    h.u(uint32_t(s.positions.size()));
+    for (const Vec3& p : s.positions) h.v3(p);
+    h.u(uint32_t(s.triangles.size()));
+    for (const Triangle& t : s.triangles) { h.u(t.v0); h.u(t.v1); h.u(t.v2); h.u(t.material); }
+    h.u(uint32_t(s.spheres.size()));
+    for (const Sphere& sp : s.spheres) { h.v3(sp.center); h.f(sp.radius); h.u(sp.material); }
+    h.u(uint32_t(s.materials.size()));
+    for (const Material& m : s.materials) {
+        h.u(uint32_t(m.kind));
+        h.v3(m.diffuse); h.v3(m.specular); h.f(m.exponent); h.f(m.ior);
+        h.v3(m.transmission); h.v3(m.emission);
+    }
+    h.u(uint32_t(s.lights.size()));
+    for (const AreaLight& l : s.lights) {
+        h.u(uint32_t(l.primitives.size()));
+        for (uint32_t p : l.primitives) h.u(p);
+    }
+    const ThinLensCamera& c = s.camera;
+    h.v3(c.eye); h.v3(c.look_at); h.v3(c.up);
+    h.f(c.vertical_fov_degrees); h.f(c.aperture_radius); h.f(c.focal_distance);
+    h.v3(s.ambient); h.v3(s.environment); h.u(s.max_depth);
+    return h.h;
+}
+
+// ---- CountingSink -------------------------------------------------------------------------
+
+double CountingSink::StageCounts::utilization(size_t width_index, uint32_t width) const {
+    const uint64_t g = groups[width_index];
+    return g ? double(lanes) / (double(width) * double(g)) : 0.0;
+}
+
+CountingSink::CountingSink(std::vector<uint32_t> widths) : m_widths(std::move(widths)) {
+    for (uint32_t w : m_widths)
+        if (w == 0) throw std::invalid_argument("CountingSink: SIMD width must be >= 1");
+    for (auto& secondary : m_stages)
+        for (StageCounts& s : secondary) {
+            s.groups.assign(m_widths.size(), 0);
+            s.histogram.assign(k_histogram_buckets, 0);
+        }
+}
+
+void CountingSink::begin_pass(const TilePass&) { ++m_passes; }
+
+void CountingSink::end_pass(const TilePass& p) { m_generations += p.generations; }
+
+void CountingSink::op(const StreamOp& op) {
+    if (op.length == 0) return;
+    StageCounts& s = m_stages[op.generation > 0][uint32_t(op.stage)];
+    ++s.ops;
+    s.lanes += op.length;
+    s.passed += op.pass_count;
+    for (size_t i = 0; i < m_widths.size(); ++i)
+        s.groups[i] += (op.length + m_widths[i] - 1) / m_widths[i];
+    uint32_t bucket = 0;
+    while (bucket + 1 < k_histogram_buckets && (op.length >> (bucket + 1)) != 0) ++bucket;
+    ++s.histogram[bucket];
+    ++m_kind_ops[uint32_t(op.kind)];
+    m_kind_lanes[uint32_t(op.kind)] += op.length;
+    if (op.kind == OpKind::box_test && op.object == 0) m_rays += op.length;  // root: one per ray
+}
+
+CountingSink& CountingSink::operator+=(const CountingSink& o) {
+    if (o.m_widths != m_widths) throw std::invalid_argument("CountingSink: widths differ");
+    for (int g = 0; g < 2; ++g)
+        for (uint32_t st = 0; st < k_op_stage_count; ++st) {
+            StageCounts& a = m_stages[g][st];
+            const StageCounts& b = o.m_stages[g][st];
+            a.ops += b.ops;
+            a.lanes += b.lanes;
+            a.passed += b.passed;
+            for (size_t i = 0; i < a.groups.size(); ++i) a.groups[i] += b.groups[i];
+            for (size_t i = 0; i < a.histogram.size(); ++i) a.histogram[i] += b.histogram[i];
+        }
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        m_kind_ops[k] += o.m_kind_ops[k];
+        m_kind_lanes[k] += o.m_kind_lanes[k];
+    }
+    m_passes += o.m_passes;
+    m_generations += o.m_generations;
+    m_rays += o.m_rays;
+    return *this;
+}
+
+// ---- Trace file ---------------------------------------------------------------------------
+// Little-endian, as the host writes it (the tree targets x86-64 and aarch64 hosts):
+//   header: "SFXTRACE" u32 version u64 scene_hash u32 width height spp tile max_depth u64 seed
+//   pass:   u8 'P' u32 tile x0 y0 x1 y1 sample slot_count
+//   op:     u8 'O' u8 kind u8 stage u16 generation u32 object length pass_count
+//           u32 slots[length] u8 passed_bits[ceil(length/8)] (bit i of byte i/8, LSB first)
+//   end:    u8 'E' u32 generations        (end of pass)
+//   frame:  u8 'F'                         (end of file)
+
+static const char k_magic[8] = {'S', 'F', 'X', 'T', 'R', 'A', 'C', 'E'};
+
+TraceFileWriter::TraceFileWriter(const std::string& path)
+    : m_path(path), m_tmp(path + ".partial") {
+    m_file = std::fopen(m_tmp.c_str(), "wb");
+    if (!m_file) throw std::runtime_error("cannot write " + path);
+}
+
+TraceFileWriter::~TraceFileWriter() {
+    if (m_file) {  // end_frame never came: leave nothing half-written behind
+        std::fclose(m_file);
+        std::remove(m_tmp.c_str());
+    }
+}
+
+void TraceFileWriter::write(const void* data, size_t n) {
+    if (std::fwrite(data, 1, n, m_file) != n) throw std::runtime_error("cannot write " + m_path);
+    m_bytes += n;
+}
+
+template <class T> static void put(std::vector<uint8_t>& out, T v) {
+    const auto* b = reinterpret_cast<const uint8_t*>(&v);
+    out.insert(out.end(), b, b + sizeof(T));
+}
+
+void TraceFileWriter::begin_frame(const TraceHeader& h) {
+    std::vector<uint8_t> b(k_magic, k_magic + 8);
+    put(b, h.version); put(b, h.scene_hash);
+    put(b, h.width); put(b, h.height); put(b, h.spp); put(b, h.tile); put(b, h.max_depth);
+    put(b, h.seed);
+    write(b.data(), b.size());
+}
+
+void TraceFileWriter::begin_pass(const TilePass& p) {
+    std::vector<uint8_t> b{uint8_t('P')};
+    for (uint32_t v : {p.tile, p.x0, p.y0, p.x1, p.y1, p.sample, p.slot_count}) put(b, v);
+    write(b.data(), b.size());
+}
+
+void TraceFileWriter::op(const StreamOp& op) {
+    m_bits.clear();
+    m_bits.push_back(uint8_t('O'));
+    m_bits.push_back(uint8_t(op.kind));
+    m_bits.push_back(uint8_t(op.stage));
+    put(m_bits, op.generation);
+    put(m_bits, op.object); put(m_bits, op.length); put(m_bits, op.pass_count);
+    write(m_bits.data(), m_bits.size());
+    write(op.slots, size_t(op.length) * 4);
+    m_bits.assign((op.length + 7) / 8, 0);
+    for (uint32_t i = 0; i < op.length; ++i)
+        if (op.passed[i]) m_bits[i >> 3] |= uint8_t(1u << (i & 7));
+    write(m_bits.data(), m_bits.size());
+}
+
+void TraceFileWriter::end_pass(const TilePass& p) {
+    std::vector<uint8_t> b{uint8_t('E')};
+    put(b, p.generations);
+    write(b.data(), b.size());
+}
+
+void TraceFileWriter::end_frame() {
+    const uint8_t f = 'F';
+    write(&f, 1);
+    const bool ok = std::fclose(m_file) == 0;
+    m_file = nullptr;
+    if (!ok || std::rename(m_tmp.c_str(), m_path.c_str()) != 0) {
+        std::remove(m_tmp.c_str());
+        throw std::runtime_error("cannot write " + m_path);
+    }
+}
+
+namespace {
+struct Reader {
+    std::FILE* f;
+    const std::string& path;
+    void read(void* p, size_t n) {
+        if (std::fread(p, 1, n, f) != n) throw std::runtime_error(path + ": truncated trace");
+    }
+    template <class T> T get() { T v; read(&v, sizeof v); return v; }
+};
+}  // namespace
+
+TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                         &std::fclose);
+    if (!file) throw std::runtime_error("cannot read " + path);
+    Reader r{file.get(), path};
+    char magic[8];
+    r.read(magic, 8);
+    if (std::memcmp(magic, k_magic, 8) != 0) throw std::runtime_error(path + ": not an sfx trace");
+    TraceHeader h;
+    h.version = r.get<uint32_t>();
+    if (h.version != TraceHeader::k_version)
+        throw std::runtime_error(path + ": trace version " + std::to_string(h.version) +
+                                 ", this sfx reads " + std::to_string(TraceHeader::k_version));
+    h.scene_hash = r.get<uint64_t>();
+    h.width = r.get<uint32_t>(); h.height = r.get<uint32_t>(); h.spp = r.get<uint32_t>();
+    h.tile = r.get<uint32_t>(); h.max_depth = r.get<uint32_t>();
+    h.seed = r.get<uint64_t>();
+    sink.begin_frame(h);
+    TilePass pass;
+    std::vector<uint32_t> slots;
+    std::vector<uint8_t> bits, passed;
+    for (;;) {
+        const uint8_t tag = r.get<uint8_t>();
+        if (tag == 'F') break;
+        if (tag == 'P') {
+            pass = TilePass{};
+            pass.tile = r.get<uint32_t>();
+            pass.x0 = r.get<uint32_t>(); pass.y0 = r.get<uint32_t>();
+            pass.x1 = r.get<uint32_t>(); pass.y1 = r.get<uint32_t>();
+            pass.sample = r.get<uint32_t>();
+            pass.slot_count = r.get<uint32_t>();
+            sink.begin_pass(pass);
+        } else if (tag == 'O') {
+            StreamOp op;
+            op.kind = OpKind(r.get<uint8_t>());
+            op.stage = OpStage(r.get<uint8_t>());
+            if (uint32_t(op.kind) >= k_op_kind_count || uint32_t(op.stage) >= k_op_stage_count)
+                throw std::runtime_error(path + ": bad op kind or stage");
+            op.generation = r.get<uint16_t>();
+            op.object = r.get<uint32_t>();
+            op.length = r.get<uint32_t>();
+            op.pass_count = r.get<uint32_t>();
+            if (op.length > pass.slot_count) throw std::runtime_error(path + ": bad op length");
+            slots.resize(op.length);
+            r.read(slots.data(), size_t(op.length) * 4);
+            bits.resize((op.length + 7) / 8);
+            r.read(bits.data(), bits.size());
+            passed.resize(op.length);
+            for (uint32_t i = 0; i < op.length; ++i) passed[i] = (bits[i >> 3] >> (i & 7)) & 1u;
+            op.slots = slots.data();
+            op.passed = passed.data();
+            sink.op(op);
+        } else if (tag == 'E') {
+            pass.generations = r.get<uint32_t>();
+            sink.end_pass(pass);
+        } else {
+            throw std::runtime_error(path + ": bad record tag");
+        }
+    }
+    sink.end_frame();
+    return h;
+}
+
+// ---- TraceRecorder ------------------------------------------------------------------------
+
+void TraceRecorder::begin_pass(const TilePass& p) {
+    clear();
+    m_pass = p;
+}
+
+void TraceRecorder::op(const StreamOp& op) {
+    m_ops.push_back({op.kind, op.stage, op.generation, op.object, op.length, op.pass_count,
+                     m_slots.size()});
+    m_slots.insert(m_slots.end(), op.slots, op.slots + op.length);
+    m_passed.insert(m_passed.end(), op.passed, op.passed + op.length);
+}
+
+void TraceRecorder::end_pass(const TilePass& p) { m_pass = p; }
+
+void TraceRecorder::replay(TraceSink& sink) const {
+    sink.begin_pass(m_pass);
+    for (const Record& r : m_ops) {
+        StreamOp op;
+        op.kind = r.kind;
+        op.stage = r.stage;
+        op.generation = r.generation;
+        op.object = r.object;
+        op.length = r.length;
+        op.pass_count = r.pass_count;
+        op.slots = m_slots.data() + r.offset;
+        op.passed = m_passed.data() + r.offset;
+        sink.op(op);
+    }
+    sink.end_pass(m_pass);
+}
+
+void TraceRecorder::clear() {
+    m_ops.clear();
+    m_slots.clear();
+    m_passed.clear();
+}
+
+}  // namespace sfx

@@ -1,0 +1,186 @@
+#pragma once
+// The workload trace: the seam between the stream tracer and every timing model.
+//
+// Per tile pass (one sample of one tile), the stream tracer reports every stream operation in
+// execution order: what was tested (kind, object), in which stage, against which ray slots (in
+// stream order) and which of them passed. Nothing here knows how the tracer works; a hardware
+// model needs only this header (and trace.cpp for the sinks and the file format).
+//
+// Stream filtering is independent of SIMD width, so one trace serves every width, bank count,
+// latency and clock: a model chunks each op's slots into groups of N lanes itself.
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sfx {
+
+struct Scene;
+
+enum class OpStage : uint8_t { traversal, intersection, shading };
+constexpr uint32_t k_op_stage_count = 3;
+const char* to_string(OpStage stage);
+
+// What one stream operation does. Shading kinds are the Fig. 4 filter stack, in stack order.
+enum class OpKind : uint8_t {
+    camera,            // shading: generate the tile's primary rays (object: none)
+    box_test,          // traversal: ray/box filter (object: BVH node index)
+    triangle_test,     // intersection: ray/triangle test (object: global primitive id)
+    sphere_test,       // intersection: ray/sphere test (object: global primitive id)
+    shadow_filter,     // shading: extract shadow rays; passed = not occluded (light added)
+    miss_filter,       // shading: extract rays that left the scene; passed = miss
+    emission_filter,   // shading: light hits; passed = the hit surface is emissive
+    depth_filter,      // shading: passed = the path may scatter (bounce < max depth)
+    material_filter,   // shading: passed = hit material has kind `object` (MaterialKind)
+    ambient,           // shading: add the constant ambient term; all pass
+    lambertian_choice, // shading: passed = samples direct light (else indirect)
+    lambertian_direct, // shading: passed = a shadow ray was pushed to the next generation
+    lambertian_indirect, // shading: passed = a bounce ray was pushed
+    dielectric,        // shading: passed = a reflected or refracted ray was pushed
+    glossy,            // shading: passed = a glossy bounce ray was pushed
+    count
+};
+constexpr uint32_t k_op_kind_count = uint32_t(OpKind::count);
+const char* to_string(OpKind kind);
+OpStage stage_of(OpKind kind);
+
+constexpr uint32_t k_no_object = 0xffffffffu;
+
+// One stream operation. `slots` and `passed` are views valid only during the sink call.
+struct StreamOp {
+    OpKind kind = OpKind::box_test;
+    OpStage stage = OpStage::traversal;
+    uint16_t generation = 0;  // ray generation of the stream: 0 = camera rays
+    uint32_t object = k_no_object;
+    uint32_t length = 0;              // stream length (lanes that carry a ray)
+    uint32_t pass_count = 0;          // how many slots passed
+    const uint32_t* slots = nullptr;  // ray slots in stream order (slot < TilePass::slot_count)
+    const uint8_t* passed = nullptr;  // per position in `slots`: 1 passed, 0 failed
+};
+
+// One tile pass: one sample of every pixel of a tile, traced breadth-first to the end.
+struct TilePass {
+    uint32_t tile = 0;        // index into make_tiles(width, height, tile_size)
+    uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    uint32_t sample = 0;
+    uint32_t slot_count = 0;  // ray slots in the buffer: (x1-x0)*(y1-y0); slot = path
+    uint32_t generations = 0; // set at end_pass: how many generations were traced
+};
+
+// What a trace is of; written at the head of a trace file.
+struct TraceHeader {
+    static constexpr uint32_t k_version = 1;
+    uint32_t version = k_version;
+    uint64_t scene_hash = 0;
+    uint32_t width = 0, height = 0, spp = 0, tile = 0, max_depth = 0;
+    uint64_t seed = 0;
+};
+
+// Hash of everything in a scene that changes a trace (geometry, materials, camera, lights).
+uint64_t scene_hash(const Scene& scene);
+
+// Receives a trace. Calls come from one thread at a time, in tile order, sample order.
+class TraceSink {
+public:
+    virtual ~TraceSink() = default;
+    virtual void begin_frame(const TraceHeader&) {}
+    virtual void begin_pass(const TilePass&) {}
+    virtual void op(const StreamOp&) = 0;
+    virtual void end_pass(const TilePass&) {}
+    virtual void end_frame() {}
+};
+
+// Counts lanes and ops: op counts, stream-length histograms and the ideal SIMD utilization
+// for many widths at once, per stage, for primary (generation 0) and secondary rays apart.
+class CountingSink : public TraceSink {
+public:
+    struct StageCounts {
+        uint64_t ops = 0;
+        uint64_t lanes = 0;    // sum of stream lengths
+        uint64_t passed = 0;   // sum of pass counts
+        std::vector<uint64_t> groups;      // per width: sum of ceil(len / width)
+        std::vector<uint64_t> histogram;   // stream lengths in buckets [2^k, 2^(k+1)), k < 32
+
+        // Ideal utilization at widths[i]: lanes / (width * groups).
+        double utilization(size_t width_index, uint32_t width) const;
+        double average_length() const { return ops ? double(lanes) / double(ops) : 0.0; }
+    };
+    static constexpr uint32_t k_histogram_buckets = 32;
+
+    explicit CountingSink(std::vector<uint32_t> widths);
+    void begin_pass(const TilePass&) override;
+    void op(const StreamOp& op) override;
+    void end_pass(const TilePass&) override;
+
+    const std::vector<uint32_t>& widths() const { return m_widths; }
+    // [secondary][stage]: secondary = generation > 0.
+    const StageCounts& stage(bool secondary, OpStage s) const {
+        return m_stages[secondary][uint32_t(s)];
+    }
+    uint64_t kind_ops(OpKind k) const { return m_kind_ops[uint32_t(k)]; }
+    uint64_t kind_lanes(OpKind k) const { return m_kind_lanes[uint32_t(k)]; }
+    uint64_t passes() const { return m_passes; }
+    uint64_t generations() const { return m_generations; }
+    uint64_t rays() const { return m_rays; }  // rays traced: lanes of the root box tests + misses
+
+    CountingSink& operator+=(const CountingSink& o);
+
+private:
+    std::vector<uint32_t> m_widths;
+    StageCounts m_stages[2][k_op_stage_count];
+    uint64_t m_kind_ops[k_op_kind_count] = {};
+    uint64_t m_kind_lanes[k_op_kind_count] = {};
+    uint64_t m_passes = 0, m_generations = 0, m_rays = 0;
+};
+
+// Writes the trace to a binary file (format in trace.cpp); memory stays one op at a time.
+class TraceFileWriter : public TraceSink {
+public:
+    explicit TraceFileWriter(const std::string& path);
+    ~TraceFileWriter() override;
+    void begin_frame(const TraceHeader& h) override;
+    void begin_pass(const TilePass& p) override;
+    void op(const StreamOp& op) override;
+    void end_pass(const TilePass& p) override;
+    void end_frame() override;
+    uint64_t bytes_written() const { return m_bytes; }
+
+private:
+    void write(const void* data, size_t n);
+    std::string m_path, m_tmp;
+    std::FILE* m_file = nullptr;
+    uint64_t m_bytes = 0;
+    std::vector<uint8_t> m_bits;
+};
+
+// Reads a trace file and replays it into a sink; returns its header. Throws on a bad file.
+TraceHeader read_trace_file(const std::string& path, TraceSink& sink);
+
+// Keeps one tile pass in memory and replays it into a sink (used to order traces of passes
+// traced on several threads; also handy in tests).
+class TraceRecorder : public TraceSink {
+public:
+    void begin_pass(const TilePass& p) override;
+    void op(const StreamOp& op) override;
+    void end_pass(const TilePass& p) override;
+    void replay(TraceSink& sink) const;  // the recorded pass, begin to end
+    void clear();
+    size_t op_count() const { return m_ops.size(); }
+
+private:
+    struct Record {
+        OpKind kind;
+        OpStage stage;
+        uint16_t generation;
+        uint32_t object, length, pass_count;
+        size_t offset;
+    };
+    TilePass m_pass;
+    std::vector<Record> m_ops;
+    std::vector<uint32_t> m_slots;
+    std::vector<uint8_t> m_passed;
+};
+
+}  // namespace sfx

@@ -1,0 +1,212 @@
+// The stream tracer against the reference tracer, bit for bit; its hit records; the trace.
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "kernels/bvh.h"
+#include "kernels/camera.h"
+#include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/stream_tracer.h"
+
+using namespace sfx;
+
+namespace {
+
+Material lambertian(Vec3 kd, Vec3 emission = Vec3(0.f)) {
+    Material m;
+    m.kind = MaterialKind::lambertian;
+    m.diffuse = kd;
+    m.emission = emission;
+    return m;
+}
+
+// Box walls (triangles), an area light, a glass and a glossy sphere, a lens; the variants
+// switch on ambient light, an environment, and remove the lights.
+enum class Variant { lights, ambient, environment_only, emissive_sphere };
+
+Scene box_scene(Variant variant) {
+    Scene s;
+    s.name = "box";
+    s.materials = {lambertian({0.7f, 0.7f, 0.7f}), lambertian({0.7f, 0.1f, 0.1f}),
+                   lambertian(Vec3(0.f), {12.f, 10.f, 8.f})};
+    Material glass;
+    glass.kind = MaterialKind::dielectric;
+    glass.ior = 1.5f;
+    Material glossy;
+    glossy.kind = MaterialKind::glossy;
+    glossy.diffuse = {0.2f, 0.3f, 0.6f};
+    glossy.specular = Vec3(0.3f);
+    glossy.exponent = 60.f;
+    s.materials.push_back(glass);
+    s.materials.push_back(glossy);
+    auto quad = [&](Vec3 o, Vec3 u, Vec3 v, uint32_t mat) {
+        const uint32_t b = uint32_t(s.positions.size());
+        s.positions.insert(s.positions.end(), {o, o + u, o + u + v, o + v});
+        s.triangles.push_back({b, b + 1, b + 2, mat});
+        s.triangles.push_back({b, b + 2, b + 3, mat});
+    };
+    quad({-2, -2, -2}, {4, 0, 0}, {0, 0, 4}, 0);  // floor
+    quad({-2, -2, -2}, {0, 4, 0}, {4, 0, 0}, 0);  // back
+    quad({-2, -2, -2}, {0, 0, 4}, {0, 4, 0}, 1);  // left, red
+    if (variant != Variant::environment_only) {
+        quad({-2, 2, -2}, {0, 0, 4}, {4, 0, 0}, 0);  // ceiling
+        if (variant != Variant::emissive_sphere)
+            quad({-0.5f, 1.99f, -0.5f}, {1, 0, 0}, {0, 0, 1}, 2);  // light
+    }
+    // Small triangles on the floor, so leaves hold several primitives and shadows are fine.
+    for (int i = 0; i < 40; ++i) {
+        const float x = -1.8f + 0.09f * float(i), z = 1.0f - 0.05f * float(i % 7);
+        const uint32_t b = uint32_t(s.positions.size());
+        s.positions.insert(s.positions.end(),
+                           {{x, -1.9f, z}, {x + 0.07f, -1.9f, z}, {x, -1.2f + 0.01f * i, z}});
+        s.triangles.push_back({b, b + 1, b + 2, uint32_t(i % 2)});
+    }
+    s.spheres = {{{-0.8f, -1.2f, -0.5f}, 0.8f, 3}, {{0.9f, -1.3f, 0.3f}, 0.7f, 4}};
+    if (variant == Variant::emissive_sphere) s.spheres.push_back({{0.f, 1.2f, 0.f}, 0.3f, 2});
+    s.camera.eye = {0.f, 0.f, 6.f};
+    s.camera.look_at = {0.f, 0.f, 0.f};
+    s.camera.aperture_radius = 0.05f;
+    s.camera.focal_distance = 6.f;
+    s.max_depth = 4;
+    if (variant == Variant::ambient) s.ambient = {0.2f, 0.25f, 0.3f};
+    if (variant == Variant::environment_only) s.environment = {0.6f, 0.7f, 0.9f};
+    std::vector<uint32_t> groups(s.primitive_count());
+    for (uint32_t p = 0; p < groups.size(); ++p) groups[p] = p / 2;
+    s.finalize(groups);
+    return s;
+}
+
+RenderSettings small(const Scene& s, uint32_t w, uint32_t h, uint32_t spp) {
+    RenderSettings r;
+    r.width = w;
+    r.height = h;
+    r.spp = spp;
+    r.max_depth = s.max_depth;
+    return r;
+}
+
+bool same_bits(const Image& a, const Image& b) {
+    return a.width == b.width && a.height == b.height &&
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(Vec3)) == 0;
+}
+
+size_t differing_pixels(const Image& a, const Image& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+        n += std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(Vec3)) != 0;
+    return n;
+}
+
+bool same_hit(const Hit& a, const Hit& b) {
+    return a.prim == b.prim && float_bits(a.t) == float_bits(b.t) &&
+           float_bits(a.u) == float_bits(b.u) && float_bits(a.v) == float_bits(b.v);
+}
+
+// Checks every k-th traced ray against the reference traversal of the same ray.
+struct HitChecker : RayObserver {
+    const Bvh& bvh;
+    uint32_t every;
+    uint64_t seen = 0, checked = 0, mismatches = 0;
+    HitChecker(const Bvh& b, uint32_t k) : bvh(b), every(k) {}
+    void ray(const PathState& p, const Ray& ray, const Hit& hit, bool occluded) override {
+        if (seen++ % every) return;
+        ++checked;
+        if (p.kind == RayKind::shadow) mismatches += bvh.occluded(ray) != occluded;
+        else mismatches += !same_hit(bvh.intersect(ray), hit);
+    }
+};
+
+void check_identical(const Scene& s, RenderSettings settings) {
+    const Bvh bvh(s);
+    settings.threads = 1;
+    const RenderResult ref = render_reference(s, bvh, settings);
+    REQUIRE(ref.image.mean().x > 0.f);
+    for (uint32_t tile : {1u, 8u, 32u, 64u})
+        for (uint32_t threads : {1u, 2u}) {
+            settings.tile = tile;
+            settings.threads = threads;
+            const RenderResult st = render_stream(s, bvh, settings);
+            INFO("scene " << s.name << " tile " << tile << " threads " << threads << ": "
+                          << differing_pixels(ref.image, st.image) << " pixels differ");
+            CHECK(same_bits(ref.image, st.image));
+            CHECK(st.stats.camera_rays == ref.stats.camera_rays);
+            CHECK(st.stats.extension_rays == ref.stats.extension_rays);
+            CHECK(st.stats.shadow_rays == ref.stats.shadow_rays);
+            CHECK(st.stats.nonfinite_paths == ref.stats.nonfinite_paths);
+        }
+}
+
+}  // namespace
+
+TEST_CASE("Stream image equals the reference image bit for bit (tiles 1-64, threads 1-2)",
+          "[stream]") {
+    SECTION("area lights, three materials, thin lens") {
+        check_identical(box_scene(Variant::lights), small(box_scene(Variant::lights), 24, 20, 2));
+    }
+    SECTION("ambient term") {
+        const Scene s = box_scene(Variant::ambient);
+        check_identical(s, small(s, 20, 20, 2));
+    }
+    SECTION("environment only, no lights") {
+        const Scene s = box_scene(Variant::environment_only);
+        check_identical(s, small(s, 20, 24, 2));
+    }
+    SECTION("emissive sphere light, deep paths") {
+        Scene s = box_scene(Variant::emissive_sphere);
+        RenderSettings r = small(s, 16, 16, 2);
+        r.max_depth = 8;
+        check_identical(s, r);
+    }
+}
+
+TEST_CASE("The stream image changes with the seed (the comparison can fail)", "[stream]") {
+    const Scene s = box_scene(Variant::lights);
+    const Bvh bvh(s);
+    RenderSettings r = small(s, 16, 16, 1);
+    const RenderResult a = render_stream(s, bvh, r);
+    r.seed = 7;
+    CHECK_FALSE(same_bits(a.image, render_stream(s, bvh, r).image));
+}
+
+TEST_CASE("Stream per-ray hit records equal the reference traversal's", "[stream]") {
+    for (Variant v : {Variant::lights, Variant::environment_only}) {
+        const Scene s = box_scene(v);
+        const Bvh bvh(s);
+        RenderSettings r = small(s, 32, 32, 2);
+        StreamTracer tracer(s, bvh, r);
+        HitChecker checker(bvh, 3);
+        RenderStats stats;
+        std::vector<Vec3> sums(32 * 32);
+        for (uint32_t smp = 0; smp < 2; ++smp)
+            tracer.trace_pass({0, 0, 32, 32}, 0, smp, sums.data(), stats, nullptr, &checker);
+        CHECK(checker.checked > 500);
+        CHECK(checker.mismatches == 0);
+    }
+    // And on a stream of arbitrary rays (including invalid ones).
+    const Scene s = box_scene(Variant::lights);
+    const Bvh bvh(s);
+    std::vector<Ray> rays;
+    for (uint32_t i = 0; i < 5000; ++i) {
+        Ray ray;
+        ray.org = {random_float(1, i, 0, 0, RngDim::pixel_x) * 3.f - 1.5f,
+                   random_float(1, i, 0, 0, RngDim::pixel_y) * 3.f - 1.5f,
+                   random_float(1, i, 0, 0, RngDim::lens_u) * 3.f - 1.5f};
+        ray.dir = to_world(sample_cosine_hemisphere(random_float(1, i, 0, 0, RngDim::lens_v),
+                                                    random_float(1, i, 0, 0, RngDim::light_u)),
+                           normalize(Vec3(0.3f, -1.f, float(i % 5) - 2.f)));
+        if (i % 1000 == 999) ray.dir = Vec3(0.f);
+        rays.push_back(ray);
+    }
+    std::vector<Hit> hits;
+    stream_intersect(bvh, rays, hits);
+    uint64_t valid = 0, mismatches = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        valid += hits[i].valid();
+        mismatches += !same_hit(hits[i], bvh.intersect(rays[i]));
+    }
+    CHECK(valid > 1000);
+    CHECK(mismatches == 0);
+}
