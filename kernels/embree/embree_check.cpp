@@ -5,7 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -200,17 +202,29 @@ int64_t ulp_distance(float a, float b) {
     return d < 0 ? -d : d;
 }
 
-bool close_distance(float a, float b, const HitTolerance& tol) {
+// How far two correct float answers for one ray may lie apart.
+struct Slack {
+    double condition = 1.0;  // 1/|cos| of the hit angle (hit_condition)
+    double t_abs = 0.0;      // absolute t slack: rounding of the coordinates involved
+    double bary_abs = 0.0;   // absolute barycentric slack: the same, over the triangle's size
+};
+
+bool close_distance(float a, float b, const HitTolerance& tol, const Slack& slack) {
     if (a == b) return true;
     if (!std::isfinite(a) || !std::isfinite(b)) return false;
-    return std::fabs(a - b) <= tol.relative * std::max(std::fabs(a), std::fabs(b)) ||
-           ulp_distance(a, b) <= int64_t(tol.ulps);
+    const double d = std::fabs(double(a) - double(b));
+    return d <= tol.relative * slack.condition * std::max(std::fabs(a), std::fabs(b)) ||
+           d <= slack.t_abs || ulp_distance(a, b) <= int64_t(tol.ulps);
 }
 
 // Barycentrics live in [0, 1]: "relative" is relative to that range.
-bool close_barycentric(float a, float b, const HitTolerance& tol) {
-    return a == b || std::fabs(a - b) <= tol.relative || ulp_distance(a, b) <= int64_t(tol.ulps);
+bool close_barycentric(float a, float b, const HitTolerance& tol, const Slack& slack) {
+    const double d = std::fabs(double(a) - double(b));
+    return a == b || d <= tol.relative * slack.condition || d <= slack.bary_abs ||
+           ulp_distance(a, b) <= int64_t(tol.ulps);
 }
+
+double max_abs(const Vec3& p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }
 
 // The ray passes within rounding distance of the sphere's silhouette, where hit and miss are
 // both right. The slack grows with the distance to the center: that is the size of the
@@ -227,6 +241,56 @@ bool grazes_sphere(const Sphere& s, const Ray& ray, const HitTolerance& tol) {
     return std::fabs(miss_distance - double(s.radius)) <= slack;
 }
 
+// Condition number of a ray/surface intersection: 1/|cos| of the angle between the ray and the
+// surface normal. At grazing incidence a rounding of the ray moves t, u and v by that factor
+// more, in any correct float implementation (sfx's and Embree's both stray from a double
+// reference by ~1e-4 in u at cos = 0.003), so the tolerances grow with it.
+double hit_condition(const Scene& scene, const Ray& ray, const Hit& hit) {
+    if (!hit.valid()) return 1.0;
+    Vec3 n;
+    if (scene.is_sphere(hit.prim)) {
+        n = ray.org + ray.dir * hit.t - scene.sphere(hit.prim).center;
+    } else {
+        const Triangle& t = scene.triangles[hit.prim];
+        const Vec3& p0 = scene.positions[t.v0];
+        n = cross(scene.positions[t.v1] - p0, scene.positions[t.v2] - p0);
+    }
+    const double nn = double(dot(n, n)), dd = double(dot(ray.dir, ray.dir));
+    const double c = std::fabs(double(dot(n, ray.dir))) / std::sqrt(nn * dd);
+    if (!(c > 0.0)) return 1e30;  // parallel or degenerate: any answer is as good
+    return std::max(1.0, 1.0 / c);
+}
+
+// Every float tracer rounds positions to ulps of the largest coordinate in play (the origin's
+// or the primitive's), whatever t is: a diffuse ray leaving a corner hits the next wall at
+// t ~ 1e-4 with t differing by 4e-5 relative, ~0.05 ulp of the coordinates. So t and u, v
+// also get an absolute slack of `ulps` such ulps, scaled by the hit's condition.
+Slack make_slack(const Scene& scene, const Ray& ray, const Hit& a, const Hit& b,
+                 const HitTolerance& tol) {
+    Slack s;
+    s.condition = std::max(hit_condition(scene, ray, a), hit_condition(scene, ray, b));
+    double coordinate = max_abs(ray.org);
+    double min_altitude = INFINITY;
+    for (const Hit* h : {&a, &b}) {
+        if (!h->valid()) continue;
+        const Bounds3 bounds = scene.primitive_bounds(h->prim);
+        coordinate = std::max(coordinate, std::max(max_abs(bounds.lo), max_abs(bounds.hi)));
+        if (scene.is_sphere(h->prim)) continue;
+        const Triangle& t = scene.triangles[h->prim];
+        const Vec3& p0 = scene.positions[t.v0];
+        const Vec3& p1 = scene.positions[t.v1];
+        const Vec3& p2 = scene.positions[t.v2];
+        const double twice_area = double(length(cross(p1 - p0, p2 - p0)));
+        const double longest =
+            std::max(double(length(p1 - p0)), std::max(double(length(p2 - p1)), double(length(p0 - p2))));
+        if (longest > 0.0) min_altitude = std::min(min_altitude, twice_area / longest);
+    }
+    const double position_slack = double(tol.ulps) * coordinate * double(FLT_EPSILON) * s.condition;
+    s.t_abs = position_slack / double(length(ray.dir));
+    s.bary_abs = min_altitude > 0.0 ? position_slack / min_altitude : INFINITY;
+    return s;
+}
+
 bool near_edge(const Scene& scene, const Ray& ray, const Hit& hit, const HitTolerance& tol) {
     if (!hit.valid()) return false;
     if (scene.is_sphere(hit.prim)) return grazes_sphere(scene.sphere(hit.prim), ray, tol);
@@ -239,14 +303,37 @@ bool near_edge(const Scene& scene, const Ray& ray, const Hit& hit, const HitTole
 HitClass classify_hits(const Scene& scene, const Ray& ray, const Hit& a, const Hit& b,
                        const HitTolerance& tol) {
     if (!a.valid() && !b.valid()) return HitClass::both_miss;
+    const Slack slack = make_slack(scene, ray, a, b, tol);
     if (a.valid() && b.valid() && a.prim == b.prim) {
-        const bool close = close_distance(a.t, b.t, tol) &&
-                           close_barycentric(a.u, b.u, tol) && close_barycentric(a.v, b.v, tol);
+        const bool close = close_distance(a.t, b.t, tol, slack) &&
+                           close_barycentric(a.u, b.u, tol, slack) &&
+                           close_barycentric(a.v, b.v, tol, slack);
         return close ? HitClass::agree : HitClass::same_prim_apart;
     }
-    if (a.valid() && b.valid() && close_distance(a.t, b.t, tol)) return HitClass::tie;
-    if (near_edge(scene, ray, a, tol) || near_edge(scene, ray, b, tol)) return HitClass::edge;
+    if (a.valid() && b.valid() && close_distance(a.t, b.t, tol, slack)) return HitClass::tie;
+    // A hit within rounding distance of the origin: the origin lies on a surface (a ray
+    // leaving a corner, offset off one wall but still on the other), where hitting at t ~ 0
+    // and passing are both right.
+    auto at_origin = [&](const Hit& h) { return h.valid() && double(h.t) <= slack.t_abs; };
+    if (near_edge(scene, ray, a, tol) || near_edge(scene, ray, b, tol) || at_origin(a) ||
+        at_origin(b))
+        return HitClass::edge;
     return a.valid() && b.valid() ? HitClass::disagree : HitClass::hit_miss;
+}
+
+std::string describe(const HitMismatch& m) {
+    std::ostringstream o;
+    o << std::setprecision(9) << to_string(m.kind) << " #" << m.index << " " << to_string(m.cls)
+      << ": org (" << m.ray.org.x << ", " << m.ray.org.y << ", " << m.ray.org.z << ") dir ("
+      << m.ray.dir.x << ", " << m.ray.dir.y << ", " << m.ray.dir.z << ")";
+    for (const Hit* h : {&m.sfx_hit, &m.embree_hit}) {
+        o << (h == &m.sfx_hit ? "; sfx " : "; embree ");
+        if (h->valid())
+            o << "prim " << h->prim << " t " << h->t << " u " << h->u << " v " << h->v;
+        else
+            o << "miss";
+    }
+    return o.str();
 }
 
 // Counts

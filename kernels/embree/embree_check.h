@@ -106,6 +106,8 @@ struct HitMismatch {
     Ray ray;
     Hit sfx_hit, embree_hit;
 };
+// One line: kind, index, class, the ray and both hits, with enough digits to replay it.
+std::string describe(const HitMismatch& m);
 
 struct EmbreeCheckOptions {
     uint64_t rays = 1000000;  // total: the first half primary, the rest diffuse
