@@ -144,7 +144,7 @@ void check_identical(const Scene& s, RenderSettings settings) {
 TEST_CASE("Stream image equals the reference image bit for bit (tiles 1-64, threads 1-2)",
           "[stream]") {
     SECTION("area lights, three materials, thin lens") {
-        check_identical(box_scene(Variant::lights), small(box_scene(Variant::lights), 24, 20, 2));
+        check_identical(box_scene(Variant::lights), small(box_scene(Variant::lights), 32, 28, 3));
     }
     SECTION("ambient term") {
         const Scene s = box_scene(Variant::ambient);

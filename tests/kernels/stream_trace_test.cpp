@@ -1,0 +1,305 @@
+// The workload trace: the counting sink's arithmetic, the Table 7 generalizations (tile 1 and
+// width 1 is recursive tracing; width = stream size is packet tracing), the trace file.
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+#include "kernels/bvh.h"
+#include "kernels/camera.h"
+#include "kernels/stream/stream_tracer.h"
+
+using namespace sfx;
+
+namespace {
+
+// A small scene with many primitives in a few clusters, triangles and spheres, no lights
+// (so every ray is a closest-hit ray) or with a light (shadow rays too).
+Scene cluster_scene(bool light) {
+    Scene s;
+    s.name = "clusters";
+    Material diffuse;
+    diffuse.diffuse = Vec3(0.6f);
+    Material glossy;
+    glossy.kind = MaterialKind::glossy;
+    glossy.exponent = 20.f;
+    Material lamp;
+    lamp.emission = Vec3(5.f);
+    s.materials = {diffuse, glossy, lamp};
+    for (int i = 0; i < 120; ++i) {
+        const float a = 0.37f * float(i), r = 0.4f + 0.012f * float(i);
+        const Vec3 c(r * std::cos(a) * 2.f, -1.f + 0.015f * float(i), r * std::sin(a) * 2.f);
+        const uint32_t b = uint32_t(s.positions.size());
+        s.positions.insert(s.positions.end(),
+                           {c, c + Vec3(0.3f, 0.05f, 0.f), c + Vec3(0.f, 0.3f, 0.1f)});
+        s.triangles.push_back({b, b + 1, b + 2, uint32_t(i % 2)});
+    }
+    const uint32_t b = uint32_t(s.positions.size());
+    s.positions.insert(s.positions.end(), {{-4, -1.5f, -4}, {4, -1.5f, -4}, {4, -1.5f, 4},
+                                           {-4, -1.5f, 4}});
+    s.triangles.push_back({b, b + 1, b + 2, 0});
+    s.triangles.push_back({b, b + 2, b + 3, 0});
+    for (int i = 0; i < 10; ++i)
+        s.spheres.push_back({{-1.5f + 0.3f * float(i), 0.8f, -0.5f}, 0.14f, uint32_t(i % 2)});
+    if (light) s.spheres.push_back({{0.f, 3.f, 0.f}, 0.5f, 2});
+    s.environment = Vec3(0.5f);
+    s.camera.eye = {0.f, 1.f, 5.f};
+    s.camera.look_at = {0.f, -0.5f, 0.f};
+    s.max_depth = 3;
+    s.finalize();
+    return s;
+}
+
+RenderSettings settings_for(const Scene& s, uint32_t size, uint32_t spp, uint32_t tile) {
+    RenderSettings r;
+    r.width = r.height = size;
+    r.spp = spp;
+    r.tile = tile;
+    r.max_depth = s.max_depth;
+    r.threads = 1;
+    return r;
+}
+
+// Bvh::intersect, counting its box and primitive tests (recursive tracing's op counts).
+struct RecursiveCounts {
+    uint64_t box = 0, prim = 0;
+};
+void count_recursive(const Bvh& bvh, const Ray& ray, RecursiveCounts& c) {
+    if (!ray_is_valid(ray)) return;
+    const RayPrecomp r(ray);
+    Hit hit;
+    float t_max = ray.t_max;
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+        const BvhNode& node = bvh.nodes()[stack.back()];
+        stack.pop_back();
+        ++c.box;
+        if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
+        if (node.is_leaf()) {
+            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                ++c.prim;
+                if (bvh.intersect_primitive(r, bvh.prim_ids()[i], t_max, hit)) t_max = hit.t;
+            }
+        } else {
+            const bool right_first = visit_right_first(node, r.dir);
+            stack.push_back(right_first ? node.first : node.right);
+            stack.push_back(right_first ? node.right : node.first);
+        }
+    }
+}
+
+// Masked packet traversal of all rays at once (packet tracing): one op per node the packet
+// visits and per primitive of the leaves it reaches.
+RecursiveCounts count_packet(const Bvh& bvh, const std::vector<Ray>& rays) {
+    RecursiveCounts c;
+    const size_t n = rays.size();
+    std::vector<RayPrecomp> pre;
+    std::vector<float> t(n);
+    std::vector<Hit> hit(n);
+    std::vector<uint8_t> root(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+        Ray safe = rays[i];
+        if (!ray_is_valid(safe)) safe.dir = {0.f, 0.f, 1.f};
+        pre.emplace_back(safe);
+        t[i] = rays[i].t_max;
+        root[i] = ray_is_valid(rays[i]);
+    }
+    std::vector<std::pair<uint32_t, std::vector<uint8_t>>> stack{{0u, root}};
+    while (!stack.empty()) {
+        auto [index, mask] = std::move(stack.back());
+        stack.pop_back();
+        const BvhNode& node = bvh.nodes()[index];
+        ++c.box;
+        uint32_t active = 0, negative = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if (!mask[i]) continue;
+            mask[i] = intersect_box(pre[i], node.bounds, t[i]) != INFINITY;
+            active += mask[i];
+            negative += mask[i] && pre[i].dir[node.axis] < 0.f;
+        }
+        if (!active) continue;
+        if (node.is_leaf()) {
+            for (uint32_t j = node.first; j < node.first + node.count; ++j) {
+                ++c.prim;
+                for (size_t i = 0; i < n; ++i)
+                    if (mask[i] && bvh.intersect_primitive(pre[i], bvh.prim_ids()[j], t[i], hit[i]))
+                        t[i] = hit[i].t;
+            }
+        } else {
+            const bool right_first = 2 * negative > active;
+            stack.push_back({right_first ? node.first : node.right, mask});
+            stack.push_back({right_first ? node.right : node.first, mask});
+        }
+    }
+    return c;
+}
+
+struct RayCollector : RayObserver {
+    std::vector<Ray> rays;
+    void ray(const PathState&, const Ray& r, const Hit&, bool) override { rays.push_back(r); }
+};
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per stage",
+          "[stream]") {
+    CountingSink sink({1, 4, 16});
+    std::vector<uint32_t> slots(40);
+    std::vector<uint8_t> passed(40, 1);
+    for (uint32_t i = 0; i < 40; ++i) slots[i] = i;
+    auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
+        StreamOp o;
+        o.kind = kind;
+        o.stage = stage_of(kind);
+        o.generation = generation;
+        o.object = 1;
+        o.length = len;
+        o.pass_count = pass;
+        o.slots = slots.data();
+        o.passed = passed.data();
+        sink.op(o);
+    };
+    sink.begin_pass({});
+    op(OpKind::box_test, 1, 5, 3);
+    op(OpKind::box_test, 1, 16, 16);
+    op(OpKind::box_test, 1, 17, 2);
+    op(OpKind::triangle_test, 0, 3, 1);
+    op(OpKind::box_test, 0, 40, 40);
+    sink.end_pass({});
+    const auto& t = sink.stage(true, OpStage::traversal);
+    CHECK(t.ops == 3);
+    CHECK(t.lanes == 38);
+    CHECK(t.passed == 21);
+    CHECK(t.groups[1] == 2 + 4 + 5);   // width 4
+    CHECK(t.groups[2] == 1 + 1 + 2);   // width 16
+    CHECK(t.utilization(0, 1) == 1.0);
+    CHECK(t.utilization(1, 4) == Approx(38.0 / 44.0));
+    CHECK(t.utilization(2, 16) == Approx(38.0 / 64.0));
+    CHECK(t.average_length() == Approx(38.0 / 3.0));
+    CHECK(t.histogram[2] == 1);  // 5 in [4, 8)
+    CHECK(t.histogram[4] == 2);  // 16, 17 in [16, 32)
+    CHECK(sink.stage(false, OpStage::intersection).utilization(2, 16) == Approx(3.0 / 16.0));
+    CHECK(sink.stage(false, OpStage::traversal).lanes == 40);
+    CHECK(sink.stage(true, OpStage::shading).ops == 0);
+    CHECK(sink.kind_ops(OpKind::box_test) == 4);
+    CHECK(sink.rays() == 0);  // object 1 is not the root
+}
+
+TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[stream]") {
+    const Scene s = cluster_scene(false);
+    const Bvh bvh(s);
+    const RenderSettings r = settings_for(s, 16, 2, 1);
+    StreamTracer tracer(s, bvh, r);
+    CountingSink sink({1});
+    RayCollector rays;
+    RenderStats stats;
+    const std::vector<TileRect> tiles = make_tiles(r.width, r.height, 1);
+    for (uint32_t t = 0; t < tiles.size(); ++t)
+        for (uint32_t smp = 0; smp < r.spp; ++smp) {
+            Vec3 sum;
+            tracer.trace_pass(tiles[t], t, smp, &sum, stats, &sink, &rays);
+        }
+    RecursiveCounts c;
+    for (const Ray& ray : rays.rays) count_recursive(bvh, ray, c);
+    REQUIRE(stats.extension_rays > 100);
+    CHECK(rays.rays.size() == stats.rays());
+    CHECK(sink.kind_ops(OpKind::box_test) == c.box);
+    CHECK(sink.kind_ops(OpKind::triangle_test) + sink.kind_ops(OpKind::sphere_test) == c.prim);
+    for (bool secondary : {false, true})
+        for (OpStage st : {OpStage::traversal, OpStage::intersection}) {
+            CHECK(sink.stage(secondary, st).utilization(0, 1) == 1.0);  // every op one lane
+            CHECK(sink.stage(secondary, st).lanes == sink.stage(secondary, st).ops);
+        }
+}
+
+TEST_CASE("Table 7: width equal to the stream size gives packet tracing's op counts",
+          "[stream]") {
+    const Scene s = cluster_scene(false);
+    const Bvh bvh(s);
+    for (uint32_t tile : {4u, 16u}) {
+        const uint32_t size = tile * tile;
+        // The camera rays of one tile pass, and a set of diffuse-like secondary rays.
+        const CameraFrame camera(s.camera, 64, 64);
+        std::vector<Ray> primary, secondary;
+        for (uint32_t y = 20; y < 20 + tile; ++y)
+            for (uint32_t x = 20; x < 20 + tile; ++x)
+                primary.push_back(camera.generate({0, y * 64 + x, 0}));
+        for (uint32_t i = 0; i < size; ++i) {
+            Ray ray;
+            ray.org = {0.1f * float(i % 7) - 0.3f, -1.4f, 0.1f * float(i % 5)};
+            ray.dir = to_world(sample_cosine_hemisphere(random_float(3, i, 0, 1, RngDim::direction_u),
+                                                        random_float(3, i, 0, 1, RngDim::direction_v)),
+                               {0.f, 1.f, 0.f});
+            secondary.push_back(ray);
+        }
+        for (const std::vector<Ray>* rays : {&primary, &secondary}) {
+            CountingSink sink({size});
+            std::vector<Hit> hits;
+            stream_intersect(bvh, *rays, hits, &sink);
+            const RecursiveCounts packet = count_packet(bvh, *rays);
+            INFO("tile " << tile);
+            CHECK(sink.stage(false, OpStage::traversal).groups[0] == packet.box);
+            CHECK(sink.stage(false, OpStage::intersection).groups[0] == packet.prim);
+            CHECK(sink.stage(false, OpStage::traversal).utilization(0, size) < 1.0);
+        }
+    }
+}
+
+TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[stream]") {
+    const Scene s = cluster_scene(true);
+    const Bvh bvh(s);
+    RenderSettings r = settings_for(s, 24, 2, 8);
+    const std::vector<uint32_t> widths{4, 8, 16};
+    CountingSink direct(widths);
+    const RenderResult a = render_stream(s, bvh, r, &direct);
+    CHECK(direct.passes() == 9 * 2);
+    CHECK(direct.rays() == a.stats.rays());
+    CHECK(direct.kind_ops(OpKind::shadow_filter) > 0);
+
+    const std::string p1 = "stream_trace_test_1.trc", p2 = "stream_trace_test_2.trc";
+    {
+        TraceFileWriter w(p1);
+        render_stream(s, bvh, r, &w);
+    }
+    r.threads = 2;
+    {
+        TraceFileWriter w(p2);
+        render_stream(s, bvh, r, &w);
+    }
+    const std::string b1 = read_file(p1), b2 = read_file(p2);
+    CHECK(b1.size() > 1000);
+    CHECK(b1 == b2);
+
+    CountingSink replayed(widths);
+    const TraceHeader h = read_trace_file(p1, replayed);
+    CHECK(h.scene_hash == scene_hash(s));
+    CHECK(h.tile == 8);
+    CHECK(h.spp == 2);
+    CHECK(replayed.passes() == direct.passes());
+    CHECK(replayed.generations() == direct.generations());
+    for (bool secondary : {false, true})
+        for (OpStage st : {OpStage::traversal, OpStage::intersection, OpStage::shading}) {
+            const auto& x = replayed.stage(secondary, st);
+            const auto& y = direct.stage(secondary, st);
+            CHECK(x.ops == y.ops);
+            CHECK(x.lanes == y.lanes);
+            CHECK(x.passed == y.passed);
+            CHECK(x.groups == y.groups);
+        }
+    std::remove(p1.c_str());
+    std::remove(p2.c_str());
+    // A truncated file is an error, not a silent partial trace.
+    {
+        std::ofstream out(p1, std::ios::binary);
+        out << b1.substr(0, b1.size() / 2);
+    }
+    CountingSink partial(widths);
+    CHECK_THROWS(read_trace_file(p1, partial));
+    std::remove(p1.c_str());
+}
