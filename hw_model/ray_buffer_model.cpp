@@ -1,0 +1,62 @@
+#include "hw_model/ray_buffer_model.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace sfx {
+
+RayBufferModel::RayBufferModel(const RayBufferConfig& config, uint32_t record_words,
+                               uint32_t slot_count)
+    : m_banks(config.banks), m_line_words(config.line_words),
+      m_latency(config.access_latency_cycles), m_slot_count(slot_count),
+      m_record_words(record_words), m_pipelined(config.pipelined), m_per_bank(config.banks) {
+    if (m_banks == 0 || m_line_words == 0 || m_latency == 0)
+        throw std::invalid_argument("ray buffer: banks, line_words and latency must be >= 1");
+}
+
+RayBufferModel::Access RayBufferModel::access_field(uint32_t field_word, const uint32_t* slots,
+                                                    uint32_t lanes) const {
+    Access a;
+    if (lanes == 0) return a;
+    std::fill(m_per_bank.begin(), m_per_bank.end(), 0u);
+    uint32_t busiest = 0;
+    for (uint32_t i = 0; i < lanes; ++i)
+        busiest = std::max(busiest, ++m_per_bank[bank_of(field_word, slots[i])]);
+    // Even without conflicts a bank serves ceil(lanes / banks) requests.
+    const uint32_t needed = (lanes + m_banks - 1) / m_banks;
+    const uint32_t per_request = m_pipelined ? 1 : m_latency;
+    const uint32_t fill = m_pipelined ? m_latency - 1 : 0;
+    a.cycles = uint64_t(busiest) * per_request + fill;
+    a.conflict_cycles = uint64_t(busiest - needed) * per_request;
+    return a;
+}
+
+RayBufferModel::Contiguous RayBufferModel::access_contiguous(uint64_t offset,
+                                                              uint32_t lanes) const {
+    Contiguous c;
+    if (lanes == 0) return c;
+    const uint64_t first = offset / m_line_words, last = (offset + lanes - 1) / m_line_words;
+    const uint64_t lines = last - first + 1;
+    const uint64_t ideal = (lanes + m_line_words - 1) / m_line_words;
+    const uint64_t realign = offset % m_line_words != 0 ? 1 : 0;  // shift through the mux tree
+    c.cycles = lines + realign;
+    c.alignment_cycles = c.cycles - ideal;
+    return c;
+}
+
+PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
+                             uint32_t length) {
+    PartitionCost p;
+    p.compare_cycles = (uint64_t(length) + config.lanes_per_cycle - 1) / config.lanes_per_cycle;
+    uint32_t pass_count = 0;
+    for (uint32_t i = 0; i < length; ++i) pass_count += passed[i] ? 1 : 0;
+    uint32_t next_pass = 0, next_fail = pass_count;
+    for (uint32_t i = 0; i < length; ++i) {
+        const uint32_t to = passed[i] ? next_pass++ : next_fail++;
+        if (to != i) ++p.moved_ids;
+    }
+    p.move_cycles = (p.moved_ids + width - 1) / width;
+    return p;
+}
+
+}  // namespace sfx

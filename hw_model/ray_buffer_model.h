@@ -1,0 +1,74 @@
+#pragma once
+// Arithmetic of the banked ray buffers, the address-generation units and the partition unit,
+// in plain classes that tests exercise without a SystemC kernel (the SystemC modules wrap them).
+//
+// Layout: each ray buffer holds its rays' records in structure-of-arrays form: field f of slot s
+// lives at word (field_base(f) + s); words are interleaved across banks word by word, so the
+// same field of consecutive slots sits in consecutive banks. A gather of one field for a group
+// of lanes costs as many cycles as the busiest bank has requests (one access per bank per cycle
+// when pipelined; access_latency cycles each when not), plus the pipeline fill.
+
+#include <cstdint>
+#include <vector>
+
+#include "hw_model/hw_config.h"
+
+namespace sfx {
+
+class RayBufferModel {
+public:
+    RayBufferModel(const RayBufferConfig& config, uint32_t record_words, uint32_t slot_count);
+
+    uint32_t bank_of(uint32_t field_word, uint32_t slot) const {
+        return (field_word * m_slot_count + slot) % m_banks;
+    }
+
+    // Cycles to access one field word of each lane's slot (a gather or a scatter of one field),
+    // and how many of those cycles are bank-conflict stalls (cycles beyond the conflict-free
+    // one issue per group).
+    struct Access {
+        uint64_t cycles = 0;
+        uint64_t conflict_cycles = 0;
+    };
+    Access access_field(uint32_t field_word, const uint32_t* slots, uint32_t lanes) const;
+
+    // Contiguous read of `lanes` words starting at word `offset` of a line-organised stream
+    // (the ray-id stream): one line per cycle; a run that straddles lines or starts off a line
+    // boundary stalls (the SIMD alignment overhead of the paper's widths 8 and 12).
+    struct Contiguous {
+        uint64_t cycles = 0;
+        uint64_t alignment_cycles = 0;
+    };
+    Contiguous access_contiguous(uint64_t offset, uint32_t lanes) const;
+
+    uint32_t banks() const { return m_banks; }
+    uint32_t latency() const { return m_latency; }
+    bool pipelined() const { return m_pipelined; }
+    uint32_t line_words() const { return m_line_words; }
+
+private:
+    uint32_t m_banks, m_line_words, m_latency, m_slot_count, m_record_words;
+    bool m_pipelined;
+    mutable std::vector<uint32_t> m_per_bank;  // scratch, sized to the bank count
+};
+
+// Address generation: `count` units, each computing `addresses_per_cycle` addresses per cycle.
+// Address work runs beside the data path; only its excess over the data work stalls.
+inline uint64_t address_cycles(const AguConfig& agu, uint64_t addresses) {
+    const uint64_t per_cycle = uint64_t(agu.count) * agu.addresses_per_cycle;
+    return (addresses + per_cycle - 1) / per_cycle;
+}
+
+// In-place partition of a stream by its mask (SIMD comparators, Sec. 3.3): the comparator pass
+// consumes lanes_per_cycle mask bits per cycle; then every id that must move (a passing id
+// behind a failing one, in a stable partition) is written once, `width` ids per cycle.
+struct PartitionCost {
+    uint64_t compare_cycles = 0;
+    uint64_t moved_ids = 0;
+    uint64_t move_cycles = 0;
+    uint64_t cycles() const { return compare_cycles + move_cycles; }
+};
+PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
+                             uint32_t length);
+
+}  // namespace sfx
