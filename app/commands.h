@@ -25,5 +25,6 @@ struct WorkloadFlags {
 };
 
 void add_render_command(CLI::App& app);
+void add_validate_command(CLI::App& app);
 
 }  // namespace sfx

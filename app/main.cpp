@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
     CLI::App app{"sfx: hardware design-space explorer for stream-filtering ray tracing"};
     app.require_subcommand(1);
     sfx::add_render_command(app);
+    sfx::add_validate_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
