@@ -25,6 +25,8 @@ struct WorkloadFlags {
 };
 
 void add_render_command(CLI::App& app);
+void add_trace_stats_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
+void add_scene_info_command(CLI::App& app);
 
 }  // namespace sfx

@@ -10,7 +10,9 @@ int main(int argc, char** argv) {
     CLI::App app{"sfx: hardware design-space explorer for stream-filtering ray tracing"};
     app.require_subcommand(1);
     sfx::add_render_command(app);
+    sfx::add_trace_stats_command(app);
     sfx::add_validate_command(app);
+    sfx::add_scene_info_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -356,7 +356,9 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
     std::mutex order_mutex;
     std::condition_variable order_cv;
     uint32_t turn = 0;
-    const bool ordered = sink && threads > 1;
+    // Counts are sums, so each tile counts for itself and the counts are added: no ordering.
+    CountingSink* const counting = dynamic_cast<CountingSink*>(sink);
+    const bool ordered = sink && threads > 1 && !counting;
 
     parallel_for(uint32_t(tiles.size()), threads, [&](uint32_t t) {
         std::unique_ptr<StreamTracer> tracer;
@@ -389,9 +391,12 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
         std::vector<Vec3> sums(count, Vec3(0.f));
         RenderStats local;
         TraceRecorder recorder;
+        std::unique_ptr<CountingSink> tile_counts;
+        if (counting && threads > 1) tile_counts = std::make_unique<CountingSink>(counting->widths());
+        TraceSink* const direct = tile_counts ? tile_counts.get() : sink;
         for (uint32_t s = 0; s < settings.spp; ++s) {
             if (!ordered) {
-                tracer->trace_pass(r, t, s, sums.data(), local, sink);
+                tracer->trace_pass(r, t, s, sums.data(), local, direct);
                 continue;
             }
             tracer->trace_pass(r, t, s, sums.data(), local, &recorder);
@@ -403,6 +408,7 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
             result.image.at(r.x0 + slot % w, r.y0 + slot / w) = sums[slot] / float(settings.spp);
         std::lock_guard<std::mutex> lock(mutex);
         result.stats += local;
+        if (tile_counts) *counting += *tile_counts;
         pool.push_back(std::move(tracer));
     });
     if (sink) sink->end_frame();

@@ -1,0 +1,126 @@
+// sfx scene-info SCENE: what a scene is made of and what it asks of a tracer and of hardware:
+// primitive, light and material counts, the feature set, bytes per ray, BVH statistics, memory.
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "kernels/bvh.h"
+#include "workloads/ray_layout.h"
+#include "workloads/scene_loader.h"
+
+namespace sfx {
+
+void add_scene_info_command(CLI::App& app) {
+    struct Options {
+        std::string scene;
+        bool json = false;
+        bool layout = false;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand("scene-info", "primitives, lights, materials, features, BVH");
+    c->add_option("scene", options->scene, "scene file or built-in scene name")->required();
+    c->add_flag("--json", options->json, "print one JSON document");
+    c->add_flag("--ray-layout", options->layout, "also list the ray record's fields");
+    c->callback([options] {
+        using clock = std::chrono::steady_clock;
+        const auto t0 = clock::now();
+        const Scene scene = load_scene(options->scene);
+        const auto t1 = clock::now();
+        const Bvh bvh(scene);
+        const auto t2 = clock::now();
+        const double load_seconds = std::chrono::duration<double>(t1 - t0).count();
+        const double build_seconds = std::chrono::duration<double>(t2 - t1).count();
+        const BvhStats st = bvh.stats();
+        const FeatureSet features = scene.features();
+        const auto fields = ray_record_fields(features);
+        const uint32_t ray_bytes = ray_record_bytes(features);
+        uint32_t kinds[3] = {0, 0, 0};
+        for (const Material& m : scene.materials) ++kinds[int(m.kind)];
+        uint32_t emissive = 0;
+        for (const Material& m : scene.materials) emissive += m.emissive();
+        uint64_t light_primitives = 0;
+        for (const AreaLight& l : scene.lights) light_primitives += l.primitives.size();
+        const Bounds3 bounds = scene.bounds();
+        const uint64_t geometry = scene.geometry_bytes();
+        if (options->json) {
+            nlohmann::json j;
+            j["scene"] = scene.name;
+            j["primitives"] = scene.primitive_count();
+            j["triangles"] = scene.triangles.size();
+            j["spheres"] = scene.spheres.size();
+            j["vertices"] = scene.positions.size();
+            j["lights"] = scene.lights.size();
+            j["light_primitives"] = light_primitives;
+            j["materials"] = scene.materials.size();
+            j["materials.lambertian"] = kinds[int(MaterialKind::lambertian)];
+            j["materials.dielectric"] = kinds[int(MaterialKind::dielectric)];
+            j["materials.glossy"] = kinds[int(MaterialKind::glossy)];
+            j["materials.emissive"] = emissive;
+            j["features"] = features.describe();
+            j["features.triangles"] = features.triangles;
+            j["features.spheres"] = features.spheres;
+            j["features.lambertian"] = features.lambertian;
+            j["features.dielectric"] = features.dielectric;
+            j["features.glossy"] = features.glossy;
+            j["features.thin_lens"] = features.thin_lens;
+            j["features.ambient"] = features.ambient;
+            j["features.environment"] = features.environment;
+            j["features.light_count"] = features.light_count;
+            j["features.max_depth"] = features.max_depth;
+            j["ray_record_bytes"] = ray_bytes;
+            for (const RayField& f : fields) j["ray_record." + f.name + "_bytes"] = f.bytes;
+            j["bounds.lo"] = {bounds.lo.x, bounds.lo.y, bounds.lo.z};
+            j["bounds.hi"] = {bounds.hi.x, bounds.hi.y, bounds.hi.z};
+            j["bvh.nodes"] = st.nodes;
+            j["bvh.leaves"] = st.leaves;
+            j["bvh.max_depth"] = st.max_depth;
+            j["bvh.average_leaf_depth"] = st.average_leaf_depth;
+            j["bvh.average_leaf_size"] = st.average_leaf_size;
+            j["bvh.max_leaf_size"] = st.max_leaf_size;
+            j["bvh.sah_cost"] = st.sah_cost;
+            j["bvh.bytes"] = st.bytes;
+            j["bvh.build_seconds"] = build_seconds;
+            j["load_seconds"] = load_seconds;
+            j["memory.geometry_bytes"] = geometry;
+            j["memory.bvh_bytes"] = st.bytes;
+            j["memory.total_bytes"] = geometry + st.bytes;
+            std::cout << j.dump(2) << "\n";
+            return;
+        }
+        auto mib = [](uint64_t bytes) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.2f MiB", double(bytes) / (1024.0 * 1024.0));
+            return std::string(buf);
+        };
+        std::printf("scene              %s\n", scene.name.c_str());
+        std::printf("primitives         %u (triangles %zu, spheres %zu), vertices %zu\n",
+                    scene.primitive_count(), scene.triangles.size(), scene.spheres.size(),
+                    scene.positions.size());
+        std::printf("lights             %zu (%llu emissive primitives)\n", scene.lights.size(),
+                    (unsigned long long)light_primitives);
+        std::printf("materials          %zu (lambertian %u, dielectric %u, glossy %u; emissive %u)\n",
+                    scene.materials.size(), kinds[0], kinds[1], kinds[2], emissive);
+        std::printf("features           %s\n", features.describe().c_str());
+        std::printf("ray record         %u bytes (%u KiB for 64x64 rays)\n", ray_bytes,
+                    ray_bytes * 4096 / 1024);
+        if (options->layout)
+            for (const RayField& f : fields)
+                std::printf("  %-18s %2u  %s\n", f.name.c_str(), f.bytes, f.why.c_str());
+        std::printf("bounds             [%g %g %g] .. [%g %g %g]\n", bounds.lo.x, bounds.lo.y,
+                    bounds.lo.z, bounds.hi.x, bounds.hi.y, bounds.hi.z);
+        std::printf("bvh                %llu nodes, %llu leaves, depth %u, built in %.3f s\n",
+                    (unsigned long long)st.nodes, (unsigned long long)st.leaves, st.max_depth,
+                    build_seconds);
+        std::printf("bvh leaves         average depth %.2f, average size %.2f, max size %u\n",
+                    st.average_leaf_depth, st.average_leaf_size, st.max_leaf_size);
+        std::printf("bvh sah cost       %.3f\n", st.sah_cost);
+        std::printf("memory             geometry %s, bvh %s, total %s\n", mib(geometry).c_str(),
+                    mib(st.bytes).c_str(), mib(geometry + st.bytes).c_str());
+        std::printf("load seconds       %.3f\n", load_seconds);
+    });
+}
+
+}  // namespace sfx

@@ -1,0 +1,182 @@
+// sfx trace-stats SCENE: stream lengths and ideal SIMD utilization per stage, from one
+// functional stream render per tile size (all SIMD widths at once), in the layout of the
+// paper's Tables 2, 3 and 4, plus per-frame operation counts (Table 1's columns).
+
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/commands.h"
+#include "kernels/bvh.h"
+#include "kernels/stream/stream_tracer.h"
+#include "workloads/input_error.h"
+#include "workloads/scene_loader.h"
+
+namespace sfx {
+
+namespace {
+
+std::vector<uint32_t> parse_list(const std::string& text, const std::string& key, uint32_t max) {
+    std::vector<uint32_t> out;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        unsigned v = 0;
+        char tail = 0;
+        if (std::sscanf(item.c_str(), "%u%c", &v, &tail) != 1 || v == 0 || v > max)
+            throw InputError("command line", 0, key,
+                             "expected a comma-separated list of 1.." + std::to_string(max) +
+                                 ", got '" + text + "'");
+        out.push_back(v);
+    }
+    if (out.empty()) throw InputError("command line", 0, key, "expected at least one value");
+    return out;
+}
+
+struct TileRun {
+    uint32_t tile;
+    CountingSink counts;
+    RenderStats stats;
+};
+
+std::string percent(double u) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "%.0f", 100.0 * u);
+    return buf;
+}
+
+}  // namespace
+
+void add_trace_stats_command(CLI::App& app) {
+    struct Options {
+        std::string scene;
+        std::string widths = "4,8,12,16,64";
+        std::string tiles = "32,64";
+        bool json = false;
+        WorkloadFlags workload;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand(
+        "trace-stats", "stream lengths and ideal SIMD utilization per stage (Tables 2-4)");
+    c->add_option("scene", options->scene, "scene file or built-in scene name")->required();
+    c->add_option("--widths", options->widths, "SIMD widths N, comma-separated")
+        ->capture_default_str();
+    c->add_option("--tiles", options->tiles, "tile edges T (stream of T x T rays), comma-separated")
+        ->capture_default_str();
+    c->add_flag("--json", options->json, "print one JSON document");
+    options->workload.add_to(c);
+    c->callback([options] {
+        const Scene scene = load_scene(options->scene);
+        RenderSettings settings = options->workload.resolve(scene);
+        const std::vector<uint32_t> widths = parse_list(options->widths, "--widths", 1u << 16);
+        const std::vector<uint32_t> tiles = parse_list(options->tiles, "--tiles", 4096);
+        const Bvh bvh(scene);
+        std::vector<TileRun> runs;
+        for (uint32_t tile : tiles) {
+            settings.tile = tile;
+            TileRun run{tile, CountingSink(widths), {}};
+            run.stats = render_stream(scene, bvh, settings, &run.counts).stats;
+            runs.push_back(std::move(run));
+        }
+        const OpStage stages[3] = {OpStage::traversal, OpStage::intersection, OpStage::shading};
+
+        if (options->json) {
+            nlohmann::json j;
+            j["scene"] = scene.name;
+            j["width"] = settings.width;
+            j["height"] = settings.height;
+            j["spp"] = settings.spp;
+            j["max_depth"] = settings.max_depth;
+            j["widths"] = widths;
+            j["tiles"] = tiles;
+            for (const TileRun& r : runs) {
+                const std::string t = "tile_" + std::to_string(r.tile) + ".";
+                j[t + "rays"] = r.stats.rays();
+                j[t + "traversal_ops"] = r.counts.kind_ops(OpKind::box_test);
+                j[t + "intersection_ops"] = r.counts.kind_ops(OpKind::triangle_test) +
+                                            r.counts.kind_ops(OpKind::sphere_test);
+                j[t + "host_seconds"] = r.stats.host_seconds;
+                for (bool secondary : {false, true})
+                    for (OpStage st : stages) {
+                        const auto& s = r.counts.stage(secondary, st);
+                        const std::string k =
+                            t + (secondary ? "secondary." : "primary.") + to_string(st) + ".";
+                        j[k + "ops"] = s.ops;
+                        j[k + "lanes"] = s.lanes;
+                        j[k + "passed"] = s.passed;
+                        j[k + "average_length"] = s.average_length();
+                        for (size_t i = 0; i < widths.size(); ++i)
+                            j[k + "utilization.w" + std::to_string(widths[i])] =
+                                s.utilization(i, widths[i]);
+                        j[k + "length_histogram_log2"] = s.histogram;
+                    }
+            }
+            std::cout << j.dump(2) << "\n";
+            return;
+        }
+
+        auto size = [](uint32_t t) { return std::to_string(t) + "x" + std::to_string(t); };
+        auto cell = [](std::string s, size_t w) {
+            return s.size() < w ? s + std::string(w - s.size(), ' ') : s + " ";
+        };
+        std::cout << "scene " << scene.name << ": " << settings.width << "x" << settings.height
+                  << " x " << settings.spp << " spp, depth " << settings.max_depth
+                  << "; ideal SIMD utilization in %\n\n";
+        std::cout << "Table 2: SIMD utilization (T / I), primary rays\n";
+        for (size_t i = 0; i < widths.size(); ++i) {
+            std::cout << "  SIMD width N = " << widths[i] << "\n";
+            for (const TileRun& r : runs) {
+                const auto& tr = r.counts.stage(false, OpStage::traversal);
+                const auto& is = r.counts.stage(false, OpStage::intersection);
+                std::cout << "    " << cell(size(r.tile), 10)
+                          << percent(tr.utilization(i, widths[i])) << " / "
+                          << percent(is.utilization(i, widths[i])) << "\n";
+            }
+        }
+        std::cout << "\nTable 3: SIMD utilization (T / I / S), secondary rays\n";
+        for (size_t i = 0; i < widths.size(); ++i) {
+            std::cout << "  SIMD width N = " << widths[i] << "\n";
+            for (const TileRun& r : runs) {
+                std::cout << "    " << cell(size(r.tile), 10);
+                for (int k = 0; k < 3; ++k)
+                    std::cout << (k ? " / " : "")
+                              << percent(r.counts.stage(true, stages[k]).utilization(i, widths[i]));
+                std::cout << "\n";
+            }
+        }
+        std::cout << "\nTable 4: average stream length, secondary rays\n"
+                  << "    " << cell("size", 10) << cell("trav", 9) << cell("isec", 9) << "shade\n";
+        for (const TileRun& r : runs) {
+            std::cout << "    " << cell(size(r.tile), 10);
+            for (int k = 0; k < 3; ++k) {
+                char buf[32];
+                std::snprintf(buf, sizeof buf, "%.1f", r.counts.stage(true, stages[k]).average_length());
+                std::cout << (k < 2 ? cell(buf, 9) : std::string(buf));
+            }
+            std::cout << "\n";
+        }
+        std::cout << "\nPer-frame operation counts (Table 1's columns; an op is one stream filter)\n"
+                  << "    " << cell("size", 10) << cell("# rays", 12) << cell("# trav ops", 12)
+                  << cell("# isec ops", 12) << cell("# shade ops", 12) << "host s\n";
+        for (const TileRun& r : runs) {
+            auto sci = [](double v) {
+                char buf[32];
+                std::snprintf(buf, sizeof buf, "%.3g", v);
+                return std::string(buf);
+            };
+            const uint64_t shade = r.counts.stage(false, OpStage::shading).ops +
+                                   r.counts.stage(true, OpStage::shading).ops;
+            char secs[32];
+            std::snprintf(secs, sizeof secs, "%.2f", r.stats.host_seconds);
+            std::cout << "    " << cell(size(r.tile), 10) << cell(sci(double(r.stats.rays())), 12)
+                      << cell(sci(double(r.counts.kind_ops(OpKind::box_test))), 12)
+                      << cell(sci(double(r.counts.kind_ops(OpKind::triangle_test) +
+                                         r.counts.kind_ops(OpKind::sphere_test))),
+                              12)
+                      << cell(sci(double(shade)), 12) << secs << "\n";
+        }
+    });
+}
+
+}  // namespace sfx
