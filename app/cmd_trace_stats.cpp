@@ -151,12 +151,13 @@ void add_trace_stats_command(CLI::App& app) {
             std::cout << "    " << cell(size(r.tile), 10);
             for (int k = 0; k < 3; ++k) {
                 char buf[32];
-                std::snprintf(buf, sizeof buf, "%.1f", r.counts.stage(true, stages[k]).average_length());
+                std::snprintf(buf, sizeof buf, "%.1f",
+                              r.counts.stage(true, stages[k]).average_length());
                 std::cout << (k < 2 ? cell(buf, 9) : std::string(buf));
             }
             std::cout << "\n";
         }
-        std::cout << "\nPer-frame operation counts (Table 1's columns; an op is one stream filter)\n"
+        std::cout << "\nPer-frame operation counts (Table 1's columns; op = one stream filter)\n"
                   << "    " << cell("size", 10) << cell("# rays", 12) << cell("# trav ops", 12)
                   << cell("# isec ops", 12) << cell("# shade ops", 12) << "host s\n";
         for (const TileRun& r : runs) {

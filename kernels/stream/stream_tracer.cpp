@@ -392,7 +392,8 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
         RenderStats local;
         TraceRecorder recorder;
         std::unique_ptr<CountingSink> tile_counts;
-        if (counting && threads > 1) tile_counts = std::make_unique<CountingSink>(counting->widths());
+        if (counting && threads > 1)
+            tile_counts = std::make_unique<CountingSink>(counting->widths());
         TraceSink* const direct = tile_counts ? tile_counts.get() : sink;
         for (uint32_t s = 0; s < settings.spp; ++s) {
             if (!ordered) {

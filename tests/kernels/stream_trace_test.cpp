@@ -233,9 +233,9 @@ TEST_CASE("Table 7: width equal to the stream size gives packet tracing's op cou
         for (uint32_t i = 0; i < size; ++i) {
             Ray ray;
             ray.org = {0.1f * float(i % 7) - 0.3f, -1.4f, 0.1f * float(i % 5)};
-            ray.dir = to_world(sample_cosine_hemisphere(random_float(3, i, 0, 1, RngDim::direction_u),
-                                                        random_float(3, i, 0, 1, RngDim::direction_v)),
-                               {0.f, 1.f, 0.f});
+            const float u = random_float(3, i, 0, 1, RngDim::direction_u);
+            const float v = random_float(3, i, 0, 1, RngDim::direction_v);
+            ray.dir = to_world(sample_cosine_hemisphere(u, v), {0.f, 1.f, 0.f});
             secondary.push_back(ray);
         }
         for (const std::vector<Ray>* rays : {&primary, &secondary}) {
