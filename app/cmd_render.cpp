@@ -6,6 +6,7 @@
 #include "app/commands.h"
 #include "kernels/bvh.h"
 #include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/stream_tracer.h"
 #include "workloads/input_error.h"
 #include "workloads/scene_loader.h"
 
@@ -16,6 +17,7 @@ void add_render_command(CLI::App& app) {
         std::string scene;
         std::string output = "render.png";
         std::string tracer = "reference";
+        std::string trace;
         bool json = false;
         WorkloadFlags workload;
     };
@@ -24,9 +26,11 @@ void add_render_command(CLI::App& app) {
     c->add_option("scene", options->scene, "scene file or built-in scene name")->required();
     c->add_option("-o,--output", options->output, "output PNG; the PFM goes beside it")
         ->capture_default_str();
-    c->add_option("--tracer", options->tracer, "reference")
-        ->check(CLI::IsMember({"reference"}))
+    c->add_option("--tracer", options->tracer, "reference or stream (bit-identical images)")
+        ->check(CLI::IsMember({"reference", "stream"}))
         ->capture_default_str();
+    c->add_option("--trace", options->trace,
+                  "stream tracer: write the workload trace (binary, see kernels/trace.cpp)");
     c->add_flag("--json", options->json, "print one JSON document");
     options->workload.add_to(c);
     c->callback([options] {
@@ -35,7 +39,13 @@ void add_render_command(CLI::App& app) {
         if (options->output.size() < 5 || options->output.substr(options->output.size() - 4) != ".png")
             throw InputError("command line", 0, "--output", "expected a .png path, got '" + options->output + "'");
         const Bvh bvh(scene);
-        const RenderResult result = render_reference(scene, bvh, settings);
+        if (!options->trace.empty() && options->tracer != "stream")
+            throw InputError("command line", 0, "--trace", "needs --tracer stream");
+        std::unique_ptr<TraceFileWriter> writer;
+        if (!options->trace.empty()) writer = std::make_unique<TraceFileWriter>(options->trace);
+        const RenderResult result = options->tracer == "stream"
+                                        ? render_stream(scene, bvh, settings, writer.get())
+                                        : render_reference(scene, bvh, settings);
         const std::string pfm = options->output.substr(0, options->output.size() - 4) + ".pfm";
         write_png(result.image, options->output);
         write_pfm(result.image, pfm);
@@ -56,6 +66,10 @@ void add_render_command(CLI::App& app) {
             j["mean_radiance"] = {mean.x, mean.y, mean.z};
             j["png"] = options->output;
             j["pfm"] = pfm;
+            if (writer) {
+                j["trace"] = options->trace;
+                j["trace_bytes"] = writer->bytes_written();
+            }
             std::cout << j.dump(2) << "\n";
         } else {
             std::cout << "scene            " << scene.name << "\n"
@@ -67,7 +81,11 @@ void add_render_command(CLI::App& app) {
                       << "nonfinite paths  " << result.stats.nonfinite_paths << "\n"
                       << "host seconds     " << result.stats.host_seconds << "\n"
                       << "mrays/s          " << result.stats.rays() / result.stats.host_seconds * 1e-6 << "\n"
-                      << "wrote            " << options->output << ", " << pfm << "\n";
+                      << "wrote            " << options->output << ", " << pfm
+                      << (writer ? ", " + options->trace + " (" +
+                                       std::to_string(writer->bytes_written()) + " bytes)"
+                                 : std::string())
+                      << "\n";
         }
     });
 }
