@@ -1,0 +1,85 @@
+// Mesh import through assimp: tiny OBJ and PLY files written here, loaded directly and from a
+// scene file (relative path, transform).
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+
+#include "workloads/mesh_import.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path test_dir() {
+    const fs::path dir = fs::temp_directory_path() / "sfx_mesh_import_test";
+    fs::create_directories(dir / "meshes");
+    return dir;
+}
+
+// A unit square made of one quad face (triangulated on import) plus one triangle.
+const char* const k_obj =
+    "# square and a triangle\n"
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+    "f 1 2 3 4\n"
+    "f 1 2 5\n";
+
+const char* const k_ply =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n2 0 0\n2 2 0\n0 2 0\n3 0 1 2\n3 0 2 3\n";
+
+}  // namespace
+
+TEST_CASE("mesh import: OBJ polygons are triangulated", "[workloads]") {
+    const fs::path p = test_dir() / "meshes" / "square.obj";
+    std::ofstream(p) << k_obj;
+    const TriangleMesh m = import_mesh(p.string());
+    CHECK(m.triangle_count() == 3);
+    CHECK(m.positions.size() >= 5);
+    Bounds3 b;
+    for (uint32_t i : m.indices) b.extend(m.positions.at(i));
+    CHECK(b.lo == Vec3(0.f));
+    CHECK(b.hi == Vec3(1.f));
+}
+
+TEST_CASE("mesh import: PLY", "[workloads]") {
+    const fs::path p = test_dir() / "meshes" / "square.ply";
+    std::ofstream(p) << k_ply;
+    const TriangleMesh m = import_mesh(p.string());
+    CHECK(m.triangle_count() == 2);
+    float area = 0.f;
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+        const Vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]];
+        const Vec3 c = m.positions[m.indices[t + 2]];
+        area += 0.5f * length(cross(b - a, c - a));
+    }
+    CHECK(area == Approx(4.f));
+}
+
+TEST_CASE("mesh import: missing file throws", "[workloads]") {
+    CHECK_THROWS(import_mesh((test_dir() / "meshes" / "nothing_here.obj").string()));
+}
+
+TEST_CASE("mesh import: scene files place meshes relative to themselves", "[workloads]") {
+    const fs::path dir = test_dir();
+    std::ofstream(dir / "meshes" / "square.obj") << k_obj;
+    std::ofstream(dir / "meshes" / "square.ply") << k_ply;
+    const fs::path scene = dir / "meshes.scene.yaml";
+    std::ofstream(scene) << "version: 1\n"
+                            "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
+                            "materials: [{name: m, kind: lambertian}]\n"
+                            "objects:\n"
+                            "  - {type: mesh, material: m, file: meshes/square.obj,\n"
+                            "     transform: {scale: [2, 2, 2], translate: [0, 0, -3]}}\n"
+                            "  - {type: mesh, material: m, file: meshes/square.ply}\n";
+    const Scene s = load_scene(scene.string());
+    CHECK(s.triangles.size() == 5);
+    Bounds3 b;
+    for (uint32_t p = 0; p < 3; ++p) b.extend(s.primitive_bounds(p));
+    CHECK(b.lo == Vec3(0.f, 0.f, -3.f));
+    CHECK(b.hi == Vec3(2.f, 2.f, -1.f));
+    CHECK(s.lights.empty());
+}
