@@ -28,5 +28,6 @@ void add_render_command(CLI::App& app);
 void add_trace_stats_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_scene_info_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 }  // namespace sfx

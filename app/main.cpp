@@ -6,6 +6,10 @@
 #include "app/commands.h"
 #include "workloads/input_error.h"
 
+// libsystemc.so defines main() and calls sc_main(); sfx has its own main(), so this is never
+// called, but the library needs the symbol to link.
+extern "C" int sc_main(int, char**) { return 0; }
+
 int main(int argc, char** argv) {
     CLI::App app{"sfx: hardware design-space explorer for stream-filtering ray tracing"};
     app.require_subcommand(1);
@@ -13,6 +17,7 @@ int main(int argc, char** argv) {
     sfx::add_trace_stats_command(app);
     sfx::add_validate_command(app);
     sfx::add_scene_info_command(app);
+    sfx::add_simulate_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -25,8 +25,7 @@ RayBufferModel::Access RayBufferModel::access_field(uint32_t field_word, const u
     // Even without conflicts a bank serves ceil(lanes / banks) requests.
     const uint32_t needed = (lanes + m_banks - 1) / m_banks;
     const uint32_t per_request = m_pipelined ? 1 : m_latency;
-    const uint32_t fill = m_pipelined ? m_latency - 1 : 0;
-    a.cycles = uint64_t(busiest) * per_request + fill;
+    a.cycles = uint64_t(busiest) * per_request;
     a.conflict_cycles = uint64_t(busiest - needed) * per_request;
     return a;
 }

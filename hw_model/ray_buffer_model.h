@@ -23,9 +23,9 @@ public:
         return (field_word * m_slot_count + slot) % m_banks;
     }
 
-    // Cycles to access one field word of each lane's slot (a gather or a scatter of one field),
-    // and how many of those cycles are bank-conflict stalls (cycles beyond the conflict-free
-    // one issue per group).
+    // Issue cycles to access one field word of each lane's slot (a gather or a scatter of one
+    // field), and how many of those cycles are bank-conflict stalls (beyond the conflict-free
+    // ceil(lanes / banks)). The pipeline fill is not included: see fill_cycles().
     struct Access {
         uint64_t cycles = 0;
         uint64_t conflict_cycles = 0;
@@ -41,6 +41,9 @@ public:
     };
     Contiguous access_contiguous(uint64_t offset, uint32_t lanes) const;
 
+    // Latency a chain of pipelined accesses pays once (zero when accesses do not overlap,
+    // since each already occupies its bank for the whole latency).
+    uint32_t fill_cycles() const { return m_pipelined ? m_latency - 1 : 0; }
     uint32_t banks() const { return m_banks; }
     uint32_t latency() const { return m_latency; }
     bool pipelined() const { return m_pipelined; }

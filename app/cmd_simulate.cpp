@@ -1,0 +1,128 @@
+// sfx simulate HW.hw.yaml [HW2.hw.yaml ...] --scene SCENE: predicted fps, utilization, stalls
+// and operation mix. Several configurations share one functional render (trace once, time many).
+
+#include <iomanip>
+#include <sstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "kernels/bvh.h"
+#include "sweeps/point_group.h"
+#include "workloads/input_error.h"
+#include "workloads/scene_loader.h"
+
+namespace sfx {
+
+nlohmann::json prediction_json(const Prediction& p) {
+    nlohmann::json j;
+    j["config"] = p.config.name;
+    j["fidelity"] = to_string(p.fidelity);
+    j["simd_width"] = p.config.simd.width;
+    for (const Stat& s : p.stats()) j[s.name] = s.value;
+    return j;
+}
+
+void print_predictions(const std::vector<Prediction>& predictions, std::ostream& out) {
+    auto row = [&](const std::string& label, auto value_of) {
+        out << std::left << std::setw(38) << label;
+        for (const Prediction& p : predictions) out << std::right << std::setw(16) << value_of(p);
+        out << "\n";
+    };
+    auto stat = [](const Prediction& p, const std::string& name) {
+        for (const Stat& s : p.stats())
+            if (s.name == name) return s.value;
+        return 0.0;
+    };
+    auto fixed = [](double v, int digits) {
+        std::ostringstream s;
+        s << std::fixed << std::setprecision(digits) << v;
+        return s.str();
+    };
+    row("configuration", [](const Prediction& p) { return p.config.name; });
+    row("fidelity", [](const Prediction& p) { return std::string(to_string(p.fidelity)); });
+    row("simd width", [](const Prediction& p) { return std::to_string(p.config.simd.width); });
+    row("tile", [](const Prediction& p) { return std::to_string(p.tile); });
+    row("fps", [&](const Prediction& p) { return fixed(p.fps(), 3); });
+    row("frame cycles", [&](const Prediction& p) { return std::to_string(p.timing.cycles); });
+    for (const char* stage : {"traversal", "intersection", "shading"}) {
+        row(std::string("utilization ") + stage + " (ideal)", [&](const Prediction& p) {
+            return fixed(100 * stat(p, std::string("simd_utilization.") + stage), 1) + "% (" +
+                   fixed(100 * stat(p, std::string("ideal_simd_utilization.") + stage), 1) + "%)";
+        });
+    }
+    for (const char* cause : {"bank_conflict", "alignment", "address_fetch", "partition",
+                              "scene_memory", "interconnect", "pipeline_fill"}) {
+        row(std::string("stall ") + cause + " (% of cycles)", [&](const Prediction& p) {
+            return fixed(100 * stat(p, std::string("stall_cycles.") + cause) /
+                             std::max(1.0, double(p.timing.cycles)), 1);
+        });
+    }
+    for (const char* m : {"load", "store", "compute", "scatter_gather", "partition"}) {
+        row(std::string("op mix ") + m + " %", [&](const Prediction& p) {
+            return fixed(stat(p, std::string("op_mix.") + m + "_percent"), 1);
+        });
+    }
+    row("bank conflict rate", [&](const Prediction& p) {
+        return fixed(100 * stat(p, "ray_buffer.bank_conflict_rate"), 2) + "%";
+    });
+    for (size_t level = 0; level < predictions.front().config.scene_memory.caches.size(); ++level) {
+        const std::string name = predictions.front().config.scene_memory.caches[level].name;
+        row("scene cache " + name + " hit rate", [&](const Prediction& p) {
+            return fixed(100 * stat(p, "scene_cache." + name + ".hit_rate"), 1) + "%";
+        });
+    }
+    row("host seconds", [&](const Prediction& p) { return fixed(p.host_seconds, 3); });
+    row("error estimate", [&](const Prediction& p) {
+        return p.error_relative < 0 ? std::string("unknown") : fixed(100 * p.error_relative, 2) + "%";
+    });
+}
+
+void add_simulate_command(CLI::App& app) {
+    struct Options {
+        std::vector<std::string> hw;
+        std::string scene;
+        std::string fidelity = "full";
+        bool json = false;
+        WorkloadFlags workload;
+    };
+    auto o = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand("simulate", "predict frame rate and utilization of hardware configurations");
+    c->add_option("hw", o->hw, "hardware configuration files (*.hw.yaml); several share one render")
+        ->required();
+    c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();
+    c->add_option("--fidelity", o->fidelity, "analytic | full")
+        ->check(CLI::IsMember({"analytic", "full"}))
+        ->capture_default_str();
+    c->add_flag("--json", o->json, "print one JSON document (a list for several configurations)");
+    o->workload.add_to(c);
+    c->callback([o] {
+        std::vector<HwConfig> configs;
+        for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
+        const Scene scene = load_scene(o->scene);
+        RenderSettings settings = o->workload.resolve(scene);
+        FeatureSet features = scene.features();
+        if (o->workload.tile == "auto") settings.tile = largest_fitting_tile(features, configs);
+        check_tile_fits(settings.tile, features, configs, "--tile");
+        const Bvh bvh(scene);
+        const PointGroupResult r =
+            run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
+        if (o->json) {
+            if (r.predictions.size() == 1) {
+                std::cout << prediction_json(r.predictions[0]).dump(2) << "\n";
+            } else {
+                nlohmann::json list = nlohmann::json::array();
+                for (const Prediction& p : r.predictions) list.push_back(prediction_json(p));
+                std::cout << list.dump(2) << "\n";
+            }
+            return;
+        }
+        std::cout << "scene " << scene.name << ", " << settings.width << "x" << settings.height
+                  << " x " << settings.spp << " spp, depth " << settings.max_depth << ", tile "
+                  << settings.tile << ", " << r.render.rays() << " rays\n\n";
+        print_predictions(r.predictions, std::cout);
+        std::cout << "\nhost seconds for the group: " << r.host_seconds << "\n";
+    });
+}
+
+}  // namespace sfx

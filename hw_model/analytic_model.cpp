@@ -1,0 +1,196 @@
+#include "hw_model/analytic_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <vector>
+
+#include "hw_model/op_costs.h"
+#include "hw_model/ray_buffer_model.h"
+
+namespace sfx {
+
+void TraceProfile::begin_pass(const TilePass& p) {
+    ++m_passes;
+    m_slots = std::max(m_slots, p.slot_count);
+}
+
+void TraceProfile::op(const StreamOp& op) {
+    Bucket& b = m_buckets[Key{op.generation > 0, op.kind, op.length}];
+    ++b.ops;
+    b.passed += op.pass_count;
+    b.fetches += op.object != k_no_object;
+}
+
+namespace {
+
+// Truncated polynomial product: coefficients up to degree n.
+std::vector<double> multiply(const std::vector<double>& a, const std::vector<double>& b, size_t n) {
+    std::vector<double> c(n + 1, 0.0);
+    for (size_t i = 0; i <= n; ++i)
+        if (a[i] != 0.0)
+            for (size_t j = 0; i + j <= n; ++j) c[i + j] += a[i] * b[j];
+    return c;
+}
+
+std::vector<double> power(std::vector<double> base, uint32_t e, size_t n) {
+    std::vector<double> result(n + 1, 0.0);
+    result[0] = 1.0;
+    while (e) {
+        if (e & 1) result = multiply(result, base, n);
+        base = multiply(base, base, n);
+        e >>= 1;
+    }
+    return result;
+}
+
+}  // namespace
+
+double expected_conflicts(uint32_t lanes, uint32_t banks) {
+    if (lanes <= 1 || banks == 0) return 0.0;
+    static std::mutex mutex;
+    static std::map<std::pair<uint32_t, uint32_t>, double> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto key = std::make_pair(lanes, banks);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+    // P(max load <= m) = n! / B^n [x^n] (sum_{j<=m} x^j / j!)^B; E[max] = sum_m P(max > m).
+    const size_t n = lanes;
+    double log_scale = std::lgamma(double(n) + 1.0) - double(n) * std::log(double(banks));
+    double expected_max = 0.0;
+    for (uint32_t m = 0; m < lanes; ++m) {
+        std::vector<double> base(n + 1, 0.0);
+        double term = 1.0;
+        for (uint32_t j = 0; j <= std::min<uint32_t>(m, lanes); ++j) {
+            base[j] = term;
+            term /= double(j + 1);
+        }
+        const double coefficient = power(base, banks, n)[n];
+        const double p_le = coefficient > 0.0 ? std::exp(std::log(coefficient) + log_scale) : 0.0;
+        expected_max += 1.0 - std::min(1.0, p_le);
+    }
+    const double needed = double((lanes + banks - 1) / banks);
+    const double result = std::max(0.0, expected_max - needed);
+    cache[key] = result;
+    return result;
+}
+
+double expected_moved_ids(uint32_t length, double p) {
+    // Id i passing moves unless every id before it passes; failing moves unless every id after
+    // it fails: sum_i p (1 - p^i) + (1 - p)(1 - (1 - p)^(L - 1 - i)).
+    if (length == 0 || p <= 0.0 || p >= 1.0) return 0.0;
+    const double q = 1.0 - p, len = double(length);
+    const double geo_p = (1.0 - std::pow(p, len)) / (1.0 - p);  // sum_{i<L} p^i
+    const double geo_q = (1.0 - std::pow(q, len)) / (1.0 - q);
+    return p * (len - geo_p) + q * (len - geo_q);
+}
+
+FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
+                            const TraceProfile& profile) {
+    const RayRecordLayout layout(shape.features);
+    const OpCostTable costs(layout, c.datapath);
+    const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
+    const uint32_t n = c.simd.width;
+    const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
+    const double l1 = c.scene_memory.caches.empty() ? double(c.scene_memory.dram_latency_cycles)
+                                                    : double(c.scene_memory.caches[0].hit_latency_cycles);
+    const double words_per_core_cycle =
+        double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
+    const double fill_bank = buffer.fill_cycles();
+    FrameTiming t;
+    t.passes = profile.passes();
+    double total_cycles = 0.0;
+    StallCycles stalls_sum;
+    double stall_values[7] = {};  // fractional sums, rounded once at the end
+    for (const auto& [key, bucket] : profile.buckets()) {
+        const auto& [secondary, kind, length] = key;
+        if (length == 0) continue;
+        const OpProfile& p = costs[kind];
+        const double ops = double(bucket.ops);
+        const double pass_rate = double(bucket.passed) / (ops * double(length));
+        const uint64_t groups = (uint64_t(length) + n - 1) / n;
+        const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
+        // Per op: exact id-stream and compute work; expected conflicts.
+        double busy = 0.0, conflict = 0.0, align = 0.0, first_group = 0.0, accesses = 0.0;
+        for (uint64_t g = 0; g < groups; ++g) {
+            const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
+            const RayBufferModel::Contiguous ids = buffer.access_contiguous(g * n, lanes);
+            busy += double(ids.cycles - ids.alignment_cycles);
+            align += double(ids.alignment_cycles);
+            const double ideal = double((lanes + c.ray_buffer.banks - 1) / c.ray_buffer.banks);
+            const double per_request = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
+            const double gathers = double(p.gather_words.size());
+            busy += gathers * ideal * per_request;
+            conflict += gathers * expected_conflicts(lanes, c.ray_buffer.banks) * sparsity * per_request;
+            accesses += gathers;
+            if (g == 0) first_group = busy + conflict + align;
+            const double scattering = std::round(pass_rate * lanes);
+            if (scattering >= 1.0 && !p.scatter_words.empty()) {
+                const double s = double(p.scatter_words.size());
+                busy += s * std::ceil(scattering / c.ray_buffer.banks) * per_request;
+                conflict += s * expected_conflicts(uint32_t(scattering), c.ray_buffer.banks) *
+                            sparsity * per_request;
+                accesses += s;
+            }
+        }
+        busy += double(groups) * p.compute_instructions;
+        const double data = busy + conflict + align;
+        const double words = double(length) * double(p.gather_words.size() + 1) +
+                             pass_rate * length * double(p.scatter_words.size());
+        const double address = std::ceil(words / (double(c.agu.count) * c.agu.addresses_per_cycle));
+        const double address_stall = std::max(0.0, address - data);
+        // Every fetch is priced as an L1 hit, overlapped with the first group's gathers.
+        const double memory_stall =
+            p.scene_bytes ? std::max(0.0, l1 - first_group) * double(bucket.fetches) / ops : 0.0;
+        double compare = 0.0, moves = 0.0;
+        if (p.partitions) {
+            compare = std::ceil(double(length) / c.partition.lanes_per_cycle);
+            moves = std::ceil(expected_moved_ids(length, pass_rate) / n);
+        }
+        const double fill = double(p.latency_cycles) + fill_bank;
+        const double scratch = std::ceil(2.0 * double(groups) / c.scratchpad.ports);
+        const double interconnect =
+            (c.interconnect.contention
+                 ? std::max(0.0, std::ceil(2.0 * words / words_per_core_cycle) - data)
+                 : 0.0) +
+            std::max(0.0, scratch - data);
+        // Average cycles of one op of this bucket.
+        const double op_cycles =
+            data + fill + address_stall + memory_stall + compare + moves + interconnect;
+
+        total_cycles += ops * op_cycles;
+        stall_values[0] += ops * conflict;
+        stall_values[1] += ops * align;
+        stall_values[2] += ops * address_stall;
+        stall_values[3] += ops * (compare + moves);
+        stall_values[4] += ops * memory_stall;
+        stall_values[5] += ops * interconnect;
+        stall_values[6] += ops * fill;
+        StageTiming& stage = t.stages[secondary][uint32_t(stage_of(kind))];
+        stage.ops += bucket.ops;
+        stage.lanes += bucket.ops * length;
+        stage.groups += bucket.ops * groups;
+        stage.busy_cycles += uint64_t(std::llround(ops * busy));
+        stage.stall_cycles += uint64_t(std::llround(ops * (op_cycles - busy)));
+        t.mix.load += uint64_t(ops * double(groups) + double(p.scene_bytes ? bucket.fetches : 0));
+        t.mix.compute += uint64_t(ops * double(groups) * p.compute_instructions);
+        t.mix.scatter_gather += uint64_t(std::llround(ops * accesses));
+        t.mix.partition += uint64_t(ops * compare);
+        t.mix.store += uint64_t(ops * moves);
+        if (kind == OpKind::camera || kind == OpKind::lambertian_direct ||
+            kind == OpKind::lambertian_indirect || kind == OpKind::dielectric || kind == OpKind::glossy)
+            t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
+        t.field_accesses += uint64_t(std::llround(ops * accesses));
+    }
+    stalls_sum.bank_conflict = uint64_t(std::llround(stall_values[0]));
+    stalls_sum.alignment = uint64_t(std::llround(stall_values[1]));
+    stalls_sum.address_fetch = uint64_t(std::llround(stall_values[2]));
+    stalls_sum.partition = uint64_t(std::llround(stall_values[3]));
+    stalls_sum.scene_memory = uint64_t(std::llround(stall_values[4]));
+    stalls_sum.interconnect = uint64_t(std::llround(stall_values[5]));
+    stalls_sum.pipeline_fill = uint64_t(std::llround(stall_values[6]));
+    t.stalls = stalls_sum;
+    t.cycles = uint64_t(std::llround(total_cycles));
+    return t;
+}
+
+}  // namespace sfx

@@ -1,0 +1,56 @@
+#pragma once
+// The analytic timing model: a closed form over the trace's operation counts and stream-length
+// histograms. The profile is gathered once per trace (a TraceSink); evaluating a configuration
+// against it takes microseconds, so a sweep can price thousands of configurations per render.
+//
+// What it knows exactly: lane groups per width, id-stream alignment, compute, partition
+// comparator passes, pipeline fill. What it estimates: bank conflicts (balls into bins,
+// scaled by how sparse the stream is in its buffer), partition moves (an i.i.d. mask with the
+// measured pass rate), and scene-data latency (every fetch an L1 hit). Its error is measured
+// against the cycle-level model, never assumed (tests/hw_model, sfx accuracy).
+
+#include <cstdint>
+#include <map>
+#include <tuple>
+
+#include "hw_model/hw_config.h"
+#include "hw_model/prediction.h"
+#include "hw_model/workload_shape.h"
+
+namespace sfx {
+
+class TraceProfile : public TraceSink {
+public:
+    struct Bucket {
+        uint64_t ops = 0;
+        uint64_t passed = 0;  // sum of pass counts
+        uint64_t fetches = 0;  // ops with a scene object
+    };
+    // (secondary, kind, stream length) -> bucket.
+    using Key = std::tuple<bool, OpKind, uint32_t>;
+
+    void begin_pass(const TilePass& p) override;
+    void op(const StreamOp& op) override;
+
+    const std::map<Key, Bucket>& buckets() const { return m_buckets; }
+    uint64_t passes() const { return m_passes; }
+    uint32_t slots() const { return m_slots; }
+
+private:
+    std::map<Key, Bucket> m_buckets;
+    uint64_t m_passes = 0;
+    uint32_t m_slots = 0;
+};
+
+FrameTiming analytic_timing(const HwConfig& config, const WorkloadShape& shape,
+                            const TraceProfile& profile);
+
+// Expected busiest-bank load minus the conflict-free load, for `lanes` requests spread
+// uniformly over `banks` banks (exact, from the multinomial distribution).
+double expected_conflicts(uint32_t lanes, uint32_t banks);
+
+// Expected number of ids a stable in-place partition moves, for `length` ids each passing
+// independently with probability `pass_rate`.
+double expected_moved_ids(uint32_t length, double pass_rate);
+
+}  // namespace sfx

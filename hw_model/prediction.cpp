@@ -1,0 +1,158 @@
+#include "hw_model/prediction.h"
+
+#include <stdexcept>
+
+namespace sfx {
+
+const char* to_string(Fidelity f) {
+    switch (f) {
+        case Fidelity::analytic: return "analytic";
+        case Fidelity::sampled: return "sampled";
+        case Fidelity::full: return "full";
+    }
+    return "?";
+}
+
+Fidelity parse_fidelity(const std::string& text) {
+    if (text == "analytic") return Fidelity::analytic;
+    if (text == "sampled") return Fidelity::sampled;
+    if (text == "full") return Fidelity::full;
+    throw std::invalid_argument("fidelity must be analytic, sampled or full, not '" + text + "'");
+}
+
+StallCycles& StallCycles::operator+=(const StallCycles& o) {
+    bank_conflict += o.bank_conflict;
+    alignment += o.alignment;
+    address_fetch += o.address_fetch;
+    partition += o.partition;
+    scene_memory += o.scene_memory;
+    interconnect += o.interconnect;
+    pipeline_fill += o.pipeline_fill;
+    return *this;
+}
+
+OpMix& OpMix::operator+=(const OpMix& o) {
+    load += o.load;
+    store += o.store;
+    compute += o.compute;
+    scatter_gather += o.scatter_gather;
+    partition += o.partition;
+    return *this;
+}
+
+StageTiming& StageTiming::operator+=(const StageTiming& o) {
+    ops += o.ops;
+    lanes += o.lanes;
+    groups += o.groups;
+    busy_cycles += o.busy_cycles;
+    stall_cycles += o.stall_cycles;
+    return *this;
+}
+
+FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
+    cycles += o.cycles;
+    stalls += o.stalls;
+    mix += o.mix;
+    for (int s = 0; s < 2; ++s)
+        for (uint32_t k = 0; k < k_op_stage_count; ++k) stages[s][k] += o.stages[s][k];
+    field_accesses += o.field_accesses;
+    conflicted_accesses += o.conflicted_accesses;
+    if (cache_hits.size() < o.cache_hits.size()) {
+        cache_hits.resize(o.cache_hits.size());
+        cache_misses.resize(o.cache_misses.size());
+    }
+    for (size_t i = 0; i < o.cache_hits.size(); ++i) {
+        cache_hits[i] += o.cache_hits[i];
+        cache_misses[i] += o.cache_misses[i];
+    }
+    dram_reads += o.dram_reads;
+    passes += o.passes;
+    return *this;
+}
+
+double Prediction::frame_seconds() const {
+    return double(timing.cycles) / (config.clock.core_mhz * 1e6);
+}
+
+double Prediction::fps() const {
+    const double s = frame_seconds();
+    return s > 0.0 ? 1.0 / s : 0.0;
+}
+
+namespace {
+double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
+}  // namespace
+
+std::vector<Stat> Prediction::stats() const {
+    std::vector<Stat> s;
+    auto add = [&](std::string name, double value, std::string unit, std::string description) {
+        s.push_back({std::move(name), value, std::move(unit), std::move(description)});
+    };
+    add("fps", fps(), "frames/s", "predicted frame rate");
+    add("frame_cycles", double(timing.cycles), "cycles", "core cycles per frame");
+    add("frame_seconds", frame_seconds(), "s", "predicted time per frame");
+    add("host_seconds", host_seconds, "s", "host time to obtain this prediction");
+    add("error.relative", error_relative, "", "relative half-width of the frame-cycle interval (<0: unknown)");
+    add("passes.total", double(total_passes), "passes", "tile passes in the frame");
+    add("passes.timed", double(sample_passes), "passes", "tile passes timed by the model");
+    add("tile", double(tile), "pixels", "tile edge: the initial stream is tile^2 rays");
+    add("bytes_per_ray", double(bytes_per_ray), "bytes", "ray record size in the ray buffer");
+
+    static const char* k_stage_names[] = {"traversal", "intersection", "shading"};
+    for (uint32_t k = 0; k < k_op_stage_count; ++k) {
+        StageTiming all = timing.stages[0][k];
+        all += timing.stages[1][k];
+        const std::string st = k_stage_names[k];
+        // Effective utilization: the ideal (lanes over issued lane slots) times the share of
+        // the stage's cycles that issue work; a stall cycle issues nothing.
+        auto effective = [](double ideal, const StageTiming& t) {
+            return ideal * ratio(double(t.busy_cycles), double(t.busy_cycles + t.stall_cycles));
+        };
+        add("simd_utilization." + st, effective(ideal_utilization_all[k], all), "",
+            "effective SIMD utilization, all rays");
+        add("ideal_simd_utilization." + st, ideal_utilization_all[k], "",
+            "ideal SIMD utilization from the trace, all rays");
+        for (int sec = 0; sec < 2; ++sec) {
+            const std::string kind = sec ? "secondary" : "primary";
+            add("simd_utilization." + kind + "." + st,
+                effective(ideal_utilization[sec][k], timing.stages[sec][k]), "",
+                "effective SIMD utilization, " + kind + " rays");
+            add("ideal_simd_utilization." + kind + "." + st, ideal_utilization[sec][k], "",
+                "ideal SIMD utilization, " + kind + " rays");
+        }
+        add("stage_cycles." + st, double(all.busy_cycles + all.stall_cycles), "cycles",
+            "cycles spent in the " + st + " stage");
+        add("stream_length." + st, ratio(double(all.lanes), double(all.ops)), "rays",
+            "average stream length of the stage's operations");
+    }
+
+    const StallCycles& st = timing.stalls;
+    add("stall_cycles.bank_conflict", double(st.bank_conflict), "cycles", "waiting on a busy ray-buffer bank");
+    add("stall_cycles.alignment", double(st.alignment), "cycles", "SIMD groups not aligned to buffer lines");
+    add("stall_cycles.address_fetch", double(st.address_fetch), "cycles", "address generation behind the data path");
+    add("stall_cycles.partition", double(st.partition), "cycles", "in-place stream partition");
+    add("stall_cycles.scene_memory", double(st.scene_memory), "cycles", "waiting for scene data");
+    add("stall_cycles.interconnect", double(st.interconnect), "cycles", "interconnect contention");
+    add("stall_cycles.pipeline_fill", double(st.pipeline_fill), "cycles", "pipeline latency per operation");
+    add("stall_cycles.total", double(st.total()), "cycles", "all stall cycles");
+
+    const double mix_total = double(timing.mix.total());
+    add("op_mix.load_percent", 100.0 * ratio(double(timing.mix.load), mix_total), "%", "loads (Table 5)");
+    add("op_mix.store_percent", 100.0 * ratio(double(timing.mix.store), mix_total), "%", "stores (Table 5)");
+    add("op_mix.compute_percent", 100.0 * ratio(double(timing.mix.compute), mix_total), "%", "compute on ray data (Table 5)");
+    add("op_mix.scatter_gather_percent", 100.0 * ratio(double(timing.mix.scatter_gather), mix_total), "%", "scatters and gathers (Table 5)");
+    add("op_mix.partition_percent", 100.0 * ratio(double(timing.mix.partition), mix_total), "%", "partition (Table 5)");
+    add("op_mix.instructions", mix_total, "instructions", "SIMD instructions per frame");
+
+    add("ray_buffer.bank_conflict_rate", ratio(double(timing.conflicted_accesses), double(timing.field_accesses)), "",
+        "share of field accesses that waited on a bank");
+    for (size_t i = 0; i < timing.cache_hits.size() && i < config.scene_memory.caches.size(); ++i) {
+        const double h = double(timing.cache_hits[i]), m = double(timing.cache_misses[i]);
+        add("scene_cache." + config.scene_memory.caches[i].name + ".hit_rate", ratio(h, h + m), "",
+            "hit rate of scene-data cache level " + config.scene_memory.caches[i].name);
+    }
+    add("scene_memory.dram_reads", double(timing.dram_reads), "lines", "scene-data lines read from DRAM");
+    return s;
+}
+
+}  // namespace sfx

@@ -1,0 +1,54 @@
+#include "hw_model/systemc/systemc_timing.h"
+
+#include <atomic>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "hw_model/systemc/accelerator.h"
+
+namespace sfx {
+namespace {
+
+std::atomic<bool> g_in_use{false};
+
+// A fresh simulation context for each point group: the previous one is abandoned (SystemC
+// 2.3 offers no reset; its memory is small and released at exit).
+void new_simulation_context() {
+    setenv("SC_COPYRIGHT_MESSAGE", "DISABLE", 0);
+    sc_core::sc_curr_simcontext = new sc_core::sc_simcontext();
+    sc_core::sc_default_global_context = sc_core::sc_curr_simcontext;
+    sc_core::sc_report_handler::set_actions(sc_core::SC_INFO, sc_core::SC_DO_NOTHING);
+}
+
+}  // namespace
+
+SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const WorkloadShape& shape) {
+    if (g_in_use.exchange(true))
+        throw std::logic_error("one SystemcTiming at a time: SystemC has one simulation context");
+    try {
+        new_simulation_context();
+        for (size_t i = 0; i < configs.size(); ++i)
+            m_accelerators.push_back(std::make_unique<Accelerator>(
+                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape));
+        sc_core::sc_start(sc_core::SC_ZERO_TIME);  // end elaboration; threads wait for passes
+    } catch (...) {
+        m_accelerators.clear();
+        g_in_use = false;
+        throw;
+    }
+}
+
+SystemcTiming::~SystemcTiming() {
+    m_accelerators.clear();
+    g_in_use = false;
+}
+
+void SystemcTiming::end_pass(const TilePass& p) {
+    m_pass.end_pass(p);
+    for (auto& a : m_accelerators) a->start(&m_pass);
+    sc_core::sc_start();  // until every sequencer waits for the next pass
+}
+
+FrameTiming SystemcTiming::timing(size_t config) const { return m_accelerators[config]->timing(); }
+
+}  // namespace sfx

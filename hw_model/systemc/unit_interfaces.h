@@ -1,0 +1,49 @@
+#pragma once
+// Plain SystemC interfaces between the sequencer and the units. Calls are blocking and
+// loosely timed: each returns the cycles its work takes and the caller annotates them
+// (STYLE: annotate time, don't tick it).
+
+#include <systemc>
+
+#include "hw_model/prediction.h"
+#include "hw_model/ray_buffer_model.h"
+
+namespace sfx {
+
+struct RayBufferIf : virtual sc_core::sc_interface {
+    // One field word for a group of lanes (gather or scatter).
+    virtual RayBufferModel::Access access_field(uint32_t word, const uint32_t* slots,
+                                                uint32_t lanes) = 0;
+    // A run of the id stream.
+    virtual RayBufferModel::Contiguous access_ids(uint64_t offset, uint32_t lanes) = 0;
+    virtual uint32_t fill_cycles() const = 0;
+};
+
+struct AddressIf : virtual sc_core::sc_interface {
+    virtual uint64_t generate(uint64_t addresses) = 0;  // cycles for that many addresses
+};
+
+struct SimdIf : virtual sc_core::sc_interface {
+    // Issue cycles of `instructions` per group over `groups` groups of kind `kind`.
+    virtual uint64_t execute(OpKind kind, uint64_t groups, uint32_t instructions) = 0;
+    virtual bool supports(OpKind kind) const = 0;
+};
+
+struct PartitionIf : virtual sc_core::sc_interface {
+    virtual PartitionCost partition(const uint8_t* passed, uint32_t length) = 0;
+};
+
+struct ScratchpadIf : virtual sc_core::sc_interface {
+    virtual uint64_t access(uint64_t words) = 0;  // cycles to move that many words
+};
+
+struct InterconnectIf : virtual sc_core::sc_interface {
+    // Stall cycles when `words` must cross in `available_cycles` core cycles.
+    virtual uint64_t transfer(uint64_t words, uint64_t available_cycles) = 0;
+};
+
+struct SceneMemoryIf : virtual sc_core::sc_interface {
+    virtual uint64_t read(uint64_t address, uint32_t bytes) = 0;  // cycles until data arrives
+};
+
+}  // namespace sfx

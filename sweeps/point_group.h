@@ -1,0 +1,35 @@
+#pragma once
+// One point group: a scene, a resolution, spp, depth and tile, rendered once by the stream
+// tracer, its trace timed on every hardware configuration of the group (trace once, time
+// many). This is where the tracer and the hardware model meet; neither knows the other.
+
+#include <string>
+#include <vector>
+
+#include "hw_model/hw_config.h"
+#include "hw_model/prediction.h"
+#include "kernels/bvh.h"
+#include "kernels/render.h"
+#include "workloads/scene.h"
+
+namespace sfx {
+
+// The largest tile whose stream fits every configuration's ray buffer: tile^2 * bytes per ray
+// <= buffer bytes.
+uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs);
+// Checks an explicit tile against every configuration; throws InputError(key) if one cannot
+// hold the stream.
+void check_tile_fits(uint32_t tile, const FeatureSet& features,
+                     const std::vector<HwConfig>& configs, const std::string& key);
+
+struct PointGroupResult {
+    std::vector<Prediction> predictions;  // one per configuration, in order
+    RenderStats render;                   // the functional render's rays and time
+    double host_seconds = 0.0;            // the whole group
+};
+
+PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
+                                 const RenderSettings& settings,
+                                 const std::vector<HwConfig>& configs, Fidelity fidelity);
+
+}  // namespace sfx
