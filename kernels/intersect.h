@@ -6,6 +6,7 @@
 // - Spheres: the numerically careful quadratic of Haines et al. (Ray Tracing Gems, ch. 7).
 // - Spawned rays: origins pushed off surfaces (Waechter & Binder, Ray Tracing Gems, ch. 6).
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -39,21 +40,30 @@ struct RayPrecomp {
     }
 };
 
-// gamma(n) of Higham/pbrt: bound on n roundings.
+// gamma(n) of Higham/pbrt: bound on the relative error of n roundings.
 constexpr float gamma_bound(int n) {
     return (float(n) * (FLT_EPSILON * 0.5f)) / (1.f - float(n) * (FLT_EPSILON * 0.5f));
 }
 
-// Slab test over (0, t_max]. Returns the entry distance, or INFINITY on a miss.
-// An axis whose direction is zero and whose origin lies on a slab plane gives 0*inf = NaN;
-// the comparisons below ignore a NaN bound, which is conservative (the box is kept).
+// Ize: the far slab distances are rounded outwards by 1 + 2 gamma(3).
+constexpr float k_slab_far_scale = 1.f + 2.f * gamma_bound(3);
+// Boxes are compared against the current closest t with extra room: a primitive's computed t
+// may lie a few ulps before the computed entry of a box that contains it (a triangle on a box
+// face, equal-t ties). Culling such a box would make the closest hit depend on traversal order.
+constexpr float k_slab_t_max_scale = 1.f + 1.f / 65536.f;
+
+// Slab test over [0, t_max]. Returns the entry distance, or INFINITY on a miss.
+// The near and far planes are chosen by the sign of the direction (-0 counts as negative), so
+// no swap is needed. The only NaN source, 0 * inf, means the origin lies on a slab plane and the
+// ray runs inside that plane: the plane then bounds nothing (the box is closed, so it is kept).
 inline float intersect_box(const RayPrecomp& r, const Bounds3& b, float t_max) {
-    float t0 = 0.f, t1 = t_max;
+    float t0 = 0.f, t1 = t_max * k_slab_t_max_scale;
     for (int a = 0; a < 3; ++a) {
-        float t_near = (b.lo[a] - r.org[a]) * r.inv_dir[a];
-        float t_far = (b.hi[a] - r.org[a]) * r.inv_dir[a];
-        if (t_near > t_far) std::swap(t_near, t_far);
-        t_far *= 1.f + 2.f * gamma_bound(3);  // Ize: round the far bound outwards
+        const bool negative = std::signbit(r.inv_dir[a]);
+        float t_near = ((negative ? b.hi[a] : b.lo[a]) - r.org[a]) * r.inv_dir[a];
+        float t_far = ((negative ? b.lo[a] : b.hi[a]) - r.org[a]) * r.inv_dir[a];
+        t_near = std::isnan(t_near) ? -INFINITY : t_near;
+        t_far = std::isnan(t_far) ? INFINITY : t_far * k_slab_far_scale;
         t0 = t_near > t0 ? t_near : t0;
         t1 = t_far < t1 ? t_far : t1;
         if (t0 > t1) return INFINITY;
@@ -61,8 +71,46 @@ inline float intersect_box(const RayPrecomp& r, const Bounds3& b, float t_max) {
     return t0;
 }
 
+// The decisions a hit candidate gets in double precision, from the input floats directly.
+// The cross product of the edges is exact whenever the coordinate differences are (exponents
+// within 29 bits of each other), so exactly collinear vertices give exactly zero.
+struct TrianglePlaneCheck {
+    bool degenerate = false;  // zero area: never hit
+    bool ahead = false;       // the ray meets the triangle's plane at t > 0
+};
+
+inline TrianglePlaneCheck check_triangle_plane(const Vec3& org, const Vec3& dir, const Vec3& p0,
+                                               const Vec3& p1, const Vec3& p2) {
+    const double e1x = double(p1.x) - double(p0.x), e1y = double(p1.y) - double(p0.y),
+                 e1z = double(p1.z) - double(p0.z);
+    const double e2x = double(p2.x) - double(p0.x), e2y = double(p2.y) - double(p0.y),
+                 e2z = double(p2.z) - double(p0.z);
+    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z,
+                 nz = e1x * e2y - e1y * e2x;
+    TrianglePlaneCheck c;
+    c.degenerate = nx == 0.0 && ny == 0.0 && nz == 0.0;
+    const double num = nx * (double(p0.x) - double(org.x)) + ny * (double(p0.y) - double(org.y)) +
+                       nz * (double(p0.z) - double(org.z));
+    const double den = nx * double(dir.x) + ny * double(dir.y) + nz * double(dir.z);
+    c.ahead = (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
+    return c;
+}
+
+inline bool triangle_is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    return check_triangle_plane(Vec3(0.f), Vec3(0.f), p0, p1, p2).degenerate;
+}
+
 // Watertight ray/triangle test. On a hit with 0 < t <= t_max fills t, u, v and returns true.
-// Degenerate (zero-area) triangles never hit: their determinant is zero.
+// - Front and back faces are hit alike (dielectrics need both).
+// - t > 0 is decided conservatively. The computed t is a convex combination of the vertices'
+//   computed z (distance along the ray's major axis): when all of them are ahead beyond their
+//   rounding, so is the hit. Otherwise the triangle reaches back to the origin (a spawned
+//   ray's own surface or its neighbours), and the side of the plane the origin is on is
+//   decided in double from the input floats. An origin offset to one side of its surface
+//   (offset_ray_origin) therefore never re-hits that surface.
+// - Degenerate (zero-area) triangles never hit. In sheared ray space collinear vertices are no
+//   longer exactly collinear, so the determinant alone does not catch them.
+// Both double-precision checks run only for candidates that passed every float test.
 inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1,
                                const Vec3& p2, float t_max, float& t_out, float& u_out,
                                float& v_out) {
@@ -83,13 +131,24 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     if (det == 0.f || !std::isfinite(det)) return false;
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
     const float t_scaled = u * az + v * bz + w * cz;
-    // Sign-agnostic range test on t * det, avoiding the division for most misses.
-    if (det < 0.f ? (t_scaled >= 0.f || t_scaled < t_max * det)
-                  : (t_scaled <= 0.f || t_scaled > t_max * det))
-        return false;
+    if (det < 0.f ? t_scaled >= 0.f : t_scaled <= 0.f) return false;  // t <= 0
+    // Range test on the divided t only: a test on t * det would round differently and could
+    // drop a candidate whose t equals t_max (an equal-t tie that the lower id must win).
+    // A true division (one rounding, not t_scaled * (1 / det)) makes coplanar triangles in an
+    // axis-aligned plane report bit-equal t, so their ties go to the lower id.
+    const float t = t_scaled / det;
+    if (!(t <= t_max) || !std::isfinite(t)) return false;
+    // z = a[kz] / dir[kz] carries at most 3 roundings (a, sz, the product).
+    const float min_z = std::min(az, std::min(bz, cz));
+    const bool all_ahead = min_z > gamma_bound(4) * std::max(std::fabs(bz), std::fabs(cz)) &&
+                           min_z > gamma_bound(4) * std::fabs(az);
+    if (all_ahead) {
+        if (triangle_is_degenerate(p0, p1, p2)) return false;
+    } else {
+        const TrianglePlaneCheck check = check_triangle_plane(r.org, r.dir, p0, p1, p2);
+        if (check.degenerate || !check.ahead) return false;
+    }
     const float inv_det = 1.f / det;
-    const float t = t_scaled * inv_det;
-    if (!(t > 0.f && t <= t_max)) return false;
     t_out = t;
     u_out = v * inv_det;  // weight of p1
     v_out = w * inv_det;  // weight of p2
@@ -97,6 +156,9 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
 }
 
 // Ray/sphere test over (0, t_max]; returns the nearest root in range.
+// An origin within rounding error of the surface (a spawned ray) is treated as on it: the root
+// near 0 is the surface being left and is dropped, so a ray leaving outwards misses and a ray
+// leaving inwards hits the far side, whichever side of the surface the origin rounded to.
 inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, float& t_out) {
     const Vec3 f = r.org - s.center;
     const float a = dot(r.dir, r.dir);
@@ -107,12 +169,16 @@ inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, 
     const float disc = a * (r2 - dot(l, l));
     if (!(disc >= 0.f)) return false;
     const float q = b_half + std::copysign(std::sqrt(disc), b_half);
-    const float c = dot(f, f) - r2;
-    float t0 = c / q, t1 = q / a;  // stable pair of roots
-    if (q == 0.f) t0 = t1 = 0.f;
+    if (q == 0.f) return false;  // tangent at the origin
+    const float f2 = dot(f, f);
+    const float c = f2 - r2;  // |f|^2 - r^2: the origin's side of the surface
+    const bool on_surface = std::fabs(c) <= gamma_bound(8) * (f2 + r2);
+    // Stable pair of roots: c / q is the one near 0 when the origin is near the surface.
+    const float t_near_origin = c / q, t_other = q / a;
+    float t0 = on_surface ? INFINITY : t_near_origin, t1 = t_other;
     if (t0 > t1) std::swap(t0, t1);
     if (t0 > 0.f && t0 <= t_max) { t_out = t0; return true; }
-    if (t1 > 0.f && t1 <= t_max) { t_out = t1; return true; }
+    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) { t_out = t1; return true; }
     return false;
 }
 
@@ -121,6 +187,8 @@ inline float bits_float(uint32_t i) { float f; std::memcpy(&f, &i, 4); return f;
 
 // Waechter & Binder: move p off the surface along n (the side the new ray leaves from),
 // by a fixed number of ulps far from the origin and by a fixed distance near it.
+// Sufficient when p's error is a few ulps of p itself; a hit near the world origin on a
+// triangle with far-away vertices has a larger error: use the SurfaceHit overload below.
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
     constexpr float k_origin = 1.f / 32.f, k_float_scale = 1.f / 65536.f, k_int_scale = 256.f;
     Vec3 out;
@@ -132,9 +200,25 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
+// Error-bound offset (pbrt-v4 OffsetRayOrigin): p lies within +-p_error (per component) of the
+// true surface, so moving it by dot(|n|, p_error) along n, then one more float outwards per
+// component, puts it strictly on n's side. Together with the conservative t > 0 tests above,
+// no ray leaving on that side can re-hit the surface it starts on.
+inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n) {
+    const float d = dot(abs(n), p_error);
+    const Vec3 offset = n * d;
+    Vec3 out = p + offset;
+    for (int a = 0; a < 3; ++a) {
+        if (offset[a] > 0.f) out[a] = std::nextafter(out[a], INFINITY);
+        else if (offset[a] < 0.f) out[a] = std::nextafter(out[a], -INFINITY);
+    }
+    return out;
+}
+
 // Surface data at a hit, computed the same way by every tracer.
 struct SurfaceHit {
     Vec3 position;
+    Vec3 position_error;  // |position - true surface point| <= position_error, per component
     Vec3 normal;  // geometric, unit length, facing against the incoming ray
     bool front_face = true;  // the ray arrived from the side the stored normal points to
     uint32_t material = 0;
@@ -149,6 +233,7 @@ inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit)
         n = (p - sp.center) * (1.f / sp.radius);
         n = normalize(n);
         s.position = sp.center + n * sp.radius;  // re-project: error ~ radius, not distance
+        s.position_error = (abs(sp.center) + abs(n * sp.radius)) * gamma_bound(6);
     } else {
         const Triangle& tri = scene.triangles[hit.prim];
         const Vec3& p0 = scene.positions[tri.v0];
@@ -156,12 +241,21 @@ inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit)
         const Vec3& p2 = scene.positions[tri.v2];
         const float w = 1.f - hit.u - hit.v;
         s.position = p0 * w + p1 * hit.u + p2 * hit.v;  // barycentric: error ~ vertex magnitude
+        // Any weights summing to 1 give a point of the plane; 1 - u - v makes the sum exact
+        // to a rounding, so the error is that of the weighted sum (pbrt-v4: gamma(7)).
+        s.position_error = (abs(p0 * w) + abs(p1 * hit.u) + abs(p2 * hit.v)) * gamma_bound(7);
         n = normalize(cross(p1 - p0, p2 - p0));
     }
     s.front_face = dot(n, ray.dir) < 0.f;
     s.normal = s.front_face ? n : -n;
     s.material = scene.material_of(hit.prim);
     return s;
+}
+
+// A spawned ray's origin on the side of s that n points to (s.normal: the side the incoming
+// ray came from; -s.normal: through the surface).
+inline Vec3 offset_ray_origin(const SurfaceHit& s, const Vec3& n) {
+    return offset_ray_origin(s.position, s.position_error, n);
 }
 
 }  // namespace sfx

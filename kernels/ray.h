@@ -17,10 +17,11 @@ struct Ray {
 };
 
 // A ray is traced only if all of its numbers are finite and its direction is nonzero;
-// anything else is inactive: it misses without touching the BVH.
+// anything else is inactive: it misses without touching the BVH. Denormal direction
+// components count as zero (RayPrecomp flushes them), so an all-denormal direction is zero.
 inline bool ray_is_valid(const Ray& r) {
     return is_finite(r.org) && is_finite(r.dir) && !std::isnan(r.t_max) && r.t_max > 0.f &&
-           !(r.dir.x == 0.f && r.dir.y == 0.f && r.dir.z == 0.f);
+           max_component(abs(r.dir)) >= std::numeric_limits<float>::min();
 }
 
 struct Hit {

@@ -1,0 +1,433 @@
+// Hard cases of traversal and intersection robustness (issue 2, cases 1-4, 11 and 12):
+// watertightness far from the origin, rays through vertices and edges, self-intersection
+// of spawned rays, tiny triangles seen from far away.
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <numeric>
+
+#include "tests/kernels/geometry_test_util.h"
+
+using namespace sfx;
+using namespace sfx::test;
+
+namespace {
+
+const Vec3 k_far_center(148376.f, 1234.f, -223423.f);
+
+Vec3 spawn_origin(const SurfaceHit& s, const Vec3& n) { return offset_ray_origin(s, n); }
+
+}  // namespace
+
+TEST_CASE("geometry: rays from inside a far-away closed sphere mesh all hit", "[geometry]") {
+    Scene s;
+    add_sphere_mesh(s, k_far_center, 2.0, 500);
+    auto world = make_world(std::move(s));
+    REQUIRE(world->scene.triangle_count() == 2u * 500u * 249u);
+    TestRng rng(1);
+    int misses = 0, occlusion_misses = 0, wrong_distance = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 offset = rng.unit_vector() * (0.5f * rng.uniform());
+        const Ray ray{k_far_center + offset, rng.unit_vector(), INFINITY};
+        const Hit hit = world->bvh.intersect(ray);
+        misses += !hit.valid();
+        // Vertices are rounded to 1/64 at this distance from the origin.
+        wrong_distance += hit.valid() && !(hit.t > 1.4f && hit.t < 2.6f);
+        occlusion_misses += !world->bvh.occluded(Ray{ray.org, ray.dir, 3.f});
+    }
+    CHECK(misses == 0);
+    CHECK(occlusion_misses == 0);
+    CHECK(wrong_distance == 0);
+}
+
+TEST_CASE("geometry: rays aimed exactly at vertices of a closed mesh never miss", "[geometry]") {
+    // Embree 3 with RTC_SCENE_FLAG_ROBUST misses about 2.2 % of such rays.
+    TestRng rng(2);
+    struct Setup {
+        Vec3 center;
+        double quantum;  // vertex offsets snapped to a dyadic grid: org + dir == vertex exactly
+    };
+    int checked = 0;
+    for (const Setup& setup : {Setup{Vec3(0.5f, -0.25f, 0.75f), 1.0 / 4096.0},
+                               Setup{k_far_center, 0.0}}) {
+        Scene s;
+        add_sphere_mesh(s, setup.center, 2.0, setup.quantum > 0.0 ? 200 : 500, setup.quantum);
+        auto world = make_world(std::move(s));
+        int misses = 0;
+        for (uint32_t v = 0; v < world->scene.positions.size(); v += 7) {
+            const Vec3 vertex = world->scene.positions[v];
+            // Origins inside, on the same dyadic grid as the vertices.
+            Vec3 off = rng.unit_vector() * (1.2f * rng.uniform());
+            for (int a = 0; a < 3; ++a) off[a] = std::round(off[a] * 256.f) / 256.f;
+            const Vec3 org = setup.center + off;
+            const Ray ray{org, vertex - org, INFINITY};
+            REQUIRE(ray.org + ray.dir == vertex);  // the ray passes through the vertex exactly
+            const Hit hit = world->bvh.intersect(ray);
+            misses += !hit.valid();
+            misses += hit.valid() && !(hit.t > 0.9f && hit.t <= 1.01f);
+            ++checked;
+        }
+        CAPTURE(setup.center.x);
+        CHECK(misses == 0);
+    }
+    // A closed torus, origins inside its tube.
+    {
+        Scene s;
+        const int major = 96, minor = 48;
+        const double quantum = 1.0 / 4096.0;
+        for (int i = 0; i < major; ++i)
+            for (int j = 0; j < minor; ++j) {
+                const double phi = 2.0 * M_PI * i / major, theta = 2.0 * M_PI * j / minor;
+                const double rr = 3.0 + 1.0 * std::cos(theta);
+                add_vertex(s, Vec3(float(std::round(rr * std::cos(phi) / quantum) * quantum),
+                                   float(std::round(rr * std::sin(phi) / quantum) * quantum),
+                                   float(std::round(std::sin(theta) / quantum) * quantum)));
+            }
+        auto id = [&](int i, int j) { return uint32_t((i % major) * minor + j % minor); };
+        for (int i = 0; i < major; ++i)
+            for (int j = 0; j < minor; ++j) {
+                add_triangle(s, id(i, j), id(i + 1, j), id(i + 1, j + 1));
+                add_triangle(s, id(i, j), id(i + 1, j + 1), id(i, j + 1));
+            }
+        auto world = make_world(std::move(s));
+        int misses = 0;
+        for (uint32_t v = 0; v < world->scene.positions.size(); ++v) {
+            const Vec3 vertex = world->scene.positions[v];
+            const float phi = 6.2831853f * rng.uniform();
+            Vec3 org(3.f * std::cos(phi), 3.f * std::sin(phi), 0.f);
+            org = org + rng.unit_vector() * (0.6f * rng.uniform());
+            for (int a = 0; a < 3; ++a) org[a] = std::round(org[a] * 256.f) / 256.f;
+            const Ray ray{org, vertex - org, INFINITY};
+            REQUIRE(ray.org + ray.dir == vertex);
+            const Hit hit = world->bvh.intersect(ray);
+            misses += !hit.valid();
+            misses += hit.valid() && hit.t > 1.01f;
+            ++checked;
+        }
+        CHECK(misses == 0);
+    }
+    CHECK(checked > 10000);
+}
+
+TEST_CASE("geometry: a tessellated plane is hit by every ray from x - 3", "[geometry]") {
+    TestRng rng(3);
+    for (float x0 : {0.f, 1.f, -7.25f, 12345.678f, 148376.f}) {
+        // Plane x = x0 over [-8, 8]^2 in (y, z): a 64 x 64 grid of jittered vertices (the
+        // plane stays flat, the triangles get irregular), each cell split into two triangles.
+        Scene s;
+        const int n = 64;
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) {
+                const bool border = i == 0 || j == 0 || i == n || j == n;
+                const float jy = border ? 0.f : rng.range(-0.4f, 0.4f);
+                const float jz = border ? 0.f : rng.range(-0.4f, 0.4f);
+                add_vertex(s, Vec3(x0, -8.f + 16.f * (float(i) + jy) / n,
+                                   -8.f + 16.f * (float(j) + jz) / n));
+            }
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + n + 1, d = c + 1;
+                if ((i + j) % 2) {
+                    add_triangle(s, a, b, d);
+                    add_triangle(s, a, d, c);
+                } else {
+                    add_triangle(s, a, b, c);
+                    add_triangle(s, b, d, c);
+                }
+            }
+        auto world = make_world(std::move(s));
+        int misses = 0, wrong_t = 0, unoccluded = 0;
+        for (int k = 0; k < 4000; ++k) {
+            const Vec3 org(x0 - 3.f, rng.range(-4.f, 4.f), rng.range(-4.f, 4.f));
+            const Ray ray{org, Vec3(1.f, rng.range(-1.f, 1.f), rng.range(-1.f, 1.f)), INFINITY};
+            const Hit hit = world->bvh.intersect(ray);
+            misses += !hit.valid();
+            // t = 3 up to the rounding of x0 - 3.
+            const float expected = x0 - org.x;
+            wrong_t += hit.valid() && std::fabs(hit.t - expected) > 1e-5f * expected;
+            unoccluded += !world->bvh.occluded(Ray{org, ray.dir, 4.f});
+        }
+        CAPTURE(x0);
+        CHECK(misses == 0);
+        CHECK(wrong_t == 0);
+        CHECK(unoccluded == 0);
+    }
+}
+
+TEST_CASE("geometry: a ray through a shared edge or vertex hits once, deterministically",
+          "[geometry]") {
+    TestRng rng(4);
+    // A fan of 8 triangles around the vertex (0, 0, 0) in the plane z = 0, and a strip of
+    // triangles sharing edges along x = 0 and y = 0. All coordinates are small dyadics so
+    // the rays below pass exactly through the shared edges and the shared vertex.
+    std::vector<std::array<Vec3, 3>> tris;
+    const Vec3 ring[8] = {Vec3(1, 0, 0),  Vec3(1, 1, 0),   Vec3(0, 1, 0),  Vec3(-1, 1, 0),
+                          Vec3(-1, 0, 0), Vec3(-1, -1, 0), Vec3(0, -1, 0), Vec3(1, -1, 0)};
+    for (int i = 0; i < 8; ++i) tris.push_back({Vec3(0.f), ring[i], ring[(i + 1) % 8]});
+    // Tilted neighbours sharing the edge from (2, 0, 0) to (2, 1, 1).
+    tris.push_back({Vec3(2.f, 0.f, 0.f), Vec3(2.f, 1.f, 1.f), Vec3(1.5f, 0.f, 1.f)});
+    tris.push_back({Vec3(2.f, 1.f, 1.f), Vec3(2.f, 0.f, 0.f), Vec3(2.5f, 1.f, 0.f)});
+    const int n = int(tris.size());
+
+    std::vector<Vec3> targets;
+    for (int k = 0; k < 64; ++k) {
+        const float s = float(k + 1) / 128.f;
+        targets.push_back(Vec3(0.f));                   // the shared vertex
+        targets.push_back(Vec3(s, 0.f, 0.f));           // edges of the fan
+        targets.push_back(Vec3(0.f, -s, 0.f));
+        targets.push_back(Vec3(s, s, 0.f));
+        targets.push_back(Vec3(-s, -s, 0.f));
+        targets.push_back(Vec3(2.f, s, s));             // the tilted shared edge
+    }
+    int ties = 0, checked = 0;
+    for (const Vec3& target : targets)
+        for (int k = 0; k < 4; ++k) {
+            // Dyadic origins so that org + dir == target exactly.
+            Vec3 dir = rng.unit_vector() * 3.f;
+            for (int a = 0; a < 3; ++a) dir[a] = std::round(dir[a] * 1024.f) / 1024.f;
+            if (std::fabs(dir.z) < 0.25f) dir.z = dir.z < 0.f ? -1.f : 1.f;
+            const Ray ray{target - dir, dir, INFINITY};
+            REQUIRE(ray.org + ray.dir == target);
+            // Geometric answer for each insertion order: permutation[i] is the geometric
+            // triangle stored as primitive i.
+            uint32_t winner_geometry = k_no_hit;
+            float winner_t = 0.f;
+            for (int order = 0; order < 3; ++order) {
+                std::vector<int> perm(n);
+                std::iota(perm.begin(), perm.end(), 0);
+                if (order == 1) std::reverse(perm.begin(), perm.end());
+                if (order == 2)
+                    for (int i = n - 1; i > 0; --i) std::swap(perm[i], perm[rng.below(i + 1)]);
+                Scene s;
+                for (int i = 0; i < n; ++i)
+                    add_triangle(s, tris[perm[i]][0], tris[perm[i]][1], tris[perm[i]][2]);
+                auto world = make_world(std::move(s), BvhBuildOptions{1, 16, 1.f, 1.f});
+                const Hit hit = world->bvh.intersect(ray);
+                CAPTURE(target.x, target.y, target.z, dir.x, dir.y, dir.z, order);
+                REQUIRE(hit.valid());
+                // The target on the shared edge is at t = 1 (exactly, on the axis-aligned fan);
+                // a tilted neighbour may be in front.
+                CHECK((hit.t < 1.f || within_ulps(hit.t, 1.f)));
+                const Hit again = world->bvh.intersect(ray);
+                CHECK((again.prim == hit.prim && same_bits(again.t, hit.t)));
+                const Hit reference = brute_force(world->bvh, ray);
+                CHECK((reference.prim == hit.prim && same_bits(reference.t, hit.t)));
+                // Every primitive reporting the same t ties: the winner is the lowest id.
+                const RayPrecomp r(ray);
+                uint32_t tied = 0, lowest = k_no_hit;
+                for (uint32_t p = 0; p < uint32_t(n); ++p) {
+                    Hit h;
+                    if (world->bvh.intersect_primitive(r, p, INFINITY, h) && h.t == hit.t) {
+                        ++tied;
+                        lowest = std::min(lowest, p);
+                    }
+                }
+                CHECK(hit.prim == lowest);
+                if (tied > 1) {
+                    ++ties;
+                } else {
+                    // A unique closest triangle is the same geometry in every order.
+                    const uint32_t geometry = uint32_t(perm[hit.prim]);
+                    if (order == 0) winner_geometry = geometry;
+                    CHECK(geometry == winner_geometry);
+                }
+                if (order == 0) winner_t = hit.t;
+                CHECK(same_bits(hit.t, winner_t));
+                ++checked;
+            }
+        }
+    CHECK(checked == int(targets.size()) * 4 * 3);
+    CHECK(ties > 100);  // the test must exercise equal-t ties
+}
+
+TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "[geometry]") {
+    TestRng rng(11);
+    int spawned = 0, self_hits_front = 0, self_hits_back = 0, shadow_hits = 0, primary_misses = 0;
+    for (int i = 0; i < 3000; ++i) {
+        // A well-shaped triangle of random size and orientation around a random center,
+        // coordinates spanning 1e-8 .. 1e8. Its size is at least 1e-4 of the center's distance
+        // from the origin (over a thousand floats across), so that its corners, the aimed-at
+        // points and the shadow targets are resolved by the float grid at all.
+        const float log_center = rng.range(-8.f, 8.f);
+        const float center_mag = std::pow(10.f, log_center);
+        const float size = std::pow(10.f, rng.range(std::max(-8.f, log_center - 4.f), 8.f));
+        const Vec3 center = rng.unit_vector() * center_mag;
+        Vec3 t, b;
+        const Vec3 n = rng.unit_vector();
+        orthonormal_basis(n, t, b);
+        Scene s;
+        const float a0 = rng.range(0.f, 6.2831853f);
+        Vec3 p[3];
+        for (int k = 0; k < 3; ++k) {
+            const float ang = a0 + 2.0943951f * float(k) + rng.range(-0.5f, 0.5f);
+            p[k] = center + (t * std::cos(ang) + b * std::sin(ang)) * size;
+        }
+        add_triangle(s, p[0], p[1], p[2]);
+        auto world = make_world(std::move(s));
+        const Vec3 gn = normalize(cross(p[1] - p[0], p[2] - p[0]));
+        if (!is_finite(gn)) continue;
+        for (int k = 0; k < 4; ++k) {
+            // Primary ray toward an interior point, from either side.
+            float u = rng.range(0.05f, 0.9f), v = rng.range(0.05f, 0.9f);
+            if (u + v > 0.95f) { u = 0.95f - u; v = 0.95f - v; u = std::fabs(u); v = std::fabs(v); }
+            const Vec3 target = p[0] * (1.f - u - v) + p[1] * u + p[2] * v;
+            const Vec3 side = rng.hemisphere(gn, 0.1f) * (rng.uniform() < 0.5f ? 1.f : -1.f);
+            const Vec3 org = target + side * (size * rng.range(0.5f, 4.f));
+            const Ray primary{org, target - org, INFINITY};
+            const Hit hit = world->bvh.intersect(primary);
+            if (!hit.valid()) { ++primary_misses; continue; }
+            const SurfaceHit sh = surface_at(world->scene, primary, hit);
+            // Reflected: leave on the side the ray came from, any direction in that hemisphere,
+            // down to grazing.
+            for (int r = 0; r < 4; ++r) {
+                const float min_cos = r == 0 ? 1e-4f : 0.01f;
+                const Ray refl{spawn_origin(sh, sh.normal), rng.hemisphere(sh.normal, min_cos),
+                               INFINITY};
+                self_hits_front += world->bvh.intersect(refl).valid();
+                const Ray trans{spawn_origin(sh, -sh.normal), rng.hemisphere(-sh.normal, min_cos),
+                                INFINITY};
+                self_hits_back += world->bvh.intersect(trans).valid();
+                // Shadow rays toward points on either side, away from the plane.
+                const Vec3 up = sh.normal * (r % 2 ? 1.f : -1.f);
+                const Vec3 from = spawn_origin(sh, up);
+                const Vec3 to = center + (rng.unit_vector() * rng.range(0.f, 3.f) +
+                                          rng.hemisphere(up, 0.05f) * rng.range(0.1f, 3.f)) * size;
+                const Vec3 to_side = to - sh.position;
+                if (dot(to_side, up) > 0.01f * size) {
+                    shadow_hits += world->bvh.occluded(Ray{from, to - from, 1.f});
+                }
+                spawned += 3;
+            }
+        }
+    }
+    CHECK(primary_misses == 0);
+    CHECK(self_hits_front == 0);
+    CHECK(self_hits_back == 0);
+    CHECK(shadow_hits == 0);
+    CHECK(spawned > 100000);
+}
+
+TEST_CASE("geometry: spawned rays never re-hit their own sphere at the spawn point",
+          "[geometry]") {
+    TestRng rng(111);
+    int outward_hits = 0, inward_wrong = 0, shadow_hits = 0, primary_misses = 0, spawned = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const float scale = std::pow(10.f, rng.range(-4.f, 4.f));
+        Sphere sp;
+        sp.center = rng.unit_vector() * (scale * rng.range(0.f, 10.f));
+        sp.radius = scale * rng.range(0.2f, 2.f);
+        Scene s;
+        s.spheres.push_back(sp);
+        auto world = make_world(std::move(s));
+        for (int k = 0; k < 4; ++k) {
+            // From outside toward a point on the sphere, or from inside (near the center).
+            const bool from_inside = k % 2 == 1;
+            Ray primary;
+            if (from_inside) {
+                primary.org = sp.center + rng.unit_vector() * (0.5f * sp.radius * rng.uniform());
+                primary.dir = rng.unit_vector();
+            } else {
+                const Vec3 aim = sp.center + rng.unit_vector() * (0.9f * sp.radius * rng.uniform());
+                primary.org = sp.center + rng.unit_vector() * (sp.radius * rng.range(1.5f, 6.f));
+                primary.dir = aim - primary.org;
+            }
+            const Hit hit = world->bvh.intersect(primary);
+            if (!hit.valid()) { ++primary_misses; continue; }
+            const SurfaceHit sh = surface_at(world->scene, primary, hit);
+            const Vec3 outward = sh.front_face ? sh.normal : -sh.normal;
+            for (int r = 0; r < 4; ++r) {
+                const float min_cos = r == 0 ? 1e-3f : 0.05f;
+                // Outward: a convex surface is never hit again.
+                const Ray out{spawn_origin(sh, outward), rng.hemisphere(outward, min_cos),
+                              INFINITY};
+                outward_hits += world->bvh.intersect(out).valid();
+                // Inward: the far side is hit, a chord away, never the spawn point.
+                const Vec3 in_dir = rng.hemisphere(-outward, std::max(min_cos, 0.05f));
+                const Ray in{spawn_origin(sh, -outward), in_dir, INFINITY};
+                const Hit h = world->bvh.intersect(in);
+                const float chord = 2.f * sp.radius * dot(in_dir, -outward);
+                inward_wrong += !h.valid() || !(h.t > 0.5f * chord && h.t < 1.5f * chord);
+                // Shadow ray outward to a point outside.
+                const Vec3 target = sh.position + rng.hemisphere(outward, 0.05f) *
+                                                      (sp.radius * rng.range(0.1f, 3.f));
+                const Vec3 from = spawn_origin(sh, outward);
+                shadow_hits += world->bvh.occluded(Ray{from, target - from, 1.f});
+                spawned += 3;
+            }
+        }
+    }
+    CHECK(primary_misses == 0);
+    CHECK(outward_hits == 0);
+    CHECK(inward_wrong == 0);
+    CHECK(shadow_hits == 0);
+    CHECK(spawned > 100000);
+}
+
+TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroids",
+          "[geometry]") {
+    TestRng rng(12);
+    // A 64 x 64 grid of triangle pairs, each 1e-4 across, near the origin in the plane z = 0.
+    Scene s;
+    const int n = 64;
+    const float cell = 1e-4f;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            add_vertex(s, Vec3((float(i) - n / 2) * cell, (float(j) - n / 2) * cell, 0.f));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + n + 1, d = c + 1;
+            add_triangle(s, a, b, d);
+            add_triangle(s, a, d, c);
+        }
+    auto world = make_world(std::move(s));
+    int wrong = 0;
+    for (uint32_t p = 0; p < world->scene.triangle_count(); ++p) {
+        const Triangle& tri = world->scene.triangles[p];
+        const Vec3 c = (world->scene.positions[tri.v0] + world->scene.positions[tri.v1] +
+                        world->scene.positions[tri.v2]) * (1.f / 3.f);
+        // Straight on from z = -1e6 (the direction is exact), and obliquely from 1e6 away
+        // along the z axis (the ray passes within float precision of the centroid).
+        const Ray straight{Vec3(0.f, 0.f, -1e6f), c - Vec3(0.f, 0.f, -1e6f), INFINITY};
+        const Hit h = world->bvh.intersect(straight);
+        wrong += h.prim != p;
+        const Vec3 off(rng.range(-100.f, 100.f), rng.range(-100.f, 100.f), 1e6f);
+        const Ray oblique{c + off, -off, INFINITY};
+        wrong += world->bvh.intersect(oblique).prim != p;
+    }
+    CHECK(wrong == 0);
+    // A tilted grid of unit triangles 1e6 from the origin, seen from another 1e6 away within
+    // 40 degrees of its normal. Float rounding at that distance (~0.06 per coordinate, in the
+    // aimed direction and in the vertices' translation to the ray origin) stays well inside a
+    // triangle's inradius (0.29): every ray must hit the triangle it is aimed at.
+    Scene far;
+    const Vec3 base(1e6f, -2e5f, 3e5f);
+    const Vec3 normal = normalize(Vec3(0.3f, -0.5f, 0.8f));
+    Vec3 t_axis, b_axis;
+    orthonormal_basis(normal, t_axis, b_axis);
+    const int m = 40;
+    for (int j = 0; j <= m; ++j)
+        for (int i = 0; i <= m; ++i)
+            add_vertex(far, base + t_axis * float(i - m / 2) + b_axis * float(j - m / 2));
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i < m; ++i) {
+            const uint32_t a = uint32_t(j * (m + 1) + i), b = a + 1, c = a + m + 1, d = c + 1;
+            add_triangle(far, a, b, d);
+            add_triangle(far, a, d, c);
+        }
+    auto far_world = make_world(std::move(far));
+    int wrong_far = 0;
+    for (uint32_t p = 0; p < far_world->scene.triangle_count(); ++p) {
+        const Triangle& tri = far_world->scene.triangles[p];
+        const Vec3 c = (far_world->scene.positions[tri.v0] + far_world->scene.positions[tri.v1] +
+                        far_world->scene.positions[tri.v2]) * (1.f / 3.f);
+        const Vec3 org = base + rng.hemisphere(normal, 0.766f) * 1e6f;
+        const Ray ray{org, c - org, INFINITY};
+        const Hit hit = far_world->bvh.intersect(ray);
+        wrong_far += hit.prim != p;
+        // Seen from behind, too (back faces).
+        const Vec3 back = base - rng.hemisphere(normal, 0.766f) * 1e6f;
+        wrong_far += far_world->bvh.intersect(Ray{back, c - back, INFINITY}).prim != p;
+    }
+    CHECK(wrong_far == 0);
+}
