@@ -29,11 +29,11 @@ enum class OpKind : uint8_t {
     box_test,          // traversal: ray/box filter (object: BVH node index)
     triangle_test,     // intersection: ray/triangle test (object: global primitive id)
     sphere_test,       // intersection: ray/sphere test (object: global primitive id)
-    shadow_filter,     // shading: extract shadow rays; passed = not occluded (light added)
+    shadow_filter,     // shading: extract shadow rays (passed); each adds its light unless occluded
     miss_filter,       // shading: extract rays that left the scene; passed = miss
     emission_filter,   // shading: light hits; passed = the hit surface is emissive
     depth_filter,      // shading: passed = the path may scatter (bounce < max depth)
-    material_filter,   // shading: passed = hit material has kind `object` (MaterialKind)
+    material_filter,   // shading: passed = the hit material is `object` (material id)
     ambient,           // shading: add the constant ambient term; all pass
     lambertian_choice, // shading: passed = samples direct light (else indirect)
     lambertian_direct, // shading: passed = a shadow ray was pushed to the next generation

@@ -134,17 +134,13 @@ struct StreamTracer::Impl {
     const Bvh& bvh;
     RenderSettings settings;
     CameraFrame camera;
-    std::vector<MaterialKind> kinds;  // material kinds present, in filter order
+    std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
+    std::vector<uint32_t> present;        // materials hit in this generation, in id order
     RayBuffers b;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
-        : scene(s), bvh(h), settings(r), camera(s.camera, r.width, r.height) {
-        for (MaterialKind k :
-             {MaterialKind::lambertian, MaterialKind::dielectric, MaterialKind::glossy})
-            if (std::any_of(s.materials.begin(), s.materials.end(),
-                            [&](const Material& m) { return m.kind == k; }))
-                kinds.push_back(k);
-    }
+        : scene(s), bvh(h), settings(r), camera(s.camera, r.width, r.height),
+          material_rays(s.materials.size(), 0) {}
 
     template <class Trace>
     void run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
@@ -233,8 +229,15 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             shade_emission(path[id], m);
             return true;
         });  // light hits reflect too: every hit goes on
-        len = run_filter(OpKind::depth_filter, k_no_object, s, len,
-                         [&](uint32_t id) { return may_scatter(path[id], max_depth); });
+        std::fill(material_rays.begin(), material_rays.end(), 0u);
+        len = run_filter(OpKind::depth_filter, k_no_object, s, len, [&](uint32_t id) {
+            if (!may_scatter(path[id], max_depth)) return false;
+            ++material_rays[surf[id].material];  // a by-product of the test's gather
+            return true;
+        });
+        present.clear();
+        for (uint32_t m = 0; m < material_rays.size(); ++m)
+            if (material_rays[m]) present.push_back(m);
 
         auto material = [&](uint32_t id) -> const Material& {
             return scene.materials[surf[id].material];
@@ -243,14 +246,16 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             next_ids[pushed++] = id;
             ++(shadow ? stats.shadow_rays : stats.extension_rays);
         };
-        for (size_t j = 0; j < kinds.size() && len > 0; ++j) {
-            const MaterialKind kind = kinds[j];
-            // The last kind present is what is left: it needs no test.
+        // One sub-stack per material (a shader instance: its constants are uniform over the
+        // lanes), for the materials this generation hit; the last one is what is left.
+        for (size_t j = 0; j < present.size(); ++j) {
+            const uint32_t mat = present[j];
+            const MaterialKind kind = scene.materials[mat].kind;
             const uint32_t g =
-                j + 1 == kinds.size()
+                j + 1 == present.size()
                     ? len
-                    : run_filter(OpKind::material_filter, uint32_t(kind), s, len,
-                                 [&](uint32_t id) { return material(id).kind == kind; });
+                    : run_filter(OpKind::material_filter, mat, s, len,
+                                 [&](uint32_t id) { return surf[id].material == mat; });
             if (kind == MaterialKind::lambertian) {
                 const bool ambient = !is_black(scene.ambient);
                 if (ambient)

@@ -47,7 +47,8 @@ private:
 // Renders the whole image with the stream tracer. Threads take whole tiles; each tile's
 // passes run in sample order, so neither thread count nor tile order changes a bit. With a
 // sink, the trace arrives in tile order, then sample order, whatever the thread count, and
-// at most one pass per thread is held in memory.
+// at most one pass per thread is held in memory. A CountingSink is the exception: counts are
+// sums, so each tile counts on its own and the counts are added (same totals, no ordering).
 RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                            TraceSink* sink = nullptr);
 
