@@ -1,0 +1,158 @@
+// sfx_bench_stream: on the same rays, one thread each, prints closest-hit throughput of
+//   the reference traversal (Bvh::intersect, one ray at a time),
+//   the stream traversal (stream_intersect, 64x64-ray streams) with the trace off and with a
+//   counting sink, and Embree 3 rtcIntersect1 (robust scene, via EmbreeScene),
+// for primary rays and diffuse-bounce rays, with ratios; then whole-frame path tracing,
+// reference against stream (trace off / counting). Not a test: speeds vary by machine.
+//
+// Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N]    (default: conference 512x512)
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+
+#include "kernels/bvh.h"
+#include "kernels/camera.h"
+#include "kernels/embree/embree_check.h"
+#include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/stream_tracer.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Best of `repeat` runs, in seconds.
+double best_seconds(int repeat, const std::function<void()>& run) {
+    double best = 1e30;
+    for (int i = 0; i < repeat; ++i) {
+        const auto t0 = Clock::now();
+        run();
+        best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
+    }
+    return best;
+}
+
+// Camera rays in tile order (64 x 64 tiles, one sample), so a 4096-ray stream is one tile.
+std::vector<Ray> primary_rays(const Scene& scene, uint32_t w, uint32_t h) {
+    const CameraFrame camera(scene.camera, w, h);
+    std::vector<Ray> rays;
+    for (const TileRect& t : make_tiles(w, h, 64))
+        for (uint32_t y = t.y0; y < t.y1; ++y)
+            for (uint32_t x = t.x0; x < t.x1; ++x)
+                rays.push_back(camera.generate({0, y * w + x, 0}));
+    return rays;
+}
+
+// One cosine-weighted bounce from each primary hit (what a Lambertian indirect step makes),
+// in the same tile order; rays Embree would refuse are left out.
+std::vector<Ray> diffuse_rays(const Scene& scene, const Bvh& bvh, const std::vector<Ray>& primary) {
+    std::vector<Ray> rays;
+    for (uint32_t i = 0; i < primary.size(); ++i) {
+        const Hit hit = bvh.intersect(primary[i]);
+        if (!hit.valid()) continue;
+        const SurfaceHit s = surface_at(scene, primary[i], hit);
+        Ray r;
+        r.org = offset_ray_origin(s.position, s.normal);
+        r.dir = to_world(sample_cosine_hemisphere(random_float(5, i, 0, 1, RngDim::direction_u),
+                                                  random_float(5, i, 0, 1, RngDim::direction_v)),
+                         s.normal);
+        if (EmbreeScene::accepts(r)) rays.push_back(r);
+    }
+    return rays;
+}
+
+void report(const char* name, size_t rays, double seconds, double embree_rate) {
+    const double rate = double(rays) / seconds;
+    std::printf("  %-34s %8.2f Mrays/s", name, rate * 1e-6);
+    if (embree_rate > 0) std::printf("   %.2fx Embree", rate / embree_rate);
+    std::printf("\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string scene_name = "conference";
+    uint32_t w = 512, h = 512;
+    int repeat = 3;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--res" && i + 1 < argc) {
+            if (std::sscanf(argv[++i], "%ux%u", &w, &h) != 2) return 2;
+        } else if (a == "--repeat" && i + 1 < argc) {
+            repeat = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "-h" || a == "--help") {
+            std::printf("usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N]\n");
+            return 0;
+        } else {
+            scene_name = a;
+        }
+    }
+    const Scene scene = load_scene(scene_name);
+    const Bvh bvh(scene);
+    const EmbreeScene embree(scene);
+    std::printf("scene %s: %u primitives; %ux%u rays per set; best of %d; one thread\n",
+                scene.name.c_str(), scene.primitive_count(), w, h, repeat);
+
+    const std::vector<Ray> primary = primary_rays(scene, w, h);
+    const std::vector<Ray> diffuse = diffuse_rays(scene, bvh, primary);
+    for (const auto& [label, rays] :
+         {std::pair<const char*, const std::vector<Ray>*>{"primary rays", &primary},
+          {"diffuse-bounce rays", &diffuse}}) {
+        std::printf("\n%s (%zu)\n", label, rays->size());
+        std::vector<Hit> ref(rays->size()), st, em(rays->size());
+        const double t_embree = best_seconds(repeat, [&] {
+            for (size_t i = 0; i < rays->size(); ++i) em[i] = embree.intersect((*rays)[i]);
+        });
+        const double t_ref = best_seconds(repeat, [&] {
+            for (size_t i = 0; i < rays->size(); ++i) ref[i] = bvh.intersect((*rays)[i]);
+        });
+        const double t_stream = best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st); });
+        CountingSink counts({8, 16});
+        const double t_counting =
+            best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st, &counts); });
+        size_t differ = 0, embree_differ = 0;
+        for (size_t i = 0; i < rays->size(); ++i) {
+            differ += std::memcmp(&ref[i], &st[i], sizeof(Hit)) != 0;
+            embree_differ += ref[i].prim != em[i].prim;
+        }
+        const double embree_rate = double(rays->size()) / t_embree;
+        report("Embree rtcIntersect1", rays->size(), t_embree, embree_rate);
+        report("reference (Bvh::intersect)", rays->size(), t_ref, embree_rate);
+        report("stream, trace off", rays->size(), t_stream, embree_rate);
+        report("stream, counting sink", rays->size(), t_counting, embree_rate);
+        std::printf("  stream / reference %.2fx; stream hits differing from reference: %zu; "
+                    "primitive differs from Embree's: %zu\n",
+                    t_ref / t_stream, differ, embree_differ);
+    }
+
+    // Whole frames: path tracing with all generations, shading included.
+    RenderSettings settings;
+    settings.width = w / 2;
+    settings.height = h / 2;
+    settings.spp = 4;
+    settings.max_depth = scene.max_depth;
+    settings.tile = 64;
+    settings.threads = 1;
+    RenderResult ref_frame, st_frame;
+    const double f_ref =
+        best_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
+    const double f_st = best_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
+    CountingSink counts({8, 16});
+    const double f_count = best_seconds(1, [&] { render_stream(scene, bvh, settings, &counts); });
+    const bool same = std::memcmp(ref_frame.image.pixels.data(), st_frame.image.pixels.data(),
+                                  ref_frame.image.pixels.size() * sizeof(Vec3)) == 0;
+    const size_t n = ref_frame.stats.rays();
+    std::printf("\npath tracing %ux%u x %u spp, tile 64 (%zu rays, images %s)\n", settings.width,
+                settings.height, settings.spp, n, same ? "bit-identical" : "DIFFER");
+    report("reference tracer", n, f_ref, 0);
+    report("stream tracer, trace off", n, f_st, 0);
+    report("stream tracer, counting sink", n, f_count, 0);
+    std::printf("  stream / reference %.2fx (trace off), %.2fx (counting)\n", f_ref / f_st,
+                f_ref / f_count);
+    return 0;
+}
