@@ -548,8 +548,8 @@ void build_conference(const GeneratorInput& in, SceneBuilder& b) {
     };
     uint32_t chair_index = 0;
     auto chair = [&](float x, float z, float facing) {
-        office_chair(b, Transform::rotate_y(facing, Vec3(x, 0.f, z)), detail,
-                     fabrics[chair_index++ % 2], metal);
+        const bool alt = hash_float(in.seed, chair_index++, 9) < 0.35f;
+        office_chair(b, Transform::rotate_y(facing, Vec3(x, 0.f, z)), detail, fabrics[alt], metal);
     };
     for (uint32_t i = 0; i < per_side; ++i) {
         const float x = -table_half + 0.5f + (2.f * table_half - 1.f) * (float(i) + 0.5f) / float(per_side);

@@ -59,6 +59,25 @@ TEST_CASE("mesh import: PLY", "[workloads]") {
     CHECK(area == Approx(4.f));
 }
 
+TEST_CASE("mesh import: glTF with an embedded buffer", "[workloads]") {
+    // One triangle (0,0,0) (1,0,0) (0,1,0), positions base64-encoded in a data URI.
+    const fs::path p = test_dir() / "meshes" / "triangle.gltf";
+    std::ofstream(p) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+ "nodes": [{"mesh": 0, "translation": [0, 0, 2]}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 4}]}],
+ "buffers": [{"byteLength": 36,
+   "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+   "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+    const TriangleMesh m = import_mesh(p.string());
+    REQUIRE(m.triangle_count() == 1);
+    Bounds3 b;
+    for (uint32_t i : m.indices) b.extend(m.positions.at(i));
+    CHECK(b.lo == Vec3(0.f, 0.f, 2.f));  // the node's translation is applied
+    CHECK(b.hi == Vec3(1.f, 1.f, 2.f));
+}
+
 TEST_CASE("mesh import: missing file throws", "[workloads]") {
     CHECK_THROWS(import_mesh((test_dir() / "meshes" / "nothing_here.obj").string()));
 }

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -233,4 +234,24 @@ TEST_CASE("scene loader: a bad mesh names the scene file, line, key and mesh pat
                                     "  - {type: mesh, material: white, file: junk.obj}\n");
     CHECK(j.key() == "objects[0].file");
     CHECK(j.line() == 7);
+}
+
+TEST_CASE("scene loader: SFX_SCENE_DIR overrides where named scenes are found", "[workloads]") {
+    const fs::path dir = fs::temp_directory_path() / "sfx_scene_dir_test";
+    fs::create_directories(dir);
+    std::ofstream(dir / "tiny.scene.yaml")
+        << "version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
+           "materials: [{name: a, kind: lambertian}]\n"
+           "objects: [{type: sphere, material: a, center: [0, 0, 0], radius: 2}]\n";
+    const char* old = std::getenv("SFX_SCENE_DIR");
+    const std::string saved = old ? old : "";
+    setenv("SFX_SCENE_DIR", dir.string().c_str(), 1);
+    const Scene s = load_scene("tiny");
+    const std::vector<std::string> names = builtin_scene_names();
+    if (old) setenv("SFX_SCENE_DIR", saved.c_str(), 1);
+    else unsetenv("SFX_SCENE_DIR");
+    CHECK(s.name == "tiny");
+    CHECK(s.spheres.at(0).radius == 2.f);
+    CHECK(names == std::vector<std::string>{"tiny"});
+    CHECK(load_scene("cornell").name == "cornell");  // back to the shipped scenes
 }
