@@ -28,6 +28,7 @@ struct ValidateOptions {
     std::string scene;
     std::string against = "reference";
     uint64_t rays = 1000000;
+    float ulps = 16.f;  // embree: agreement tolerance
     bool json = false;
     WorkloadFlags workload;
 };
@@ -52,6 +53,8 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
     if (o.rays == 0 || o.rays > 100000000)
         throw InputError("command line", 0, "--rays",
                          "expected 1..100000000, got " + std::to_string(o.rays));
+    if (!(o.ulps >= 0.f && o.ulps <= 1e6f))
+        throw InputError("command line", 0, "--ulps", "expected 0..1e6, got " + std::to_string(o.ulps));
     const auto bvh_start = Clock::now();
     const Bvh bvh(scene);
     const double bvh_seconds = seconds_since(bvh_start);
@@ -62,6 +65,7 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
     options.height = settings.height;
     options.seed = settings.seed;
     options.threads = settings.threads;
+    options.tolerance.ulps = o.ulps;
     const EmbreeAgreement a = check_against_embree(scene, bvh, options);
     const double total_seconds = seconds_since(start);
 
@@ -77,6 +81,9 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
         j["width"] = settings.width;
         j["height"] = settings.height;
         j["seed"] = settings.seed;
+        j["tolerance.ulps"] = o.ulps;
+        j["tolerance.relative"] = options.tolerance.relative;
+        j["tolerance.edge"] = options.tolerance.edge;
         j["rays"] = o.rays;
         j["diffuse_sources"] = a.diffuse_sources;
         for (const auto& [name, c] : {std::pair<std::string, const ClassCounts*>{"primary", &primary},
@@ -126,9 +133,13 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
     row("traced", primary.traced(), diffuse.traced(), total.traced());
     row("explained", primary.explained(), diffuse.explained(), total.explained());
     row("unexplained *", primary.unexplained(), diffuse.unexplained(), total.unexplained());
-    std::printf("%-18s %12llu %12llu %12llu %10s\n", "filtered (not traced)",
+    std::printf("%-18s %12llu %12llu %12llu %10s\n", "filtered",
                 (unsigned long long)primary.filtered, (unsigned long long)diffuse.filtered,
                 (unsigned long long)total.filtered, "");
+    std::printf("(* unexplained; filtered: NaN/Inf/out of Embree's range, not traced)\n");
+    std::printf("tolerance        %g ulps or %g relative, times 1/|cos| of the hit angle; "
+                "edge %g\n", double(options.tolerance.ulps), double(options.tolerance.relative),
+                double(options.tolerance.edge));
     std::printf("\nunexplained rate %s (limit %s): %s\n", format_rate(a.unexplained_rate()).c_str(),
                 format_rate(a.max_unexplained_rate).c_str(), a.pass() ? "PASS" : "FAIL");
     std::printf("host seconds     %.2f (load %.2f, sfx bvh %.2f, embree build %.2f, trace %.2f)\n",
@@ -276,6 +287,10 @@ void add_validate_command(CLI::App& app) {
         ->check(CLI::IsMember(k_targets))
         ->capture_default_str();
     c->add_option("--rays", options->rays, "rays in total, half primary and half diffuse")
+        ->capture_default_str();
+    c->add_option("--ulps", options->ulps,
+                  "embree: t, u, v agree within this many ulps (of t and of the coordinates) "
+                  "or 1e-5 relative")
         ->capture_default_str();
     c->add_flag("--json", options->json, "print one JSON document");
     // --res, --seed and --threads apply; --spp, --depth and --tile are accepted for uniformity

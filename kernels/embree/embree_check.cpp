@@ -204,7 +204,7 @@ int64_t ulp_distance(float a, float b) {
 
 // How far two correct float answers for one ray may lie apart.
 struct Slack {
-    double condition = 1.0;  // 1/|cos| of the hit angle (hit_condition)
+    double condition = 1.0;  // 1/|cos| of the hit angle (hit_condition), the worse of the two
     double t_abs = 0.0;      // absolute t slack: rounding of the coordinates involved
     double bary_abs = 0.0;   // absolute barycentric slack: the same, over the triangle's size
 };
@@ -263,39 +263,55 @@ double hit_condition(const Scene& scene, const Ray& ray, const Hit& hit) {
 
 // Every float tracer rounds positions to ulps of the largest coordinate in play (the origin's
 // or the primitive's), whatever t is: a diffuse ray leaving a corner hits the next wall at
-// t ~ 1e-4 with t differing by 4e-5 relative, ~0.05 ulp of the coordinates. So t and u, v
-// also get an absolute slack of `ulps` such ulps, scaled by the hit's condition.
-Slack make_slack(const Scene& scene, const Ray& ray, const Hit& a, const Hit& b,
-                 const HitTolerance& tol) {
-    Slack s;
-    s.condition = std::max(hit_condition(scene, ray, a), hit_condition(scene, ray, b));
+// t ~ 1e-4 with t differing by 4e-5 relative, ~0.05 ulp of the coordinates. So t, u, v and
+// the edge test also get an absolute slack of `ulps` such ulps, scaled by the hit's condition;
+// for barycentrics it is divided by the triangle's smallest altitude.
+struct HitError {
+    double condition = 1.0;
+    double position = 0.0;        // absolute position slack at this hit
+    double altitude = INFINITY;   // triangle's smallest altitude; infinite for spheres and misses
+};
+
+HitError hit_error(const Scene& scene, const Ray& ray, const Hit& hit, const HitTolerance& tol) {
+    HitError e;
     double coordinate = max_abs(ray.org);
-    double min_altitude = INFINITY;
-    for (const Hit* h : {&a, &b}) {
-        if (!h->valid()) continue;
-        const Bounds3 bounds = scene.primitive_bounds(h->prim);
+    if (hit.valid()) {
+        e.condition = hit_condition(scene, ray, hit);
+        const Bounds3 bounds = scene.primitive_bounds(hit.prim);
         coordinate = std::max(coordinate, std::max(max_abs(bounds.lo), max_abs(bounds.hi)));
-        if (scene.is_sphere(h->prim)) continue;
-        const Triangle& t = scene.triangles[h->prim];
-        const Vec3& p0 = scene.positions[t.v0];
-        const Vec3& p1 = scene.positions[t.v1];
-        const Vec3& p2 = scene.positions[t.v2];
-        const double twice_area = double(length(cross(p1 - p0, p2 - p0)));
-        const double longest =
-            std::max(double(length(p1 - p0)), std::max(double(length(p2 - p1)), double(length(p0 - p2))));
-        if (longest > 0.0) min_altitude = std::min(min_altitude, twice_area / longest);
+        if (!scene.is_sphere(hit.prim)) {
+            const Triangle& t = scene.triangles[hit.prim];
+            const Vec3& p0 = scene.positions[t.v0];
+            const Vec3& p1 = scene.positions[t.v1];
+            const Vec3& p2 = scene.positions[t.v2];
+            const double twice_area = double(length(cross(p1 - p0, p2 - p0)));
+            const double longest = std::max(double(length(p1 - p0)),
+                                            std::max(double(length(p2 - p1)), double(length(p0 - p2))));
+            e.altitude = longest > 0.0 ? twice_area / longest : 0.0;
+        }
     }
-    const double position_slack = double(tol.ulps) * coordinate * double(FLT_EPSILON) * s.condition;
-    s.t_abs = position_slack / double(length(ray.dir));
-    s.bary_abs = min_altitude > 0.0 ? position_slack / min_altitude : INFINITY;
+    e.position = double(tol.ulps) * coordinate * double(FLT_EPSILON) * e.condition;
+    return e;
+}
+
+Slack make_slack(const Ray& ray, const HitError& a, const HitError& b) {
+    Slack s;
+    s.condition = std::max(a.condition, b.condition);
+    const double position = std::max(a.position, b.position);
+    s.t_abs = position / double(length(ray.dir));
+    const double altitude = std::min(a.altitude, b.altitude);
+    s.bary_abs = altitude > 0.0 ? position / altitude : INFINITY;
     return s;
 }
 
-bool near_edge(const Scene& scene, const Ray& ray, const Hit& hit, const HitTolerance& tol) {
+bool near_edge(const Scene& scene, const Ray& ray, const Hit& hit, const HitError& e,
+               const HitTolerance& tol) {
     if (!hit.valid()) return false;
     if (scene.is_sphere(hit.prim)) return grazes_sphere(scene.sphere(hit.prim), ray, tol);
     const float w = 1.f - hit.u - hit.v;
-    return std::min(hit.u, std::min(hit.v, w)) <= tol.edge;
+    const double slack = std::max(double(tol.edge) * e.condition,
+                                  e.altitude > 0.0 ? e.position / e.altitude : INFINITY);
+    return double(std::min(hit.u, std::min(hit.v, w))) <= slack;
 }
 
 }  // namespace
@@ -303,7 +319,8 @@ bool near_edge(const Scene& scene, const Ray& ray, const Hit& hit, const HitTole
 HitClass classify_hits(const Scene& scene, const Ray& ray, const Hit& a, const Hit& b,
                        const HitTolerance& tol) {
     if (!a.valid() && !b.valid()) return HitClass::both_miss;
-    const Slack slack = make_slack(scene, ray, a, b, tol);
+    const HitError error_a = hit_error(scene, ray, a, tol), error_b = hit_error(scene, ray, b, tol);
+    const Slack slack = make_slack(ray, error_a, error_b);
     if (a.valid() && b.valid() && a.prim == b.prim) {
         const bool close = close_distance(a.t, b.t, tol, slack) &&
                            close_barycentric(a.u, b.u, tol, slack) &&
@@ -315,8 +332,8 @@ HitClass classify_hits(const Scene& scene, const Ray& ray, const Hit& a, const H
     // leaving a corner, offset off one wall but still on the other), where hitting at t ~ 0
     // and passing are both right.
     auto at_origin = [&](const Hit& h) { return h.valid() && double(h.t) <= slack.t_abs; };
-    if (near_edge(scene, ray, a, tol) || near_edge(scene, ray, b, tol) || at_origin(a) ||
-        at_origin(b))
+    if (near_edge(scene, ray, a, error_a, tol) || near_edge(scene, ray, b, error_b, tol) ||
+        at_origin(a) || at_origin(b))
         return HitClass::edge;
     return a.valid() && b.valid() ? HitClass::disagree : HitClass::hit_miss;
 }
