@@ -10,17 +10,37 @@
 
 namespace sfx {
 
+TraceProfile::TraceProfile(const WorkloadShape& shape) {
+    m_map.nodes = shape.bvh_nodes;
+    m_map.triangles = shape.triangles;
+    m_map.spheres = shape.spheres;
+    // Data sizes do not depend on the datapath latencies: any configuration's table will do.
+    const OpCostTable costs(RayRecordLayout(shape.features), DatapathConfig{});
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) m_scene_bytes.push_back(costs[OpKind(k)].scene_bytes);
+}
+
 void TraceProfile::begin_pass(const TilePass& p) {
     ++m_passes;
     m_slots = std::max(m_slots, p.slot_count);
+    m_pass_lines.clear();
 }
 
 void TraceProfile::op(const StreamOp& op) {
     Bucket& b = m_buckets[Key{op.generation > 0, op.kind, op.length}];
     ++b.ops;
     b.passed += op.pass_count;
-    b.fetches += op.object != k_no_object;
+    const uint32_t bytes = m_scene_bytes[size_t(op.kind)];
+    if (op.object == k_no_object || op.length == 0 || bytes == 0) return;
+    ++b.fetches;
+    ++m_footprint.fetches;
+    const uint64_t address = m_map.address(op.kind, op.object);
+    for (uint64_t line = address / k_line_bytes; line <= (address + bytes - 1) / k_line_bytes; ++line) {
+        m_footprint.pass_distinct += m_pass_lines.insert(line).second;
+        m_footprint.frame_distinct += m_frame_lines.insert(line).second;
+    }
 }
+
+void TraceProfile::end_pass(const TilePass&) { m_pass_lines.clear(); }
 
 namespace {
 
@@ -84,6 +104,41 @@ double expected_moved_ids(uint32_t length, double p) {
     return p * (len - geo_p) + q * (len - geo_q);
 }
 
+namespace {
+
+// Expected cycles of one scene-data fetch. Per level of capacity C: a fetch that re-touches a
+// line already fetched in this pass hits if the pass's working set fits (in proportion, if
+// not); a first touch in the pass hits if the line survived from earlier passes, in
+// proportion to how much of the frame's working set fits; the frame's first touches miss.
+double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
+                             const TraceProfile& profile) {
+    const TraceProfile::Footprint& f = profile.footprint();
+    const double fetches = double(f.fetches);
+    const double line = TraceProfile::k_line_bytes;
+    const double pass_bytes = line * double(f.pass_distinct) / double(std::max<uint64_t>(1, profile.passes()));
+    const double frame_bytes = line * double(f.frame_distinct);
+    const double first_in_pass = double(f.pass_distinct), first_in_frame = double(f.frame_distinct);
+    if (fetches == 0) return 0.0;
+    const double compulsory = first_in_frame / fetches;
+    const double first_touch = first_in_pass / fetches;
+    double previous_miss = 1.0, cycles = 0.0;
+    for (const CacheLevelConfig& level : memory.caches) {
+        const double capacity = double(level.kib) * 1024.0;
+        const double survives = std::min(1.0, capacity / frame_bytes);
+        const double retouch_hits = std::min(1.0, capacity / pass_bytes);
+        const double miss = compulsory + (first_touch - compulsory) * (1.0 - survives) +
+                            (1.0 - first_touch) * (1.0 - retouch_hits);
+        const double global_miss = std::min(previous_miss, std::max(0.0, miss));  // inclusive
+        cycles += (previous_miss - global_miss) * level.hit_latency_cycles;
+        previous_miss = global_miss;
+    }
+    const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
+    const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
+    return cycles + previous_miss * (double(memory.dram_latency_cycles) + transfer);
+}
+
+}  // namespace
+
 FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                             const TraceProfile& profile) {
     const RayRecordLayout layout(shape.features);
@@ -91,8 +146,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
-    const double l1 = c.scene_memory.caches.empty() ? double(c.scene_memory.dram_latency_cycles)
-                                                    : double(c.scene_memory.caches[0].hit_latency_cycles);
+    const double fetch_cycles = expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, profile);
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank = buffer.fill_cycles();
@@ -138,9 +192,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                              pass_rate * length * double(p.scatter_words.size());
         const double address = std::ceil(words / (double(c.agu.count) * c.agu.addresses_per_cycle));
         const double address_stall = std::max(0.0, address - data);
-        // Every fetch is priced as an L1 hit, overlapped with the first group's gathers.
+        // A fetch overlaps the first group's id read and gathers.
         const double memory_stall =
-            p.scene_bytes ? std::max(0.0, l1 - first_group) * double(bucket.fetches) / ops : 0.0;
+            p.scene_bytes ? std::max(0.0, fetch_cycles - first_group) * double(bucket.fetches) / ops
+                          : 0.0;
         double compare = 0.0, moves = 0.0;
         if (p.partitions) {
             compare = std::ceil(double(length) / c.partition.lanes_per_cycle);

@@ -6,14 +6,19 @@
 // What it knows exactly: lane groups per width, id-stream alignment, compute, partition
 // comparator passes, pipeline fill. What it estimates: bank conflicts (balls into bins,
 // scaled by how sparse the stream is in its buffer), partition moves (an i.i.d. mask with the
-// measured pass rate), and scene-data latency (every fetch an L1 hit). Its error is measured
+// measured pass rate), and scene-data latency (per cache level, a miss rate from the working
+// sets of a pass and of the frame against the level's capacity). Its error is measured
 // against the cycle-level model, never assumed (tests/hw_model, sfx accuracy).
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <tuple>
+#include <vector>
+#include <unordered_set>
 
 #include "hw_model/hw_config.h"
+#include "hw_model/op_costs.h"
 #include "hw_model/prediction.h"
 #include "hw_model/workload_shape.h"
 
@@ -29,15 +34,31 @@ public:
     // (secondary, kind, stream length) -> bucket.
     using Key = std::tuple<bool, OpKind, uint32_t>;
 
+    // Scene-data lines (k_line_bytes) fetched: spatial locality (sibling nodes, the triangles
+    // of a leaf) is what the caches live on, so distinct lines, not objects, are counted.
+    static constexpr uint32_t k_line_bytes = 64;
+    struct Footprint {
+        uint64_t fetches = 0;
+        uint64_t pass_distinct = 0;   // sum over passes of distinct lines in the pass
+        uint64_t frame_distinct = 0;  // distinct lines over the frame
+    };
+
+    explicit TraceProfile(const WorkloadShape& shape);
     void begin_pass(const TilePass& p) override;
     void op(const StreamOp& op) override;
+    void end_pass(const TilePass& p) override;
 
     const std::map<Key, Bucket>& buckets() const { return m_buckets; }
+    const Footprint& footprint() const { return m_footprint; }
     uint64_t passes() const { return m_passes; }
     uint32_t slots() const { return m_slots; }
 
 private:
     std::map<Key, Bucket> m_buckets;
+    SceneDataMap m_map;
+    std::vector<uint32_t> m_scene_bytes;  // per OpKind, from the op cost table
+    Footprint m_footprint;
+    std::unordered_set<uint64_t> m_pass_lines, m_frame_lines;
     uint64_t m_passes = 0;
     uint32_t m_slots = 0;
 };

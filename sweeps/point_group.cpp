@@ -73,7 +73,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     CountingSink counts(widths);
     FanOutSink fan;
     fan.add(&counts);
-    TraceProfile profile;
+    TraceProfile profile(shape);
     std::unique_ptr<SystemcTiming> systemc;
     if (fidelity == Fidelity::analytic) {
         fan.add(&profile);

@@ -85,7 +85,7 @@ uint64_t Sequencer::time_op(const StreamOp& op, FrameTiming& t) {
                            uint64_t(op.pass_count) * p.scatter_words.size();
     const uint64_t address_cycles = address->generate(words);
     stalls.address_fetch = address_cycles > data ? address_cycles - data : 0;
-    if (p.scene_bytes) {
+    if (p.scene_bytes && op.object != k_no_object) {
         const uint64_t latency = scene_memory->read(m_map.address(op.kind, op.object), p.scene_bytes);
         stalls.scene_memory = latency > first_group ? latency - first_group : 0;
     }
@@ -101,7 +101,7 @@ uint64_t Sequencer::time_op(const StreamOp& op, FrameTiming& t) {
                           (scratch > data ? scratch - data : 0);
 
     OpMix& mix = t.mix;
-    mix.load += groups + (p.scene_bytes ? 1 : 0);
+    mix.load += groups + (p.scene_bytes && op.object != k_no_object ? 1 : 0);
     mix.compute += groups * p.compute_instructions;
     mix.scatter_gather += field_accesses;
     mix.partition += part.compare_cycles;
