@@ -22,7 +22,9 @@ struct RayBuffers {
     std::vector<PathState> path;
     std::vector<Ray> ray[2];          // current and next generation
     std::vector<RayPrecomp> pre;      // per-ray constants of the box and triangle tests
-    std::vector<float> t;             // box-test t_max: the closest hit so far, or the ray's
+    std::vector<float> t;             // test t_max: the closest hit so far, or the ray's;
+                                      // -1 for an occluded shadow ray (every test misses)
+    std::vector<uint8_t> negative;    // bit a: the direction is negative on axis a
     std::vector<Hit> hit;
     std::vector<uint8_t> any_hit;     // shadow ray: any hit in (0, t_max) occludes it
     std::vector<SurfaceHit> surf;
@@ -41,6 +43,7 @@ struct RayBuffers {
         pre.resize(n, RayPrecomp(unit));
         t.resize(n);
         hit.resize(n);
+        negative.resize(n);
         any_hit.resize(n);
         surf.resize(n);
         ids.resize(n);
@@ -69,6 +72,7 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
     float* t = b.t.data();
     Hit* hit = b.hit.data();
     const uint8_t* any_hit = b.any_hit.data();
+    const uint8_t* sign = b.negative.data();
     auto& stack = b.stack;
     stack.clear();
     stack.push_back({0u, n});
@@ -83,9 +87,8 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         const uint32_t k = filter<k_host_width>(
             trace, OpKind::box_test, generation, node_index, ids, len, mask, scratch,
             [&](uint32_t id) {
-                if (any_hit[id] && hit[id].valid()) return false;  // occluded already
                 const bool in = intersect_box(pre[id], node.bounds, t[id]) != INFINITY;
-                negative += in && pre[id].dir[axis] < 0.f;
+                negative += in & ((sign[id] >> axis) & 1);
                 return in;
             });
         if (k == 0) continue;
@@ -93,11 +96,10 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
                 const uint32_t passed = evaluate<k_host_width>(ids, k, mask, [&](uint32_t id) {
-                    if (any_hit[id])
-                        return !hit[id].valid() &&
-                               bvh.intersect_primitive(pre[id], prim, t[id], hit[id]);
                     if (!bvh.intersect_primitive(pre[id], prim, t[id], hit[id])) return false;
-                    t[id] = hit[id].t;
+                    // Closest hit: later tests need t or less. Any hit: the ray is done, and
+                    // with t = -1 every later box and primitive test misses it.
+                    t[id] = any_hit[id] ? -1.f : hit[id].t;
                     return true;
                 });
                 trace.op(scene.is_sphere(prim) ? OpKind::sphere_test : OpKind::triangle_test,
@@ -105,8 +107,10 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             }
         } else {
             const bool right_first = 2 * negative > k;
+            const uint32_t front = right_first ? node.right : node.first;
+            __builtin_prefetch(&nodes[front]);
             stack.push_back({right_first ? node.first : node.right, k});  // back: popped last
-            stack.push_back({right_first ? node.right : node.first, k});
+            stack.push_back({front, k});
         }
     }
 }
@@ -122,6 +126,8 @@ uint32_t load_rays(RayBuffers& b, const Ray* rays, uint32_t n) {
         if (!ray_is_valid(r)) continue;
         b.pre[id] = RayPrecomp(r);
         b.t[id] = r.t_max;
+        const Vec3& d = b.pre[id].dir;
+        b.negative[id] = uint8_t((d.x < 0.f) | (d.y < 0.f) << 1 | (d.z < 0.f) << 2);
         b.trav_ids[m++] = id;
     }
     return m;
