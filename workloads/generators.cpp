@@ -412,6 +412,24 @@ void build_atrium(const GeneratorInput& in, SceneBuilder& b) {
             }
         }
     }
+    // End walls: blind arcades on pilasters continue the rhythm of the long sides.
+    const float end_bays[6] = {-gallery, -court, -2.f, 2.f, court, gallery};
+    for (int s = -1; s <= 1; s += 2) {
+        const float x = float(s) * (half_l - 0.15f);
+        for (int storey = 0; storey < 2; ++storey) {
+            const float floor_y = storey ? h1 + 0.2f : 0.f, spring = storey ? h1 + 2.8f : 3.f;
+            const float top = storey ? h2 : h1;
+            for (int k = 0; k < 5; ++k) {
+                const float z0 = end_bays[k], z1 = end_bays[k + 1];
+                const float half_w = 0.5f * (z1 - z0);
+                const Transform xf = Transform::rotate_y(90.f, Vec3(x, spring, 0.5f * (z0 + z1)));
+                shapes::arch(b, half_w - 0.3f, half_w, top - spring, 0.3f, arch_seg, stone, xf);
+            }
+            for (int k = 0; k < 6; ++k)
+                shapes::box(b, Vec3(x - 0.2f, floor_y, end_bays[k] - 0.3f),
+                            Vec3(x + 0.2f, spring, end_bays[k] + 0.3f), stone);
+        }
+    }
     // Courtyard: a fountain with a glass sphere, pedestals with glass and metal spheres,
     // and planters with shrubs.
     const uint32_t glass = c.m("glass"), metal = c.m("metal"), plant = c.m("plant");
@@ -817,7 +835,7 @@ const std::vector<GeneratorInfo>& generators() {
          "two-storey arcaded courtyard under a sky panel, fountain, glass and metal spheres",
          {P("bays", 8, 2, 64, true, "arches per side and storey (3 m each)"),
           P("column_segments", 28, 3, 512, true, "segments around a column"),
-          P("column_rings", 16, 1, 512, true, "rings up a column"),
+          P("column_rings", 15, 1, 512, true, "rings up a column"),
           P("arch_segments", 24, 2, 512, true, "segments along an arch"),
           P("balusters_per_bay", 7, 0, 64, true, "balusters in each upper bay"),
           P("baluster_segments", 12, 3, 256, true, "segments around a baluster"),
