@@ -65,7 +65,8 @@ enum class HitClass : uint8_t {
     both_miss,        // explained
     agree,            // same primitive, t, u, v within tolerance; explained
     tie,              // different primitives at equal t (within tolerance); explained
-    edge,             // a hit on an edge/vertex/silhouette, where either answer is right; explained
+    edge,             // a hit on an edge/vertex/sphere silhouette, or at the ray origin (the
+                      // origin lies on a surface), where either answer is right; explained
     same_prim_apart,  // same primitive, but t, u or v beyond tolerance
     hit_miss,         // one hit, the other missed, away from any edge
     disagree,         // different primitives at different t, away from any edge
@@ -75,9 +76,12 @@ constexpr size_t k_hit_class_count = size_t(HitClass::count);
 const char* to_string(HitClass c);
 inline bool is_explained(HitClass c) { return c <= HitClass::edge; }
 
+// Two hits agree if t, u, v are within `ulps` ulps (of t itself, and of the largest coordinate
+// in play: positions round there whatever t is) or `relative` of each other. Both are scaled
+// by 1/|cos| of the angle between ray and surface, the condition number of the intersection.
 struct HitTolerance {
-    float ulps = 16.f;       // t, u, v agree within this many ulps ...
-    float relative = 1e-5f;  // ... or this relative difference (u, v: absolute, they are in [0,1])
+    float ulps = 16.f;
+    float relative = 1e-5f;  // u, v: absolute, they live in [0, 1]
     float edge = 1e-5f;      // barycentric distance to an edge, relative distance to a silhouette
 };
 

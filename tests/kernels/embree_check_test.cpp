@@ -190,6 +190,49 @@ TEST_CASE("Hits on a shared edge or vertex are ties or edge hits, not disagreeme
     Hit inner_a_ulps = inner_a;
     inner_a_ulps.t = std::nextafter(std::nextafter(inner_a.t, 4.f), 4.f);
     CHECK(classify_hits(s, down, inner_a, inner_a_ulps) == HitClass::agree);
+
+    // Tolerances grow with 1/|cos| of the hit angle: u off by 3e-4 is rounding at cos = 0.001,
+    // and a real difference at normal incidence.
+    const Ray grazing{{-0.5f, 0.3f, 0.001f}, normalize(Vec3(1.f, 0.f, -0.001f))};
+    Hit g = inner_a;
+    g.t = 1.f;
+    g.u = 0.2f;
+    g.v = 0.3f;
+    Hit g_off = g;
+    g_off.u += 3e-4f;
+    CHECK(classify_hits(s, grazing, g, g_off) == HitClass::agree);
+    CHECK(classify_hits(s, down, g, g_off) == HitClass::same_prim_apart);
+
+    // A hit at the origin (the origin lies on a surface) against a miss is an edge case; the
+    // same hit well away from the origin is not.
+    const Ray from_surface{{0.5f, 0.3f, 0.f}, {0.f, 0.f, 1.f}};
+    Hit at_origin = g;
+    at_origin.t = 1e-9f;
+    CHECK(classify_hits(s, from_surface, at_origin, Hit{}) == HitClass::edge);
+    at_origin.t = 0.5f;
+    CHECK(classify_hits(s, from_surface, at_origin, Hit{}) == HitClass::hit_miss);
+}
+
+TEST_CASE("Sphere silhouettes are edge cases, sphere centers are not", "[embree]") {
+    Scene s;
+    s.materials.push_back(Material{});
+    s.spheres.push_back({{0.f, 0.f, 0.f}, 1.f, 0});
+    Hit hit;
+    hit.t = 5.f;
+    hit.prim = 0;
+    const Ray tangent{{1.f, 0.f, -5.f}, {0.f, 0.f, 1.f}};
+    CHECK(classify_hits(s, tangent, hit, Hit{}) == HitClass::edge);
+    CHECK(classify_hits(s, tangent, Hit{}, hit) == HitClass::edge);
+    const Ray central{{0.f, 0.f, -5.f}, {0.f, 0.f, 1.f}};
+    hit.t = 4.f;
+    CHECK(classify_hits(s, central, hit, Hit{}) == HitClass::hit_miss);
+    // And Embree's sphere (RTC_GEOMETRY_TYPE_SPHERE_POINT) agrees with sfx's through the center.
+    const Bvh bvh(s);
+    const EmbreeScene embree(s);
+    const Hit mine = bvh.intersect(central), theirs = embree.intersect(central);
+    CHECK(classify_hits(s, central, mine, theirs) == HitClass::agree);
+    CHECK(theirs.prim == 0);
+    CHECK(theirs.t == Approx(4.f));
 }
 
 TEST_CASE("NaN, Inf and out-of-range rays are filtered and never reach Embree", "[embree]") {
