@@ -17,14 +17,19 @@ namespace {
 // The ray buffers of one stream, one array per field group (structure of arrays). A slot is a
 // path: a path carries one ray at a time, so its next ray goes to the same slot of the
 // next-generation buffer, and streams are lists of slots.
+// What a box test gathers per lane, in one cache line: the test's constants and its t_max
+// (the closest hit so far, or the ray's t_max; -1 for an occluded shadow ray, which every
+// later box and primitive test then misses).
+struct alignas(64) TraversalRay {
+    RayPrecomp pre;
+    float t;
+};
+
 struct RayBuffers {
     uint32_t capacity = 0;
     std::vector<PathState> path;
     std::vector<Ray> ray[2];          // current and next generation
-    std::vector<RayPrecomp> pre;      // per-ray constants of the box and triangle tests
-    std::vector<float> t;             // test t_max: the closest hit so far, or the ray's;
-                                      // -1 for an occluded shadow ray (every test misses)
-    std::vector<uint8_t> negative;    // bit a: the direction is negative on axis a
+    std::vector<TraversalRay> trav;
     std::vector<Hit> hit;
     std::vector<uint8_t> any_hit;     // shadow ray: any hit in (0, t_max) occludes it
     std::vector<SurfaceHit> surf;
@@ -40,10 +45,8 @@ struct RayBuffers {
         ray[1].resize(n);
         Ray unit;
         unit.dir = {0.f, 0.f, 1.f};
-        pre.resize(n, RayPrecomp(unit));
-        t.resize(n);
+        trav.resize(n, TraversalRay{RayPrecomp(unit), 0.f});
         hit.resize(n);
-        negative.resize(n);
         any_hit.resize(n);
         surf.resize(n);
         ids.resize(n);
@@ -68,11 +71,9 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
     uint32_t* ids = b.trav_ids.data();
     uint8_t* mask = b.mask.data();
     uint32_t* scratch = b.scratch.data();
-    const RayPrecomp* pre = b.pre.data();
-    float* t = b.t.data();
+    TraversalRay* rays = b.trav.data();
     Hit* hit = b.hit.data();
     const uint8_t* any_hit = b.any_hit.data();
-    const uint8_t* sign = b.negative.data();
     auto& stack = b.stack;
     stack.clear();
     stack.push_back({0u, n});
@@ -87,8 +88,9 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         const uint32_t k = filter<k_host_width>(
             trace, OpKind::box_test, generation, node_index, ids, len, mask, scratch,
             [&](uint32_t id) {
-                const bool in = intersect_box(pre[id], node.bounds, t[id]) != INFINITY;
-                negative += in & ((sign[id] >> axis) & 1);
+                const TraversalRay& r = rays[id];
+                const bool in = intersect_box(r.pre, node.bounds, r.t) != INFINITY;
+                negative += in && r.pre.dir[axis] < 0.f;
                 return in;
             });
         if (k == 0) continue;
@@ -96,10 +98,11 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
                 const uint32_t passed = evaluate<k_host_width>(ids, k, mask, [&](uint32_t id) {
-                    if (!bvh.intersect_primitive(pre[id], prim, t[id], hit[id])) return false;
+                    TraversalRay& r = rays[id];
+                    if (!bvh.intersect_primitive(r.pre, prim, r.t, hit[id])) return false;
                     // Closest hit: later tests need t or less. Any hit: the ray is done, and
                     // with t = -1 every later box and primitive test misses it.
-                    t[id] = any_hit[id] ? -1.f : hit[id].t;
+                    r.t = any_hit[id] ? -1.f : hit[id].t;
                     return true;
                 });
                 trace.op(scene.is_sphere(prim) ? OpKind::sphere_test : OpKind::triangle_test,
@@ -124,10 +127,8 @@ uint32_t load_rays(RayBuffers& b, const Ray* rays, uint32_t n) {
         const Ray& r = rays[id];
         b.hit[id] = Hit{};
         if (!ray_is_valid(r)) continue;
-        b.pre[id] = RayPrecomp(r);
-        b.t[id] = r.t_max;
-        const Vec3& d = b.pre[id].dir;
-        b.negative[id] = uint8_t((d.x < 0.f) | (d.y < 0.f) << 1 | (d.z < 0.f) << 2);
+        b.trav[id].pre = RayPrecomp(r);
+        b.trav[id].t = r.t_max;
         b.trav_ids[m++] = id;
     }
     return m;
