@@ -26,12 +26,17 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-bool in_range(float x) { return std::fabs(x) <= EmbreeScene::k_coordinate_limit; }
-bool in_range(const Vec3& p) { return in_range(p.x) && in_range(p.y) && in_range(p.z); }
+bool in_range(float x) {
+    return std::fabs(x) <= EmbreeScene::k_coordinate_limit;
+}
+bool in_range(const Vec3& p) {
+    return in_range(p.x) && in_range(p.y) && in_range(p.z);
+}
 
 void record_error(void* user, RTCError code, const char* message) {
     auto* text = static_cast<std::string*>(user);
-    if (text->empty()) *text = "embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
+    if (text->empty())
+        *text = "embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
 }
 
 }  // namespace
@@ -58,7 +63,10 @@ EmbreeScene::EmbreeScene(const Scene& scene) {
         const bool ok = t.v0 < vertex_count && t.v1 < vertex_count && t.v2 < vertex_count &&
                         in_range(scene.positions[t.v0]) && in_range(scene.positions[t.v1]) &&
                         in_range(scene.positions[t.v2]);
-        if (ok) triangle_ids.push_back(i); else ++m_excluded;
+        if (ok)
+            triangle_ids.push_back(i);
+        else
+            ++m_excluded;
     }
     if (!triangle_ids.empty()) {
         RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -72,9 +80,9 @@ EmbreeScene::EmbreeScene(const Scene& scene) {
             v[3 * i + 1] = p.y;
             v[3 * i + 2] = p.z;
         }
-        auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-            g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
-            triangle_ids.size()));
+        auto* idx = static_cast<uint32_t*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(uint32_t), triangle_ids.size()));
         for (size_t k = 0; k < triangle_ids.size(); ++k) {
             const Triangle& t = scene.triangles[triangle_ids[k]];
             idx[3 * k] = t.v0;
@@ -94,13 +102,15 @@ EmbreeScene::EmbreeScene(const Scene& scene) {
         const bool ok = in_range(s.center) && std::isfinite(s.radius) && s.radius > 0.f &&
                         in_range(s.radius) && in_range(s.center + Vec3(s.radius)) &&
                         in_range(s.center - Vec3(s.radius));
-        if (ok) sphere_ids.push_back(scene.triangle_count() + i); else ++m_excluded;
+        if (ok)
+            sphere_ids.push_back(scene.triangle_count() + i);
+        else
+            ++m_excluded;
     }
     if (!sphere_ids.empty()) {
         RTCGeometry g = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-            sphere_ids.size()));
+            g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), sphere_ids.size()));
         for (size_t k = 0; k < sphere_ids.size(); ++k) {
             const Sphere& s = scene.sphere(sphere_ids[k]);
             v[4 * k] = s.center.x;
@@ -174,14 +184,22 @@ Hit EmbreeScene::intersect(const Ray& ray) const {
 
 const char* to_string(HitClass c) {
     switch (c) {
-    case HitClass::both_miss: return "both_miss";
-    case HitClass::agree: return "agree";
-    case HitClass::tie: return "tie";
-    case HitClass::edge: return "edge";
-    case HitClass::same_prim_apart: return "same_prim_apart";
-    case HitClass::hit_miss: return "hit_miss";
-    case HitClass::disagree: return "disagree";
-    case HitClass::count: break;
+        case HitClass::both_miss:
+            return "both_miss";
+        case HitClass::agree:
+            return "agree";
+        case HitClass::tie:
+            return "tie";
+        case HitClass::edge:
+            return "edge";
+        case HitClass::same_prim_apart:
+            return "same_prim_apart";
+        case HitClass::hit_miss:
+            return "hit_miss";
+        case HitClass::disagree:
+            return "disagree";
+        case HitClass::count:
+            break;
     }
     return "?";
 }
@@ -224,7 +242,9 @@ bool close_barycentric(float a, float b, const HitTolerance& tol, const Slack& s
            ulp_distance(a, b) <= int64_t(tol.ulps);
 }
 
-double max_abs(const Vec3& p) { return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z))); }
+double max_abs(const Vec3& p) {
+    return std::max(std::fabs(p.x), std::max(std::fabs(p.y), std::fabs(p.z)));
+}
 
 // The ray passes within rounding distance of the sphere's silhouette, where hit and miss are
 // both right. The slack grows with the distance to the center: that is the size of the
@@ -268,8 +288,8 @@ double hit_condition(const Scene& scene, const Ray& ray, const Hit& hit) {
 // for barycentrics it is divided by the triangle's smallest altitude.
 struct HitError {
     double condition = 1.0;
-    double position = 0.0;        // absolute position slack at this hit
-    double altitude = INFINITY;   // triangle's smallest altitude; infinite for spheres and misses
+    double position = 0.0;       // absolute position slack at this hit
+    double altitude = INFINITY;  // triangle's smallest altitude; infinite for spheres and misses
 };
 
 HitError hit_error(const Scene& scene, const Ray& ray, const Hit& hit, const HitTolerance& tol) {
@@ -285,8 +305,9 @@ HitError hit_error(const Scene& scene, const Ray& ray, const Hit& hit, const Hit
             const Vec3& p1 = scene.positions[t.v1];
             const Vec3& p2 = scene.positions[t.v2];
             const double twice_area = double(length(cross(p1 - p0, p2 - p0)));
-            const double longest = std::max(double(length(p1 - p0)),
-                                            std::max(double(length(p2 - p1)), double(length(p0 - p2))));
+            const double longest =
+                std::max(double(length(p1 - p0)),
+                         std::max(double(length(p2 - p1)), double(length(p0 - p2))));
             e.altitude = longest > 0.0 ? twice_area / longest : 0.0;
         }
     }

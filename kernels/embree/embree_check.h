@@ -28,7 +28,7 @@ namespace sfx {
 // spheres (as RTC_GEOMETRY_TYPE_SPHERE_POINT, so Embree's own sphere test is checked against
 // sfx's rather than sfx's against itself). Built with RTC_SCENE_FLAG_ROBUST at high quality.
 class EmbreeScene {
-public:
+  public:
     // Largest coordinate magnitude handed to Embree; beyond ~1.8e18 Embree aborts.
     static constexpr float k_coordinate_limit = 1e18f;
 
@@ -49,7 +49,7 @@ public:
     uint32_t excluded_primitives() const { return m_excluded; }
     double build_seconds() const { return m_build_seconds; }
 
-private:
+  private:
     RTCDeviceTy* m_device = nullptr;
     RTCSceneTy* m_scene = nullptr;
     uint32_t m_triangle_geometry = ~0u, m_sphere_geometry = ~0u;
@@ -74,7 +74,9 @@ enum class HitClass : uint8_t {
 };
 constexpr size_t k_hit_class_count = size_t(HitClass::count);
 const char* to_string(HitClass c);
-inline bool is_explained(HitClass c) { return c <= HitClass::edge; }
+inline bool is_explained(HitClass c) {
+    return c <= HitClass::edge;
+}
 
 // Two hits agree if t, u, v are within `ulps` ulps (of t itself, and of the largest coordinate
 // in play: positions round there whatever t is) or `relative` of each other. Both are scaled

@@ -1,11 +1,12 @@
 // sfx's BVH against Embree 3: a small scene agrees, shared edges are explained, bad rays never
 // reach Embree, and a deliberately wrong Embree scene is caught.
 
+#include "kernels/embree/embree_check.h"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "kernels/bvh.h"
-#include "kernels/embree/embree_check.h"
 #include "kernels/sampling.h"
 
 using namespace sfx;
@@ -126,16 +127,15 @@ TEST_CASE("A room far from the origin agrees with Embree (robust mode)", "[embre
     CHECK(a.pass());
 }
 
-TEST_CASE("Hits on a shared edge or vertex are ties or edge hits, not disagreements",
-          "[embree]") {
+TEST_CASE("Hits on a shared edge or vertex are ties or edge hits, not disagreements", "[embree]") {
     // One quad split along its diagonal (0,0)-(1,1), and a fan of four triangles around (2,0.5).
     Scene s;
     s.materials.push_back(Material{});
-    s.positions = {{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {1.f, 1.f, 0.f}, {0.f, 1.f, 0.f},
-                   {2.f, 0.5f, 0.f}, {1.5f, 0.f, 0.f}, {2.5f, 0.f, 0.f}, {2.5f, 1.f, 0.f},
-                   {1.5f, 1.f, 0.f}};
-    s.triangles = {{0, 1, 2, 0}, {0, 2, 3, 0}, {4, 5, 6, 0}, {4, 6, 7, 0}, {4, 7, 8, 0},
-                   {4, 8, 5, 0}};
+    s.positions = {{0.f, 0.f, 0.f},  {1.f, 0.f, 0.f},  {1.f, 1.f, 0.f},
+                   {0.f, 1.f, 0.f},  {2.f, 0.5f, 0.f}, {1.5f, 0.f, 0.f},
+                   {2.5f, 0.f, 0.f}, {2.5f, 1.f, 0.f}, {1.5f, 1.f, 0.f}};
+    s.triangles = {{0, 1, 2, 0}, {0, 2, 3, 0}, {4, 5, 6, 0},
+                   {4, 6, 7, 0}, {4, 7, 8, 0}, {4, 8, 5, 0}};
     const Bvh bvh(s);
     const EmbreeScene embree(s);
 
@@ -144,9 +144,10 @@ TEST_CASE("Hits on a shared edge or vertex are ties or edge hits, not disagreeme
     std::vector<Ray> rays;
     for (int i = 1; i < 64; ++i) {  // interior points: the mesh's outer corners may miss
         const float f = float(i) / 64.f;
-        for (const Vec3 d : {Vec3(0.f, 0.f, -1.f), Vec3(0.3f, -0.2f, -1.f), Vec3(-0.4f, 0.1f, -1.f)}) {
-            rays.push_back({Vec3(f, f, 0.f) - d * 3.f, d});                  // the diagonal
-            rays.push_back({Vec3(2.f, 0.5f, 0.f) - d * (1.f + f), d});       // the fan's center
+        for (const Vec3 d :
+             {Vec3(0.f, 0.f, -1.f), Vec3(0.3f, -0.2f, -1.f), Vec3(-0.4f, 0.1f, -1.f)}) {
+            rays.push_back({Vec3(f, f, 0.f) - d * 3.f, d});             // the diagonal
+            rays.push_back({Vec3(2.f, 0.5f, 0.f) - d * (1.f + f), d});  // the fan's center
             rays.push_back({Vec3(2.f - 0.5f * f, 0.5f - 0.5f * f, 0.f) - d * 2.f, d});  // a spoke
         }
     }
@@ -243,16 +244,11 @@ TEST_CASE("NaN, Inf and out-of-range rays are filtered and never reach Embree", 
     const EmbreeScene embree(scene);
     const float nan = std::nanf(""), inf = INFINITY;
     const std::vector<Ray> bad = {
-        {{nan, 0.f, 0.f}, {0.f, 0.f, -1.f}},
-        {{0.f, 0.f, 0.f}, {0.f, nan, -1.f}},
-        {{inf, 0.f, 0.f}, {0.f, 0.f, -1.f}},
-        {{0.f, 0.f, 0.f}, {-inf, 0.f, -1.f}},
-        {{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}},
-        {{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, nan},
-        {{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, -1.f},
-        {{2e18f, 0.f, 0.f}, {0.f, 0.f, -1.f}},
-        {{0.f, 0.f, -3e18f}, {0.f, 0.f, 1.f}},
-        {{0.f, 0.f, 0.f}, {1e30f, 0.f, -1.f}},
+        {{nan, 0.f, 0.f}, {0.f, 0.f, -1.f}},        {{0.f, 0.f, 0.f}, {0.f, nan, -1.f}},
+        {{inf, 0.f, 0.f}, {0.f, 0.f, -1.f}},        {{0.f, 0.f, 0.f}, {-inf, 0.f, -1.f}},
+        {{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}},         {{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, nan},
+        {{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, -1.f},  {{2e18f, 0.f, 0.f}, {0.f, 0.f, -1.f}},
+        {{0.f, 0.f, -3e18f}, {0.f, 0.f, 1.f}},      {{0.f, 0.f, 0.f}, {1e30f, 0.f, -1.f}},
         {{0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, 1e30f},
     };
     std::vector<Ray> rays;
