@@ -92,7 +92,10 @@ void add_scene_info_command(CLI::App& app) {
         }
         auto mib = [](uint64_t bytes) {
             char buf[32];
-            std::snprintf(buf, sizeof buf, "%.2f MiB", double(bytes) / (1024.0 * 1024.0));
+            if (bytes < 1024 * 1024)
+                std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
+            else
+                std::snprintf(buf, sizeof buf, "%.2f MiB", double(bytes) / (1024.0 * 1024.0));
             return std::string(buf);
         };
         std::printf("scene              %s\n", scene.name.c_str());
