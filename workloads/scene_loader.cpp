@@ -60,7 +60,8 @@ public:
     }
 
     double number(const YAML::Node& node, const std::string& key) const {
-        if (!node.IsScalar()) fail(node, key, "expected a number");
+        // A quoted scalar ("1.5") is a string in YAML: refuse it rather than guess.
+        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected a number");
         double v;
         try {
             v = node.as<double>();
@@ -81,7 +82,7 @@ public:
     }
 
     int64_t integer(const YAML::Node& node, const std::string& key, int64_t lo, int64_t hi) const {
-        if (!node.IsScalar()) fail(node, key, "expected an integer");
+        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected an integer");
         long long v;
         try {
             v = node.as<long long>();
@@ -95,7 +96,7 @@ public:
     }
 
     uint64_t seed(const YAML::Node& node, const std::string& key) const {
-        if (!node.IsScalar()) fail(node, key, "expected a non-negative integer");
+        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected a non-negative integer");
         try {
             const std::string& s = node.Scalar();
             if (s.empty() || s[0] == '-') throw YAML::Exception(node.Mark(), "negative");

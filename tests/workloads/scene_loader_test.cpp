@@ -142,6 +142,12 @@ TEST_CASE("scene loader: wrong types and bad values", "[workloads]") {
                  "objects[0].radius", "expected a number");
     expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: -1}\n", 7,
                  "objects[0].radius", "must be in");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: '1'}\n", 7,
+                 "objects[0].radius", "expected a number");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: true}\n", 7,
+                 "objects[0].radius", "expected a number");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: [1]}\n", 7,
+                 "objects[0].radius", "expected a number");
     expect_error(h + "  - {type: sphere, material: white, center: [0, 0], radius: 1}\n", 7,
                  "objects[0].center", "expected [x, y, z]");
     expect_error(h + "  - {type: sphere, material: white,\n     center: [0, .nan, 0], radius: 1}\n", 8,
