@@ -8,6 +8,7 @@
 
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/stream_box.h"
 #include "kernels/stream/stream_filter.h"
 
 namespace sfx {
@@ -57,6 +58,52 @@ struct RayBuffers {
     }
 };
 
+// The box filter of Fig. 5: gather Width lanes (a partial last group repeats its last ray),
+// test them together, partition. `negative` counts passing rays whose direction is negative
+// on the node's split axis (for the front-child vote).
+template <class Trace>
+uint32_t box_filter(Trace& trace, const BvhNode& node, uint32_t node_index, uint16_t generation,
+                    const TraversalRay* rays, uint32_t* ids, uint32_t len, uint8_t* mask,
+                    uint32_t* scratch, uint32_t& negative) {
+    constexpr int W = k_host_width;
+    BoxLanes<W> lanes;
+    uint8_t m[W];
+    const int axis = node.axis;
+    uint32_t front = 0, back = 0, passed = 0;
+    for (uint32_t g = 0; g < len; g += W) {
+        const uint32_t count = std::min<uint32_t>(W, len - g);
+        for (int l = 0; l < W; ++l) {
+            const TraversalRay& r = rays[ids[g + std::min<uint32_t>(uint32_t(l), count - 1)]];
+            for (int a = 0; a < 3; ++a) {
+                lanes.org[a][l] = r.pre.org[a];
+                lanes.inv[a][l] = r.pre.inv_dir[a];
+            }
+            lanes.t_max[l] = r.t;
+        }
+        box_test_lanes<W>(lanes, node.bounds, m);
+        for (uint32_t l = 0; l < count; ++l) {
+            const uint32_t id = ids[g + l];
+            if constexpr (Trace::k_enabled) {
+                mask[g + l] = m[l];
+            } else {  // in-place compaction: front <= g + l, so no unread id is overwritten
+                if (m[l]) ids[front++] = id;
+                else scratch[back++] = id;
+            }
+            if (m[l]) {
+                ++passed;
+                negative += rays[id].pre.dir[axis] < 0.f;
+            }
+        }
+    }
+    if constexpr (Trace::k_enabled) {
+        trace.op(OpKind::box_test, generation, node_index, ids, len, mask, passed);
+        partition(ids, len, mask, passed, scratch);
+    } else if (front != 0) {
+        for (uint32_t i = 0; i < back; ++i) ids[front + i] = scratch[i];
+    }
+    return passed;
+}
+
 // Fig. 3: test the stream against the node's box, filter, stop on empty; at a leaf intersect
 // each primitive with the sub-stream; else the front child, then the back child. Closest-hit
 // rays tighten their t as they find hits; shadow rays leave the stream once occluded.
@@ -83,16 +130,9 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         const auto [node_index, len] = stack.back();
         stack.pop_back();
         const BvhNode& node = nodes[node_index];
-        const int axis = node.axis;
         uint32_t negative = 0;
-        const uint32_t k = filter<k_host_width>(
-            trace, OpKind::box_test, generation, node_index, ids, len, mask, scratch,
-            [&](uint32_t id) {
-                const TraversalRay& r = rays[id];
-                const bool in = intersect_box(r.pre, node.bounds, r.t) != INFINITY;
-                negative += in && r.pre.dir[axis] < 0.f;
-                return in;
-            });
+        const uint32_t k = box_filter(trace, node, node_index, generation, rays, ids, len, mask,
+                                      scratch, negative);
         if (k == 0) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
