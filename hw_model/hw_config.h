@@ -39,6 +39,7 @@ struct RayBufferConfig {
     uint32_t line_words = 16;  // 32-bit words per bank line; widths that don't divide it stall
     uint32_t access_latency_cycles = 2;
     bool pipelined = true;
+    std::string layout = "soa";  // ray records as structure of arrays (the paper) or array of structs
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
@@ -50,6 +51,9 @@ struct RayBufferConfig {
         v.param("access_latency_cycles", access_latency_cycles, "cycles",
                 "bank access latency", 1u, 64u);
         v.param("pipelined", pipelined, "", "bank accesses overlap (one issue per cycle)");
+        v.choice("layout", layout, {"soa", "aos"},
+                 "ray records: soa puts a field of consecutive slots in consecutive banks; aos "
+                 "puts slot * record words + field word in bank (that word mod banks)");
     }
 };
 

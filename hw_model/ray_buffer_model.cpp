@@ -9,7 +9,8 @@ RayBufferModel::RayBufferModel(const RayBufferConfig& config, uint32_t record_wo
                                uint32_t slot_count)
     : m_banks(config.banks), m_line_words(config.line_words),
       m_latency(config.access_latency_cycles), m_slot_count(slot_count),
-      m_record_words(record_words), m_pipelined(config.pipelined), m_per_bank(config.banks) {
+      m_record_words(record_words), m_pipelined(config.pipelined), m_aos(config.layout == "aos"),
+      m_per_bank(config.banks) {
     if (m_banks == 0 || m_line_words == 0 || m_latency == 0)
         throw std::invalid_argument("ray buffer: banks, line_words and latency must be >= 1");
 }
@@ -18,10 +19,10 @@ RayBufferModel::Access RayBufferModel::access_field(uint32_t field_word, const u
                                                     uint32_t lanes) const {
     Access a;
     if (lanes == 0) return a;
-    std::fill(m_per_bank.begin(), m_per_bank.end(), 0u);
     uint32_t busiest = 0;
     for (uint32_t i = 0; i < lanes; ++i)
-        busiest = std::max(busiest, ++m_per_bank[bank_of(field_word, slots[i])]);
+        busiest = std::max<uint32_t>(busiest, ++m_per_bank[bank_of(field_word, slots[i])]);
+    for (uint32_t i = 0; i < lanes; ++i) m_per_bank[bank_of(field_word, slots[i])] = 0;
     // Even without conflicts a bank serves ceil(lanes / banks) requests.
     const uint32_t needed = (lanes + m_banks - 1) / m_banks;
     const uint32_t per_request = m_pipelined ? 1 : m_latency;

@@ -2,11 +2,12 @@
 // Arithmetic of the banked ray buffers, the address-generation units and the partition unit,
 // in plain classes that tests exercise without a SystemC kernel (the SystemC modules wrap them).
 //
-// Layout: each ray buffer holds its rays' records in structure-of-arrays form: field f of slot s
-// lives at word (field_base(f) + s); words are interleaved across banks word by word, so the
-// same field of consecutive slots sits in consecutive banks. A gather of one field for a group
-// of lanes costs as many cycles as the busiest bank has requests (one access per bank per cycle
-// when pipelined; access_latency cycles each when not), plus the pipeline fill.
+// Layout: words are interleaved across banks word by word. With `soa` records (the paper's
+// ray streams), field word w of slot s lives at word w * capacity + s, so the same field of
+// consecutive slots sits in consecutive banks; with `aos` records it lives at
+// s * record_words + w. A gather of one field word for a group of lanes costs as many cycles
+// as the busiest bank has requests (one access per bank per cycle when pipelined;
+// access_latency cycles each when not), plus the pipeline fill once per chain.
 
 #include <cstdint>
 #include <vector>
@@ -20,7 +21,9 @@ public:
     RayBufferModel(const RayBufferConfig& config, uint32_t record_words, uint32_t slot_count);
 
     uint32_t bank_of(uint32_t field_word, uint32_t slot) const {
-        return (field_word * m_slot_count + slot) % m_banks;
+        const uint64_t word = m_aos ? uint64_t(slot) * m_record_words + field_word
+                                    : uint64_t(field_word) * m_slot_count + slot;
+        return uint32_t(word % m_banks);
     }
 
     // Issue cycles to access one field word of each lane's slot (a gather or a scatter of one
@@ -31,6 +34,16 @@ public:
         uint64_t conflict_cycles = 0;
     };
     Access access_field(uint32_t field_word, const uint32_t* slots, uint32_t lanes) const;
+    // The same for `words` field words of the same lanes, one after another. In both layouts a
+    // field word's banks are the first word's shifted by a constant (mod banks), so every word
+    // costs what the first does: computed once, exactly.
+    Access access_fields(uint32_t words, const uint32_t* slots, uint32_t lanes) const {
+        if (words == 0) return {};
+        Access a = access_field(0, slots, lanes);
+        a.cycles *= words;
+        a.conflict_cycles *= words;
+        return a;
+    }
 
     // Contiguous read of `lanes` words starting at word `offset` of a line-organised stream
     // (the ray-id stream): one line per cycle; a run that straddles lines or starts off a line
@@ -51,8 +64,8 @@ public:
 
 private:
     uint32_t m_banks, m_line_words, m_latency, m_slot_count, m_record_words;
-    bool m_pipelined;
-    mutable std::vector<uint32_t> m_per_bank;  // scratch, sized to the bank count
+    bool m_pipelined, m_aos;
+    mutable std::vector<uint16_t> m_per_bank;  // scratch: zero between calls
 };
 
 // Address generation: `count` units, each computing `addresses_per_cycle` addresses per cycle.

@@ -12,9 +12,9 @@ public:
                   uint32_t record_words, uint32_t capacity)
         : sc_module(name), m_model(config, record_words, capacity) {}
 
-    RayBufferModel::Access access_field(uint32_t word, const uint32_t* slots,
-                                        uint32_t lanes) override {
-        return m_model.access_field(word, slots, lanes);
+    RayBufferModel::Access access_fields(uint32_t words, const uint32_t* slots,
+                                         uint32_t lanes) override {
+        return m_model.access_fields(words, slots, lanes);
     }
     RayBufferModel::Contiguous access_ids(uint64_t offset, uint32_t lanes) override {
         return m_model.access_contiguous(offset, lanes);

@@ -51,27 +51,28 @@ uint64_t Sequencer::time_op(const StreamOp& op, FrameTiming& t) {
         const RayBufferModel::Contiguous ids = ray_buffer->access_ids(begin, lanes);
         busy += ids.cycles - ids.alignment_cycles;
         align += ids.alignment_cycles;
-        for (uint32_t word : p.gather_words) {
-            const RayBufferModel::Access a = ray_buffer->access_field(word, slots, lanes);
+        const uint32_t gathers = uint32_t(p.gather_words.size());
+        if (gathers) {
+            const RayBufferModel::Access a = ray_buffer->access_fields(gathers, slots, lanes);
             busy += a.cycles - a.conflict_cycles;
             conflict += a.conflict_cycles;
-            ++field_accesses;
-            conflicted += a.conflict_cycles > 0;
+            field_accesses += gathers;
+            conflicted += a.conflict_cycles > 0 ? gathers : 0;
         }
         if (g == 0) first_group = busy + conflict + align;
         if (!p.scatter_words.empty()) {
             m_scratch_slots.clear();
             for (uint32_t i = 0; i < lanes; ++i)
                 if (op.passed[begin + i]) m_scratch_slots.push_back(slots[i]);
-            if (!m_scratch_slots.empty())
-                for (uint32_t word : p.scatter_words) {
-                    const RayBufferModel::Access a = ray_buffer->access_field(
-                        word, m_scratch_slots.data(), uint32_t(m_scratch_slots.size()));
-                    busy += a.cycles - a.conflict_cycles;
-                    conflict += a.conflict_cycles;
-                    ++field_accesses;
-                    conflicted += a.conflict_cycles > 0;
-                }
+            const uint32_t scatters = uint32_t(p.scatter_words.size());
+            if (!m_scratch_slots.empty()) {
+                const RayBufferModel::Access a = ray_buffer->access_fields(
+                    scatters, m_scratch_slots.data(), uint32_t(m_scratch_slots.size()));
+                busy += a.cycles - a.conflict_cycles;
+                conflict += a.conflict_cycles;
+                field_accesses += scatters;
+                conflicted += a.conflict_cycles > 0 ? scatters : 0;
+            }
         }
     }
     busy += simd->execute(op.kind, groups, p.compute_instructions);

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include <tlm>
+
 #include "hw_model/systemc/accelerator.h"
 
 namespace sfx {
@@ -18,6 +20,10 @@ void new_simulation_context() {
     sc_core::sc_curr_simcontext = new sc_core::sc_simcontext();
     sc_core::sc_default_global_context = sc_core::sc_curr_simcontext;
     sc_core::sc_report_handler::set_actions(sc_core::SC_INFO, sc_core::SC_DO_NOTHING);
+    // Sequencers run ahead of the kernel by up to one quantum: a wait() per quantum rather
+    // than per operation. Nothing else shares time with them, so the quantum never changes
+    // a result, only how often the kernel switches contexts.
+    tlm::tlm_global_quantum::instance().set(sc_core::sc_time(100, sc_core::SC_US));
 }
 
 }  // namespace

@@ -11,9 +11,9 @@
 namespace sfx {
 
 struct RayBufferIf : virtual sc_core::sc_interface {
-    // One field word for a group of lanes (gather or scatter).
-    virtual RayBufferModel::Access access_field(uint32_t word, const uint32_t* slots,
-                                                uint32_t lanes) = 0;
+    // `words` field words for a group of lanes, one after another (gathers or scatters).
+    virtual RayBufferModel::Access access_fields(uint32_t words, const uint32_t* slots,
+                                                 uint32_t lanes) = 0;
     // A run of the id stream.
     virtual RayBufferModel::Contiguous access_ids(uint64_t offset, uint32_t lanes) = 0;
     virtual uint32_t fill_cycles() const = 0;

@@ -84,3 +84,19 @@ TEST_CASE("Address generation: units times rate per cycle", "[hw_model]") {
     a.addresses_per_cycle = 2;
     CHECK(address_cycles(a, 64) == 1);
 }
+
+TEST_CASE("Record layout: soa spreads consecutive slots, aos strides by the record size",
+          "[hw_model]") {
+    RayBufferConfig c;  // 32 banks
+    std::vector<uint32_t> slots(16);
+    std::iota(slots.begin(), slots.end(), 0u);
+    const RayBufferModel soa(c, 24, 4096);
+    c.layout = "aos";
+    const RayBufferModel aos(c, 24, 4096);
+    CHECK(soa.access_field(5, slots.data(), 16).conflict_cycles == 0);
+    // 24-word records: slot * 24 mod 32 takes 4 values, so 16 slots queue 4 deep.
+    CHECK(aos.access_field(5, slots.data(), 16).cycles == 4);
+    CHECK(aos.access_fields(3, slots.data(), 16).conflict_cycles == 3 * 3);
+    const RayBufferModel odd(c, 25, 4096);  // an odd record size spreads again
+    CHECK(odd.access_field(0, slots.data(), 16).conflict_cycles == 0);
+}

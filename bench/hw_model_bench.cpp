@@ -1,0 +1,150 @@
+// Speed of the cycle-level hardware model, measured side by side in one run:
+//  1. simulated cycles per host second of the full SystemC model (width 16, 32 banks) against
+//     an empty clocked SystemC process (an sc_clock driving one SC_METHOD) — target >= 2x;
+//  2. the cost of each extra hardware configuration timed on the same trace, as a fraction of
+//     the first configuration's cost (functional render included) — target <= 10 %.
+// Usage: sfx_bench_hw_model [scene] [WxH] [spp] [repetitions]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <systemc>
+#include <vector>
+
+#include "hw_model/pass_buffer.h"
+#include "hw_model/systemc/systemc_timing.h"
+#include "kernels/bvh.h"
+#include "kernels/stream/stream_tracer.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+struct EmptyClocked : sc_core::sc_module {
+    sc_core::sc_in<bool> clk;
+    uint64_t ticks = 0;
+    SC_HAS_PROCESS(EmptyClocked);
+    explicit EmptyClocked(sc_core::sc_module_name n) : sc_module(n) {
+        SC_METHOD(tick);
+        sensitive << clk.pos();
+        dont_initialize();
+    }
+    void tick() { ++ticks; }
+};
+
+// Host seconds for `cycles` cycles of an sc_clock driving one empty SC_METHOD.
+double empty_clocked_seconds(uint64_t cycles) {
+    sc_core::sc_curr_simcontext = new sc_core::sc_simcontext();
+    sc_core::sc_default_global_context = sc_core::sc_curr_simcontext;
+    sc_core::sc_clock clock("clock", 2, sc_core::SC_NS);
+    EmptyClocked m("empty");
+    m.clk(clock);
+    const auto t0 = Clock::now();
+    sc_core::sc_start(double(2 * cycles), sc_core::SC_NS);
+    return seconds(t0);
+}
+
+// Records every pass of a render so timing can be measured without the tracer.
+class PassRecorder : public TraceSink {
+public:
+    void begin_pass(const TilePass& p) override { m_passes.emplace_back(); m_passes.back().begin_pass(p); }
+    void op(const StreamOp& o) override { m_passes.back().op(o); }
+    void end_pass(const TilePass& p) override { m_passes.back().end_pass(p); }
+    void replay(TraceSink& sink) const {
+        for (const PassBuffer& b : m_passes) {
+            sink.begin_pass(b.pass());
+            for (size_t i = 0; i < b.size(); ++i) sink.op(b.at(i));
+            sink.end_pass(b.pass());
+        }
+    }
+
+private:
+    std::vector<PassBuffer> m_passes;
+};
+
+}  // namespace
+
+extern "C" int sc_main(int, char**) { return 0; }
+
+int main(int argc, char** argv) {
+    setenv("SC_COPYRIGHT_MESSAGE", "DISABLE", 1);
+    const std::string scene_name = argc > 1 ? argv[1] : "atrium";
+    const std::string res = argc > 2 ? argv[2] : "128x128";
+    const uint32_t spp = argc > 3 ? uint32_t(std::atoi(argv[3])) : 4;
+    const int reps = argc > 4 ? std::atoi(argv[4]) : 3;
+    RenderSettings settings;
+    std::sscanf(res.c_str(), "%ux%u", &settings.width, &settings.height);
+    settings.spp = spp;
+    settings.tile = 32;
+    const Scene scene = load_scene(scene_name);
+    settings.max_depth = scene.max_depth;
+    const Bvh bvh(scene);
+    WorkloadShape shape;
+    shape.features = scene.features();
+    shape.triangles = scene.triangles.size();
+    shape.spheres = scene.spheres.size();
+    shape.bvh_nodes = bvh.nodes().size();
+    shape.tile = settings.tile;
+    std::printf("scene %s %ux%u x %u spp, tile %u, width 16, 32 banks, %d repetitions (median)\n",
+                scene_name.c_str(), settings.width, settings.height, spp, settings.tile, reps);
+
+    PassRecorder recorded;
+    render_stream(scene, bvh, settings, &recorded);
+    HwConfig gr08;  // width 16, 32 banks
+
+    // 1. Cycle-level model on recorded passes versus an empty clocked process.
+    std::vector<double> model_s, empty_s;
+    uint64_t cycles = 0;
+    for (int r = 0; r < reps; ++r) {
+        const auto t0 = Clock::now();
+        {
+            SystemcTiming timing({gr08}, shape);
+            recorded.replay(timing);
+            cycles = timing.timing(0).cycles;
+        }
+        model_s.push_back(seconds(t0));
+        empty_s.push_back(empty_clocked_seconds(cycles));
+    }
+    const double model_rate = double(cycles) / median(model_s);
+    const double empty_rate = double(cycles) / median(empty_s);
+    std::printf("simulated cycles          %llu\n", (unsigned long long)cycles);
+    std::printf("full model                %.3g cycles/host s (%.3f s)\n", model_rate, median(model_s));
+    std::printf("empty clocked process     %.3g cycles/host s (%.3f s)\n", empty_rate, median(empty_s));
+    std::printf("ratio model/empty         %.2fx (target >= 2x)\n", model_rate / empty_rate);
+
+    // 2. Extra configurations on one trace: render + K accelerators, K = 1..4.
+    std::vector<HwConfig> configs;
+    for (uint32_t w : {16u, 8u, 12u, 4u}) {
+        HwConfig c = gr08;
+        c.simd.width = w;
+        c.name = "w" + std::to_string(w);
+        configs.push_back(c);
+    }
+    std::vector<double> group_s(configs.size());
+    for (size_t k = 1; k <= configs.size(); ++k) {
+        std::vector<double> s;
+        for (int r = 0; r < reps; ++r) {
+            const auto t0 = Clock::now();
+            SystemcTiming timing(std::vector<HwConfig>(configs.begin(), configs.begin() + k), shape);
+            render_stream(scene, bvh, settings, &timing);
+            s.push_back(seconds(t0));
+        }
+        group_s[k - 1] = median(s);
+        std::printf("render + %zu configuration%s %.3f s\n", k, k == 1 ? " " : "s", group_s[k - 1]);
+    }
+    const double extra = (group_s.back() - group_s.front()) / double(configs.size() - 1);
+    std::printf("each extra configuration  %.1f %% of the first (target <= 10 %%)\n",
+                100.0 * extra / group_s.front());
+    return 0;
+}
