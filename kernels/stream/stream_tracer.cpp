@@ -58,6 +58,21 @@ struct RayBuffers {
     }
 };
 
+// The first stage of intersect_triangle, the same float operations: true only where that
+// test rejects (strictly mixed edge signs, none zero), so most misses skip the full call.
+inline bool triangle_edge_reject(const RayPrecomp& r, const Vec3& p0, const Vec3& p1,
+                                 const Vec3& p2) {
+    const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
+    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
+    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
+    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    const float u = cx * by - cy * bx;
+    const float v = ax * cy - ay * cx;
+    const float w = bx * ay - by * ax;
+    if (u == 0.f || v == 0.f || w == 0.f) return false;  // the full test decides in double
+    return (u < 0.f || v < 0.f || w < 0.f) && (u > 0.f || v > 0.f || w > 0.f);
+}
+
 // The box filter of Fig. 5: gather Width lanes (a partial last group repeats its last ray),
 // test them together, partition. `negative` counts passing rays whose direction is negative
 // on the node's split axis (for the front-child vote).
@@ -130,6 +145,10 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         const auto [node_index, len] = stack.back();
         stack.pop_back();
         const BvhNode& node = nodes[node_index];
+        if (!node.is_leaf()) {  // the children arrive while this node's filter runs
+            __builtin_prefetch(&nodes[node.first]);
+            __builtin_prefetch(&nodes[node.right]);
+        }
         uint32_t negative = 0;
         const uint32_t k = box_filter(trace, node, node_index, generation, rays, ids, len, mask,
                                       scratch, negative);
@@ -137,8 +156,14 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
+                const bool sphere = scene.is_sphere(prim);
+                const Triangle& tri = scene.triangles[sphere ? 0 : prim];
+                const Vec3 p0 = sphere ? Vec3() : scene.positions[tri.v0];
+                const Vec3 p1 = sphere ? Vec3() : scene.positions[tri.v1];
+                const Vec3 p2 = sphere ? Vec3() : scene.positions[tri.v2];
                 const uint32_t passed = evaluate<k_host_width>(ids, k, mask, [&](uint32_t id) {
                     TraversalRay& r = rays[id];
+                    if (!sphere && triangle_edge_reject(r.pre, p0, p1, p2)) return false;
                     if (!bvh.intersect_primitive(r.pre, prim, r.t, hit[id])) return false;
                     // Closest hit: later tests need t or less. Any hit: the ray is done, and
                     // with t = -1 every later box and primitive test misses it.
@@ -151,7 +176,6 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         } else {
             const bool right_first = 2 * negative > k;
             const uint32_t front = right_first ? node.right : node.first;
-            __builtin_prefetch(&nodes[front]);
             stack.push_back({right_first ? node.first : node.right, k});  // back: popped last
             stack.push_back({front, k});
         }
