@@ -65,7 +65,9 @@ std::vector<Ray> soup_rays(uint32_t seed, int count) {
         Ray r;
         r.org = Vec3(rng.range(-12.f, 12.f), rng.range(-12.f, 12.f), rng.range(-12.f, 12.f));
         switch (i % 4) {
-            case 0: r.dir = rng.unit_vector(); break;
+            case 0:
+                r.dir = rng.unit_vector();
+                break;
             case 1: {  // along an axis from a half-integer grid: hits the coplanar squares
                 const int axis = int(rng.below(3));
                 r.dir = Vec3(0.f);
@@ -82,7 +84,9 @@ std::vector<Ray> soup_rays(uint32_t seed, int count) {
                 r.dir = target - r.org;
                 break;
             }
-            default: r.dir = rng.unit_vector() * rng.range(0.01f, 100.f); break;
+            default:
+                r.dir = rng.unit_vector() * rng.range(0.01f, 100.f);
+                break;
         }
         if (i % 3 == 0) r.t_max = rng.range(0.5f, 20.f);
         rays.push_back(r);
@@ -156,9 +160,9 @@ TEST_CASE("geometry: BVH traversal equals brute force, ties included", "[geometr
             if (!same) {
                 ++mismatches;
                 UNSCOPED_INFO("ray " << ray.org.x << ' ' << ray.org.y << ' ' << ray.org.z << " / "
-                              << ray.dir.x << ' ' << ray.dir.y << ' ' << ray.dir.z << " bvh "
-                              << hit.prim << " t " << hit.t << " ref " << reference.prim
-                              << " t " << reference.t);
+                                     << ray.dir.x << ' ' << ray.dir.y << ' ' << ray.dir.z << " bvh "
+                                     << hit.prim << " t " << hit.t << " ref " << reference.prim
+                                     << " t " << reference.t);
             }
             occlusion_mismatches += bvh.occluded(ray) != reference.valid();
         };

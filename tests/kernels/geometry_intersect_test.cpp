@@ -3,7 +3,6 @@
 // back faces and coplanar ties.
 
 #include <catch2/catch.hpp>
-
 #include <cfloat>
 #include <limits>
 
@@ -100,8 +99,8 @@ TEST_CASE("geometry: denormal direction components behave exactly like zeros", "
             denormal.dir[a] = denormals[rng.below(6)];
             zero.dir[a] = std::copysign(0.f, denormal.dir[a]);
         }
-        CAPTURE(i, denormal.org.x, denormal.org.y, denormal.org.z, denormal.dir.x,
-                denormal.dir.y, denormal.dir.z);
+        CAPTURE(i, denormal.org.x, denormal.org.y, denormal.org.z, denormal.dir.x, denormal.dir.y,
+                denormal.dir.z);
         const Hit hz = world->bvh.intersect(zero), hd = world->bvh.intersect(denormal);
         REQUIRE(same_hit(hz, hd));
         REQUIRE(world->bvh.occluded(zero) == world->bvh.occluded(denormal));
@@ -140,7 +139,10 @@ TEST_CASE("geometry: NaN or Inf rays are inactive and miss", "[geometry]") {
     for (float b : bad)
         for (int which = 0; which < 6; ++which) {
             Ray ray{Vec3(0.1f, 0.2f, -5.f), Vec3(0.f, 0.f, 1.f), INFINITY};
-            if (which < 3) ray.org[which] = b; else ray.dir[which - 3] = b;
+            if (which < 3)
+                ray.org[which] = b;
+            else
+                ray.dir[which - 3] = b;
             CAPTURE(b, which);
             CHECK_FALSE(ray_is_valid(ray));
             CHECK_FALSE(world->bvh.intersect(ray).valid());
@@ -172,11 +174,22 @@ TEST_CASE("geometry: degenerate triangles are never hit", "[geometry]") {
         Vec3 d = dyadic(256, scale);
         if (is_black(d)) d = Vec3(scale, 0.f, 0.f);
         switch (i % 5) {
-            case 0: add_triangle(s, p, p, p); targets.push_back(p); break;  // a point
-            case 1: add_triangle(s, p, p + d, p); break;                    // two equal vertices
-            case 2: add_triangle(s, p, p + d, p + d * 2.f); break;          // collinear
-            case 3: add_triangle(s, p + d * 2.f, p, p + d * 3.f); break;    // collinear, middle first
-            case 4: add_triangle(s, p, p + d * 4.f, p + d); break;
+            case 0:
+                add_triangle(s, p, p, p);
+                targets.push_back(p);
+                break;  // a point
+            case 1:
+                add_triangle(s, p, p + d, p);
+                break;  // two equal vertices
+            case 2:
+                add_triangle(s, p, p + d, p + d * 2.f);
+                break;  // collinear
+            case 3:
+                add_triangle(s, p + d * 2.f, p, p + d * 3.f);
+                break;  // collinear, middle first
+            case 4:
+                add_triangle(s, p, p + d * 4.f, p + d);
+                break;
         }
         if (i % 5 != 0) {
             targets.push_back(p + d * 0.5f);
@@ -238,7 +251,10 @@ TEST_CASE("geometry: exact hit on a unit triangle within 16 ulp", "[geometry]") 
         float x, y;
         if (i < 1891) {  // all (i, j) / 64 with i, j >= 1 and i + j <= 63
             int k = i, a = 1;
-            while (k >= 63 - a) { k -= 63 - a; ++a; }
+            while (k >= 63 - a) {
+                k -= 63 - a;
+                ++a;
+            }
             x = float(a) / 64.f;
             y = float(k + 1) / 64.f;
         } else {

@@ -2,9 +2,8 @@
 // watertightness far from the origin, rays through vertices and edges, self-intersection
 // of spawned rays, tiny triangles seen from far away.
 
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <numeric>
 
 #include "tests/kernels/geometry_test_util.h"
@@ -16,7 +15,26 @@ namespace {
 
 const Vec3 k_far_center(148376.f, 1234.f, -223423.f);
 
-Vec3 spawn_origin(const SurfaceHit& s, const Vec3& n) { return offset_ray_origin(s, n); }
+Vec3 spawn_origin(const SurfaceHit& s, const Vec3& n) {
+    return offset_ray_origin(s, n);
+}
+
+// Signed distance (times the normal's length) of q from the plane of p0 p1 p2, in long double.
+long double plane_side(const Vec3* p, const Vec3& q) {
+    using R = long double;
+    const R e1[3] = {R(p[1].x) - p[0].x, R(p[1].y) - p[0].y, R(p[1].z) - p[0].z};
+    const R e2[3] = {R(p[2].x) - p[0].x, R(p[2].y) - p[0].y, R(p[2].z) - p[0].z};
+    const R n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0]};
+    return n[0] * (R(q.x) - p[0].x) + n[1] * (R(q.y) - p[0].y) + n[2] * (R(q.z) - p[0].z);
+}
+
+// |q - center|^2 - r^2 in long double: positive outside the sphere.
+long double sphere_side(const Sphere& s, const Vec3& q) {
+    using R = long double;
+    const R dx = R(q.x) - s.center.x, dy = R(q.y) - s.center.y, dz = R(q.z) - s.center.z;
+    return dx * dx + dy * dy + dz * dz - R(s.radius) * s.radius;
+}
 
 }  // namespace
 
@@ -49,8 +67,8 @@ TEST_CASE("geometry: rays aimed exactly at vertices of a closed mesh never miss"
         double quantum;  // vertex offsets snapped to a dyadic grid: org + dir == vertex exactly
     };
     int checked = 0;
-    for (const Setup& setup : {Setup{Vec3(0.5f, -0.25f, 0.75f), 1.0 / 4096.0},
-                               Setup{k_far_center, 0.0}}) {
+    for (const Setup& setup :
+         {Setup{Vec3(0.5f, -0.25f, 0.75f), 1.0 / 4096.0}, Setup{k_far_center, 0.0}}) {
         Scene s;
         add_sphere_mesh(s, setup.center, 2.0, setup.quantum > 0.0 ? 200 : 500, setup.quantum);
         auto world = make_world(std::move(s));
@@ -173,12 +191,12 @@ TEST_CASE("geometry: a ray through a shared edge or vertex hits once, determinis
     std::vector<Vec3> targets;
     for (int k = 0; k < 64; ++k) {
         const float s = float(k + 1) / 128.f;
-        targets.push_back(Vec3(0.f));                   // the shared vertex
-        targets.push_back(Vec3(s, 0.f, 0.f));           // edges of the fan
+        targets.push_back(Vec3(0.f));          // the shared vertex
+        targets.push_back(Vec3(s, 0.f, 0.f));  // edges of the fan
         targets.push_back(Vec3(0.f, -s, 0.f));
         targets.push_back(Vec3(s, s, 0.f));
         targets.push_back(Vec3(-s, -s, 0.f));
-        targets.push_back(Vec3(2.f, s, s));             // the tilted shared edge
+        targets.push_back(Vec3(2.f, s, s));  // the tilted shared edge
     }
     int ties = 0, checked = 0;
     for (const Vec3& target : targets)
@@ -244,6 +262,7 @@ TEST_CASE("geometry: a ray through a shared edge or vertex hits once, determinis
 TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "[geometry]") {
     TestRng rng(11);
     int spawned = 0, self_hits_front = 0, self_hits_back = 0, shadow_hits = 0, primary_misses = 0;
+    int wrong_side = 0;
     for (int i = 0; i < 3000; ++i) {
         // A well-shaped triangle of random size and orientation around a random center,
         // coordinates spanning 1e-8 .. 1e8. Its size is at least 1e-4 of the center's distance
@@ -270,13 +289,21 @@ TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "
         for (int k = 0; k < 4; ++k) {
             // Primary ray toward an interior point, from either side.
             float u = rng.range(0.05f, 0.9f), v = rng.range(0.05f, 0.9f);
-            if (u + v > 0.95f) { u = 0.95f - u; v = 0.95f - v; u = std::fabs(u); v = std::fabs(v); }
+            if (u + v > 0.95f) {
+                u = 0.95f - u;
+                v = 0.95f - v;
+                u = std::fabs(u);
+                v = std::fabs(v);
+            }
             const Vec3 target = p[0] * (1.f - u - v) + p[1] * u + p[2] * v;
             const Vec3 side = rng.hemisphere(gn, 0.1f) * (rng.uniform() < 0.5f ? 1.f : -1.f);
             const Vec3 org = target + side * (size * rng.range(0.5f, 4.f));
             const Ray primary{org, target - org, INFINITY};
             const Hit hit = world->bvh.intersect(primary);
-            if (!hit.valid()) { ++primary_misses; continue; }
+            if (!hit.valid()) {
+                ++primary_misses;
+                continue;
+            }
             const SurfaceHit sh = surface_at(world->scene, primary, hit);
             // Reflected: leave on the side the ray came from, any direction in that hemisphere,
             // down to grazing.
@@ -284,6 +311,11 @@ TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "
                 const float min_cos = r == 0 ? 1e-4f : 0.01f;
                 const Ray refl{spawn_origin(sh, sh.normal), rng.hemisphere(sh.normal, min_cos),
                                INFINITY};
+                // The offset origins lie strictly on their side of the plane (checked exactly).
+                const long double front = plane_side(p, refl.org) * dot(gn, sh.normal);
+                const long double back =
+                    plane_side(p, spawn_origin(sh, -sh.normal)) * dot(gn, sh.normal);
+                wrong_side += !(front > 0) + !(back < 0);
                 self_hits_front += world->bvh.intersect(refl).valid();
                 const Ray trans{spawn_origin(sh, -sh.normal), rng.hemisphere(-sh.normal, min_cos),
                                 INFINITY};
@@ -292,7 +324,8 @@ TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "
                 const Vec3 up = sh.normal * (r % 2 ? 1.f : -1.f);
                 const Vec3 from = spawn_origin(sh, up);
                 const Vec3 to = center + (rng.unit_vector() * rng.range(0.f, 3.f) +
-                                          rng.hemisphere(up, 0.05f) * rng.range(0.1f, 3.f)) * size;
+                                          rng.hemisphere(up, 0.05f) * rng.range(0.1f, 3.f)) *
+                                             size;
                 const Vec3 to_side = to - sh.position;
                 if (dot(to_side, up) > 0.01f * size) {
                     shadow_hits += world->bvh.occluded(Ray{from, to - from, 1.f});
@@ -302,16 +335,17 @@ TEST_CASE("geometry: spawned and shadow rays never re-hit their own triangle", "
         }
     }
     CHECK(primary_misses == 0);
+    CHECK(wrong_side == 0);
     CHECK(self_hits_front == 0);
     CHECK(self_hits_back == 0);
     CHECK(shadow_hits == 0);
     CHECK(spawned > 100000);
 }
 
-TEST_CASE("geometry: spawned rays never re-hit their own sphere at the spawn point",
-          "[geometry]") {
+TEST_CASE("geometry: spawned rays never re-hit their own sphere at the spawn point", "[geometry]") {
     TestRng rng(111);
     int outward_hits = 0, inward_wrong = 0, shadow_hits = 0, primary_misses = 0, spawned = 0;
+    int wrong_side = 0;
     for (int i = 0; i < 3000; ++i) {
         const float scale = std::pow(10.f, rng.range(-4.f, 4.f));
         Sphere sp;
@@ -333,12 +367,17 @@ TEST_CASE("geometry: spawned rays never re-hit their own sphere at the spawn poi
                 primary.dir = aim - primary.org;
             }
             const Hit hit = world->bvh.intersect(primary);
-            if (!hit.valid()) { ++primary_misses; continue; }
+            if (!hit.valid()) {
+                ++primary_misses;
+                continue;
+            }
             const SurfaceHit sh = surface_at(world->scene, primary, hit);
             const Vec3 outward = sh.front_face ? sh.normal : -sh.normal;
             for (int r = 0; r < 4; ++r) {
                 const float min_cos = r == 0 ? 1e-3f : 0.05f;
                 // Outward: a convex surface is never hit again.
+                wrong_side += !(sphere_side(sp, spawn_origin(sh, outward)) > 0);
+                wrong_side += !(sphere_side(sp, spawn_origin(sh, -outward)) < 0);
                 const Ray out{spawn_origin(sh, outward), rng.hemisphere(outward, min_cos),
                               INFINITY};
                 outward_hits += world->bvh.intersect(out).valid();
@@ -358,14 +397,14 @@ TEST_CASE("geometry: spawned rays never re-hit their own sphere at the spawn poi
         }
     }
     CHECK(primary_misses == 0);
+    CHECK(wrong_side == 0);
     CHECK(outward_hits == 0);
     CHECK(inward_wrong == 0);
     CHECK(shadow_hits == 0);
     CHECK(spawned > 100000);
 }
 
-TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroids",
-          "[geometry]") {
+TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroids", "[geometry]") {
     TestRng rng(12);
     // A 64 x 64 grid of triangle pairs, each 1e-4 across, near the origin in the plane z = 0.
     Scene s;
@@ -385,7 +424,8 @@ TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroid
     for (uint32_t p = 0; p < world->scene.triangle_count(); ++p) {
         const Triangle& tri = world->scene.triangles[p];
         const Vec3 c = (world->scene.positions[tri.v0] + world->scene.positions[tri.v1] +
-                        world->scene.positions[tri.v2]) * (1.f / 3.f);
+                        world->scene.positions[tri.v2]) *
+                       (1.f / 3.f);
         // Straight on from z = -1e6 (the direction is exact), and obliquely from 1e6 away
         // along the z axis (the ray passes within float precision of the centroid).
         const Ray straight{Vec3(0.f, 0.f, -1e6f), c - Vec3(0.f, 0.f, -1e6f), INFINITY};
@@ -420,7 +460,8 @@ TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroid
     for (uint32_t p = 0; p < far_world->scene.triangle_count(); ++p) {
         const Triangle& tri = far_world->scene.triangles[p];
         const Vec3 c = (far_world->scene.positions[tri.v0] + far_world->scene.positions[tri.v1] +
-                        far_world->scene.positions[tri.v2]) * (1.f / 3.f);
+                        far_world->scene.positions[tri.v2]) *
+                       (1.f / 3.f);
         const Vec3 org = base + rng.hemisphere(normal, 0.766f) * 1e6f;
         const Ray ray{org, c - org, INFINITY};
         const Hit hit = far_world->bvh.intersect(ray);

@@ -18,7 +18,7 @@ namespace sfx::test {
 
 // Deterministic uniform numbers from mt19937's raw output (its sequence is fixed by the standard).
 class TestRng {
-public:
+  public:
     explicit TestRng(uint32_t seed) : m_engine(seed) {}
     float uniform() { return float(m_engine() >> 8) * (1.f / 16777216.f); }  // [0, 1)
     double uniform_double() { return double(m_engine() >> 5) * (1.0 / 134217728.0); }
@@ -40,7 +40,7 @@ public:
         }
     }
 
-private:
+  private:
     std::mt19937 m_engine;
 };
 
@@ -54,8 +54,12 @@ inline int64_t ulp_distance(float a, float b) {
     const int64_t d = key(a) - key(b);
     return d < 0 ? -d : d;
 }
-inline bool within_ulps(float a, float b, int64_t ulps = 16) { return ulp_distance(a, b) <= ulps; }
-inline bool same_bits(float a, float b) { return float_bits(a) == float_bits(b); }
+inline bool within_ulps(float a, float b, int64_t ulps = 16) {
+    return ulp_distance(a, b) <= ulps;
+}
+inline bool same_bits(float a, float b) {
+    return float_bits(a) == float_bits(b);
+}
 
 inline uint32_t add_material(Scene& s) {
     Material m;
@@ -104,14 +108,17 @@ inline void add_sphere_mesh(Scene& s, const Vec3& center, double radius, int seg
         }
     }
     const uint32_t south = put(0, 0, -radius);
-    auto ring = [&](int b, int i) { return first_ring + uint32_t((b - 1) * segments + i % segments); };
+    auto ring = [&](int b, int i) {
+        return first_ring + uint32_t((b - 1) * segments + i % segments);
+    };
     for (int i = 0; i < segments; ++i) add_triangle(s, north, ring(1, i), ring(1, i + 1));
     for (int b = 1; b + 1 < bands; ++b)
         for (int i = 0; i < segments; ++i) {
             add_triangle(s, ring(b, i), ring(b + 1, i), ring(b + 1, i + 1));
             add_triangle(s, ring(b, i), ring(b + 1, i + 1), ring(b, i + 1));
         }
-    for (int i = 0; i < segments; ++i) add_triangle(s, ring(bands - 1, i), south, ring(bands - 1, i + 1));
+    for (int i = 0; i < segments; ++i)
+        add_triangle(s, ring(bands - 1, i), south, ring(bands - 1, i + 1));
 }
 
 // A scene and its BVH, kept together (the BVH points at the scene, so neither may move).
