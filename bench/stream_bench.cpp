@@ -183,7 +183,8 @@ int main(int argc, char** argv) {
     RenderResult ref_frame, st_frame;
     const double f_ref =
         best_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
-    const double f_st = best_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
+    const double f_st =
+        best_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
     CountingSink counts({8, 16});
     const double f_count = best_seconds(1, [&] { render_stream(scene, bvh, settings, &counts); });
     const bool same = std::memcmp(ref_frame.image.pixels.data(), st_frame.image.pixels.data(),

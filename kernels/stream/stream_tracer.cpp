@@ -15,9 +15,6 @@ namespace sfx {
 
 namespace {
 
-// The ray buffers of one stream, one array per field group (structure of arrays). A slot is a
-// path: a path carries one ray at a time, so its next ray goes to the same slot of the
-// next-generation buffer, and streams are lists of slots.
 // What a box test gathers per lane, in one cache line: the test's constants and its t_max
 // (the closest hit so far, or the ray's t_max; -1 for an occluded shadow ray, which every
 // later box and primitive test then misses).
@@ -26,6 +23,9 @@ struct alignas(64) TraversalRay {
     float t;
 };
 
+// The ray buffers of one stream, one array per field group (structure of arrays). A slot is a
+// path: a path carries one ray at a time, so its next ray goes to the same slot of the
+// next-generation buffer, and streams are lists of slots.
 struct RayBuffers {
     uint32_t capacity = 0;
     std::vector<PathState> path;
