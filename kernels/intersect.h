@@ -215,6 +215,18 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n)
     return out;
 }
 
+// Error bounds of surface points, for offset_ray_origin(p, p_error, n).
+// A point p0 w + p1 u + p2 v: any weights summing to 1 give a point of the plane, and
+// w = 1 - u - v makes the sum 1 to a rounding, so the error is the weighted sum's (pbrt-v4).
+inline Vec3 triangle_point_error(const Vec3& p0, const Vec3& p1, const Vec3& p2, float w,
+                                 float u, float v) {
+    return (abs(p0 * w) + abs(p1 * u) + abs(p2 * v)) * gamma_bound(7);
+}
+// A point center + n * radius with n normalized in float.
+inline Vec3 sphere_point_error(const Vec3& center, const Vec3& n, float radius) {
+    return (abs(center) + abs(n * radius)) * gamma_bound(6);
+}
+
 // Surface data at a hit, computed the same way by every tracer.
 struct SurfaceHit {
     Vec3 position;
@@ -233,7 +245,7 @@ inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit)
         n = (p - sp.center) * (1.f / sp.radius);
         n = normalize(n);
         s.position = sp.center + n * sp.radius;  // re-project: error ~ radius, not distance
-        s.position_error = (abs(sp.center) + abs(n * sp.radius)) * gamma_bound(6);
+        s.position_error = sphere_point_error(sp.center, n, sp.radius);
     } else {
         const Triangle& tri = scene.triangles[hit.prim];
         const Vec3& p0 = scene.positions[tri.v0];
@@ -241,9 +253,7 @@ inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit)
         const Vec3& p2 = scene.positions[tri.v2];
         const float w = 1.f - hit.u - hit.v;
         s.position = p0 * w + p1 * hit.u + p2 * hit.v;  // barycentric: error ~ vertex magnitude
-        // Any weights summing to 1 give a point of the plane; 1 - u - v makes the sum exact
-        // to a rounding, so the error is that of the weighted sum (pbrt-v4: gamma(7)).
-        s.position_error = (abs(p0 * w) + abs(p1 * hit.u) + abs(p2 * hit.v)) * gamma_bound(7);
+        s.position_error = triangle_point_error(p0, p1, p2, w, hit.u, hit.v);
         n = normalize(cross(p1 - p0, p2 - p0));
     }
     s.front_face = dot(n, ray.dir) < 0.f;
