@@ -2,7 +2,10 @@
 // width 1 is recursive tracing; width = stream size is packet tracing), the trace file.
 
 #include <catch2/catch.hpp>
+#include <unistd.h>
+
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -262,7 +265,10 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CHECK(direct.rays() == a.stats.rays());
     CHECK(direct.kind_ops(OpKind::shadow_filter) > 0);
 
-    const std::string p1 = "stream_trace_test_1.trc", p2 = "stream_trace_test_2.trc";
+    // In the temporary directory, named by process, so parallel test runs never share a file.
+    const std::string base = (std::filesystem::temp_directory_path() /
+                              ("sfx_stream_trace_" + std::to_string(::getpid()))).string();
+    const std::string p1 = base + "_1.trc", p2 = base + "_2.trc";
     {
         TraceFileWriter w(p1);
         render_stream(s, bvh, r, &w);
