@@ -131,16 +131,18 @@ int main(int argc, char** argv) {
         c.name = "w" + std::to_string(w);
         configs.push_back(c);
     }
-    std::vector<double> group_s(configs.size());
-    for (size_t k = 1; k <= configs.size(); ++k) {
-        std::vector<double> s;
-        for (int r = 0; r < reps; ++r) {
+    // Interleaved (k = 1..4 within each repetition) so machine noise hits every k alike.
+    std::vector<std::vector<double>> samples(configs.size());
+    for (int r = 0; r < reps; ++r)
+        for (size_t k = 1; k <= configs.size(); ++k) {
             const auto t0 = Clock::now();
             SystemcTiming timing(std::vector<HwConfig>(configs.begin(), configs.begin() + k), shape);
             render_stream(scene, bvh, settings, &timing);
-            s.push_back(seconds(t0));
+            samples[k - 1].push_back(seconds(t0));
         }
-        group_s[k - 1] = median(s);
+    std::vector<double> group_s(configs.size());
+    for (size_t k = 1; k <= configs.size(); ++k) {
+        group_s[k - 1] = median(samples[k - 1]);
         std::printf("render + %zu configuration%s %.3f s\n", k, k == 1 ? " " : "s", group_s[k - 1]);
     }
     const double extra = (group_s.back() - group_s.front()) / double(configs.size() - 1);

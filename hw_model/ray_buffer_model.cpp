@@ -13,6 +13,7 @@ RayBufferModel::RayBufferModel(const RayBufferConfig& config, uint32_t record_wo
       m_per_bank(config.banks) {
     if (m_banks == 0 || m_line_words == 0 || m_latency == 0)
         throw std::invalid_argument("ray buffer: banks, line_words and latency must be >= 1");
+    if ((m_banks & (m_banks - 1)) == 0) m_bank_mask = m_banks - 1;
 }
 
 RayBufferModel::Access RayBufferModel::access_field(uint32_t field_word, const uint32_t* slots,
@@ -44,19 +45,29 @@ RayBufferModel::Contiguous RayBufferModel::access_contiguous(uint64_t offset,
     return c;
 }
 
-PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
-                             uint32_t length) {
-    PartitionCost p;
-    p.compare_cycles = (uint64_t(length) + config.lanes_per_cycle - 1) / config.lanes_per_cycle;
+uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length) {
     uint32_t pass_count = 0;
     for (uint32_t i = 0; i < length; ++i) pass_count += passed[i] ? 1 : 0;
-    uint32_t next_pass = 0, next_fail = pass_count;
+    uint32_t next_pass = 0, next_fail = pass_count, moved = 0;
     for (uint32_t i = 0; i < length; ++i) {
         const uint32_t to = passed[i] ? next_pass++ : next_fail++;
-        if (to != i) ++p.moved_ids;
+        moved += to != i;
     }
+    return moved;
+}
+
+PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint32_t length,
+                             uint32_t moved_ids) {
+    PartitionCost p;
+    p.compare_cycles = (uint64_t(length) + config.lanes_per_cycle - 1) / config.lanes_per_cycle;
+    p.moved_ids = moved_ids;
     p.move_cycles = (p.moved_ids + width - 1) / width;
     return p;
+}
+
+PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
+                             uint32_t length) {
+    return partition_cost(config, width, length, stable_partition_moves(passed, length));
 }
 
 }  // namespace sfx

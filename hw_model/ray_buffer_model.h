@@ -23,7 +23,7 @@ public:
     uint32_t bank_of(uint32_t field_word, uint32_t slot) const {
         const uint64_t word = m_aos ? uint64_t(slot) * m_record_words + field_word
                                     : uint64_t(field_word) * m_slot_count + slot;
-        return uint32_t(word % m_banks);
+        return m_bank_mask ? uint32_t(word & m_bank_mask) : uint32_t(word % m_banks);
     }
 
     // Issue cycles to access one field word of each lane's slot (a gather or a scatter of one
@@ -64,6 +64,7 @@ public:
 
 private:
     uint32_t m_banks, m_line_words, m_latency, m_slot_count, m_record_words;
+    uint32_t m_bank_mask = 0;  // banks - 1 when banks is a power of two: no division per lane
     bool m_pipelined, m_aos;
     mutable std::vector<uint16_t> m_per_bank;  // scratch: zero between calls
 };
@@ -86,5 +87,10 @@ struct PartitionCost {
 };
 PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
                              uint32_t length);
+// The same from the number of ids a stable partition moves, which no configuration changes
+// (a pass buffer computes it once per operation for every configuration).
+PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint32_t length,
+                             uint32_t moved_ids);
+uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 
 }  // namespace sfx

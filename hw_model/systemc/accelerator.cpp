@@ -2,7 +2,8 @@
 
 namespace sfx {
 
-Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c, const WorkloadShape& shape)
+Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c, const WorkloadShape& shape,
+                         std::shared_ptr<SharedSceneMemory> scene_memory)
     : sc_module(name) {
     const RayRecordLayout layout(shape.features);
     const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());
@@ -13,7 +14,7 @@ Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c, const 
     m_partition = std::make_unique<PartitionUnit>("partition", c.partition, c.simd.width);
     m_scratchpad = std::make_unique<ScratchpadUnit>("scratchpad", c.scratchpad);
     m_interconnect = std::make_unique<InterconnectUnit>("interconnect", c.interconnect, c.clock);
-    m_scene_memory = std::make_unique<SceneMemoryUnit>("scene_memory", c.scene_memory, c.clock.core_mhz);
+    m_scene_memory = std::make_unique<SceneMemoryUnit>("scene_memory", std::move(scene_memory));
     SceneDataMap map;
     map.nodes = shape.bvh_nodes;
     map.triangles = shape.triangles;

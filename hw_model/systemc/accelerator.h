@@ -18,7 +18,8 @@ namespace sfx {
 
 class Accelerator : public sc_core::sc_module {
 public:
-    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape);
+    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape,
+                std::shared_ptr<SharedSceneMemory> scene_memory);
 
     void start(const PassBuffer* pass) { m_sequencer->start(pass); }
     // The frame so far, with the scene-cache counters filled in.

@@ -9,8 +9,8 @@ class PartitionUnit : public sc_core::sc_module, public PartitionIf {
 public:
     PartitionUnit(sc_core::sc_module_name name, const PartitionConfig& config, uint32_t width)
         : sc_module(name), m_config(config), m_width(width) {}
-    PartitionCost partition(const uint8_t* passed, uint32_t length) override {
-        return partition_cost(m_config, m_width, passed, length);
+    PartitionCost partition(uint32_t length, uint32_t moved_ids) override {
+        return partition_cost(m_config, m_width, length, moved_ids);
     }
 
 private:

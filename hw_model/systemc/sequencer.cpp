@@ -22,7 +22,7 @@ void Sequencer::run() {
         FrameTiming pass_timing;
         pass_timing.passes = 1;
         for (size_t i = 0; i < m_pass->size(); ++i) {
-            const uint64_t cycles = time_op(m_pass->at(i), pass_timing);
+            const uint64_t cycles = time_op(i, m_pass->at(i), pass_timing);
             m_keeper.inc(m_period * double(cycles));
             if (m_keeper.need_sync()) m_keeper.sync();
         }
@@ -36,7 +36,7 @@ static bool pushes_rays(OpKind k) {
            k == OpKind::lambertian_indirect || k == OpKind::dielectric || k == OpKind::glossy;
 }
 
-uint64_t Sequencer::time_op(const StreamOp& op, FrameTiming& t) {
+uint64_t Sequencer::time_op(size_t index, const StreamOp& op, FrameTiming& t) {
     const uint32_t length = op.length;
     if (length == 0) return 0;
     const OpProfile& p = m_costs[op.kind];
@@ -87,12 +87,12 @@ uint64_t Sequencer::time_op(const StreamOp& op, FrameTiming& t) {
     const uint64_t address_cycles = address->generate(words);
     stalls.address_fetch = address_cycles > data ? address_cycles - data : 0;
     if (p.scene_bytes && op.object != k_no_object) {
-        const uint64_t latency = scene_memory->read(m_map.address(op.kind, op.object), p.scene_bytes);
+        const uint64_t latency = scene_memory->read(index, m_map.address(op.kind, op.object), p.scene_bytes);
         stalls.scene_memory = latency > first_group ? latency - first_group : 0;
     }
     PartitionCost part;
     if (p.partitions) {
-        part = partition->partition(op.passed, length);
+        part = partition->partition(length, m_pass->moved_ids(index));
         stalls.partition = part.cycles();
     }
     // Filter masks go through the scratchpad (one word per group, written then read); it is

@@ -38,7 +38,7 @@ public:
 
 private:
     void run();
-    uint64_t time_op(const StreamOp& op, FrameTiming& t);
+    uint64_t time_op(size_t index, const StreamOp& op, FrameTiming& t);
 
     OpCostTable m_costs;
     SceneDataMap m_map;

@@ -1,6 +1,7 @@
 #include "hw_model/systemc/systemc_timing.h"
 
 #include <atomic>
+#include <map>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -33,12 +34,24 @@ SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const Workloa
         throw std::logic_error("one SystemcTiming at a time: SystemC has one simulation context");
     try {
         new_simulation_context();
-        for (size_t i = 0; i < configs.size(); ++i)
+        std::map<std::string, std::shared_ptr<SharedSceneMemory>> by_config;
+        for (size_t i = 0; i < configs.size(); ++i) {
+            HwConfig memory_only;  // the key: the scene-memory parameters and the core clock
+            memory_only.scene_memory = configs[i].scene_memory;
+            memory_only.clock.core_mhz = configs[i].clock.core_mhz;
+            auto& memory = by_config[dump_hw_config(memory_only)];
+            if (!memory) {
+                memory = std::make_shared<SharedSceneMemory>(configs[i].scene_memory,
+                                                             configs[i].clock.core_mhz);
+                m_memories.push_back(memory);
+            }
             m_accelerators.push_back(std::make_unique<Accelerator>(
-                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape));
+                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape, memory));
+        }
         sc_core::sc_start(sc_core::SC_ZERO_TIME);  // end elaboration; threads wait for passes
     } catch (...) {
         m_accelerators.clear();
+        m_memories.clear();
         g_in_use = false;
         throw;
     }
@@ -46,11 +59,13 @@ SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const Workloa
 
 SystemcTiming::~SystemcTiming() {
     m_accelerators.clear();
+    m_memories.clear();
     g_in_use = false;
 }
 
 void SystemcTiming::end_pass(const TilePass& p) {
     m_pass.end_pass(p);
+    for (auto& m : m_memories) m->begin_pass(m_pass.size());
     for (auto& a : m_accelerators) a->start(&m_pass);
     sc_core::sc_start();  // until every sequencer waits for the next pass
 }

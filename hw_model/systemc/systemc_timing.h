@@ -20,6 +20,7 @@
 namespace sfx {
 
 class Accelerator;
+class SharedSceneMemory;
 
 class SystemcTiming : public TraceSink {
 public:
@@ -38,6 +39,7 @@ public:
 
 private:
     PassBuffer m_pass;
+    std::vector<std::shared_ptr<SharedSceneMemory>> m_memories;  // one per distinct memory config
     std::vector<std::unique_ptr<Accelerator>> m_accelerators;
 };
 

@@ -30,7 +30,7 @@ struct SimdIf : virtual sc_core::sc_interface {
 };
 
 struct PartitionIf : virtual sc_core::sc_interface {
-    virtual PartitionCost partition(const uint8_t* passed, uint32_t length) = 0;
+    virtual PartitionCost partition(uint32_t length, uint32_t moved_ids) = 0;
 };
 
 struct ScratchpadIf : virtual sc_core::sc_interface {
@@ -43,7 +43,8 @@ struct InterconnectIf : virtual sc_core::sc_interface {
 };
 
 struct SceneMemoryIf : virtual sc_core::sc_interface {
-    virtual uint64_t read(uint64_t address, uint32_t bytes) = 0;  // cycles until data arrives
+    // Cycles until the data of operation `op` of the current pass arrives.
+    virtual uint64_t read(size_t op, uint64_t address, uint32_t bytes) = 0;
 };
 
 }  // namespace sfx
