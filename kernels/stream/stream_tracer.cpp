@@ -73,38 +73,36 @@ inline bool triangle_edge_reject(const RayPrecomp& r, const Vec3& p0, const Vec3
     return (u < 0.f || v < 0.f || w < 0.f) && (u > 0.f || v > 0.f || w > 0.f);
 }
 
-// The box filter of Fig. 5: gather Width lanes (a partial last group repeats its last ray),
+// The box filter of Fig. 5: gather 4 lanes (a partial last group repeats its last ray),
 // test them together, partition. `negative` counts passing rays whose direction is negative
 // on the node's split axis (for the front-child vote).
 template <class Trace>
 uint32_t box_filter(Trace& trace, const BvhNode& node, uint32_t node_index, uint16_t generation,
                     const TraversalRay* rays, uint32_t* ids, uint32_t len, uint8_t* mask,
                     uint32_t* scratch, uint32_t& negative) {
-    constexpr int W = k_host_width;
-    BoxLanes<W> lanes;
-    uint8_t m[W];
+    constexpr uint32_t W = 4;
     const int axis = node.axis;
     uint32_t front = 0, back = 0, passed = 0;
     for (uint32_t g = 0; g < len; g += W) {
         const uint32_t count = std::min<uint32_t>(W, len - g);
-        for (int l = 0; l < W; ++l) {
-            const TraversalRay& r = rays[ids[g + std::min<uint32_t>(uint32_t(l), count - 1)]];
-            for (int a = 0; a < 3; ++a) {
-                lanes.org[a][l] = r.pre.org[a];
-                lanes.inv[a][l] = r.pre.inv_dir[a];
-            }
-            lanes.t_max[l] = r.t;
+        const RayPrecomp* lane[W];
+        float t_max[W];
+        for (uint32_t l = 0; l < W; ++l) {
+            const TraversalRay& r = rays[ids[g + std::min(l, count - 1)]];
+            lane[l] = &r.pre;
+            t_max[l] = r.t;
         }
-        box_test_lanes<W>(lanes, node.bounds, m);
+        const uint32_t bits = box_test_gather4(lane, t_max, node.bounds);
         for (uint32_t l = 0; l < count; ++l) {
             const uint32_t id = ids[g + l];
+            const bool in = (bits >> l) & 1u;
             if constexpr (Trace::k_enabled) {
-                mask[g + l] = m[l];
+                mask[g + l] = uint8_t(in);
             } else {  // in-place compaction: front <= g + l, so no unread id is overwritten
-                if (m[l]) ids[front++] = id;
+                if (in) ids[front++] = id;
                 else scratch[back++] = id;
             }
-            if (m[l]) {
+            if (in) {
                 ++passed;
                 negative += rays[id].pre.dir[axis] < 0.f;
             }
