@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <numeric>
 #include <vector>
 
 #include "hw_model/op_costs.h"
@@ -149,7 +150,23 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const double fetch_cycles = expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, profile);
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
-    const double fill_bank = buffer.fill_cycles();
+    const double fill_bank =
+        buffer.fill_cycles() +
+        std::ceil(c.interconnect.mux_levels * c.clock.core_mhz / c.clock.interconnect_mhz);
+    // Banks a group can reach: all of them for soa records; for aos records consecutive slots
+    // step by the record size, reaching banks / gcd(record words, banks) of them.
+    const uint32_t banks = c.ray_buffer.banks;
+    const uint32_t reachable =
+        c.ray_buffer.layout == "aos" ? banks / std::gcd(layout.words(), banks) : banks;
+    // Conflict cycles of one access of `lanes` lanes: dense streams (consecutive slots) queue
+    // only on unreachable banks; sparse ones behave like random slots over the reachable banks.
+    auto group_conflicts = [&](uint32_t lanes, double sparsity) {
+        const double needed = double((lanes + banks - 1) / banks);
+        const double dense = double((lanes + reachable - 1) / reachable) - needed;
+        const double random = expected_conflicts(lanes, reachable) +
+                              double((lanes + reachable - 1) / reachable) - needed;
+        return (1.0 - sparsity) * dense + sparsity * random;
+    };
     FrameTiming t;
     t.passes = profile.passes();
     double total_cycles = 0.0;
@@ -174,15 +191,14 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             const double per_request = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
             const double gathers = double(p.gather_words.size());
             busy += gathers * ideal * per_request;
-            conflict += gathers * expected_conflicts(lanes, c.ray_buffer.banks) * sparsity * per_request;
+            conflict += gathers * group_conflicts(lanes, sparsity) * per_request;
             accesses += gathers;
             if (g == 0) first_group = busy + conflict + align;
             const double scattering = std::round(pass_rate * lanes);
             if (scattering >= 1.0 && !p.scatter_words.empty()) {
                 const double s = double(p.scatter_words.size());
                 busy += s * std::ceil(scattering / c.ray_buffer.banks) * per_request;
-                conflict += s * expected_conflicts(uint32_t(scattering), c.ray_buffer.banks) *
-                            sparsity * per_request;
+                conflict += s * group_conflicts(uint32_t(scattering), sparsity) * per_request;
                 accesses += s;
             }
         }

@@ -96,7 +96,8 @@ struct InterconnectConfig {
     bool contention = true;
 
     template <class V> void visit(V& v) {
-        v.param("mux_levels", mux_levels, "levels", "pipelined multiplexer levels", 1u, 16u);
+        v.param("mux_levels", mux_levels, "levels",
+                "pipelined multiplexer levels data crosses once per operation", 1u, 16u);
         v.param("width_words", width_words, "words/cycle", "words moved per interconnect cycle",
                 1u, 1024u);
         v.param("contention", contention, "", "model contention between address and data traffic");

@@ -81,7 +81,8 @@ uint64_t Sequencer::time_op(size_t index, const StreamOp& op, FrameTiming& t) {
     StallCycles stalls;
     stalls.bank_conflict = conflict;
     stalls.alignment = align;
-    stalls.pipeline_fill = p.latency_cycles + ray_buffer->fill_cycles();
+    stalls.pipeline_fill =
+        p.latency_cycles + ray_buffer->fill_cycles() + interconnect->crossing_cycles();
     const uint64_t words = uint64_t(length) * (p.gather_words.size() + 1) +
                            uint64_t(op.pass_count) * p.scatter_words.size();
     const uint64_t address_cycles = address->generate(words);

@@ -40,6 +40,8 @@ struct ScratchpadIf : virtual sc_core::sc_interface {
 struct InterconnectIf : virtual sc_core::sc_interface {
     // Stall cycles when `words` must cross in `available_cycles` core cycles.
     virtual uint64_t transfer(uint64_t words, uint64_t available_cycles) = 0;
+    // Core cycles for data to cross the multiplexer levels once (paid once per operation).
+    virtual uint32_t crossing_cycles() const = 0;
 };
 
 struct SceneMemoryIf : virtual sc_core::sc_interface {
