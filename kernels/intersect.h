@@ -10,6 +10,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "kernels/ray.h"
 #include "workloads/scene.h"
@@ -132,11 +133,20 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
     const float t_scaled = u * az + v * bz + w * cz;
     if (det < 0.f ? t_scaled >= 0.f : t_scaled <= 0.f) return false;  // t <= 0
-    // Range test on the divided t only: a test on t * det would round differently and could
+    // The watertight test decides inside/outside and the sign of t; t itself comes from the
+    // plane equation in double: the scaled-barycentric t loses digits on slivers (0.4 % on a
+    // 20 x 0.05 triangle), the plane's does not. Products of floats are exact in double, so
+    // coplanar triangles report bit-equal t and their ties go to the lower id.
+    const double e1x = double(p1.x) - p0.x, e1y = double(p1.y) - p0.y, e1z = double(p1.z) - p0.z;
+    const double e2x = double(p2.x) - p0.x, e2y = double(p2.y) - p0.y, e2z = double(p2.z) - p0.z;
+    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+    const double n_dot_d = nx * r.dir.x + ny * r.dir.y + nz * r.dir.z;
+    const double n_dot_a = nx * (double(p0.x) - r.org.x) + ny * (double(p0.y) - r.org.y) +
+                           nz * (double(p0.z) - r.org.z);
+    float t = n_dot_d != 0.0 ? float(n_dot_a / n_dot_d) : t_scaled / det;
+    if (!(t > 0.f)) t = std::numeric_limits<float>::denorm_min();  // the sign test above rules
+    // Range test on the final t only: a test on t * det would round differently and could
     // drop a candidate whose t equals t_max (an equal-t tie that the lower id must win).
-    // A true division (one rounding, not t_scaled * (1 / det)) makes coplanar triangles in an
-    // axis-aligned plane report bit-equal t, so their ties go to the lower id.
-    const float t = t_scaled / det;
     if (!(t <= t_max) || !std::isfinite(t)) return false;
     // z = a[kz] / dir[kz] carries at most 3 roundings (a, sz, the product).
     const float min_z = std::min(az, std::min(bz, cz));

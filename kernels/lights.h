@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "kernels/intersect.h"
 #include "kernels/sampling.h"
 #include "workloads/scene.h"
 
@@ -11,6 +12,7 @@ namespace sfx {
 
 struct LightSample {
     Vec3 position;
+    Vec3 position_error;  // bound on |position - true surface point|, per component
     Vec3 normal;  // outward geometric normal of the sampled primitive
     Vec3 emission;
     float pdf_area = 0.f;  // density per unit area of choosing this point
@@ -39,6 +41,7 @@ inline LightSample sample_light(const Scene& scene, float u_light, float u_prim,
         const Sphere& sp = scene.sphere(s.prim);
         s.normal = sample_uniform_sphere(u, v);
         s.position = sp.center + s.normal * sp.radius;
+        s.position_error = sphere_point_error(sp.center, s.normal, sp.radius);
     } else {
         const Triangle& t = scene.triangles[s.prim];
         const Vec3& p0 = scene.positions[t.v0];
@@ -46,7 +49,9 @@ inline LightSample sample_light(const Scene& scene, float u_light, float u_prim,
         const Vec3& p2 = scene.positions[t.v2];
         float b1, b2;
         sample_triangle(u, v, b1, b2);
-        s.position = p0 * (1.f - b1 - b2) + p1 * b1 + p2 * b2;
+        const float b0 = 1.f - b1 - b2;
+        s.position = p0 * b0 + p1 * b1 + p2 * b2;
+        s.position_error = triangle_point_error(p0, p1, p2, b0, b1, b2);
         s.normal = normalize(cross(p1 - p0, p2 - p0));
     }
     s.emission = light.emission;

@@ -85,8 +85,8 @@ inline bool lambertian_direct(PathState& p, const Scene& scene, const Material& 
     const float weight = k_inv_pi * cos_s * cos_l / (dist2 * ls.pdf_area * q);
     p.pending = p.throughput * m.diffuse * ls.emission * weight;
     const Vec3 light_side = dot(ls.normal, wi) < 0.f ? ls.normal : -ls.normal;
-    const Vec3 from = offset_ray_origin(s.position, s.normal);
-    const Vec3 to = offset_ray_origin(ls.position, light_side);
+    const Vec3 from = offset_ray_origin(s, s.normal);
+    const Vec3 to = offset_ray_origin(ls.position, ls.position_error, light_side);
     next.org = from;
     next.dir = to - from;
     next.t_max = 1.f;
@@ -105,7 +105,7 @@ inline bool lambertian_indirect(PathState& p, const Scene& scene, const Material
     p.throughput *= m.diffuse * (1.f / (1.f - q));
     if (is_black(p.throughput)) return false;
     p.count_emission = false;
-    next.org = offset_ray_origin(s.position, s.normal);
+    next.org = offset_ray_origin(s, s.normal);
     next.dir = to_world(local, s.normal);
     next.t_max = INFINITY;
     begin_next(p, RayKind::extension);
@@ -123,11 +123,11 @@ inline bool dielectric_scatter(PathState& p, const Material& m, const SurfaceHit
     Vec3 wt;
     if (p.key.uniform(b, RngDim::lobe_choice) < f || !refract(wo, s.normal, eta, wt)) {
         next.dir = reflect(wo, s.normal);
-        next.org = offset_ray_origin(s.position, s.normal);
+        next.org = offset_ray_origin(s, s.normal);
     } else {
         p.throughput *= m.transmission;
         next.dir = wt;
-        next.org = offset_ray_origin(s.position, -s.normal);
+        next.org = offset_ray_origin(s, -s.normal);
     }
     p.count_emission = true;
     next.t_max = INFINITY;
@@ -152,7 +152,7 @@ inline bool glossy_scatter(PathState& p, const Material& m, const SurfaceHit& s,
     p.throughput *= f * (cos_i / pdf);
     if (is_black(p.throughput)) return false;
     p.count_emission = true;
-    next.org = offset_ray_origin(s.position, s.normal);
+    next.org = offset_ray_origin(s, s.normal);
     next.dir = wi;
     next.t_max = INFINITY;
     begin_next(p, RayKind::extension);
