@@ -29,5 +29,7 @@ void add_trace_stats_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_scene_info_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_sweep_command(CLI::App& app);  // also the hidden run-group
+void add_compare_command(CLI::App& app);
 
 }  // namespace sfx

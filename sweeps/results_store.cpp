@@ -1,0 +1,324 @@
+#include "sweeps/results_store.h"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <stdexcept>
+
+#include "workloads/input_error.h"
+
+namespace sfx {
+namespace {
+
+// Hardware columns with their SQL types, from the same visit() that drives YAML: numbers are
+// REAL, strings and bools TEXT.
+class HwColumns {
+public:
+    explicit HwColumns(std::vector<std::pair<std::string, bool>>& out, std::string prefix = "")
+        : m_out(out), m_prefix(std::move(prefix)) {}
+    template <class T, class B> void param(const char* name, T& value, const char* unit,
+                                           const char* description, B, B) {
+        param(name, value, unit, description);
+    }
+    template <class T> void param(const char* name, T&, const char*, const char*) {
+        m_out.emplace_back(join(name), std::is_arithmetic<T>::value && !std::is_same<T, bool>::value);
+    }
+    void choice(const char* name, std::string&, std::initializer_list<const char*>, const char*) {
+        m_out.emplace_back(join(name), false);
+    }
+    template <class G> void group(const char* name, G& g) {
+        HwColumns c(m_out, join(name));
+        g.visit(c);
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        for (size_t i = 0; i < items.size(); ++i) {
+            HwColumns c(m_out, join(name) + "[" + std::to_string(i) + "]");
+            items[i].visit(c);
+        }
+    }
+
+private:
+    std::string join(const char* name) const { return m_prefix.empty() ? name : m_prefix + "." + name; }
+    std::vector<std::pair<std::string, bool>>& m_out;
+    std::string m_prefix;
+};
+
+class Statement {
+public:
+    Statement(sqlite3* db, const std::string& sql) : m_db(db) {
+        if (sqlite3_prepare_v2(db, sql.c_str(), -1, &m_stmt, nullptr) != SQLITE_OK)
+            throw std::runtime_error("results store: " + std::string(sqlite3_errmsg(db)) + " in: " + sql);
+    }
+    ~Statement() { sqlite3_finalize(m_stmt); }
+    Statement(const Statement&) = delete;
+    Statement& operator=(const Statement&) = delete;
+    sqlite3_stmt* get() const { return m_stmt; }
+    void bind(int i, const std::string& text) {
+        sqlite3_bind_text(m_stmt, i, text.c_str(), int(text.size()), SQLITE_TRANSIENT);
+    }
+    void bind(int i, double v) {
+        if (std::isnan(v)) sqlite3_bind_null(m_stmt, i);
+        else sqlite3_bind_double(m_stmt, i, v);
+    }
+    void bind_int(int i, int64_t v) { sqlite3_bind_int64(m_stmt, i, v); }
+    // SQLITE_ROW: true, SQLITE_DONE: false; anything else throws.
+    bool step() {
+        const int rc = sqlite3_step(m_stmt);
+        if (rc == SQLITE_ROW) return true;
+        if (rc == SQLITE_DONE) return false;
+        throw std::runtime_error("results store: " + std::string(sqlite3_errmsg(m_db)));
+    }
+
+private:
+    sqlite3* m_db;
+    sqlite3_stmt* m_stmt = nullptr;
+};
+
+const char* const k_fixed_columns =
+    "key TEXT PRIMARY KEY, sfx_version TEXT, sweep TEXT, point_index INTEGER, started_at TEXT, "
+    "finished_at TEXT, config_yaml TEXT, \"workload.scene\" TEXT, \"workload.width\" INTEGER, "
+    "\"workload.height\" INTEGER, \"workload.spp\" INTEGER, \"workload.depth\" INTEGER, "
+    "\"workload.tile\" INTEGER, \"workload.seed\" INTEGER, fidelity TEXT";
+
+std::string number_text(double v) {
+    char buf[64];
+    for (int precision = 1; precision <= 17; ++precision) {
+        std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+        if (std::strtod(buf, nullptr) == v) break;
+    }
+    return buf;
+}
+
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
+}  // namespace
+
+std::string sql_quote_identifier(const std::string& name) {
+    std::string out = "\"";
+    for (char c : name) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+
+std::string iso8601_now() {
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t t = std::chrono::system_clock::to_time_t(now);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
+                  tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, int(ms));
+    return buf;
+}
+
+ResultsStore::ResultsStore(const std::string& path) : m_path(path) {
+    if (sqlite3_open_v2(path.c_str(), &m_db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
+        SQLITE_OK) {
+        const std::string msg = m_db ? sqlite3_errmsg(m_db) : "out of memory";
+        sqlite3_close(m_db);
+        m_db = nullptr;
+        throw InputError(path, 0, "--store", "cannot open the results store: " + msg);
+    }
+    // Readers (analysis, a progress check) may look while a sweep writes: wait, don't fail.
+    sqlite3_busy_timeout(m_db, 30000);
+    try {
+        // Is this a SQLite file at all, and ours? (A text file fails on the first query.)
+        Statement probe(m_db, "SELECT name FROM sqlite_master WHERE type='table' AND name='meta'");
+        const bool has_meta = probe.step();
+        // WAL: a reader never blocks the writer; NORMAL sync still survives a killed process
+        // (only a power loss may drop the last transactions, never part of one).
+        exec("PRAGMA journal_mode=WAL");
+        exec("PRAGMA synchronous=NORMAL");
+        if (has_meta) {
+            Statement v(m_db, "SELECT value FROM meta WHERE key='schema_version'");
+            const std::string version =
+                v.step() ? reinterpret_cast<const char*>(sqlite3_column_text(v.get(), 0)) : "";
+            if (version != std::to_string(k_schema_version))
+                throw InputError(path, 0, "meta.schema_version",
+                                 "results store has schema version '" + version + "'; this sfx writes " +
+                                     std::to_string(k_schema_version));
+        }
+        exec("BEGIN IMMEDIATE");
+        exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
+        exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
+             std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
+        exec(std::string("CREATE TABLE IF NOT EXISTS points(") + k_fixed_columns + ")");
+        exec("COMMIT");
+    } catch (const InputError&) {
+        sqlite3_close(m_db);
+        throw;
+    } catch (const std::exception& e) {
+        sqlite3_close(m_db);
+        throw InputError(path, 0, "--store", std::string("not a usable results store: ") + e.what());
+    }
+    for (const std::string& c : columns()) m_columns.insert(c);
+}
+
+ResultsStore::~ResultsStore() { sqlite3_close(m_db); }
+
+void ResultsStore::exec(const std::string& sql) const {
+    char* err = nullptr;
+    if (sqlite3_exec(m_db, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+        const std::string msg = err ? err : "unknown error";
+        sqlite3_free(err);
+        throw std::runtime_error("results store " + m_path + ": " + msg + " in: " + sql.substr(0, 200));
+    }
+}
+
+std::vector<std::string> ResultsStore::columns() const {
+    std::vector<std::string> out;
+    Statement s(m_db, "PRAGMA table_info(points)");
+    while (s.step()) out.push_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
+    return out;
+}
+
+std::set<std::string> ResultsStore::keys() const {
+    std::set<std::string> out;
+    Statement s(m_db, "SELECT key FROM points");
+    while (s.step()) out.insert(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0)));
+    return out;
+}
+
+bool ResultsStore::contains(const std::string& key) const {
+    Statement s(m_db, "SELECT 1 FROM points WHERE key = ?");
+    s.bind(1, key);
+    return s.step();
+}
+
+void ResultsStore::ensure_column(const std::string& name, const char* type) {
+    if (m_columns.count(name)) return;
+    exec("ALTER TABLE points ADD COLUMN " + sql_quote_identifier(name) + " " + type);
+    m_columns.insert(name);
+}
+
+bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep, const PointRun& run) {
+    std::vector<std::pair<std::string, bool>> hw_columns;
+    HwColumns visitor(hw_columns);
+    const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
+    const std::vector<HwParamInfo> hw_values = flatten_hw_config(point.hw);
+
+    exec("BEGIN IMMEDIATE");
+    try {
+        // Another process may have added columns since we looked: re-read inside the lock.
+        m_columns.clear();
+        for (const std::string& c : columns()) m_columns.insert(c);
+        std::vector<std::string> names = {"key", "sfx_version", "sweep", "point_index", "started_at",
+                                          "finished_at", "config_yaml", "workload.scene",
+                                          "workload.width", "workload.height", "workload.spp",
+                                          "workload.depth", "workload.tile", "workload.seed",
+                                          "fidelity"};
+        for (const auto& [name, numeric] : hw_columns) {
+            ensure_column("hw." + name, numeric ? "REAL" : "TEXT");
+            names.push_back("hw." + name);
+        }
+        for (const auto& [name, value] : run.metrics) {
+            (void)value;
+            ensure_column(name, "REAL");
+            names.push_back(name);
+        }
+        std::string sql = "INSERT OR IGNORE INTO points(";
+        std::string marks;
+        for (size_t i = 0; i < names.size(); ++i) {
+            sql += (i ? ", " : "") + sql_quote_identifier(names[i]);
+            marks += i ? ", ?" : "?";
+        }
+        sql += ") VALUES(" + marks + ")";
+        Statement insert(m_db, sql);
+        int i = 1;
+        insert.bind(i++, point.key);
+        insert.bind(i++, run.sfx_version);
+        insert.bind(i++, sweep);
+        insert.bind_int(i++, int64_t(point.index));
+        insert.bind(i++, run.started_at);
+        insert.bind(i++, run.finished_at);
+        insert.bind(i++, point.config_yaml);
+        insert.bind(i++, point.workload.scene);
+        insert.bind_int(i++, point.workload.width);
+        insert.bind_int(i++, point.workload.height);
+        insert.bind_int(i++, point.workload.spp);
+        insert.bind_int(i++, point.workload.depth);
+        insert.bind_int(i++, point.workload.tile);
+        insert.bind_int(i++, int64_t(point.workload.seed));
+        insert.bind(i++, std::string(to_string(point.fidelity)));
+        for (size_t k = 0; k < hw_columns.size(); ++k) {
+            if (hw_columns[k].second) insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));
+            else insert.bind(i++, hw_values[k].value);
+        }
+        for (const auto& [name, value] : run.metrics) {
+            (void)name;
+            insert.bind(i++, value);
+        }
+        insert.step();
+        const bool inserted = sqlite3_changes(m_db) == 1;
+        exec("COMMIT");
+        return inserted;
+    } catch (...) {
+        sqlite3_exec(m_db, "ROLLBACK", nullptr, nullptr, nullptr);
+        m_columns.clear();
+        for (const std::string& c : columns()) m_columns.insert(c);
+        throw;
+    }
+}
+
+std::map<std::string, double> ResultsStore::numbers(const std::string& key) const {
+    std::map<std::string, double> out;
+    Statement s(m_db, "SELECT * FROM points WHERE key = ?");
+    s.bind(1, key);
+    if (!s.step()) return out;
+    for (int c = 0; c < sqlite3_column_count(s.get()); ++c) {
+        const int type = sqlite3_column_type(s.get(), c);
+        if (type == SQLITE_FLOAT || type == SQLITE_INTEGER)
+            out[sqlite3_column_name(s.get(), c)] = sqlite3_column_double(s.get(), c);
+    }
+    return out;
+}
+
+void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std::string>& keys) const {
+    std::ofstream out(csv_path);
+    if (!out) throw InputError(csv_path, 0, "--csv", "cannot write the CSV file");
+    std::vector<std::string> cols;
+    for (const std::string& c : columns())
+        if (c != "config_yaml") cols.push_back(c);
+    for (size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << csv_field(cols[i]);
+    out << "\n";
+    std::string select = "SELECT ";
+    for (size_t i = 0; i < cols.size(); ++i) select += (i ? ", " : "") + sql_quote_identifier(cols[i]);
+    select += " FROM points";
+    auto write_rows = [&](Statement& s) {
+        while (s.step()) {
+            for (int c = 0; c < int(cols.size()); ++c) {
+                if (c) out << ",";
+                switch (sqlite3_column_type(s.get(), c)) {
+                case SQLITE_NULL: break;
+                case SQLITE_INTEGER: out << sqlite3_column_int64(s.get(), c); break;
+                case SQLITE_FLOAT: out << number_text(sqlite3_column_double(s.get(), c)); break;
+                default: out << csv_field(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), c)));
+                }
+            }
+            out << "\n";
+        }
+    };
+    if (keys.empty()) {
+        Statement s(m_db, select + " ORDER BY sweep, point_index, key");
+        write_rows(s);
+    } else {
+        Statement s(m_db, select + " WHERE key = ?");
+        for (const std::string& k : keys) {
+            sqlite3_reset(s.get());
+            s.bind(1, k);
+            write_rows(s);
+        }
+    }
+    if (!out) throw InputError(csv_path, 0, "--csv", "error writing the CSV file");
+}
+
+}  // namespace sfx

@@ -1,0 +1,73 @@
+#pragma once
+// The results store: one SQLite file, one row per point, written through SQLite's C API.
+// The schema (version 1) is a contract with analysis/ and is described in sweeps/README.md:
+// meta(key, value) and points(key, sfx_version, sweep, point_index, started_at, finished_at,
+// config_yaml, "workload.*", fidelity, "hw.*" per parameter, one REAL column per stat).
+//
+// Each point is written in its own transaction (new stat columns included), so a process
+// killed at any instant leaves only whole rows; the key makes re-writes no-ops.
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sweeps/sweep.h"
+
+struct sqlite3;
+
+namespace sfx {
+
+// What a worker returns for one point (`sfx run-group` prints it as one JSON line).
+struct PointRun {
+    std::string key;
+    std::string sfx_version;
+    std::string started_at, finished_at;  // ISO-8601 UTC
+    std::vector<std::pair<std::string, double>> metrics;  // Prediction::stats() names; NaN: NULL
+};
+
+class ResultsStore {
+public:
+    static constexpr int k_schema_version = 1;
+
+    // Opens or creates the store; throws InputError if the file is not a version-1 store.
+    explicit ResultsStore(const std::string& path);
+    ~ResultsStore();
+    ResultsStore(const ResultsStore&) = delete;
+    ResultsStore& operator=(const ResultsStore&) = delete;
+
+    std::set<std::string> keys() const;
+    bool contains(const std::string& key) const;
+    // Writes one point in one transaction; false if its key was already stored.
+    bool write_point(const SweepPoint& point, const std::string& sweep, const PointRun& run);
+
+    // Metric and column values of one stored row by column name (NULLs left out).
+    std::map<std::string, double> numbers(const std::string& key) const;
+    // Every column name of the points table, in table order.
+    std::vector<std::string> columns() const;
+
+    // Writes the given keys' rows (all rows if `keys` is empty) as CSV: one column per stored
+    // column except config_yaml, in table order; rows by sweep and point index.
+    void export_csv(const std::string& csv_path, const std::vector<std::string>& keys = {}) const;
+
+    sqlite3* handle() const { return m_db; }
+
+private:
+    void exec(const std::string& sql) const;
+    void ensure_column(const std::string& name, const char* type);
+
+    std::string m_path;
+    sqlite3* m_db = nullptr;
+    std::set<std::string> m_columns;
+};
+
+// Quotes an identifier for SQL ("hw.simd.width" -> "\"hw.simd.width\"").
+std::string sql_quote_identifier(const std::string& name);
+
+// The current time as ISO-8601 UTC with milliseconds ("2026-11-22T01:02:03.456Z").
+std::string iso8601_now();
+
+}  // namespace sfx

@@ -1,0 +1,687 @@
+#include "sweeps/sweep.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "sweeps/point_group.h"
+#include "sweeps/sha256.h"
+#include "workloads/input_error.h"
+#include "workloads/ray_layout.h"
+#include "workloads/scene_loader.h"
+
+#ifndef SFX_VERSION
+#define SFX_VERSION "unknown"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace sfx {
+
+const char* sfx_version() { return SFX_VERSION; }
+
+namespace {
+
+constexpr size_t k_max_points = 1000000;  // a typo in a range should not eat the machine
+
+int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+
+// The message of an InputError without its "file:line: key: " prefix, to re-throw it with
+// the sweep's location.
+std::string bare_message(const InputError& e) {
+    std::string prefix = e.file();
+    if (e.line() > 0) prefix += ":" + std::to_string(e.line());
+    if (!e.key().empty()) prefix += ": " + e.key();
+    prefix += ": ";
+    const std::string what = e.what();
+    return what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
+}
+
+bool parse_u64(const std::string& s, uint64_t& out) {
+    if (s.empty() || s[0] == '-' || s[0] == '+') return false;
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+    if (errno || *end != '\0') return false;
+    out = v;
+    return true;
+}
+
+bool parse_double(const std::string& s, double& out) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s.c_str(), &end);
+    if (errno || *end != '\0' || !std::isfinite(v)) return false;
+    out = v;
+    return true;
+}
+
+// Shortest decimal text that reads back as the same double (range values like 0.1 + 0.2).
+std::string double_text(double v) {
+    char buf[64];
+    for (int precision = 1; precision <= 17; ++precision) {
+        std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+        if (std::strtod(buf, nullptr) == v) break;
+    }
+    return buf;
+}
+
+// Checks a mapping's keys against an allowed list: unknown and duplicate keys are errors.
+void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
+                std::initializer_list<const char*> allowed) {
+    std::set<std::string> seen;
+    for (const auto& kv : map) {
+        const std::string key = kv.first.as<std::string>();
+        const std::string dotted = prefix.empty() ? key : prefix + "." + key;
+        bool ok = false;
+        for (const char* a : allowed) ok |= key == a;
+        if (!ok) {
+            std::string list;
+            for (const char* a : allowed) list += list.empty() ? a : std::string(", ") + a;
+            throw InputError(file, line_of(kv.first), dotted, "unknown key (expected one of: " + list + ")");
+        }
+        if (!seen.insert(key).second) throw InputError(file, line_of(kv.first), dotted, "duplicate key");
+    }
+}
+
+std::string scalar(const YAML::Node& n, const std::string& file, const std::string& key) {
+    if (!n.IsScalar()) throw InputError(file, line_of(n), key, "expected a single value");
+    return n.Scalar();
+}
+
+// The workload before resolution against a scene: depth -1 is the scene's, tile 0 is auto.
+struct WorkloadSpec {
+    std::string scene;
+    uint32_t width = 256, height = 256, spp = 4;
+    int64_t depth = -1;
+    uint32_t tile = 32;
+    uint64_t seed = 0;
+};
+
+// A scene given as a plain name is a built-in; anything else is a path relative to the sweep.
+std::string resolve_scene_name(const std::string& value, const std::string& base_dir) {
+    const bool plain = value.find('/') == std::string::npos &&
+                       value.find(".yaml") == std::string::npos &&
+                       value.find('.') == std::string::npos;
+    if (plain) return value;
+    fs::path p(value);
+    if (p.is_relative()) p = fs::path(base_dir) / p;
+    return p.lexically_normal().string();
+}
+
+uint32_t parse_bounded(const std::string& value, uint64_t lo, uint64_t hi, const std::string& file,
+                       int line, const std::string& key) {
+    uint64_t v = 0;
+    if (!parse_u64(value, v) || v < lo || v > hi)
+        throw InputError(file, line, key, "expected an integer in [" + std::to_string(lo) + ", " +
+                                              std::to_string(hi) + "], got '" + value + "'");
+    return uint32_t(v);
+}
+
+// Sets one workload field from scalar text; `key` names it in errors.
+void set_workload(WorkloadSpec& w, const std::string& field, const std::string& value,
+                  const std::string& base_dir, const std::string& file, int line,
+                  const std::string& key) {
+    if (field == "scene") {
+        if (value.empty()) throw InputError(file, line, key, "expected a scene name or path");
+        w.scene = resolve_scene_name(value, base_dir);
+    } else if (field == "res") {
+        unsigned width = 0, height = 0;
+        char tail = 0;
+        if (std::sscanf(value.c_str(), "%ux%u%c", &width, &height, &tail) != 2 || width == 0 ||
+            height == 0 || width > 65536 || height > 65536)
+            throw InputError(file, line, key, "expected WxH with 1..65536, got '" + value + "'");
+        w.width = width;
+        w.height = height;
+    } else if (field == "width") {
+        w.width = parse_bounded(value, 1, 65536, file, line, key);
+    } else if (field == "height") {
+        w.height = parse_bounded(value, 1, 65536, file, line, key);
+    } else if (field == "spp") {
+        w.spp = parse_bounded(value, 1, 1u << 20, file, line, key);
+    } else if (field == "depth") {
+        w.depth = parse_bounded(value, 0, 1000, file, line, key);
+    } else if (field == "tile") {
+        w.tile = value == "auto" ? 0 : parse_bounded(value, 1, 4096, file, line, key);
+        if (value != "auto" && w.tile == 0)
+            throw InputError(file, line, key, "expected 1..4096 or auto");
+    } else if (field == "seed") {
+        uint64_t v = 0;
+        if (!parse_u64(value, v))
+            throw InputError(file, line, key, "expected a non-negative integer, got '" + value + "'");
+        w.seed = v;
+    } else {
+        throw InputError(file, line, key,
+                         "no such workload field (scene, res, width, height, spp, depth, tile, seed)");
+    }
+}
+
+Fidelity parse_fidelity_at(const std::string& value, const std::string& file, int line,
+                           const std::string& key) {
+    try {
+        return parse_fidelity(value);
+    } catch (const std::exception&) {
+        throw InputError(file, line, key, "expected analytic, sampled or full, got '" + value + "'");
+    }
+}
+
+// Sets a hardware parameter, naming the sweep's dotted key (not the bare path) in errors.
+void set_hw_at(HwConfig& c, const std::string& path, const std::string& value,
+               const std::string& file, int line, const std::string& key) {
+    try {
+        set_hw_param(c, path, value, file, line);
+    } catch (const InputError& e) {
+        throw InputError(file, line, key, bare_message(e));
+    }
+}
+
+struct Axis {
+    std::string path;   // "hw.simd.width", "workload.tile", "fidelity"
+    std::string field;  // the path below hw./workload.
+    enum Kind { hw, workload, fidelity } kind = hw;
+    int line = 0;
+    std::vector<std::string> values;
+    std::vector<int> value_lines;
+};
+
+// Values of one axis: a list of scalars, {values: [...]} or {from, to, step}.
+void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& file) {
+    const std::string key = "axes." + axis.path;
+    YAML::Node list = node;
+    if (node.IsMap() && node["values"]) {
+        check_keys(node, file, key, {"values"});
+        list = node["values"];
+    }
+    if (list.IsSequence()) {
+        if (list.size() == 0) throw InputError(file, line_of(list), key, "an axis needs at least one value");
+        for (size_t i = 0; i < list.size(); ++i) {
+            axis.values.push_back(scalar(list[i], file, key + "[" + std::to_string(i) + "]"));
+            axis.value_lines.push_back(line_of(list[i]));
+        }
+        return;
+    }
+    if (!node.IsMap())
+        throw InputError(file, line_of(node), key,
+                         "expected a list of values, {values: [...]} or {from, to, step}");
+    check_keys(node, file, key, {"from", "to", "step"});
+    for (const char* k : {"from", "to", "step"})
+        if (!node[k]) throw InputError(file, line_of(node), key + "." + k, "missing (a range needs from, to and step)");
+    const std::string from = scalar(node["from"], file, key + ".from");
+    const std::string to = scalar(node["to"], file, key + ".to");
+    const std::string step = scalar(node["step"], file, key + ".step");
+    const int line = line_of(node);
+    uint64_t ifrom = 0, ito = 0, istep = 0;
+    if (parse_u64(from, ifrom) && parse_u64(to, ito) && parse_u64(step, istep)) {
+        if (istep == 0) throw InputError(file, line_of(node["step"]), key + ".step", "must be positive");
+        if (ito < ifrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
+        if ((ito - ifrom) / istep >= k_max_points)
+            throw InputError(file, line, key, "more than " + std::to_string(k_max_points) + " values");
+        for (uint64_t v = ifrom; v <= ito; v += istep) {
+            axis.values.push_back(std::to_string(v));
+            axis.value_lines.push_back(line);
+        }
+        return;
+    }
+    double dfrom = 0, dto = 0, dstep = 0;
+    if (!parse_double(from, dfrom)) throw InputError(file, line_of(node["from"]), key + ".from", "expected a number");
+    if (!parse_double(to, dto)) throw InputError(file, line_of(node["to"]), key + ".to", "expected a number");
+    if (!parse_double(step, dstep) || dstep <= 0)
+        throw InputError(file, line_of(node["step"]), key + ".step", "expected a positive number");
+    if (dto < dfrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
+    // Inclusive of `to` up to rounding: 0.1 to 0.3 step 0.1 has three values.
+    const double count = std::floor((dto - dfrom) / dstep * (1 + 1e-12) + 1e-9) + 1;
+    if (count > double(k_max_points))
+        throw InputError(file, line, key, "more than " + std::to_string(k_max_points) + " values");
+    for (uint64_t i = 0; i < uint64_t(count); ++i) {
+        axis.values.push_back(double_text(dfrom + double(i) * dstep));
+        axis.value_lines.push_back(line);
+    }
+}
+
+struct SceneInfo {
+    FeatureSet features;
+    uint32_t max_depth = 0;
+};
+
+class SweepParser {
+public:
+    SweepParser(std::string file, std::string base_dir)
+        : m_file(std::move(file)), m_base_dir(std::move(base_dir)) {}
+
+    Sweep parse(const std::string& text, const std::vector<std::string>& sets) {
+        YAML::Node root;
+        try {
+            root = YAML::Load(text);
+        } catch (const YAML::Exception& e) {
+            throw InputError(m_file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", e.msg);
+        }
+        if (!root.IsMap()) throw InputError(m_file, line_of(root), "(top level)", "expected a mapping");
+        check_keys(root, m_file, "",
+                   {"version", "name", "hw", "hw_overrides", "workload", "fidelity", "axes", "zip"});
+        if (!root["version"]) throw InputError(m_file, 1, "version", "missing (this format is version: 1)");
+        if (scalar(root["version"], m_file, "version") != "1")
+            throw InputError(m_file, line_of(root["version"]), "version", "only version 1 is supported");
+
+        Sweep sweep;
+        sweep.file = m_file;
+        sweep.name = root["name"] ? scalar(root["name"], m_file, "name") : default_name();
+        read_hw(root);
+        read_workload(root);
+        if (root["fidelity"])
+            m_fidelity = parse_fidelity_at(scalar(root["fidelity"], m_file, "fidelity"), m_file,
+                                           line_of(root["fidelity"]), "fidelity");
+        apply_sets(sets);
+        if (root["axes"]) read_axes(root["axes"]);
+        read_zip(root["zip"]);
+        for (const Axis& a : m_axes) sweep.axes.push_back(a.path);
+        expand(sweep);
+        return sweep;
+    }
+
+private:
+    std::string default_name() const {
+        std::string n = fs::path(m_file).filename().string();
+        const std::string suffix = ".sweep.yaml";
+        if (n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0)
+            n.resize(n.size() - suffix.size());
+        return n;
+    }
+
+    void read_hw(const YAML::Node& root) {
+        if (!root["hw"]) throw InputError(m_file, 1, "hw", "missing (a base hardware file, e.g. gr08.hw.yaml)");
+        fs::path p(scalar(root["hw"], m_file, "hw"));
+        if (p.is_relative()) p = fs::path(m_base_dir) / p;
+        std::error_code ec;
+        if (!fs::is_regular_file(p, ec))
+            throw InputError(m_file, line_of(root["hw"]), "hw", "no such file: " + p.string());
+        m_base = load_hw_config(p.string());  // errors inside it name that file
+        const YAML::Node over = root["hw_overrides"];
+        if (!over) return;
+        if (!over.IsMap())
+            throw InputError(m_file, line_of(over), "hw_overrides", "expected a mapping of dotted parameter paths to values");
+        apply_overrides(over);
+    }
+
+    void read_workload(const YAML::Node& root) {
+        const YAML::Node w = root["workload"];
+        if (!w) throw InputError(m_file, 1, "workload", "missing (at least workload.scene)");
+        if (!w.IsMap()) throw InputError(m_file, line_of(w), "workload", "expected a mapping");
+        check_keys(w, m_file, "workload", {"scene", "res", "width", "height", "spp", "depth", "tile", "seed"});
+        if (!w["scene"]) throw InputError(m_file, line_of(w), "workload.scene", "missing");
+        if (w["res"] && (w["width"] || w["height"]))
+            throw InputError(m_file, line_of(w["res"]), "workload.res", "give res or width/height, not both");
+        for (const auto& kv : w) {
+            const std::string field = kv.first.as<std::string>();
+            set_workload(m_workload, field, scalar(kv.second, m_file, "workload." + field),
+                         m_base_dir, m_file, line_of(kv.second), "workload." + field);
+            m_workload_lines[field] = line_of(kv.second);
+        }
+    }
+
+    // Dotted paths below hw (`simd.width: 8`), applied to the base in file order.
+    void apply_overrides(const YAML::Node& over) {
+        std::set<std::string> seen;
+        for (const auto& kv : over) {
+            const std::string path = kv.first.as<std::string>();
+            const std::string key = "hw_overrides." + path;
+            if (!seen.insert(path).second) throw InputError(m_file, line_of(kv.first), key, "duplicate key");
+            set_hw_at(m_base, path, scalar(kv.second, m_file, key), m_file, line_of(kv.second), key);
+            m_hw_lines[path] = line_of(kv.second);
+        }
+        check_base();
+    }
+    void check_base() {
+        try {
+            check_hw_config(m_base, m_file, m_hw_lines);
+        } catch (const InputError& e) {
+            throw InputError(m_file, e.line(), "hw_overrides." + e.key(), bare_message(e));
+        }
+    }
+
+    // Command-line `--set PATH=VALUE`: changes the base point (an axis on PATH still moves it).
+    void apply_sets(const std::vector<std::string>& sets) {
+        for (const std::string& s : sets) {
+            const size_t eq = s.find('=');
+            const std::string path = s.substr(0, eq);
+            const std::string key = "--set " + path;
+            if (eq == std::string::npos || eq == 0)
+                throw InputError("command line", 0, "--set", "expected PATH=VALUE, got '" + s + "'");
+            const std::string value = s.substr(eq + 1);
+            if (path.rfind("hw.", 0) == 0) {
+                set_hw_at(m_base, path.substr(3), value, "command line", 0, key);
+                try {
+                    check_hw_config(m_base, "command line");
+                } catch (const InputError& e) {
+                    throw InputError("command line", 0, key, bare_message(e));
+                }
+            } else if (path.rfind("workload.", 0) == 0) {
+                const std::string field = path.substr(9);
+                if (field == "res" || field == "width" || field == "height") m_workload_lines.erase(field);
+                set_workload(m_workload, field, value, fs::current_path().string(), "command line", 0, key);
+                m_workload_lines[field] = 0;
+            } else if (path == "fidelity") {
+                m_fidelity = parse_fidelity_at(value, "command line", 0, key);
+            } else {
+                throw InputError("command line", 0, key, "a path starts with hw. or workload., or is fidelity");
+            }
+        }
+    }
+
+    void read_axes(const YAML::Node& axes) {
+        if (!axes.IsMap()) throw InputError(m_file, line_of(axes), "axes", "expected a mapping of dotted paths to values");
+        std::set<std::string> seen;
+        for (const auto& kv : axes) {
+            Axis axis;
+            axis.path = kv.first.as<std::string>();
+            axis.line = line_of(kv.first);
+            const std::string key = "axes." + axis.path;
+            if (!seen.insert(axis.path).second) throw InputError(m_file, axis.line, key, "duplicate axis");
+            if (axis.path.rfind("hw.", 0) == 0) {
+                axis.kind = Axis::hw;
+                axis.field = axis.path.substr(3);
+            } else if (axis.path.rfind("workload.", 0) == 0) {
+                axis.kind = Axis::workload;
+                axis.field = axis.path.substr(9);
+            } else if (axis.path == "fidelity") {
+                axis.kind = Axis::fidelity;
+            } else {
+                throw InputError(m_file, axis.line, key,
+                                 "an axis path starts with hw. or workload., or is fidelity");
+            }
+            read_axis_values(axis, kv.second, m_file);
+            // Every value is checked now, on scratch copies, before anything runs.
+            for (size_t i = 0; i < axis.values.size(); ++i) apply(axis, i, m_base, m_workload, m_fidelity, true);
+            m_axes.push_back(std::move(axis));
+        }
+        auto has = [&](const char* p) { return seen.count(p) > 0; };
+        if (has("workload.res") && (has("workload.width") || has("workload.height")))
+            throw InputError(m_file, line_of(axes), "axes.workload.res", "give res or width/height axes, not both");
+    }
+
+    void apply(const Axis& axis, size_t i, HwConfig& hw, WorkloadSpec& w, Fidelity& f,
+               bool scratch) const {
+        const std::string key = "axes." + axis.path;
+        const std::string& value = axis.values[i];
+        const int line = axis.value_lines[i];
+        if (axis.kind == Axis::hw) {
+            HwConfig copy;
+            HwConfig& target = scratch ? (copy = hw) : hw;
+            set_hw_at(target, axis.field, value, m_file, line, key);
+        } else if (axis.kind == Axis::workload) {
+            WorkloadSpec copy;
+            WorkloadSpec& target = scratch ? (copy = w) : w;
+            set_workload(target, axis.field, value, m_base_dir, m_file, line, key);
+            if (scratch && axis.field == "scene") scene_info(target.scene, line, key);
+        } else {
+            const Fidelity parsed = parse_fidelity_at(value, m_file, line, key);
+            if (!scratch) f = parsed;
+        }
+    }
+
+    void read_zip(const YAML::Node& zip) {
+        m_dimension_of.assign(m_axes.size(), -1);
+        if (zip) {
+            if (!zip.IsSequence()) throw InputError(m_file, line_of(zip), "zip", "expected a list of lists of axis paths");
+            for (size_t g = 0; g < zip.size(); ++g) {
+                const std::string key = "zip[" + std::to_string(g) + "]";
+                const YAML::Node group = zip[g];
+                if (!group.IsSequence() || group.size() < 2)
+                    throw InputError(m_file, line_of(group), key, "expected a list of at least two axis paths");
+                std::vector<size_t> members;
+                for (size_t k = 0; k < group.size(); ++k) {
+                    const std::string path = scalar(group[k], m_file, key);
+                    size_t a = 0;
+                    while (a < m_axes.size() && m_axes[a].path != path) ++a;
+                    if (a == m_axes.size())
+                        throw InputError(m_file, line_of(group[k]), key + "." + path, "not an axis of this sweep");
+                    if (m_dimension_of[a] >= 0)
+                        throw InputError(m_file, line_of(group[k]), key + "." + path, "axis is already zipped");
+                    if (m_axes[a].values.size() != m_axes[members.empty() ? a : members[0]].values.size())
+                        throw InputError(m_file, line_of(group[k]), key + "." + path,
+                                         "zipped axes need equal lengths (" +
+                                             std::to_string(m_axes[a].values.size()) + " vs " +
+                                             std::to_string(m_axes[members[0]].values.size()) + ")");
+                    m_dimension_of[a] = int(g);  // provisional: the zip group number
+                    members.push_back(a);
+                }
+                m_zips.push_back(members);
+            }
+        }
+        // Dimensions in file order of their first axis: a zip group moves as one axis.
+        std::vector<int> zip_dimension(m_zips.size(), -1);
+        std::vector<int> final_dimension(m_axes.size(), -1);
+        for (size_t a = 0; a < m_axes.size(); ++a) {
+            const int z = m_dimension_of[a];
+            if (z < 0) {
+                final_dimension[a] = int(m_dimensions.size());
+                m_dimensions.push_back({a});
+            } else if (zip_dimension[z] < 0) {
+                zip_dimension[z] = int(m_dimensions.size());
+                final_dimension[a] = zip_dimension[z];
+                m_dimensions.push_back(m_zips[z]);
+            } else {
+                final_dimension[a] = zip_dimension[z];
+            }
+        }
+    }
+
+    const SceneInfo& scene_info(const std::string& scene, int line, const std::string& key) const {
+        auto it = m_scenes.find(scene);
+        if (it != m_scenes.end()) return it->second;
+        try {
+            const Scene s = load_scene(scene);
+            SceneInfo info{s.features(), s.max_depth};
+            return m_scenes.emplace(scene, info).first->second;
+        } catch (const InputError& e) {
+            if (e.file() == scene && e.line() == 0) throw InputError(m_file, line, key, bare_message(e));
+            throw;  // an error inside the scene file names that file
+        }
+    }
+
+    void expand(Sweep& sweep) {
+        size_t total = 1;
+        for (const auto& d : m_dimensions) {
+            total *= m_axes[d[0]].values.size();
+            if (total > k_max_points)
+                throw InputError(m_file, line_of_axes(), "axes", "more than " + std::to_string(k_max_points) + " points");
+        }
+        std::map<std::string, size_t> by_key;
+        std::vector<std::pair<WorkloadPoint, Fidelity>> group_keys;
+        std::vector<size_t> at(m_dimensions.size(), 0);
+        for (size_t n = 0; n < total; ++n) {
+            SweepPoint p;
+            p.index = n;
+            p.hw = m_base;
+            WorkloadSpec w = m_workload;
+            p.fidelity = m_fidelity;
+            HwLineMap lines = m_hw_lines;
+            std::map<std::string, int> workload_lines = m_workload_lines;
+            for (size_t d = 0; d < m_dimensions.size(); ++d)
+                for (size_t a : m_dimensions[d]) {
+                    const Axis& axis = m_axes[a];
+                    apply(axis, at[d], p.hw, w, p.fidelity, false);
+                    p.axis_values.emplace_back(axis.path, axis.values[at[d]]);
+                    if (axis.kind == Axis::hw) lines[axis.field] = axis.value_lines[at[d]];
+                    if (axis.kind == Axis::workload) workload_lines[axis.field] = axis.value_lines[at[d]];
+                }
+            check_point_hw(p, lines);
+            p.workload = resolve(w, p, workload_lines);
+            p.config_yaml = point_config_yaml(p.hw, p.workload, p.fidelity);
+            p.key = point_key(p.config_yaml);
+            if (by_key.count(p.key)) {
+                ++sweep.duplicates;
+            } else {
+                by_key[p.key] = sweep.points.size();
+                size_t g = 0;
+                while (g < group_keys.size() && !(group_keys[g].second == p.fidelity &&
+                                                  group_keys[g].first.same_render(p.workload)))
+                    ++g;
+                if (g == group_keys.size()) {
+                    group_keys.emplace_back(p.workload, p.fidelity);
+                    sweep.groups.emplace_back();
+                }
+                sweep.groups[g].points.push_back(sweep.points.size());
+                sweep.points.push_back(std::move(p));
+            }
+            // Odometer: the last dimension moves fastest.
+            for (size_t d = m_dimensions.size(); d-- > 0;) {
+                if (++at[d] < m_axes[m_dimensions[d][0]].values.size()) break;
+                at[d] = 0;
+            }
+        }
+    }
+
+    int line_of_axes() const { return m_axes.empty() ? 0 : m_axes.front().line; }
+
+    std::string describe(const SweepPoint& p) const {
+        std::string s;
+        for (const auto& [k, v] : p.axis_values) s += (s.empty() ? "" : ", ") + k + "=" + v;
+        return s.empty() ? "the base point" : s;
+    }
+
+    void check_point_hw(const SweepPoint& p, const HwLineMap& lines) const {
+        try {
+            check_hw_config(p.hw, m_file, lines);
+        } catch (const InputError& e) {
+            throw InputError(m_file, e.line() > 0 ? e.line() : line_of_axes(), "hw." + e.key(),
+                             bare_message(e) + " (at point " + std::to_string(p.index) + ": " +
+                                 describe(p) + ")");
+        }
+    }
+
+    WorkloadPoint resolve(const WorkloadSpec& w, const SweepPoint& p,
+                          const std::map<std::string, int>& lines) const {
+        auto line = [&](const char* field) {
+            auto it = lines.find(field);
+            return it == lines.end() ? 0 : it->second;
+        };
+        const SceneInfo& info = scene_info(w.scene, line("scene"), "workload.scene");
+        WorkloadPoint r;
+        r.scene = w.scene;
+        r.width = w.width;
+        r.height = w.height;
+        r.spp = w.spp;
+        r.depth = w.depth < 0 ? info.max_depth : uint32_t(w.depth);
+        r.seed = w.seed;
+        FeatureSet features = info.features;
+        features.max_depth = r.depth;  // as run_point_group sees it
+        // tile: auto is resolved per point (its own buffer), so a buffer-size axis changes
+        // the tile; points then group by the resolved tile.
+        r.tile = w.tile ? w.tile : largest_fitting_tile(features, {p.hw});
+        if (r.tile == 0)
+            throw InputError(m_file, line("tile"), "workload.tile",
+                             "not even one ray record fits the ray buffer at point " +
+                                 std::to_string(p.index) + " (" + describe(p) + ")");
+        try {
+            check_tile_fits(r.tile, features, {p.hw}, "workload.tile");
+        } catch (const InputError& e) {
+            throw InputError(m_file, line("tile"), "workload.tile",
+                             bare_message(e) + " (at point " + std::to_string(p.index) + ": " +
+                                 describe(p) + ")");
+        }
+        return r;
+    }
+
+    std::string m_file, m_base_dir;
+    HwConfig m_base;
+    HwLineMap m_hw_lines;
+    WorkloadSpec m_workload;
+    std::map<std::string, int> m_workload_lines;
+    Fidelity m_fidelity = Fidelity::full;
+    std::vector<Axis> m_axes;
+    std::vector<int> m_dimension_of;
+    std::vector<std::vector<size_t>> m_zips;
+    std::vector<std::vector<size_t>> m_dimensions;  // axes moving together, outermost first
+    mutable std::map<std::string, SceneInfo> m_scenes;
+};
+
+}  // namespace
+
+Sweep parse_sweep(const std::string& text, const std::string& file, const std::string& base_dir,
+                  const std::vector<std::string>& sets) {
+    return SweepParser(file, base_dir).parse(text, sets);
+}
+
+Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "", "cannot read sweep file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    const fs::path dir = fs::absolute(fs::path(path)).parent_path();
+    return parse_sweep(text.str(), path, dir.string(), sets);
+}
+
+std::string point_config_yaml(const HwConfig& hw, const WorkloadPoint& w, Fidelity fidelity) {
+    // Values only, in a fixed order: the key must not change when a description does.
+    // dump_hw_config's text read back drops its comments and keeps its scalars verbatim.
+    YAML::Emitter out;
+    out << YAML::BeginMap << YAML::Key << "hw" << YAML::Value << YAML::Load(dump_hw_config(hw));
+    out << YAML::Key << "workload" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "scene" << YAML::Value << YAML::DoubleQuoted << w.scene;
+    out << YAML::Key << "width" << YAML::Value << w.width;
+    out << YAML::Key << "height" << YAML::Value << w.height;
+    out << YAML::Key << "spp" << YAML::Value << w.spp;
+    out << YAML::Key << "depth" << YAML::Value << w.depth;
+    out << YAML::Key << "tile" << YAML::Value << w.tile;
+    out << YAML::Key << "seed" << YAML::Value << w.seed;
+    out << YAML::EndMap;
+    out << YAML::Key << "fidelity" << YAML::Value << to_string(fidelity);
+    out << YAML::EndMap;
+    return std::string(out.c_str()) + "\n";
+}
+
+std::string point_key(const std::string& config_yaml) {
+    return sha256_hex(config_yaml + "\n" + sfx_version());
+}
+
+ParsedPoint parse_point_config(const std::string& text, const std::string& file) {
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", e.msg);
+    }
+    if (!root.IsMap()) throw InputError(file, line_of(root), "(top level)", "expected a mapping");
+    check_keys(root, file, "", {"hw", "workload", "fidelity"});
+    for (const char* k : {"hw", "workload", "fidelity"})
+        if (!root[k]) throw InputError(file, 1, k, "missing");
+    ParsedPoint p;
+    // The hw section is a whole configuration as dump_hw_config writes it (lines shift by one
+    // in messages: they count from the hw: key).
+    p.hw = parse_hw_config(YAML::Dump(root["hw"]), file + " (hw)");
+
+    const YAML::Node w = root["workload"];
+    if (!w.IsMap()) throw InputError(file, line_of(w), "workload", "expected a mapping");
+    check_keys(w, file, "workload", {"scene", "width", "height", "spp", "depth", "tile", "seed"});
+    WorkloadSpec spec;
+    for (const char* k : {"scene", "width", "height", "spp", "depth", "tile", "seed"}) {
+        const std::string key = std::string("workload.") + k;
+        if (!w[k]) throw InputError(file, line_of(w), key, "missing");
+        // The scene is stored resolved (a built-in name or an absolute path): taken as is.
+        if (key == "workload.scene") spec.scene = scalar(w[k], file, key);
+        else set_workload(spec, k, scalar(w[k], file, key), "", file, line_of(w[k]), key);
+    }
+    if (spec.tile == 0) throw InputError(file, line_of(w["tile"]), "workload.tile", "must be resolved, not auto");
+    p.workload.scene = spec.scene;
+    p.workload.width = spec.width;
+    p.workload.height = spec.height;
+    p.workload.spp = spec.spp;
+    p.workload.depth = uint32_t(spec.depth);
+    p.workload.tile = spec.tile;
+    p.workload.seed = spec.seed;
+    p.fidelity = parse_fidelity_at(scalar(root["fidelity"], file, "fidelity"), file,
+                                   line_of(root["fidelity"]), "fidelity");
+    return p;
+}
+
+}  // namespace sfx
