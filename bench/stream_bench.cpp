@@ -82,7 +82,8 @@ void count_reference_tests(const Bvh& bvh, const Ray& ray, uint64_t& boxes, uint
     float t_max = ray.t_max;
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
-        const BvhNode& node = bvh.nodes()[stack.back()];
+        const uint32_t index = stack.back();
+        const BvhNode& node = bvh.nodes()[index];
         stack.pop_back();
         ++boxes;
         if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
@@ -91,8 +92,8 @@ void count_reference_tests(const Bvh& bvh, const Ray& ray, uint64_t& boxes, uint
                 if (bvh.intersect_primitive(r, bvh.prim_ids()[i], t_max, hit)) t_max = hit.t;
         } else {
             const bool right_first = visit_right_first(node, r.dir);
-            stack.push_back(right_first ? node.first : node.right);
-            stack.push_back(right_first ? node.right : node.first);
+            stack.push_back(right_first ? BvhNode::left(index) : node.right());
+            stack.push_back(right_first ? node.right() : BvhNode::left(index));
         }
     }
 }

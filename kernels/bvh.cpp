@@ -7,8 +7,8 @@
 namespace sfx {
 
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : m_scene(&scene) {
-    if (options.max_leaf_size == 0 || options.bins < 2)
-        throw std::invalid_argument("bvh: max_leaf_size must be >= 1 and bins >= 2");
+    if (options.max_leaf_size == 0 || options.max_leaf_size > 0xffff || options.bins < 2)
+        throw std::invalid_argument("bvh: max_leaf_size must be in 1..65535 and bins >= 2");
     const uint32_t n = scene.primitive_count();
     std::vector<Bounds3> prim_bounds(n);
     std::vector<Vec3> centroids(n);
@@ -40,7 +40,7 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& pr
     const uint32_t count = end - begin;
     auto make_leaf = [&] {
         m_nodes[index].first = begin;
-        m_nodes[index].count = count;
+        m_nodes[index].count = uint16_t(count);
         return index;
     };
     if (count == 1) return make_leaf();
@@ -123,8 +123,8 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& pr
     }
     const uint32_t left = build(begin, mid, prim_bounds, centroids, options, depth + 1);
     const uint32_t right = build(mid, end, prim_bounds, centroids, options, depth + 1);
-    m_nodes[index].first = left;
-    m_nodes[index].right = right;
+    if (left != BvhNode::left(index)) throw std::logic_error("bvh: left child must follow its parent");
+    m_nodes[index].first = right;
     m_nodes[index].count = 0;
     m_nodes[index].axis = uint8_t(axis);
     return index;
@@ -158,15 +158,17 @@ Hit Bvh::intersect(const Ray& ray) const {
     uint32_t top = 0;
     stack[top++] = 0;
     while (top > 0) {
-        const BvhNode& node = m_nodes[stack[--top]];
+        const uint32_t index = stack[--top];
+        const BvhNode& node = m_nodes[index];
         if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i)
                 if (intersect_primitive(r, m_prim_ids[i], t_max, hit)) t_max = hit.t;
         } else {
             const bool right_first = visit_right_first(node, r.dir);
-            stack[top++] = right_first ? node.first : node.right;  // back child, popped last
-            stack[top++] = right_first ? node.right : node.first;
+            const uint32_t left = BvhNode::left(index), right = node.right();
+            stack[top++] = right_first ? left : right;  // back child, popped last
+            stack[top++] = right_first ? right : left;
         }
     }
     return hit;
@@ -180,14 +182,15 @@ bool Bvh::occluded(const Ray& ray) const {
     uint32_t top = 0;
     stack[top++] = 0;
     while (top > 0) {
-        const BvhNode& node = m_nodes[stack[--top]];
+        const uint32_t index = stack[--top];
+        const BvhNode& node = m_nodes[index];
         if (intersect_box(r, node.bounds, ray.t_max) == INFINITY) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i)
                 if (intersect_primitive(r, m_prim_ids[i], ray.t_max, hit)) return true;
         } else {
-            stack[top++] = node.right;
-            stack[top++] = node.first;
+            stack[top++] = node.right();
+            stack[top++] = BvhNode::left(index);
         }
     }
     return false;
@@ -212,12 +215,12 @@ BvhStats Bvh::stats() const {
             ++s.leaves;
             depth_sum += depth;
             size_sum += n.count;
-            s.max_leaf_size = std::max(s.max_leaf_size, n.count);
+            s.max_leaf_size = std::max<uint32_t>(s.max_leaf_size, n.count);
             sah += rel * n.count;
         } else {
             sah += rel;
-            stack.push_back({n.first, depth + 1});
-            stack.push_back({n.right, depth + 1});
+            stack.push_back({BvhNode::left(index), depth + 1});
+            stack.push_back({n.right(), depth + 1});
         }
     }
     s.average_leaf_depth = s.leaves ? double(depth_sum) / double(s.leaves) : 0.0;

@@ -12,15 +12,20 @@
 
 namespace sfx {
 
-struct BvhNode {
+// 32 bytes, two to a cache line: the children of a node are visited together, and the left
+// child is stored right after its parent (the build is depth first), so only the right
+// child's index is kept.
+struct alignas(32) BvhNode {
     Bounds3 bounds;
-    uint32_t first = 0;  // leaf: first index into Bvh::prim_ids; interior: left child index
-    uint32_t count = 0;  // leaf: primitive count (> 0); interior: 0
-    uint32_t right = 0;  // interior: right child index
+    uint32_t first = 0;  // leaf: first index into Bvh::prim_ids; interior: right child index
+    uint16_t count = 0;  // leaf: primitive count (> 0); interior: 0
     uint8_t axis = 0;    // interior: split axis, for front-to-back order
 
     bool is_leaf() const { return count > 0; }
+    static uint32_t left(uint32_t index) { return index + 1; }
+    uint32_t right() const { return first; }
 };
+static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
 
 struct BvhBuildOptions {
     uint32_t max_leaf_size = 4;
@@ -35,7 +40,7 @@ struct BvhStats {
     uint32_t max_depth = 0;
     double average_leaf_depth = 0.0;
     double average_leaf_size = 0.0;
-    uint32_t max_leaf_size = 0;
+    uint32_t max_leaf_size = 4;
     double sah_cost = 0.0;
     uint64_t bytes = 0;
 };

@@ -144,8 +144,8 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
         stack.pop_back();
         const BvhNode& node = nodes[node_index];
         if (!node.is_leaf()) {  // the children arrive while this node's filter runs
-            __builtin_prefetch(&nodes[node.first]);
-            __builtin_prefetch(&nodes[node.right]);
+            __builtin_prefetch(&nodes[BvhNode::left(node_index)]);
+            __builtin_prefetch(&nodes[node.right()]);
         }
         uint32_t negative = 0;
         const uint32_t k = box_filter(trace, node, node_index, generation, rays, ids, len, mask,
@@ -173,9 +173,9 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             }
         } else {
             const bool right_first = 2 * negative > k;
-            const uint32_t front = right_first ? node.right : node.first;
-            stack.push_back({right_first ? node.first : node.right, k});  // back: popped last
-            stack.push_back({front, k});
+            const uint32_t left = BvhNode::left(node_index), right = node.right();
+            stack.push_back({right_first ? left : right, k});  // back: popped last
+            stack.push_back({right_first ? right : left, k});
         }
     }
 }

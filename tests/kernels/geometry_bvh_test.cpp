@@ -102,7 +102,7 @@ bool same_nodes(const Bvh& a, const Bvh& b) {
             if (!same_bits(x.bounds.lo[k], y.bounds.lo[k]) ||
                 !same_bits(x.bounds.hi[k], y.bounds.hi[k]))
                 return false;
-        if (x.first != y.first || x.count != y.count || x.right != y.right || x.axis != y.axis)
+        if (x.first != y.first || x.count != y.count || x.axis != y.axis)
             return false;
     }
     return true;

@@ -75,7 +75,8 @@ void count_recursive(const Bvh& bvh, const Ray& ray, RecursiveCounts& c) {
     float t_max = ray.t_max;
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
-        const BvhNode& node = bvh.nodes()[stack.back()];
+        const uint32_t index = stack.back();
+        const BvhNode& node = bvh.nodes()[index];
         stack.pop_back();
         ++c.box;
         if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
@@ -86,8 +87,8 @@ void count_recursive(const Bvh& bvh, const Ray& ray, RecursiveCounts& c) {
             }
         } else {
             const bool right_first = visit_right_first(node, r.dir);
-            stack.push_back(right_first ? node.first : node.right);
-            stack.push_back(right_first ? node.right : node.first);
+            stack.push_back(right_first ? BvhNode::left(index) : node.right());
+            stack.push_back(right_first ? node.right() : BvhNode::left(index));
         }
     }
 }
@@ -131,8 +132,8 @@ RecursiveCounts count_packet(const Bvh& bvh, const std::vector<Ray>& rays) {
             }
         } else {
             const bool right_first = 2 * negative > active;
-            stack.push_back({right_first ? node.first : node.right, mask});
-            stack.push_back({right_first ? node.right : node.first, mask});
+            stack.push_back({right_first ? BvhNode::left(index) : node.right(), mask});
+            stack.push_back({right_first ? node.right() : BvhNode::left(index), mask});
         }
     }
     return c;
