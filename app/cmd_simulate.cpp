@@ -73,8 +73,11 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
         });
     }
     row("host seconds", [&](const Prediction& p) { return fixed(p.host_seconds, 3); });
-    row("error estimate", [&](const Prediction& p) {
-        return p.error_relative < 0 ? std::string("unknown") : fixed(100 * p.error_relative, 2) + "%";
+    row("error estimate (interval)", [&](const Prediction& p) {
+        return p.error_relative < 0 ? std::string("unknown") : "+-" + fixed(100 * p.error_relative, 2) + "%";
+    });
+    row("tile passes timed", [&](const Prediction& p) {
+        return std::to_string(p.sample_passes) + "/" + std::to_string(p.total_passes);
     });
 }
 
@@ -85,17 +88,19 @@ void add_simulate_command(CLI::App& app) {
         std::string fidelity = "full";
         bool json = false;
         WorkloadFlags workload;
+        SamplingFlags sampling;
     };
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand("simulate", "predict frame rate and utilization of hardware configurations");
     c->add_option("hw", o->hw, "hardware configuration files (*.hw.yaml); several share one render")
         ->required();
     c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();
-    c->add_option("--fidelity", o->fidelity, "analytic | full")
-        ->check(CLI::IsMember({"analytic", "full"}))
+    c->add_option("--fidelity", o->fidelity, "analytic | sampled | full")
+        ->check(CLI::IsMember({"analytic", "sampled", "full"}))
         ->capture_default_str();
     c->add_flag("--json", o->json, "print one JSON document (a list for several configurations)");
     o->workload.add_to(c);
+    o->sampling.add_to(c);
     c->callback([o] {
         std::vector<HwConfig> configs;
         for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
@@ -106,7 +111,8 @@ void add_simulate_command(CLI::App& app) {
         check_tile_fits(settings.tile, features, configs, "--tile");
         const Bvh bvh(scene);
         const PointGroupResult r =
-            run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
+            run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity),
+                            o->sampling.resolve(settings.seed));
         if (o->json) {
             if (r.predictions.size() == 1) {
                 std::cout << prediction_json(r.predictions[0]).dump(2) << "\n";

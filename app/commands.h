@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kernels/render.h"
+#include "sweeps/sampling.h"
 #include "workloads/scene.h"
 
 namespace sfx {
@@ -24,11 +25,25 @@ struct WorkloadFlags {
     RenderSettings resolve(const Scene& scene) const;
 };
 
+// Sampling flags shared by the commands that predict at sampled fidelity.
+struct SamplingFlags {
+    std::string fraction = "2%";
+    std::string target_error;  // empty: sample `fraction` of the passes
+    std::string confidence = "99.7%";
+    uint32_t warmup_passes = 1;
+    uint32_t strata = 8;
+
+    void add_to(CLI::App* command);
+    // Throws InputError (key = the flag) on a bad value. "2%" and "0.02" mean the same.
+    SamplingOptions resolve(uint64_t seed) const;
+};
+
 void add_render_command(CLI::App& app);
 void add_trace_stats_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_scene_info_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_accuracy_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);  // also the hidden run-group
 void add_compare_command(CLI::App& app);
 

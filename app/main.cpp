@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     sfx::add_validate_command(app);
     sfx::add_scene_info_command(app);
     sfx::add_simulate_command(app);
+    sfx::add_accuracy_command(app);
     sfx::add_sweep_command(app);
     sfx::add_compare_command(app);
     try {

@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <cstdlib>
 
 #include "app/commands.h"
 #include "workloads/input_error.h"
@@ -38,6 +39,47 @@ RenderSettings WorkloadFlags::resolve(const Scene& scene) const {
     s.seed = seed;
     s.threads = threads;
     return s;
+}
+
+namespace {
+double parse_fraction(const std::string& text, const std::string& key) {
+    std::string t = text;
+    double scale = 1.0;
+    if (!t.empty() && t.back() == '%') {
+        t.pop_back();
+        scale = 0.01;
+    }
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (t.empty() || *end != '\0' || !(v * scale > 0.0) || v * scale > 1.0)
+        throw InputError("command line", 0, key, "expected a fraction in (0, 1] or a percentage, got '" + text + "'");
+    return v * scale;
+}
+}  // namespace
+
+void SamplingFlags::add_to(CLI::App* c) {
+    c->add_option("--sample-fraction", fraction, "sampled fidelity: share of tile passes timed")
+        ->capture_default_str();
+    c->add_option("--target-error", target_error,
+                  "sampled fidelity: sample until the interval's relative half-width is below this");
+    c->add_option("--confidence", confidence, "sampled fidelity: two-sided confidence level")
+        ->capture_default_str();
+    c->add_option("--warmup-passes", warmup_passes, "sampled fidelity: passes replayed into the caches first")
+        ->capture_default_str();
+    c->add_option("--strata", strata, "sampled fidelity: strata of tiles")->capture_default_str();
+}
+
+SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
+    SamplingOptions o;
+    o.fraction = parse_fraction(fraction, "--sample-fraction");
+    if (!target_error.empty()) o.target_error = parse_fraction(target_error, "--target-error");
+    o.confidence = parse_fraction(confidence, "--confidence");
+    if (o.confidence >= 1.0) throw InputError("command line", 0, "--confidence", "must be below 100%");
+    if (strata == 0) throw InputError("command line", 0, "--strata", "must be at least 1");
+    o.warmup_passes = warmup_passes;
+    o.strata = strata;
+    o.seed = seed + 1;
+    return o;
 }
 
 }  // namespace sfx

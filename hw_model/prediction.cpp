@@ -1,5 +1,7 @@
 #include "hw_model/prediction.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace sfx {
@@ -68,6 +70,55 @@ FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
     dram_reads += o.dram_reads;
     passes += o.passes;
     return *this;
+}
+
+namespace {
+// Applies f(counter of this, counter of o) to every counter of a FrameTiming pair.
+template <class F> void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
+    f(t.cycles, o.cycles);
+    f(t.stalls.bank_conflict, o.stalls.bank_conflict);
+    f(t.stalls.alignment, o.stalls.alignment);
+    f(t.stalls.address_fetch, o.stalls.address_fetch);
+    f(t.stalls.partition, o.stalls.partition);
+    f(t.stalls.scene_memory, o.stalls.scene_memory);
+    f(t.stalls.interconnect, o.stalls.interconnect);
+    f(t.stalls.pipeline_fill, o.stalls.pipeline_fill);
+    f(t.mix.load, o.mix.load);
+    f(t.mix.store, o.mix.store);
+    f(t.mix.compute, o.mix.compute);
+    f(t.mix.scatter_gather, o.mix.scatter_gather);
+    f(t.mix.partition, o.mix.partition);
+    for (int s = 0; s < 2; ++s)
+        for (uint32_t k = 0; k < k_op_stage_count; ++k) {
+            f(t.stages[s][k].ops, o.stages[s][k].ops);
+            f(t.stages[s][k].lanes, o.stages[s][k].lanes);
+            f(t.stages[s][k].groups, o.stages[s][k].groups);
+            f(t.stages[s][k].busy_cycles, o.stages[s][k].busy_cycles);
+            f(t.stages[s][k].stall_cycles, o.stages[s][k].stall_cycles);
+        }
+    f(t.field_accesses, o.field_accesses);
+    f(t.conflicted_accesses, o.conflicted_accesses);
+    t.cache_hits.resize(std::max(t.cache_hits.size(), o.cache_hits.size()));
+    t.cache_misses.resize(std::max(t.cache_misses.size(), o.cache_misses.size()));
+    for (size_t i = 0; i < o.cache_hits.size(); ++i) {
+        f(t.cache_hits[i], o.cache_hits[i]);
+        f(t.cache_misses[i], o.cache_misses[i]);
+    }
+    f(t.dram_reads, o.dram_reads);
+    f(t.passes, o.passes);
+}
+}  // namespace
+
+void FrameTiming::add_scaled(const FrameTiming& o, double weight) {
+    for_each_counter(*this, o, [weight](uint64_t& a, uint64_t b) {
+        a += uint64_t(std::llround(double(b) * weight));
+    });
+}
+
+FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b) {
+    FrameTiming d = b;
+    for_each_counter(d, a, [](uint64_t& x, uint64_t y) { x -= y; });
+    return d;
 }
 
 double Prediction::frame_seconds() const {

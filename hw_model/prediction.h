@@ -65,7 +65,12 @@ struct FrameTiming {
     uint64_t passes = 0;
 
     FrameTiming& operator+=(const FrameTiming& o);
+    // Adds o * weight (each counter rounded): the expansion of a sampled pass to its stratum.
+    void add_scaled(const FrameTiming& o, double weight);
 };
+
+// What happened between two snapshots of the same model (b taken after a).
+FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b);
 
 struct Stat {
     std::string name;

@@ -1,9 +1,14 @@
 #include "sweeps/point_group.h"
 
+#include <algorithm>
 #include <chrono>
+#include <memory>
+#include <mutex>
+#include <thread>
 #include <cmath>
 
 #include "hw_model/analytic_model.h"
+#include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/stream/stream_tracer.h"
 #include "workloads/input_error.h"
@@ -30,6 +35,182 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+
+WorkloadShape shape_of(const Scene& scene, const Bvh& bvh, const RenderSettings& settings) {
+    WorkloadShape shape;
+    shape.features = scene.features();
+    shape.features.max_depth = settings.max_depth;
+    shape.triangles = scene.triangles.size();
+    shape.spheres = scene.spheres.size();
+    shape.bvh_nodes = bvh.nodes().size();
+    shape.tile = settings.tile;
+    return shape;
+}
+
+// Ideal utilization at configuration i's width from the counted trace.
+void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
+    for (int sec = 0; sec < 2; ++sec)
+        for (uint32_t k = 0; k < k_op_stage_count; ++k)
+            p.ideal_utilization[sec][k] = counts.stage(sec, OpStage(k)).utilization(i, width);
+    for (uint32_t k = 0; k < k_op_stage_count; ++k) {
+        const auto& a = counts.stage(false, OpStage(k));
+        const auto& b = counts.stage(true, OpStage(k));
+        const double slots = double(width) * double(a.groups[i] + b.groups[i]);
+        p.ideal_utilization_all[k] = slots > 0 ? double(a.lanes + b.lanes) / slots : 0.0;
+    }
+}
+
+// Sums the lanes of a pass: the pilot's cost estimate of a tile.
+class LaneCounter : public TraceSink {
+public:
+    void op(const StreamOp& op) override { lanes += op.length; }
+    uint64_t lanes = 0;
+};
+
+// Holds the passes of one traced unit: warm-up passes first, the sampled pass last.
+class UnitPasses : public TraceSink {
+public:
+    void begin_pass(const TilePass& p) override { passes.emplace_back(); passes.back().begin_pass(p); }
+    void op(const StreamOp& o) override { passes.back().op(o); }
+    void end_pass(const TilePass& p) override { passes.back().end_pass(p); }
+    std::vector<PassBuffer> passes;
+};
+
+void replay(const PassBuffer& b, TraceSink& sink) {
+    sink.begin_pass(b.pass());
+    for (size_t i = 0; i < b.size(); ++i) sink.op(b.at(i));
+    sink.end_pass(b.pass());
+}
+
+PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
+                             const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
+    const auto start = std::chrono::steady_clock::now();
+    const WorkloadShape shape = shape_of(scene, bvh, settings);
+    check_tile_fits(settings.tile, shape.features, configs, "--tile");
+    if (!(opt.fraction > 0.0 && opt.fraction <= 1.0))
+        throw InputError("command line", 0, "--sample-fraction", "must lie in (0, 1]");
+    if (opt.target_error < 0.0)
+        throw InputError("command line", 0, "--target-error", "must be positive");
+    const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
+    const uint32_t spp = settings.spp;
+    const uint32_t units = uint32_t(tiles.size()) * spp;
+    const uint32_t slots = settings.tile * settings.tile;
+    const uint32_t threads =
+        settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
+    std::vector<std::unique_ptr<StreamTracer>> tracers(threads);
+    std::vector<std::vector<Vec3>> sums(threads, std::vector<Vec3>(slots));
+    std::vector<RenderStats> stats(threads);
+    // parallel_for hands out indices to any thread; a tracer per worker slot, claimed by id.
+    std::mutex claim_mutex;
+    std::vector<bool> busy(threads, false);
+    auto with_tracer = [&](auto&& body) {
+        size_t slot;
+        {
+            std::lock_guard<std::mutex> lock(claim_mutex);
+            slot = size_t(std::find(busy.begin(), busy.end(), false) - busy.begin());
+            busy[slot] = true;
+        }
+        if (!tracers[slot]) tracers[slot] = std::make_unique<StreamTracer>(scene, bvh, settings);
+        body(*tracers[slot], sums[slot].data(), stats[slot]);
+        std::lock_guard<std::mutex> lock(claim_mutex);
+        busy[slot] = false;
+    };
+
+    // Strata: by a pilot estimate of each tile's cost (its sample-0 pass, traced functionally)
+    // when spp is high enough for the pilot to be cheap, else by image region.
+    Stratification strata;
+    if (spp >= opt.pilot_min_spp) {
+        std::vector<double> cost(tiles.size());
+        parallel_for(uint32_t(tiles.size()), threads, [&](uint32_t t) {
+            with_tracer([&](StreamTracer& tracer, Vec3* s, RenderStats& st) {
+                LaneCounter lanes;
+                tracer.trace_pass(tiles[t], t, 0, s, st, &lanes);
+                cost[t] = double(lanes.lanes);
+            });
+        });
+        strata = stratify_tiles_by_cost(cost, spp, opt.strata);
+    } else {
+        strata = stratify_tiles_by_region(uint32_t(tiles.size()), spp, opt.strata);
+    }
+    StratifiedSampler sampler(strata, opt.seed ^ settings.seed);
+
+    std::vector<uint32_t> widths;
+    for (const HwConfig& c : configs) widths.push_back(c.simd.width);
+    CountingSink counts(widths);
+    SystemcTiming timing(configs, shape);
+    std::vector<uint32_t> sampled;                       // units, in the order timed
+    std::vector<std::vector<FrameTiming>> per_unit(configs.size());
+    std::vector<Estimate> estimates(configs.size());
+    uint64_t target = std::max<uint64_t>(2ull * strata.strata, uint64_t(std::ceil(opt.fraction * units)));
+    const uint32_t chunk = 4 * threads;
+    for (;;) {
+        const std::vector<uint32_t> batch = sampler.grow_to(target);
+        for (size_t first = 0; first < batch.size(); first += chunk) {
+            const size_t count = std::min<size_t>(chunk, batch.size() - first);
+            std::vector<UnitPasses> traced(count);
+            parallel_for(uint32_t(count), threads, [&](uint32_t i) {
+                const uint32_t unit = batch[first + i];
+                with_tracer([&](StreamTracer& tracer, Vec3* s, RenderStats& st) {
+                    // The passes that precede this one in execution order warm the caches.
+                    const uint32_t warm = std::min<uint32_t>(opt.warmup_passes, unit);
+                    for (uint32_t u = unit - warm; u <= unit; ++u)
+                        tracer.trace_pass(tiles[u / spp], u / spp, u % spp, s, st, &traced[i]);
+                });
+            });
+            for (size_t i = 0; i < count; ++i) {
+                const std::vector<PassBuffer>& passes = traced[i].passes;
+                timing.set_warming(true);
+                for (size_t w = 0; w + 1 < passes.size(); ++w) replay(passes[w], timing);
+                timing.set_warming(false);
+                std::vector<FrameTiming> before(configs.size());
+                for (size_t c = 0; c < configs.size(); ++c) before[c] = timing.timing(c);
+                replay(passes.back(), timing);
+                replay(passes.back(), counts);
+                for (size_t c = 0; c < configs.size(); ++c)
+                    per_unit[c].push_back(timing_between(before[c], timing.timing(c)));
+                sampled.push_back(batch[first + i]);
+            }
+        }
+        double worst = 0.0;
+        for (size_t c = 0; c < configs.size(); ++c) {
+            std::vector<double> cycles;
+            for (const FrameTiming& t : per_unit[c]) cycles.push_back(double(t.cycles));
+            estimates[c] = estimate_total(strata, sampled, cycles, opt.confidence);
+            worst = std::max(worst, estimates[c].relative());
+        }
+        if (opt.target_error <= 0.0 || worst <= opt.target_error || sampled.size() >= units) break;
+        target = std::min<uint64_t>(units, std::max<uint64_t>(target + 1, uint64_t(target * 1.5)));
+    }
+
+    // Expand each sampled pass to its stratum: weight N_h / n_h.
+    const std::vector<uint64_t> sizes = strata.sizes();
+    std::vector<uint64_t> taken(strata.strata, 0);
+    for (uint32_t u : sampled) ++taken[strata.stratum_of[u]];
+    PointGroupResult result;
+    const double seconds = seconds_since(start);
+    for (size_t c = 0; c < configs.size(); ++c) {
+        Prediction p;
+        p.config = configs[c];
+        p.fidelity = Fidelity::sampled;
+        p.tile = settings.tile;
+        p.bytes_per_ray = ray_record_bytes(shape.features);
+        for (size_t i = 0; i < sampled.size(); ++i) {
+            const uint32_t h = strata.stratum_of[sampled[i]];
+            p.timing.add_scaled(per_unit[c][i], double(sizes[h]) / double(taken[h]));
+        }
+        p.timing.cycles = uint64_t(std::llround(estimates[c].total));  // the estimator's own
+        fill_ideal(p, counts, c, widths[c]);
+        p.error_relative = estimates[c].relative();
+        p.sample_passes = sampled.size();
+        p.total_passes = units;
+        p.host_seconds = seconds / double(configs.size());
+        result.predictions.push_back(std::move(p));
+    }
+    for (const RenderStats& st : stats) result.render += st;
+    result.host_seconds = seconds_since(start);
+    return result;
+}
+
 }  // namespace
 
 uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs) {
@@ -54,18 +235,11 @@ void check_tile_fits(uint32_t tile, const FeatureSet& features,
 
 PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const RenderSettings& settings,
-                                 const std::vector<HwConfig>& configs, Fidelity fidelity) {
-    if (fidelity == Fidelity::sampled)
-        throw InputError("command line", 0, "--fidelity",
-                         "sampled fidelity is not available yet; use analytic or full");
+                                 const std::vector<HwConfig>& configs, Fidelity fidelity,
+                                 const SamplingOptions& sampling) {
+    if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);
     const auto start = std::chrono::steady_clock::now();
-    WorkloadShape shape;
-    shape.features = scene.features();
-    shape.features.max_depth = settings.max_depth;
-    shape.triangles = scene.triangles.size();
-    shape.spheres = scene.spheres.size();
-    shape.bvh_nodes = bvh.nodes().size();
-    shape.tile = settings.tile;
+    const WorkloadShape shape = shape_of(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
 
     std::vector<uint32_t> widths;
@@ -94,17 +268,11 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
         p.bytes_per_ray = ray_record_bytes(shape.features);
         p.timing = fidelity == Fidelity::analytic ? analytic_timing(configs[i], shape, profile)
                                                   : systemc->timing(i);
-        for (int sec = 0; sec < 2; ++sec)
-            for (uint32_t k = 0; k < k_op_stage_count; ++k)
-                p.ideal_utilization[sec][k] = counts.stage(sec, OpStage(k)).utilization(i, widths[i]);
-        for (uint32_t k = 0; k < k_op_stage_count; ++k) {
-            // Over all rays: lanes over issued lane slots, from both halves.
-            const auto& a = counts.stage(false, OpStage(k));
-            const auto& b = counts.stage(true, OpStage(k));
-            const double slots = double(widths[i]) * double(a.groups[i] + b.groups[i]);
-            p.ideal_utilization_all[k] = slots > 0 ? double(a.lanes + b.lanes) / slots : 0.0;
-        }
+        fill_ideal(p, counts, i, widths[i]);
         p.total_passes = p.sample_passes = counts.passes();
+        // Full fidelity is the reference the other levels are measured against: no sampling
+        // error. The analytic model's error is unknown until measured (sfx accuracy).
+        if (fidelity == Fidelity::full) p.error_relative = 0.0;
         // The functional render and the shared simulation are split evenly over the group.
         p.host_seconds = shared_seconds / double(configs.size()) + seconds_since(model_start);
         result.predictions.push_back(std::move(p));

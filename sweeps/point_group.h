@@ -10,6 +10,7 @@
 #include "hw_model/prediction.h"
 #include "kernels/bvh.h"
 #include "kernels/render.h"
+#include "sweeps/sampling.h"
 #include "workloads/scene.h"
 
 namespace sfx {
@@ -28,8 +29,12 @@ struct PointGroupResult {
     double host_seconds = 0.0;            // the whole group
 };
 
+// Analytic: the closed form over the whole frame's trace. Full: every tile pass at cycle
+// level. Sampled: a stratified sample of tile passes at cycle level (see sweeps/sampling.h),
+// extrapolated with a confidence interval on frame cycles.
 PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const RenderSettings& settings,
-                                 const std::vector<HwConfig>& configs, Fidelity fidelity);
+                                 const std::vector<HwConfig>& configs, Fidelity fidelity,
+                                 const SamplingOptions& sampling = {});
 
 }  // namespace sfx

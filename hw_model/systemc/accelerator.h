@@ -22,6 +22,7 @@ public:
                 std::shared_ptr<SharedSceneMemory> scene_memory);
 
     void start(const PassBuffer* pass) { m_sequencer->start(pass); }
+    void set_warming(bool warming) { m_sequencer->set_warming(warming); }
     // The frame so far, with the scene-cache counters filled in.
     FrameTiming timing() const;
     const SimdUnit& simd() const { return *m_simd; }

@@ -19,6 +19,15 @@ void Sequencer::start(const PassBuffer* pass) {
 void Sequencer::run() {
     for (;;) {
         wait(m_start);
+        if (m_warming) {
+            for (size_t i = 0; i < m_pass->size(); ++i) {
+                const StreamOp op = m_pass->at(i);
+                const OpProfile& p = m_costs[op.kind];
+                if (p.scene_bytes && op.object != k_no_object && op.length)
+                    scene_memory->read(i, m_map.address(op.kind, op.object), p.scene_bytes);
+            }
+            continue;
+        }
         FrameTiming pass_timing;
         pass_timing.passes = 1;
         for (size_t i = 0; i < m_pass->size(); ++i) {

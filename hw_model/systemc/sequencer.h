@@ -34,6 +34,9 @@ public:
     // Starts replaying `pass` at the next delta cycle; the pass must outlive the simulation
     // run (sc_start returns when every sequencer is idle again).
     void start(const PassBuffer* pass);
+    // Warming: passes only feed the scene-data caches (their fetches, in order) and count no
+    // time, so a sampled pass starts with the caches the full frame would have left.
+    void set_warming(bool warming) { m_warming = warming; }
     const FrameTiming& timing() const { return m_timing; }
 
 private:
@@ -45,6 +48,7 @@ private:
     uint32_t m_width;
     sc_core::sc_time m_period;
     const PassBuffer* m_pass = nullptr;
+    bool m_warming = false;
     sc_core::sc_event m_start;
     tlm_utils::tlm_quantumkeeper m_keeper;
     FrameTiming m_timing;

@@ -70,6 +70,10 @@ void SystemcTiming::end_pass(const TilePass& p) {
     sc_core::sc_start();  // until every sequencer waits for the next pass
 }
 
+void SystemcTiming::set_warming(bool warming) {
+    for (auto& a : m_accelerators) a->set_warming(warming);
+}
+
 FrameTiming SystemcTiming::timing(size_t config) const { return m_accelerators[config]->timing(); }
 
 }  // namespace sfx

@@ -33,6 +33,9 @@ public:
     void op(const StreamOp& op) override { m_pass.op(op); }
     void end_pass(const TilePass& p) override;
 
+    // While warming, passes only warm the scene-data caches; no time is counted.
+    void set_warming(bool warming);
+
     size_t configs() const { return m_accelerators.size(); }
     FrameTiming timing(size_t config) const;
     const Accelerator& accelerator(size_t config) const { return *m_accelerators[config]; }

@@ -1,0 +1,75 @@
+#pragma once
+// Sampled simulation (SMARTS-style): time a stratified random sample of a frame's tile passes at
+// cycle level and extrapolate the frame, with a confidence interval.
+//
+// The sampling unit is one tile pass, exactly as the hardware schedules it (SIMD efficiency
+// depends on which rays share a stream, so resolution and spp are never reduced). Units are
+// numbered in execution order: unit = tile * spp + sample. This file holds the statistics,
+// which need no tracer and no hardware model; sweeps/point_group.cpp drives them.
+
+#include <cstdint>
+#include <vector>
+
+namespace sfx {
+
+struct SamplingOptions {
+    double fraction = 0.02;      // of the frame's tile passes, when no target error is given
+    double target_error = 0.0;   // > 0: sample until every configuration's relative half-width
+                                 // of frame cycles is at most this (or every pass is timed)
+    double confidence = 0.997;   // two-sided level of the interval
+    uint32_t strata = 8;
+    uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
+    uint32_t pilot_min_spp = 8;  // stratify by a pilot cost estimate from this spp on
+    uint64_t seed = 1;
+};
+
+// Which stratum each unit belongs to.
+struct Stratification {
+    std::vector<uint32_t> stratum_of;  // per unit
+    uint32_t strata = 0;
+
+    std::vector<uint64_t> sizes() const;  // units per stratum
+};
+
+// Tiles sorted by a cost estimate (ties by tile index) and cut into equal-count groups; every
+// pass of a tile falls in its tile's stratum.
+Stratification stratify_tiles_by_cost(const std::vector<double>& tile_cost, uint32_t spp,
+                                      uint32_t strata);
+// Tiles cut into contiguous runs in raster order (image regions).
+Stratification stratify_tiles_by_region(uint32_t tiles, uint32_t spp, uint32_t strata);
+
+// Draws units without replacement, stratum by stratum in a seeded random order, keeping the
+// allocation proportional to stratum sizes (and at least two per stratum where possible, so
+// every stratum has a variance).
+class StratifiedSampler {
+public:
+    StratifiedSampler(const Stratification& strata, uint64_t seed);
+    // New units (sorted) that bring the sample to about `total` units.
+    std::vector<uint32_t> grow_to(uint64_t total);
+    uint64_t sampled() const { return m_sampled; }
+    uint64_t population() const { return m_population; }
+
+private:
+    const Stratification& m_strata;
+    std::vector<std::vector<uint32_t>> m_order;  // per stratum: its units, shuffled
+    std::vector<uint64_t> m_taken;               // per stratum: how many are in the sample
+    uint64_t m_sampled = 0, m_population = 0;
+};
+
+struct Estimate {
+    double total = 0.0;       // estimated population total
+    double half_width = 0.0;  // of the confidence interval for the total
+    uint64_t sampled = 0, population = 0;
+
+    double relative() const { return total > 0.0 ? half_width / total : 0.0; }
+};
+
+// Stratified estimate of a population total from observed (unit, value) pairs, with the
+// finite-population correction: Var = sum_h N_h^2 (1 - n_h/N_h) s_h^2 / n_h.
+Estimate estimate_total(const Stratification& strata, const std::vector<uint32_t>& units,
+                        const std::vector<double>& values, double confidence);
+
+// Two-sided standard-normal quantile: z with P(|Z| <= z) = confidence.
+double normal_quantile_two_sided(double confidence);
+
+}  // namespace sfx
