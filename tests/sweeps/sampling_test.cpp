@@ -1,0 +1,147 @@
+// Sampled fidelity: the interval covers the truth, shrinks with the sample, and adaptive
+// sampling stops at its target.
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "hw_model/systemc/systemc_timing.h"
+#include "kernels/bvh.h"
+#include "kernels/stream/stream_tracer.h"
+#include "sweeps/point_group.h"
+#include "sweeps/sampling.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+
+namespace {
+
+// Cycles of every tile pass of a frame, in execution order, from the cycle-level model.
+class PassCycles : public TraceSink {
+public:
+    explicit PassCycles(SystemcTiming& timing) : m_timing(timing) {}
+    void begin_pass(const TilePass& p) override { m_timing.begin_pass(p); }
+    void op(const StreamOp& o) override { m_timing.op(o); }
+    void end_pass(const TilePass& p) override {
+        m_timing.end_pass(p);
+        const uint64_t now = m_timing.timing(0).cycles;
+        cycles.push_back(double(now - m_last));
+        m_last = now;
+    }
+    std::vector<double> cycles;
+
+private:
+    SystemcTiming& m_timing;
+    uint64_t m_last = 0;
+};
+
+RenderSettings small_settings(const Scene& scene) {
+    RenderSettings s;
+    s.width = s.height = 64;
+    s.spp = 8;
+    s.tile = 8;
+    s.max_depth = scene.max_depth;
+    s.threads = 2;
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("Normal quantiles", "[sampling]") {
+    CHECK(normal_quantile_two_sided(0.95) == Approx(1.959964).epsilon(1e-5));
+    CHECK(normal_quantile_two_sided(0.997) == Approx(2.967738).epsilon(1e-5));
+}
+
+TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity total in >= 97 of "
+          "100 seeded repetitions and shrinks as the sample grows",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    const RenderSettings settings = small_settings(scene);
+    WorkloadShape shape;
+    shape.features = scene.features();
+    shape.triangles = scene.triangles.size();
+    shape.spheres = scene.spheres.size();
+    shape.bvh_nodes = bvh.nodes().size();
+    shape.tile = settings.tile;
+    SystemcTiming timing({HwConfig{}}, shape);
+    PassCycles passes(timing);
+    render_stream(scene, bvh, settings, &passes);
+    // The population: the cycle-level model's cycles of each pass (a cheap timing model to
+    // sample from many times).
+    const std::vector<double>& population = passes.cycles;
+    const uint32_t tiles = 64;
+    REQUIRE(population.size() == tiles * settings.spp);
+    double truth = 0.0;
+    for (double c : population) truth += c;
+    // Tile cost for the strata: the sample-0 pass of each tile (the pilot).
+    std::vector<double> pilot(tiles);
+    for (uint32_t t = 0; t < tiles; ++t) pilot[t] = population[t * settings.spp];
+    const Stratification strata = stratify_tiles_by_cost(pilot, settings.spp, 4);
+
+    auto mean_half_width = [&](double fraction, int& covered) {
+        double sum = 0.0;
+        covered = 0;
+        for (uint64_t seed = 1; seed <= 100; ++seed) {
+            StratifiedSampler sampler(strata, seed);
+            const std::vector<uint32_t> units =
+                sampler.grow_to(uint64_t(std::ceil(fraction * population.size())));
+            std::vector<double> values;
+            for (uint32_t u : units) values.push_back(population[u]);
+            const Estimate e = estimate_total(strata, units, values, 0.997);
+            covered += std::fabs(e.total - truth) <= e.half_width;
+            sum += e.relative();
+        }
+        return sum / 100.0;
+    };
+    int covered_small = 0, covered_mid = 0, covered_large = 0;
+    const double small = mean_half_width(0.05, covered_small);
+    const double mid = mean_half_width(0.2, covered_mid);
+    const double large = mean_half_width(0.5, covered_large);
+    INFO("coverage " << covered_small << " " << covered_mid << " " << covered_large
+                     << "; half-widths " << small << " " << mid << " " << large);
+    CHECK(covered_small >= 97);
+    CHECK(covered_mid >= 97);
+    CHECK(covered_large >= 97);
+    CHECK(small > mid);
+    CHECK(mid > large);
+    // The whole population: no sampling error.
+    StratifiedSampler all(strata, 1);
+    const std::vector<uint32_t> units = all.grow_to(population.size());
+    std::vector<double> values;
+    for (uint32_t u : units) values.push_back(population[u]);
+    const Estimate e = estimate_total(strata, units, values, 0.997);
+    CHECK(e.half_width == 0.0);
+    CHECK(e.total == Approx(truth));
+}
+
+TEST_CASE("Sampled fidelity agrees with full within its interval; adaptive sampling stops at "
+          "its target",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    const RenderSettings settings = small_settings(scene);
+    const std::vector<HwConfig> configs = {HwConfig{}};
+    const Prediction full = run_point_group(scene, bvh, settings, configs, Fidelity::full).predictions[0];
+    SamplingOptions options;
+    options.fraction = 0.25;
+    const Prediction sampled =
+        run_point_group(scene, bvh, settings, configs, Fidelity::sampled, options).predictions[0];
+    CHECK(sampled.sample_passes < sampled.total_passes);
+    CHECK(sampled.total_passes == full.total_passes);
+    const double error = std::fabs(double(sampled.timing.cycles) / double(full.timing.cycles) - 1.0);
+    INFO("sampled error " << error << " interval " << sampled.error_relative);
+    // Warm-up leaves a small bias of its own on top of the sampling error.
+    CHECK(error <= sampled.error_relative + 0.02);
+
+    for (double target : {0.05, 0.02}) {
+        SamplingOptions adaptive;
+        adaptive.fraction = 0.02;
+        adaptive.target_error = target;
+        const Prediction p =
+            run_point_group(scene, bvh, settings, configs, Fidelity::sampled, adaptive).predictions[0];
+        INFO("target " << target << " reached " << p.error_relative << " with " << p.sample_passes
+                       << " of " << p.total_passes);
+        CHECK((p.error_relative <= target || p.sample_passes == p.total_passes));
+        CHECK(p.sample_passes > uint64_t(0.02 * p.total_passes));  // it had to grow
+    }
+}
