@@ -48,7 +48,9 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
     std::string scene = p.workload.scene;
     if (scene.find('/') != std::string::npos) scene = scene.substr(scene.find_last_of('/') + 1);
     return scene + " " + std::to_string(p.workload.width) + "x" + std::to_string(p.workload.height) +
-           " spp " + std::to_string(p.workload.spp) + " tile " + std::to_string(p.workload.tile) + " " +
+           " spp " + std::to_string(p.workload.spp) + " depth " + std::to_string(p.workload.depth) +
+           " tile " + std::to_string(p.workload.tile) +
+           (p.workload.seed ? " seed " + std::to_string(p.workload.seed) : std::string()) + " " +
            to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
            (points.size() == 1 ? "" : "s") + ")";
 }

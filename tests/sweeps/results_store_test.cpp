@@ -1,0 +1,149 @@
+// The results store (schema version 1): columns and types, one row per key, new stat columns,
+// CSV export; and a point group run from its JSON spec.
+
+#include <catch2/catch.hpp>
+#include <sqlite3.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <unistd.h>
+
+#include "sweeps/group_runner.h"
+#include "sweeps/results_store.h"
+#include "sweeps/sweep.h"
+#include "workloads/input_error.h"
+
+using namespace sfx;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        path = fs::temp_directory_path() / ("sfx-store-test-" + std::to_string(getpid()));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+};
+
+Sweep small_sweep(const std::string& fidelity = "analytic") {
+    return parse_sweep("version: 1\nhw: gr08.hw.yaml\n"
+                       "workload: {scene: cornell, res: 16x16, spp: 1, tile: 8}\n"
+                       "fidelity: " + fidelity + "\n"
+                       "axes:\n  hw.simd.width: [4, 8]\n",
+                       "small.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
+}
+
+PointRun fake_run(const std::string& key, double fps) {
+    PointRun r;
+    r.key = key;
+    r.sfx_version = sfx_version();
+    r.started_at = r.finished_at = iso8601_now();
+    r.metrics = {{"fps", fps}, {"error.relative", -1}, {"scene_cache.l1.hit_rate", std::nan("")}};
+    return r;
+}
+
+std::string query(sqlite3* db, const std::string& sql) {
+    sqlite3_stmt* s = nullptr;
+    REQUIRE(sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) == SQLITE_OK);
+    std::string out;
+    while (sqlite3_step(s) == SQLITE_ROW) {
+        for (int c = 0; c < sqlite3_column_count(s); ++c) {
+            const unsigned char* t = sqlite3_column_text(s, c);
+            out += (c ? "|" : "") + std::string(t ? reinterpret_cast<const char*>(t) : "NULL");
+        }
+        out += "\n";
+    }
+    sqlite3_finalize(s);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps]") {
+    TempDir dir;
+    const std::string db = (dir.path / "r.db").string();
+    const Sweep sweep = small_sweep();
+    {
+        ResultsStore store(db);
+        CHECK(store.keys().empty());
+        CHECK(store.write_point(sweep.points[0], sweep.name, fake_run(sweep.points[0].key, 10)));
+        CHECK_FALSE(store.write_point(sweep.points[0], sweep.name, fake_run(sweep.points[0].key, 99)));
+        CHECK(store.contains(sweep.points[0].key));
+        CHECK_FALSE(store.contains(sweep.points[1].key));
+        // A later sfx adds a stat: it becomes a new column, NULL in older rows.
+        PointRun later = fake_run(sweep.points[1].key, 20);
+        later.metrics.emplace_back("new_stat.cycles", 5);
+        CHECK(store.write_point(sweep.points[1], sweep.name, later));
+        sqlite3* h = store.handle();
+        CHECK(query(h, "SELECT value FROM meta WHERE key = 'schema_version'") == "1\n");
+        CHECK(query(h, "SELECT value FROM meta WHERE key = 'created_by'") == std::string("sfx ") + sfx_version() + "\n");
+        CHECK(query(h, "SELECT count(*) FROM points") == "2\n");
+        CHECK(query(h, "SELECT fps FROM points ORDER BY point_index") == "10.0\n20.0\n");  // not overwritten
+        CHECK(query(h, "SELECT \"new_stat.cycles\" FROM points ORDER BY point_index") == "NULL\n5.0\n");
+        CHECK(query(h, "SELECT \"scene_cache.l1.hit_rate\" FROM points LIMIT 1") == "NULL\n");
+        CHECK(query(h, "SELECT \"hw.simd.width\", \"hw.name\", \"hw.ray_buffer.pipelined\", "
+                       "\"hw.scene_memory.caches[2].kib\", \"workload.scene\", \"workload.tile\", fidelity, sweep "
+                       "FROM points ORDER BY point_index") ==
+              "4.0|gr08|true|2048.0|cornell|8|analytic|small\n8.0|gr08|true|2048.0|cornell|8|analytic|small\n");
+        const std::string types = query(h, "SELECT name, type FROM pragma_table_info('points') WHERE name IN "
+                                           "('hw.simd.width', 'hw.name', 'fps', 'point_index', 'key')");
+        CHECK(types == "key|TEXT\npoint_index|INTEGER\nhw.name|TEXT\nhw.simd.width|REAL\nfps|REAL\n");
+        // The stored YAML reproduces the point.
+        const std::string yaml = query(h, "SELECT config_yaml FROM points WHERE point_index = 1");
+        CHECK(point_key(yaml.substr(0, yaml.size() - 1)) == sweep.points[1].key);
+
+        store.export_csv((dir.path / "r.csv").string());
+    }
+    std::ifstream csv(dir.path / "r.csv");
+    std::string header, row;
+    std::getline(csv, header);
+    std::getline(csv, row);
+    CHECK(header.rfind("key,sfx_version,sweep,point_index,started_at,finished_at,workload.scene,", 0) == 0);
+    CHECK(header.find("hw.simd.width") != std::string::npos);
+    CHECK(header.find("config_yaml") == std::string::npos);
+    CHECK(header.find(",fps,") != std::string::npos);
+    CHECK(row.rfind(sweep.points[0].key + ",", 0) == 0);
+
+    // Reopening keeps everything; a store of another schema version is refused.
+    ResultsStore again(db);
+    CHECK(again.keys().size() == 2);
+    sqlite3_exec(again.handle(), "UPDATE meta SET value = '9' WHERE key = 'schema_version'", nullptr, nullptr, nullptr);
+    CHECK_THROWS_AS(ResultsStore(db), InputError);
+    std::ofstream((dir.path / "text.db").string()) << "not a database, just some text that is long enough\n";
+    CHECK_THROWS_AS(ResultsStore((dir.path / "text.db").string()), InputError);
+}
+
+TEST_CASE("A point group runs from its JSON spec: one row per point, keys from the YAML", "[sweeps]") {
+    const Sweep sweep = small_sweep();
+    const nlohmann::json spec = group_spec_json(sweep, sweep.groups[0].points, 1);
+    const std::vector<PointRun> rows = run_group(nlohmann::json::parse(spec.dump()));
+    REQUIRE(rows.size() == 2);
+    for (size_t i = 0; i < rows.size(); ++i) {
+        CHECK(rows[i].key == sweep.points[sweep.groups[0].points[i]].key);
+        CHECK(rows[i].sfx_version == sfx_version());
+        // The JSON line a worker prints reads back the same.
+        const PointRun back = point_run_from_json(nlohmann::ordered_json::parse(point_run_json(rows[i]).dump()));
+        CHECK(back.key == rows[i].key);
+        REQUIRE(back.metrics.size() == rows[i].metrics.size());
+        CHECK(back.metrics.front().first == "fps");
+        CHECK(back.metrics.front().second == rows[i].metrics.front().second);
+    }
+    CHECK(rows[0].metrics.front().second > 0);
+    CHECK(rows[0].metrics.front().second != rows[1].metrics.front().second);  // widths 4 vs 8
+
+    // Every fidelity of the ladder is accepted by the sweep language.
+    CHECK(small_sweep("sampled").points[0].fidelity == Fidelity::sampled);
+    CHECK(small_sweep("full").points[0].fidelity == Fidelity::full);
+    // Points of different renders cannot share a group.
+    const Sweep two = parse_sweep("version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16x16, spp: 1}\n"
+                                  "axes:\n  workload.seed: [1, 2]\n",
+                                  "two.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
+    REQUIRE(two.groups.size() == 2);
+    CHECK_THROWS_AS(run_group(group_spec_json(two, {0, 1}, 1)), InputError);
+}
