@@ -234,8 +234,8 @@ void run_dask(const std::vector<GroupJob>& jobs, const std::string& scheduler,
     for (const GroupJob& job : jobs)
         if (!done[job.group])
             events.failed(job.group, 1,
-                          "the Dask client (" SFX_DASK_CLIENT ") exited with status " +
-                              std::to_string(code) + " before this group finished");
+                          "not run: the Dask client exited with status " + std::to_string(code) +
+                              " (its own message is above)");
 }
 
 }  // namespace sfx
