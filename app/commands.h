@@ -32,6 +32,7 @@ struct SamplingFlags {
     std::string confidence = "99.7%";
     uint32_t warmup_passes = 1;
     uint32_t strata = 8;
+    std::string calibration = "2%";  // analytic fidelity: passes also timed at cycle level
 
     void add_to(CLI::App* command);
     // Throws InputError (key = the flag) on a bad value. "2%" and "0.02" mean the same.

@@ -67,6 +67,10 @@ void SamplingFlags::add_to(CLI::App* c) {
     c->add_option("--warmup-passes", warmup_passes, "sampled fidelity: passes replayed into the caches first")
         ->capture_default_str();
     c->add_option("--strata", strata, "sampled fidelity: strata of tiles")->capture_default_str();
+    c->add_option("--calibration", calibration,
+                  "analytic fidelity: share of passes also timed at cycle level to calibrate it "
+                  "(0: uncalibrated, error unknown)")
+        ->capture_default_str();
 }
 
 SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
@@ -76,6 +80,9 @@ SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
     o.confidence = parse_fraction(confidence, "--confidence");
     if (o.confidence >= 1.0) throw InputError("command line", 0, "--confidence", "must be below 100%");
     if (strata == 0) throw InputError("command line", 0, "--strata", "must be at least 1");
+    o.calibration_fraction = calibration == "0" || calibration == "0%"
+                                 ? 0.0
+                                 : parse_fraction(calibration, "--calibration");
     o.warmup_passes = warmup_passes;
     o.strata = strata;
     o.seed = seed + 1;

@@ -141,13 +141,14 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
 }  // namespace
 
 FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
-                            const TraceProfile& profile) {
+                            const TraceProfile& profile, const TraceProfile* footprint) {
     const RayRecordLayout layout(shape.features);
     const OpCostTable costs(layout, c.datapath);
     const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
-    const double fetch_cycles = expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, profile);
+    const double fetch_cycles =
+        expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, footprint ? *footprint : profile);
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank =

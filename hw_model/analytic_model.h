@@ -63,8 +63,10 @@ private:
     uint32_t m_slots = 0;
 };
 
+// `footprint`, when given, is the profile whose scene-data working sets price the fetches
+// (the whole frame's, when `profile` holds only some of its passes).
 FrameTiming analytic_timing(const HwConfig& config, const WorkloadShape& shape,
-                            const TraceProfile& profile);
+                            const TraceProfile& profile, const TraceProfile* footprint = nullptr);
 
 // Expected busiest-bank load minus the conflict-free load, for `lanes` requests spread
 // uniformly over `banks` banks (exact, from the multinomial distribution).

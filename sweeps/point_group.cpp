@@ -82,6 +82,79 @@ void replay(const PassBuffer& b, TraceSink& sink) {
     sink.end_pass(b.pass());
 }
 
+
+// Calibrates the analytic model against the cycle-level one on the same frame: every k-th
+// tile pass (a systematic sample across the image, k = 1 / fraction) is also timed at cycle
+// level, after its predecessor has warmed the caches, and priced by the analytic model alone.
+// The ratio of the two over the sample scales each configuration's analytic frame, and the
+// ratio's interval is the calibrated prediction's error estimate.
+class AnalyticCalibration : public TraceSink {
+public:
+    AnalyticCalibration(const std::vector<HwConfig>& configs, const WorkloadShape& shape,
+                        uint32_t stride)
+        : m_configs(configs), m_shape(shape), m_stride(std::max(1u, stride)),
+          m_timing(configs, shape), m_cycle(configs.size()) {}
+
+    void begin_pass(const TilePass& p) override {
+        m_current.begin_pass(p);
+        m_selected = m_unit % m_stride == m_stride / 2;
+    }
+    void op(const StreamOp& o) override { m_current.op(o); }
+    void end_pass(const TilePass& p) override {
+        m_current.end_pass(p);
+        if (m_selected) {
+            if (m_unit > 0) {
+                m_timing.set_warming(true);
+                replay(m_previous, m_timing);
+                m_timing.set_warming(false);
+            }
+            std::vector<FrameTiming> before;
+            for (size_t c = 0; c < m_configs.size(); ++c) before.push_back(m_timing.timing(c));
+            replay(m_current, m_timing);
+            m_profiles.emplace_back(m_shape);
+            replay(m_current, m_profiles.back());
+            for (size_t c = 0; c < m_configs.size(); ++c)
+                m_cycle[c].push_back(double(timing_between(before[c], m_timing.timing(c)).cycles));
+        }
+        std::swap(m_previous, m_current);
+        ++m_unit;
+    }
+
+    // Ratio cycle-level / analytic for configuration c, and the relative half-width of its
+    // interval (ratio estimator, finite-population corrected); {1, -1} without a sample. Each
+    // sampled pass is priced with the whole frame's working sets (`frame`), as the frame is.
+    std::pair<double, double> ratio(size_t c, double confidence, const TraceProfile& frame) const {
+        const std::vector<double>& y = m_cycle[c];
+        std::vector<double> x;
+        for (const TraceProfile& one : m_profiles)
+            x.push_back(double(analytic_timing(m_configs[c], m_shape, one, &frame).cycles));
+        const size_t n = y.size();
+        double sy = 0, sx = 0;
+        for (size_t i = 0; i < n; ++i) { sy += y[i]; sx += x[i]; }
+        if (n < 2 || sx <= 0.0) return {1.0, -1.0};
+        const double r = sy / sx, mean_x = sx / double(n);
+        double s2 = 0.0;
+        for (size_t i = 0; i < n; ++i) s2 += (y[i] - r * x[i]) * (y[i] - r * x[i]);
+        s2 /= double(n - 1);
+        const double f = double(n) / double(std::max<uint64_t>(n, m_unit));
+        const double half = normal_quantile_two_sided(confidence) *
+                            std::sqrt((1.0 - f) * s2 / double(n)) / mean_x;
+        return {r, half / r};
+    }
+    uint64_t sampled() const { return m_cycle.empty() ? 0 : m_cycle[0].size(); }
+
+private:
+    const std::vector<HwConfig>& m_configs;
+    WorkloadShape m_shape;
+    uint32_t m_stride;
+    SystemcTiming m_timing;
+    PassBuffer m_current, m_previous;
+    bool m_selected = false;
+    uint64_t m_unit = 0;
+    std::vector<std::vector<double>> m_cycle;
+    std::vector<TraceProfile> m_profiles;  // of the sampled passes
+};
+
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
@@ -249,8 +322,14 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     fan.add(&counts);
     TraceProfile profile(shape);
     std::unique_ptr<SystemcTiming> systemc;
+    std::unique_ptr<AnalyticCalibration> calibration;
     if (fidelity == Fidelity::analytic) {
         fan.add(&profile);
+        if (sampling.calibration_fraction > 0.0) {
+            calibration = std::make_unique<AnalyticCalibration>(
+                configs, shape, uint32_t(std::lround(1.0 / sampling.calibration_fraction)));
+            fan.add(calibration.get());
+        }
     } else {
         systemc = std::make_unique<SystemcTiming>(configs, shape);
         fan.add(systemc.get());
@@ -269,7 +348,16 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
         p.timing = fidelity == Fidelity::analytic ? analytic_timing(configs[i], shape, profile)
                                                   : systemc->timing(i);
         fill_ideal(p, counts, i, widths[i]);
-        p.total_passes = p.sample_passes = counts.passes();
+        // Passes timed at cycle level: all of them at full fidelity; at analytic fidelity only
+        // the calibration sample, if any.
+        p.total_passes = counts.passes();
+        p.sample_passes = fidelity == Fidelity::full ? counts.passes() : 0;
+        if (calibration && calibration->sampled() >= 2) {
+            const auto [r, error] = calibration->ratio(i, sampling.confidence, profile);
+            p.timing.cycles = uint64_t(std::llround(double(p.timing.cycles) * r));
+            p.error_relative = error;
+            p.sample_passes = calibration->sampled();
+        }
         // Full fidelity is the reference the other levels are measured against: no sampling
         // error. The analytic model's error is unknown until measured (sfx accuracy).
         if (fidelity == Fidelity::full) p.error_relative = 0.0;

@@ -21,6 +21,9 @@ struct SamplingOptions {
     uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
     uint32_t pilot_min_spp = 8;  // stratify by a pilot cost estimate from this spp on
     uint64_t seed = 1;
+    // Analytic fidelity: share of tile passes also timed at cycle level to calibrate the
+    // closed form on this very frame (0: uncalibrated, error unknown).
+    double calibration_fraction = 0.02;
 };
 
 // Which stratum each unit belongs to.

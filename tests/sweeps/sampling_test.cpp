@@ -145,3 +145,32 @@ TEST_CASE("Sampled fidelity agrees with full within its interval; adaptive sampl
         CHECK(p.sample_passes > uint64_t(0.02 * p.total_passes));  // it had to grow
     }
 }
+
+TEST_CASE("Calibrated analytic fidelity: within its interval of full; uncalibrated says unknown",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    const RenderSettings settings = small_settings(scene);
+    HwConfig w8;
+    w8.simd.width = 8;
+    const std::vector<HwConfig> configs = {HwConfig{}, w8};
+    const PointGroupResult full = run_point_group(scene, bvh, settings, configs, Fidelity::full);
+    SamplingOptions calibrated;
+    calibrated.calibration_fraction = 0.05;
+    const PointGroupResult analytic =
+        run_point_group(scene, bvh, settings, configs, Fidelity::analytic, calibrated);
+    for (size_t c = 0; c < configs.size(); ++c) {
+        const Prediction& a = analytic.predictions[c];
+        const double error = std::fabs(double(a.timing.cycles) / double(full.predictions[c].timing.cycles) - 1.0);
+        INFO("config " << c << " calibrated analytic error " << error << " interval " << a.error_relative);
+        CHECK(a.error_relative >= 0.0);
+        CHECK(a.sample_passes >= 2);
+        CHECK(error <= a.error_relative + 0.02);
+    }
+    SamplingOptions none;
+    none.calibration_fraction = 0.0;
+    const Prediction raw =
+        run_point_group(scene, bvh, settings, configs, Fidelity::analytic, none).predictions[0];
+    CHECK(raw.error_relative < 0.0);
+    CHECK(raw.sample_passes == 0);
+}
