@@ -282,6 +282,25 @@ std::map<std::string, double> ResultsStore::numbers(const std::string& key) cons
     return out;
 }
 
+std::vector<ResultsStore::RowValues> ResultsStore::rows() const {
+    std::vector<RowValues> out;
+    Statement s(m_db, "SELECT * FROM points ORDER BY sweep, point_index, key");
+    while (s.step()) {
+        RowValues r;
+        for (int c = 0; c < sqlite3_column_count(s.get()); ++c) {
+            const char* name = sqlite3_column_name(s.get(), c);
+            switch (sqlite3_column_type(s.get(), c)) {
+            case SQLITE_NULL: break;
+            case SQLITE_INTEGER:
+            case SQLITE_FLOAT: r.numbers[name] = sqlite3_column_double(s.get(), c); break;
+            default: r.text[name] = reinterpret_cast<const char*>(sqlite3_column_text(s.get(), c));
+            }
+        }
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
 void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std::string>& keys) const {
     std::ofstream out(csv_path);
     if (!out) throw InputError(csv_path, 0, "--csv", "cannot write the CSV file");

@@ -49,6 +49,13 @@ public:
     // Every column name of the points table, in table order.
     std::vector<std::string> columns() const;
 
+    // Every row: text of the TEXT columns, values of the numeric ones (NULLs left out).
+    struct RowValues {
+        std::map<std::string, std::string> text;
+        std::map<std::string, double> numbers;
+    };
+    std::vector<RowValues> rows() const;
+
     // Writes the given keys' rows (all rows if `keys` is empty) as CSV: one column per stored
     // column except config_yaml, in table order; rows by sweep and point index.
     void export_csv(const std::string& csv_path, const std::vector<std::string>& keys = {}) const;
