@@ -340,7 +340,8 @@ void add_sweep_command(CLI::App& app) {
     r->add_option("--parent-pid", *parent, "exit when this process dies");
     r->callback([parent] {
 #ifdef __linux__
-        // A killed sweep (or Dask worker) must not leave its renders running.
+        // A killed sweep (or Dask worker) must not leave its renders running. The signal follows
+        // the spawning thread, which lives until this process has been waited for.
         if (*parent > 0) {
             prctl(PR_SET_PDEATHSIG, SIGKILL);
             if (getppid() != pid_t(*parent)) return;

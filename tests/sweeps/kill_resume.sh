@@ -32,6 +32,10 @@ has_rows() { [ "$(rows)" -ge 1 ]; }
 wait_for 120 has_rows || fail "no row was stored in 120 s"
 kill -9 "$pid" 2>/dev/null || fail "the sweep had already finished: nothing was interrupted"
 wait "$pid" 2>/dev/null && fail "the sweep was not killed" || true
+# Its `sfx run-group` child dies with it (PR_SET_PDEATHSIG), leaving no orphan render.
+orphan() { pgrep -f "run-group --parent-pid $pid" >/dev/null; }
+no_orphan() { ! orphan; }
+wait_for 10 no_orphan || fail "the killed sweep left its render running"
 pid=
 before=$(rows)
 [ "$before" -lt "$total" ] || fail "all $total points were stored before the kill"
