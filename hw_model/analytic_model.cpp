@@ -18,12 +18,26 @@ TraceProfile::TraceProfile(const WorkloadShape& shape) {
     // Data sizes do not depend on the datapath latencies: any configuration's table will do.
     const OpCostTable costs(RayRecordLayout(shape.features), DatapathConfig{});
     for (uint32_t k = 0; k < k_op_kind_count; ++k) m_scene_bytes.push_back(costs[OpKind(k)].scene_bytes);
+    // Nodes, triangles, spheres, then a few materials (shading ops name a material kind).
+    const uint64_t bytes = m_map.address(OpKind::material_filter, 0) + 64 * m_map.material_bytes;
+    const uint64_t words = bytes / k_line_bytes / 64 + 2;
+    m_frame_lines.assign(words, 0);
+    m_pass_lines.assign(words, 0);
+}
+
+bool TraceProfile::mark(std::vector<uint64_t>& bits, uint64_t line) {
+    const uint64_t word = line >> 6, bit = uint64_t(1) << (line & 63);
+    if (word >= bits.size()) bits.resize(word + 1, 0);
+    if (bits[word] & bit) return false;
+    bits[word] |= bit;
+    return true;
 }
 
 void TraceProfile::begin_pass(const TilePass& p) {
     ++m_passes;
     m_slots = std::max(m_slots, p.slot_count);
-    m_pass_lines.clear();
+    for (uint64_t w : m_pass_touched) m_pass_lines[w] = 0;
+    m_pass_touched.clear();
 }
 
 void TraceProfile::op(const StreamOp& op) {
@@ -36,12 +50,15 @@ void TraceProfile::op(const StreamOp& op) {
     ++m_footprint.fetches;
     const uint64_t address = m_map.address(op.kind, op.object);
     for (uint64_t line = address / k_line_bytes; line <= (address + bytes - 1) / k_line_bytes; ++line) {
-        m_footprint.pass_distinct += m_pass_lines.insert(line).second;
-        m_footprint.frame_distinct += m_frame_lines.insert(line).second;
+        if (mark(m_pass_lines, line)) {
+            ++m_footprint.pass_distinct;
+            m_pass_touched.push_back(line >> 6);
+        }
+        m_footprint.frame_distinct += mark(m_frame_lines, line);
     }
 }
 
-void TraceProfile::end_pass(const TilePass&) { m_pass_lines.clear(); }
+void TraceProfile::end_pass(const TilePass&) {}
 
 namespace {
 

@@ -55,10 +55,16 @@ public:
 
 private:
     std::map<Key, Bucket> m_buckets;
+    // Marks a line in a bitmap; true if it was not marked yet.
+    static bool mark(std::vector<uint64_t>& bits, uint64_t line);
+
     SceneDataMap m_map;
     std::vector<uint32_t> m_scene_bytes;  // per OpKind, from the op cost table
     Footprint m_footprint;
-    std::unordered_set<uint64_t> m_pass_lines, m_frame_lines;
+    // Lines seen in the frame and in the current pass: bitmaps over the scene data (a few
+    // hundred KiB even for millions of primitives), so counting costs no hashing per op.
+    std::vector<uint64_t> m_frame_lines, m_pass_lines;
+    std::vector<uint64_t> m_pass_touched;  // words of m_pass_lines to clear at the next pass
     uint64_t m_passes = 0;
     uint32_t m_slots = 0;
 };
