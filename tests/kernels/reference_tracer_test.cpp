@@ -7,18 +7,13 @@
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
+#include "tests/kernels/test_scenes.h"
 
 using namespace sfx;
 
 namespace {
 
-Material lambertian(Vec3 kd, Vec3 emission = Vec3(0.f)) {
-    Material m;
-    m.kind = MaterialKind::lambertian;
-    m.diffuse = kd;
-    m.emission = emission;
-    return m;
-}
+using test::lambertian;
 
 Scene sphere_scene(const Material& m, Vec3 eye, Vec3 environment, uint32_t depth) {
     Scene s;
@@ -40,45 +35,6 @@ RenderSettings small(const Scene& s, uint32_t size, uint32_t spp) {
     r.spp = spp;
     r.max_depth = s.max_depth;
     return r;
-}
-
-// Mixed scene: box walls, a light, spheres of each material, a thin lens.
-Scene mixed_scene() {
-    Scene s;
-    s.name = "mixed";
-    s.materials = {lambertian({0.7f, 0.7f, 0.7f}), lambertian({0.7f, 0.1f, 0.1f}),
-                   lambertian(Vec3(0.f), {12.f, 10.f, 8.f})};
-    Material glass;
-    glass.kind = MaterialKind::dielectric;
-    glass.ior = 1.5f;
-    Material glossy;
-    glossy.kind = MaterialKind::glossy;
-    glossy.diffuse = {0.2f, 0.3f, 0.6f};
-    glossy.specular = Vec3(0.3f);
-    glossy.exponent = 60.f;
-    s.materials.push_back(glass);
-    s.materials.push_back(glossy);
-    auto quad = [&](Vec3 o, Vec3 u, Vec3 v, uint32_t mat) {
-        const uint32_t b = uint32_t(s.positions.size());
-        s.positions.insert(s.positions.end(), {o, o + u, o + u + v, o + v});
-        s.triangles.push_back({b, b + 1, b + 2, mat});
-        s.triangles.push_back({b, b + 2, b + 3, mat});
-    };
-    quad({-2, -2, -2}, {4, 0, 0}, {0, 0, 4}, 0);   // floor
-    quad({-2, 2, -2}, {0, 0, 4}, {4, 0, 0}, 0);    // ceiling
-    quad({-2, -2, -2}, {0, 4, 0}, {4, 0, 0}, 0);   // back
-    quad({-2, -2, -2}, {0, 0, 4}, {0, 4, 0}, 1);   // left, red
-    quad({-0.5f, 1.99f, -0.5f}, {1, 0, 0}, {0, 0, 1}, 2);  // light
-    s.spheres = {{{-0.8f, -1.2f, -0.5f}, 0.8f, 3}, {{0.9f, -1.3f, 0.3f}, 0.7f, 4}};
-    s.camera.eye = {0.f, 0.f, 6.f};
-    s.camera.look_at = {0.f, 0.f, 0.f};
-    s.camera.aperture_radius = 0.05f;
-    s.camera.focal_distance = 6.f;
-    s.max_depth = 3;
-    std::vector<uint32_t> groups(s.primitive_count());
-    for (uint32_t p = 0; p < groups.size(); ++p) groups[p] = p / 2;
-    s.finalize(groups);
-    return s;
 }
 
 bool same_bits(const Image& a, const Image& b) {
@@ -157,7 +113,7 @@ TEST_CASE("Non-finite radiance is zeroed and counted, never written", "[referenc
 }
 
 TEST_CASE("The reference image is identical for 1, 2 and 7 threads", "[reference]") {
-    const Scene s = mixed_scene();
+    const Scene s = test::box_scene(test::Variant::lights);
     const Bvh bvh(s);
     RenderSettings settings = small(s, 40, 3);
     settings.width = 48;  // not a multiple of the internal tile
