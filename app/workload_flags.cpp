@@ -3,6 +3,7 @@
 
 #include "app/commands.h"
 #include "workloads/input_error.h"
+#include "workloads/strict_number.h"
 
 namespace sfx {
 
@@ -49,9 +50,8 @@ double parse_fraction(const std::string& text, const std::string& key) {
         t.pop_back();
         scale = 0.01;
     }
-    char* end = nullptr;
-    const double v = std::strtod(t.c_str(), &end);
-    if (t.empty() || *end != '\0' || !(v * scale > 0.0) || v * scale > 1.0)
+    double v = 0.0;
+    if (!parse_finite(t, v) || !(v * scale > 0.0) || v * scale > 1.0)
         throw InputError("command line", 0, key, "expected a fraction in (0, 1] or a percentage, got '" + text + "'");
     return v * scale;
 }

@@ -10,29 +10,19 @@
 #include <sstream>
 
 #include "workloads/input_error.h"
+#include "workloads/strict_number.h"
 
 namespace sfx {
 namespace {
 
 // Scalar text <-> typed values, strictly: "16x", "-1" for unsigned, "1e999" are errors.
 bool parse_scalar(const std::string& s, uint32_t& out) {
-    if (s.empty() || s[0] == '-' || s[0] == '+') return false;
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-    if (errno || *end != '\0' || v > 0xffffffffull) return false;
+    uint64_t v = 0;
+    if (!parse_unsigned(s, v) || v > 0xffffffffull) return false;
     out = uint32_t(v);
     return true;
 }
-bool parse_scalar(const std::string& s, double& out) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s.c_str(), &end);
-    if (errno || *end != '\0' || !std::isfinite(v)) return false;
-    out = v;
-    return true;
-}
+bool parse_scalar(const std::string& s, double& out) { return parse_finite(s, out); }
 bool parse_scalar(const std::string& s, bool& out) {
     if (s == "true") { out = true; return true; }
     if (s == "false") { out = false; return true; }
@@ -50,12 +40,7 @@ const char* type_name(const std::string&) { return "a string"; }
 std::string to_text(uint32_t v) { return std::to_string(v); }
 std::string to_text(bool v) { return v ? "true" : "false"; }
 std::string to_text(const std::string& v) { return v; }
-std::string to_text(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-}
+std::string to_text(double v) { return shortest_text(v); }
 
 template <class T> bool in_range(const T& v, const T& lo, const T& hi) { return v >= lo && v <= hi; }
 

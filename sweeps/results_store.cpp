@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "workloads/input_error.h"
+#include "workloads/strict_number.h"
 
 namespace sfx {
 namespace {
@@ -83,15 +84,6 @@ const char* const k_fixed_columns =
     "finished_at TEXT, config_yaml TEXT, \"workload.scene\" TEXT, \"workload.width\" INTEGER, "
     "\"workload.height\" INTEGER, \"workload.spp\" INTEGER, \"workload.depth\" INTEGER, "
     "\"workload.tile\" INTEGER, \"workload.seed\" INTEGER, fidelity TEXT";
-
-std::string number_text(double v) {
-    char buf[64];
-    for (int precision = 1; precision <= 17; ++precision) {
-        std::snprintf(buf, sizeof buf, "%.*g", precision, v);
-        if (std::strtod(buf, nullptr) == v) break;
-    }
-    return buf;
-}
 
 std::string csv_field(const std::string& s) {
     if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -319,7 +311,7 @@ void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std
                 switch (sqlite3_column_type(s.get(), c)) {
                 case SQLITE_NULL: break;
                 case SQLITE_INTEGER: out << sqlite3_column_int64(s.get(), c); break;
-                case SQLITE_FLOAT: out << number_text(sqlite3_column_double(s.get(), c)); break;
+                case SQLITE_FLOAT: out << shortest_text(sqlite3_column_double(s.get(), c)); break;
                 default: out << csv_field(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), c)));
                 }
             }

@@ -16,6 +16,7 @@
 #include "sweeps/point_group.h"
 #include "sweeps/sha256.h"
 #include "workloads/input_error.h"
+#include "workloads/strict_number.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 
@@ -37,45 +38,6 @@ int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1
 
 // The message of an InputError without its "file:line: key: " prefix, to re-throw it with
 // the sweep's location.
-std::string bare_message(const InputError& e) {
-    std::string prefix = e.file();
-    if (e.line() > 0) prefix += ":" + std::to_string(e.line());
-    if (!e.key().empty()) prefix += ": " + e.key();
-    prefix += ": ";
-    const std::string what = e.what();
-    return what.compare(0, prefix.size(), prefix) == 0 ? what.substr(prefix.size()) : what;
-}
-
-bool parse_u64(const std::string& s, uint64_t& out) {
-    if (s.empty() || s[0] == '-' || s[0] == '+') return false;
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-    if (errno || *end != '\0') return false;
-    out = v;
-    return true;
-}
-
-bool parse_double(const std::string& s, double& out) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s.c_str(), &end);
-    if (errno || *end != '\0' || !std::isfinite(v)) return false;
-    out = v;
-    return true;
-}
-
-// Shortest decimal text that reads back as the same double (range values like 0.1 + 0.2).
-std::string double_text(double v) {
-    char buf[64];
-    for (int precision = 1; precision <= 17; ++precision) {
-        std::snprintf(buf, sizeof buf, "%.*g", precision, v);
-        if (std::strtod(buf, nullptr) == v) break;
-    }
-    return buf;
-}
-
 // Checks a mapping's keys against an allowed list: unknown and duplicate keys are errors.
 void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
                 std::initializer_list<const char*> allowed) {
@@ -122,7 +84,7 @@ std::string resolve_scene_name(const std::string& value, const std::string& base
 uint32_t parse_bounded(const std::string& value, uint64_t lo, uint64_t hi, const std::string& file,
                        int line, const std::string& key) {
     uint64_t v = 0;
-    if (!parse_u64(value, v) || v < lo || v > hi)
+    if (!parse_unsigned(value, v) || v < lo || v > hi)
         throw InputError(file, line, key, "expected an integer in [" + std::to_string(lo) + ", " +
                                               std::to_string(hi) + "], got '" + value + "'");
     return uint32_t(v);
@@ -157,7 +119,7 @@ void set_workload(WorkloadSpec& w, const std::string& field, const std::string& 
             throw InputError(file, line, key, "expected 1..4096 or auto");
     } else if (field == "seed") {
         uint64_t v = 0;
-        if (!parse_u64(value, v))
+        if (!parse_unsigned(value, v))
             throw InputError(file, line, key, "expected a non-negative integer, got '" + value + "'");
         w.seed = v;
     } else {
@@ -181,7 +143,7 @@ void set_hw_at(HwConfig& c, const std::string& path, const std::string& value,
     try {
         set_hw_param(c, path, value, file, line);
     } catch (const InputError& e) {
-        throw InputError(file, line, key, bare_message(e));
+        throw InputError(file, line, key, e.message());
     }
 }
 
@@ -221,7 +183,7 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     const std::string step = scalar(node["step"], file, key + ".step");
     const int line = line_of(node);
     uint64_t ifrom = 0, ito = 0, istep = 0;
-    if (parse_u64(from, ifrom) && parse_u64(to, ito) && parse_u64(step, istep)) {
+    if (parse_unsigned(from, ifrom) && parse_unsigned(to, ito) && parse_unsigned(step, istep)) {
         if (istep == 0) throw InputError(file, line_of(node["step"]), key + ".step", "must be positive");
         if (ito < ifrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
         if ((ito - ifrom) / istep >= k_max_points)
@@ -233,9 +195,9 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
         return;
     }
     double dfrom = 0, dto = 0, dstep = 0;
-    if (!parse_double(from, dfrom)) throw InputError(file, line_of(node["from"]), key + ".from", "expected a number");
-    if (!parse_double(to, dto)) throw InputError(file, line_of(node["to"]), key + ".to", "expected a number");
-    if (!parse_double(step, dstep) || dstep <= 0)
+    if (!parse_finite(from, dfrom)) throw InputError(file, line_of(node["from"]), key + ".from", "expected a number");
+    if (!parse_finite(to, dto)) throw InputError(file, line_of(node["to"]), key + ".to", "expected a number");
+    if (!parse_finite(step, dstep) || dstep <= 0)
         throw InputError(file, line_of(node["step"]), key + ".step", "expected a positive number");
     if (dto < dfrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
     // Inclusive of `to` up to rounding: 0.1 to 0.3 step 0.1 has three values.
@@ -243,7 +205,7 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     if (count > double(k_max_points))
         throw InputError(file, line, key, "more than " + std::to_string(k_max_points) + " values");
     for (uint64_t i = 0; i < uint64_t(count); ++i) {
-        axis.values.push_back(double_text(dfrom + double(i) * dstep));
+        axis.values.push_back(shortest_text(dfrom + double(i) * dstep));
         axis.value_lines.push_back(line);
     }
 }
@@ -344,7 +306,7 @@ private:
         try {
             check_hw_config(m_base, m_file, m_hw_lines);
         } catch (const InputError& e) {
-            throw InputError(m_file, e.line(), "hw_overrides." + e.key(), bare_message(e));
+            throw InputError(m_file, e.line(), "hw_overrides." + e.key(), e.message());
         }
     }
 
@@ -362,7 +324,7 @@ private:
                 try {
                     check_hw_config(m_base, "command line");
                 } catch (const InputError& e) {
-                    throw InputError("command line", 0, key, bare_message(e));
+                    throw InputError("command line", 0, key, e.message());
                 }
             } else if (path.rfind("workload.", 0) == 0) {
                 const std::string field = path.substr(9);
@@ -483,7 +445,7 @@ private:
             SceneInfo info{s.features(), s.max_depth};
             return m_scenes.emplace(scene, info).first->second;
         } catch (const InputError& e) {
-            if (e.file() == scene && e.line() == 0) throw InputError(m_file, line, key, bare_message(e));
+            if (e.file() == scene && e.line() == 0) throw InputError(m_file, line, key, e.message());
             throw;  // an error inside the scene file names that file
         }
     }
@@ -554,7 +516,7 @@ private:
             check_hw_config(p.hw, m_file, lines);
         } catch (const InputError& e) {
             throw InputError(m_file, e.line() > 0 ? e.line() : line_of_axes(), "hw." + e.key(),
-                             bare_message(e) + " (at point " + std::to_string(p.index) + ": " +
+                             e.message() + " (at point " + std::to_string(p.index) + ": " +
                                  describe(p) + ")");
         }
     }
@@ -586,7 +548,7 @@ private:
             check_tile_fits(r.tile, features, {p.hw}, "workload.tile");
         } catch (const InputError& e) {
             throw InputError(m_file, line("tile"), "workload.tile",
-                             bare_message(e) + " (at point " + std::to_string(p.index) + ": " +
+                             e.message() + " (at point " + std::to_string(p.index) + ": " +
                                  describe(p) + ")");
         }
         return r;

@@ -10,11 +10,14 @@ namespace sfx {
 class InputError : public std::runtime_error {
 public:
     InputError(const std::string& file, int line, const std::string& key, const std::string& what)
-        : std::runtime_error(format(file, line, key, what)), m_file(file), m_line(line), m_key(key) {}
+        : std::runtime_error(format(file, line, key, what)), m_file(file), m_line(line), m_key(key),
+          m_message(what) {}
 
     const std::string& file() const { return m_file; }
     int line() const { return m_line; }  // 1-based; 0 when unknown
     const std::string& key() const { return m_key; }
+    // What is wrong, without the file, line and key (to re-throw it under another key).
+    const std::string& message() const { return m_message; }
 
 private:
     static std::string format(const std::string& file, int line, const std::string& key,
@@ -27,6 +30,7 @@ private:
     std::string m_file;
     int m_line;
     std::string m_key;
+    std::string m_message;
 };
 
 }  // namespace sfx
