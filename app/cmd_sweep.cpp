@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -123,6 +124,7 @@ void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set
         {"simd_utilization.intersection", "util isec"},
         {"simd_utilization.shading", "util shade"},
         {"stall_cycles.total", "stalls %"},
+        {"error.relative", "interval"},
         {"host_seconds", "host s"}};
     for (const auto& m : metrics) headers.push_back(m.second);
     headers.push_back("");
@@ -139,10 +141,14 @@ void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set
             for (size_t i = 0; i < metrics.size(); ++i) row.push_back("-");
             row.push_back("missing");
         } else {
-            row.push_back(fixed(get("fps"), 2));
+            char fps[32];  // 4 significant digits: paper-scale frames run well below 1 fps
+            std::snprintf(fps, sizeof fps, "%.4g", get("fps"));
+            row.push_back(fps);
             for (const char* s : {"traversal", "intersection", "shading"})
                 row.push_back(fixed(100 * get(std::string("simd_utilization.") + s), 1) + "%");
             row.push_back(fixed(100 * get("stall_cycles.total") / std::max(1.0, get("frame_cycles")), 1));
+            const double interval = get("error.relative");
+            row.push_back(interval >= 0 ? "+-" + fixed(100 * interval, 2) + "%" : "unknown");
             row.push_back(fixed(get("host_seconds"), 3));
             row.push_back(ran.count(p.key) ? "" : "stored");
         }
