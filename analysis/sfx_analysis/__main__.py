@@ -1,0 +1,68 @@
+"""Command line: `python3 -m sfx_analysis report DB -o DIR` and `python3 -m sfx_analysis tables
+DB`. A store that cannot be reported on prints one line and exits 2 (no traceback)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from .store import StoreError, load_store
+from .tables import build_tables, tables_markdown, to_markdown
+
+
+def _report(args) -> int:
+    from .report import write_report  # imports matplotlib: only when drawing
+
+    report = write_report(args.db, args.output)
+    for w in report.store.warnings:
+        print(f"sfx report: note: {w}", file=sys.stderr)
+    if not args.quiet:
+        fps = [t for t in report.tables if t.ident.startswith("table6")]
+        if fps:
+            print(to_markdown(fps[0]))
+            if len(fps) > 1:
+                print(f"({len(fps) - 1} more block(s) of Table 6, one per configuration, in "
+                      f"tables.md)\n")
+    drawn = [p for p in report.plots if p.file]
+    skipped = [p for p in report.plots if not p.file]
+    print(f"report: {os.path.abspath(report.index)}")
+    print(f"tables: {os.path.abspath(report.tables_md)}")
+    print(f"points: {os.path.abspath(report.points_csv)}")
+    print(f"plots:  {len(drawn)} in {os.path.abspath(report.directory)}/: "
+          + (", ".join(p.file for p in drawn) if drawn else "none"))
+    for p in skipped:
+        print(f"skipped {p.name}: {p.skipped}")
+    return 0
+
+
+def _tables(args) -> int:
+    store = load_store(args.db)
+    for w in store.warnings:
+        print(f"sfx_analysis: note: {w}", file=sys.stderr)
+    print(tables_markdown(build_tables(store), f"# Tables from {args.db}"))
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="sfx_analysis",
+                                     description="tables, plots and a report from a results store")
+    sub = parser.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("report", help="index.html, tables.md, points.csv and PNG plots")
+    r.add_argument("db", help="results store (SQLite) written by `sfx sweep`")
+    r.add_argument("-o", "--output", default="report", help="report directory (default: report)")
+    r.add_argument("--quiet", action="store_true", help="print only where the files are")
+    r.set_defaults(run=_report)
+    t = sub.add_parser("tables", help="the paper's Tables 2-6 in Markdown on stdout")
+    t.add_argument("db")
+    t.set_defaults(run=_tables)
+    args = parser.parse_args(argv)
+    try:
+        return args.run(args)
+    except StoreError as e:
+        print(f"sfx report: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,379 @@
+"""The report's plots (PNG, matplotlib's Agg backend). A plot with no data is skipped with a
+reason, never drawn empty. Error bars show fps × error.relative where the model reported an
+interval (error.relative >= 0)."""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Callable, Dict, List, Optional, Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from .slicing import (SCENE, TABLE_KEY, TILE, WIDTH, describe, dominant_context,  # noqa: E402
+                      fidelity_rank)
+from .store import FIDELITIES, STAGES, Store  # noqa: E402
+
+KIB = "hw.ray_buffer.kib"
+BUFFERS = "hw.ray_buffer.buffers"
+DPI = 110
+
+
+@dataclass
+class Plot:
+    name: str                    # file stem, 'fps_vs_width'
+    title: str
+    caption: str = ""
+    file: Optional[str] = None   # the PNG's file name (beside index.html); None when skipped
+    skipped: str = ""            # why the plot was not drawn
+
+
+def _n(v) -> str:
+    f = float(v)
+    return str(int(f)) if f.is_integer() else f"{f:g}"
+
+
+def _subplots(n: int, ncols: int = 3, size=(4.4, 3.3)):
+    ncols = max(1, min(ncols, n))
+    nrows = math.ceil(n / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows),
+                             squeeze=False, layout="constrained")
+    flat = list(axes.flat)
+    for ax in flat[n:]:
+        ax.set_visible(False)
+    return fig, flat[:n]
+
+
+def _save(fig, directory: str, name: str) -> str:
+    file = f"{name}.png"
+    fig.savefig(os.path.join(directory, file), dpi=DPI, bbox_inches="tight")
+    plt.close(fig)
+    return file
+
+
+def _fps_error(frame: pd.DataFrame) -> pd.Series:
+    """Half-width of the fps interval: fps × error.relative where known, NaN elsewhere."""
+    if "error.relative" not in frame.columns:
+        return pd.Series(np.nan, index=frame.index)
+    rel = frame["error.relative"].where(frame["error.relative"] >= 0)
+    return frame["fps"] * rel
+
+
+def _line_with_errors(ax, x, y, err, **style) -> bool:
+    """Draws a line; adds error bars at the points that have an interval. True if any did."""
+    (line,) = ax.plot(x, y, marker="o", **style)
+    ok = np.isfinite(np.asarray(err, dtype=float))
+    if ok.any():
+        ax.errorbar(np.asarray(x)[ok], np.asarray(y)[ok], yerr=np.asarray(err, dtype=float)[ok],
+                    fmt="none", ecolor=line.get_color(), capsize=3, linewidth=1)
+        return True
+    return False
+
+
+def _context_caption(context: Dict[str, object]) -> str:
+    return f" Points with {describe(context)} (the sweep's most common setting)." if context \
+        else ""
+
+
+def _with(points: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
+    if any(c not in points.columns for c in columns):
+        return points.iloc[0:0]
+    return points.dropna(subset=list(columns))
+
+
+def plot_fps_vs_width(store: Store, directory: str) -> Plot:
+    plot = Plot("fps_vs_width", "Predicted frame rate against SIMD width")
+    data = _with(store.points, ["fps"])
+    if data.empty:
+        plot.skipped = "the store has no fps values"
+        return plot
+    context, data = dominant_context(data, TABLE_KEY)
+    if data.groupby([SCENE, TILE])[WIDTH].nunique().max() < 2:
+        widths = ", ".join(_n(w) for w in sorted(data[WIDTH].unique()))
+        plot.skipped = f"needs two SIMD widths for one scene and tile; the store has N = {widths}"
+        return plot
+    scenes = sorted(data[SCENE].unique())
+    fig, axes = _subplots(len(scenes))
+    any_error = False
+    for ax, scene in zip(axes, scenes):
+        at_scene = data[data[SCENE] == scene]
+        for tile in sorted(at_scene[TILE].unique()):
+            d = at_scene[at_scene[TILE] == tile].sort_values(WIDTH)
+            any_error |= _line_with_errors(ax, d[WIDTH], d["fps"], _fps_error(d),
+                                           label=f"tile {_n(tile)}×{_n(tile)}")
+        ax.set_title(scene)
+        ax.set_xlabel("SIMD width N [lanes]")
+        ax.set_ylabel("predicted fps [frames/s]")
+        ax.set_xticks(sorted(at_scene[WIDTH].unique()))
+        ax.set_ylim(bottom=0)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = ("One panel per scene, one line per initial stream (tile) size." +
+                    (" Error bars: the model's fps interval." if any_error else "") +
+                    _context_caption(context))
+    return plot
+
+
+def plot_utilization_vs_width(store: Store, directory: str) -> Plot:
+    plot = Plot("utilization_vs_width", "SIMD utilization per stage against SIMD width")
+    stages = [s for s in STAGES if store.has(f"simd_utilization.{s}")]
+    if not stages:
+        plot.skipped = "the store has no simd_utilization.<stage> values"
+        return plot
+    data = store.points[store.points[[f"simd_utilization.{s}" for s in stages]].notna().any(axis=1)]
+    context, data = dominant_context(data, TABLE_KEY)
+    if data.groupby([SCENE, TILE])[WIDTH].nunique().max() < 2:
+        plot.skipped = "needs two SIMD widths for one scene and tile"
+        return plot
+    panels = [(s, t) for s in sorted(data[SCENE].unique())
+              for t in sorted(data[data[SCENE] == s][TILE].unique())]
+    tiles = sorted(data[TILE].unique())
+    fig, axes = _subplots(len(panels), ncols=len(tiles) if len(tiles) > 1 else 3)
+    colors = {s: f"C{i}" for i, s in enumerate(STAGES)}
+    for ax, (scene, tile) in zip(axes, panels):
+        d = data[(data[SCENE] == scene) & (data[TILE] == tile)].sort_values(WIDTH)
+        for s in stages:
+            ax.plot(d[WIDTH], 100 * d[f"simd_utilization.{s}"], marker="o", color=colors[s],
+                    label=f"{s}")
+            ideal = f"ideal_simd_utilization.{s}"
+            if ideal in d.columns and d[ideal].notna().any():
+                ax.plot(d[WIDTH], 100 * d[ideal], linestyle=":", color=colors[s],
+                        label=f"{s} (ideal)")
+        ax.set_title(f"{scene}, tile {_n(tile)}×{_n(tile)}")
+        ax.set_xlabel("SIMD width N [lanes]")
+        ax.set_ylabel("SIMD utilization [%]")
+        ax.set_xticks(sorted(d[WIDTH].unique()))
+        ax.set_ylim(0, 105)
+        ax.grid(True, alpha=0.3)
+        if ax is axes[0]:  # the same stages in every panel: one legend
+            ax.legend(fontsize="x-small")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = ("All rays. Solid: effective utilization (stalls issue nothing); dotted: the "
+                    "ideal from the trace." + _context_caption(context))
+    return plot
+
+
+def plot_stalls(store: Store, directory: str) -> Plot:
+    plot = Plot("stalls", "Stall cycles by cause")
+    causes = [c for c in store.points.columns
+              if c.startswith("stall_cycles.") and c != "stall_cycles.total" and store.has(c)]
+    if not causes:
+        plot.skipped = "the store has no stall_cycles.<cause> values"
+        return plot
+    data = store.points[store.points[causes].notna().any(axis=1)]
+    context, data = dominant_context(data, TABLE_KEY)
+    scenes = sorted(data[SCENE].unique())
+    fig, axes = _subplots(len(scenes), ncols=2, size=(6.0, 3.6))
+    colors = {c: f"C{i}" for i, c in enumerate(causes)}
+    scale = 1e6 if data[causes].sum(axis=1).max() >= 1e6 else 1.0
+    unit = "Mcycles" if scale == 1e6 else "cycles"
+    for ax, scene in zip(axes, scenes):
+        d = data[data[SCENE] == scene].sort_values([TILE, WIDTH], kind="mergesort")
+        x = np.arange(len(d))
+        bottom = np.zeros(len(d))
+        for c in causes:
+            v = d[c].fillna(0).to_numpy() / scale
+            ax.bar(x, v, bottom=bottom, color=colors[c], label=c.split(".", 1)[1])
+            bottom += v
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"N={_n(w)}\n{_n(t)}×{_n(t)}" for t, w in zip(d[TILE], d[WIDTH])],
+                           fontsize="small")
+        ax.set_title(scene)
+        ax.set_xlabel("SIMD width, tile")
+        ax.set_ylabel(f"stall cycles per frame [{unit}]")
+        ax.grid(True, axis="y", alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=min(4, len(causes)),
+               bbox_to_anchor=(0.5, -0.02), fontsize="small")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = ("Cycles per frame in which the SIMD unit issued nothing, stacked by cause." +
+                    _context_caption(context))
+    return plot
+
+
+def plot_fps_vs_buffer(store: Store, directory: str) -> Plot:
+    plot = Plot("fps_vs_buffer", "Predicted frame rate against ray-buffer size")
+    data = _with(store.points, ["fps", KIB])
+    if data.empty:
+        plot.skipped = f"the store has no fps or {KIB} values"
+        return plot
+    context, data = dominant_context(data, TABLE_KEY + [KIB])
+    if data.groupby(TABLE_KEY)[KIB].nunique().max() < 2:
+        sizes = ", ".join(_n(k) for k in sorted(data[KIB].unique()))
+        plot.skipped = f"needs two ray-buffer sizes for one configuration; the store has " \
+                       f"{sizes} KiB"
+        return plot
+    scenes = sorted(data[SCENE].unique())
+    fig, axes = _subplots(len(scenes))
+    any_error = False
+    for ax, scene in zip(axes, scenes):
+        at_scene = data[data[SCENE] == scene]
+        for (tile, width), d in at_scene.groupby([TILE, WIDTH]):
+            d = d.sort_values(KIB)
+            any_error |= _line_with_errors(ax, d[KIB], d["fps"], _fps_error(d),
+                                           label=f"N={_n(width)}, {_n(tile)}×{_n(tile)}")
+        ax.set_xscale("log", base=2)
+        ticks = sorted(at_scene[KIB].unique())
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([_n(t) for t in ticks])
+        ax.set_title(scene)
+        ax.set_xlabel("ray-buffer size [KiB per buffer]")
+        ax.set_ylabel("predicted fps [frames/s]")
+        ax.set_ylim(bottom=0)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="x-small")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = ("One line per SIMD width and tile." +
+                    (" Error bars: the model's fps interval." if any_error else "") +
+                    _context_caption(context))
+    return plot
+
+
+def pareto_front(area: Sequence[float], fps: Sequence[float]) -> List[int]:
+    """Indices of the points no other point beats: none has less or equal area with more or
+    equal fps (strictly better in one). Ordered by area."""
+    order = sorted(range(len(area)), key=lambda i: (area[i], -fps[i]))
+    front, best = [], -math.inf
+    for i in order:
+        if fps[i] > best:
+            front.append(i)
+            best = fps[i]
+    return front
+
+
+def plot_pareto(store: Store, directory: str) -> Plot:
+    plot = Plot("pareto_fps_vs_buffer", "Pareto front: frame rate against ray-buffer capacity")
+    data = _with(store.points, ["fps", KIB])
+    if data.empty:
+        plot.skipped = f"the store has no fps or {KIB} values"
+        return plot
+    data = data.copy()
+    if BUFFERS in data.columns and data[BUFFERS].notna().all():
+        data["area"] = data[KIB] * data[BUFFERS]
+        xlabel = "ray-buffer capacity [KiB] (kib × buffers)"
+    else:
+        data["area"] = data[KIB]
+        xlabel = "ray-buffer size [KiB]"
+    # Every hardware point and tile of a scene competes; the workload and fidelity are held.
+    hw_key = [SCENE, TILE] + [c for c in data.columns if c.startswith("hw.")]
+    context, data = dominant_context(data, hw_key)
+    if data.groupby(SCENE)["area"].nunique().max() < 2:
+        plot.skipped = "needs points at two ray-buffer sizes for one scene"
+        return plot
+    scenes = sorted(data[SCENE].unique())
+    fig, axes = _subplots(len(scenes))
+    for ax, scene in zip(axes, scenes):
+        d = data[data[SCENE] == scene].reset_index(drop=True)
+        ax.scatter(d["area"], d["fps"], color="0.6", s=18, label="sweep points")
+        front = pareto_front(list(d["area"]), list(d["fps"]))
+        f = d.iloc[front]
+        ax.step(f["area"], f["fps"], where="post", color="C3", linewidth=1.2)
+        ax.scatter(f["area"], f["fps"], color="C3", s=30, zorder=3, label="Pareto front")
+        for _, r in f.iterrows():
+            ax.annotate(f"N={_n(r[WIDTH])}, {_n(r[TILE])}²", (r["area"], r["fps"]),
+                        textcoords="offset points", xytext=(4, 4), fontsize="x-small")
+        ax.set_xscale("log", base=2)
+        ticks = sorted(d["area"].unique())
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([_n(t) for t in ticks])
+        ax.set_title(scene)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("predicted fps [frames/s]")
+        ax.margins(x=0.15)
+        ax.set_ylim(0, 1.12 * d["fps"].max())  # room for the labels
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="x-small", loc="lower right")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = ("Ray-buffer capacity as an area proxy. Red: the designs no other design "
+                    "beats with less or equal capacity; labels give SIMD width and tile." +
+                    _context_caption(context))
+    return plot
+
+
+def accuracy_rows(points: pd.DataFrame) -> pd.DataFrame:
+    """Points whose configuration was run at two or more fidelities (`sfx accuracy`), with
+    `error.measured`: |fps - fps at full fidelity| / fps at full fidelity, when a full row
+    exists."""
+    if "host_seconds" not in points.columns or "fps" not in points.columns:
+        return points.iloc[0:0]
+    config = [c for c in points.columns
+              if (c.startswith("hw.") or c.startswith("workload.")) and c != "fidelity"]
+    data = points.dropna(subset=["host_seconds"]).copy()
+    data["config_id"] = data.groupby(config, dropna=False).ngroup()
+    counts = data.groupby("config_id")["fidelity"].nunique()
+    data = data[data["config_id"].isin(counts[counts > 1].index)].copy()
+    data["error.measured"] = np.nan
+    for _, group in data.groupby("config_id"):
+        full = group[group["fidelity"] == "full"]["fps"].dropna()
+        if len(full) and full.iloc[0] > 0:
+            ref = full.iloc[0]
+            data.loc[group.index, "error.measured"] = (group["fps"] - ref).abs() / ref
+    return data
+
+
+def plot_error_vs_host_time(store: Store, directory: str) -> Plot:
+    plot = Plot("error_vs_host_time", "Fidelity: error against host time")
+    data = accuracy_rows(store.points)
+    if data.empty:
+        plot.skipped = ("no accuracy rows: no configuration in the store was run at more than "
+                        "one fidelity (`sfx accuracy` writes them)")
+        return plot
+    estimate = data["error.relative"].where(data["error.relative"] >= 0) \
+        if "error.relative" in data.columns else pd.Series(np.nan, index=data.index)
+    if data["error.measured"].isna().all() and estimate.isna().all():
+        plot.skipped = "the accuracy rows have neither a full-fidelity reference nor an error " \
+                       "estimate"
+        return plot
+    fig, ax = plt.subplots(figsize=(6.0, 4.2), layout="constrained")
+    markers = {"analytic": "s", "sampled": "o", "full": "D"}
+    for i, fidelity in enumerate(sorted(data["fidelity"].unique(), key=fidelity_rank)):
+        d = data[data["fidelity"] == fidelity]
+        color = f"C{FIDELITIES.index(fidelity) if fidelity in FIDELITIES else 3 + i}"
+        m = d["error.measured"].notna()
+        if m.any():
+            ax.scatter(d["host_seconds"][m], 100 * d["error.measured"][m], color=color,
+                       marker=markers.get(fidelity, "^"), label=f"{fidelity}: measured vs full")
+        e = estimate[d.index].notna()
+        if e.any():
+            ax.scatter(d["host_seconds"][e], 100 * estimate[d.index][e], facecolors="none",
+                       edgecolors=color, marker=markers.get(fidelity, "^"), s=60,
+                       label=f"{fidelity}: model's estimate")
+    ax.set_xscale("log")
+    ax.set_xlabel("host time per prediction [s]")
+    ax.set_ylabel("relative fps error [%]")
+    top = ax.get_ylim()[1]
+    ax.set_ylim(-0.03 * top, top)  # exact (0 %) points stay visible
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    plot.caption = (f"{data['config_id'].nunique()} configuration(s) run at several fidelities. "
+                    "Filled: |fps − fps at full fidelity| / fps at full fidelity; hollow: the "
+                    "half-width of the interval the model reports (error.relative).")
+    return plot
+
+
+PLOTTERS: List[Callable[[Store, str], Plot]] = [
+    plot_fps_vs_width,
+    plot_utilization_vs_width,
+    plot_stalls,
+    plot_fps_vs_buffer,
+    plot_pareto,
+    plot_error_vs_host_time,
+]
+
+
+def make_plots(store: Store, directory: str) -> List[Plot]:
+    return [plotter(store, directory) for plotter in PLOTTERS]
