@@ -47,5 +47,6 @@ void add_simulate_command(CLI::App& app);
 void add_accuracy_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);  // also the hidden run-group
 void add_compare_command(CLI::App& app);
+void add_report_command(CLI::App& app);
 
 }  // namespace sfx

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     sfx::add_accuracy_command(app);
     sfx::add_sweep_command(app);
     sfx::add_compare_command(app);
+    sfx::add_report_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

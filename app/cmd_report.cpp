@@ -1,0 +1,86 @@
+// sfx report DB -o DIR: tables and plots from a results store. The work is Python
+// (analysis/sfx_analysis, pandas and matplotlib); this command only finds it and runs it.
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/commands.h"
+#include "workloads/input_error.h"
+
+#ifndef SFX_ANALYSIS_DIR
+#error "SFX_ANALYSIS_DIR (the analysis/ folder) is set by app/CMakeLists.txt"
+#endif
+
+namespace sfx {
+namespace {
+
+// Debian's pandas and matplotlib are visible to the system interpreter only.
+constexpr const char* k_python = "/usr/bin/python3";
+
+std::string env_or(const char* name, const std::string& fallback) {
+    const char* v = std::getenv(name);
+    return v && *v ? std::string(v) : fallback;
+}
+
+// Runs argv, waits, returns its exit code (128 + signal when killed).
+int run(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    std::cout.flush();
+    const pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+    if (pid == 0) {
+        execv(argv[0], argv.data());
+        std::cerr << "sfx report: cannot run " << args[0] << ": " << std::strerror(errno)
+                  << " (install python3-pandas python3-matplotlib: ./scripts/install-deps)\n";
+        _exit(127);
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+    if (WIFEXITED(status)) return WEXITSTATUS(status);
+    return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace
+
+void add_report_command(CLI::App& app) {
+    struct Options {
+        std::string db;
+        std::string output = "report";
+        bool quiet = false;
+    };
+    auto options = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand("report", "tables and plots from a results store (HTML)");
+    c->add_option("db", options->db, "results store written by sfx sweep")->required();
+    c->add_option("-o,--output", options->output, "report directory (default: report)");
+    c->add_flag("--quiet", options->quiet, "print only where the files are");
+    c->callback([options] {
+        struct stat st;
+        if (stat(options->db.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+            throw InputError(options->db, 0, "db", "no such results store");
+        // SFX_ANALYSIS_DIR in the environment overrides the baked-in path (an installed sfx).
+        const std::string analysis = env_or("SFX_ANALYSIS_DIR", SFX_ANALYSIS_DIR);
+        const std::string old_path = env_or("PYTHONPATH", "");
+        const std::string path = analysis + (old_path.empty() ? "" : ":" + old_path);
+        setenv("PYTHONPATH", path.c_str(), 1);
+        std::vector<std::string> args = {k_python, "-m", "sfx_analysis", "report",
+                                         options->db, "-o", options->output};
+        if (options->quiet) args.push_back("--quiet");
+        const int code = run(args);
+        // The exit code passes through: 2 for a store that cannot be reported on.
+        if (code != 0) std::exit(code);
+    });
+}
+
+}  // namespace sfx
