@@ -1,0 +1,96 @@
+"""Plots are drawn as valid, non-empty PNGs; index.html references only files that exist."""
+
+import os
+import re
+import shutil
+import struct
+import subprocess
+
+import pytest
+
+from conftest import grid_points, point, write_store
+from sfx_analysis.plots import pareto_front
+from sfx_analysis.report import write_report
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def png_size(path):
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == PNG_SIGNATURE and head[12:16] == b"IHDR"
+    return struct.unpack(">II", head[16:24])
+
+
+def accuracy_store(tmp_path):
+    points = grid_points(kibs=(128.0, 512.0))
+    for fidelity, fps, err, host in [("sampled", 26.0, 0.05, 0.5), ("full", 25.0, 0.0, 5.0)]:
+        points.append(point("rtrt", 32, 16, 512.0, fps=fps, fidelity=fidelity,
+                            **{"error.relative": err, "host_seconds": host}))
+    return write_store(str(tmp_path / "acc.db"), points)
+
+
+def test_every_plot_drawn_and_valid(tmp_path):
+    report = write_report(accuracy_store(tmp_path), str(tmp_path / "r"))
+    assert [p.name for p in report.plots if p.skipped] == []
+    for p in report.plots:
+        path = os.path.join(report.directory, p.file)
+        width, height = png_size(path)
+        assert width > 200 and height > 150 and os.path.getsize(path) > 5000, p.name
+
+
+def test_plots_without_data_are_skipped_and_listed(grid_store, tmp_path):
+    report = write_report(grid_store, str(tmp_path / "r"))
+    skipped = {p.name: p.skipped for p in report.plots if p.skipped}
+    # One ray-buffer size and no accuracy rows.
+    assert set(skipped) == {"fps_vs_buffer", "pareto_fps_vs_buffer", "error_vs_host_time"}
+    assert not os.path.exists(tmp_path / "r" / "fps_vs_buffer.png")
+    html = open(report.index, encoding="utf-8").read()
+    assert "Skipped plots" in html and "no accuracy rows" in html
+
+
+def test_index_references_only_existing_files(tmp_path):
+    report = write_report(accuracy_store(tmp_path), str(tmp_path / "r"))
+    html = open(report.index, encoding="utf-8").read()
+    refs = re.findall(r'(?:src|href)="([^"]+)"', html)
+    assert len([r for r in refs if r.endswith(".png")]) == 6
+    for ref in refs:
+        assert not re.match(r"^[a-z]+:", ref) and not ref.startswith("/"), ref
+        assert os.path.isfile(os.path.join(report.directory, ref)), ref
+    assert "<table" in html and "Table 6" in html
+    # Seven tables per context; contexts: 128 KiB analytic, 512 KiB at each of three fidelities.
+    assert open(report.tables_md, encoding="utf-8").read().count("### Table") == 28
+
+
+def test_pareto_front():
+    area = [256, 256, 512, 1024, 1024]
+    fps = [10, 12, 11, 15, 15]
+    assert pareto_front(area, fps) == [1, 3]
+
+
+def sfx_binary():
+    candidates = [os.environ.get("SFX_BIN", "")] + [
+        os.path.join(os.path.dirname(__file__), "..", "..", d, "sfx")
+        for d in ["build", "build-analysis"]]
+    for c in candidates:
+        if c and os.access(c, os.X_OK):
+            return c
+    return None
+
+
+@pytest.mark.skipif(sfx_binary() is None, reason="no built sfx (set SFX_BIN)")
+def test_sfx_report_command(grid_store, tmp_path):
+    sfx = sfx_binary()
+    out = tmp_path / "r"
+    done = subprocess.run([sfx, "report", grid_store, "-o", str(out)], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "report: " in done.stdout and (out / "index.html").exists()
+    assert "25.00 fps" in done.stdout  # Table 6 printed
+    old = write_store(str(tmp_path / "old.db"), grid_points(), schema_version="0")
+    done = subprocess.run([sfx, "report", old, "-o", str(out)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 2 and "older" in done.stderr and "Traceback" not in done.stderr
+    done = subprocess.run([sfx, "report", str(tmp_path / "none.db")], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 2
