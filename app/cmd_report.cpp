@@ -47,7 +47,8 @@ int run(const std::vector<std::string>& args) {
     }
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+        if (errno != EINTR)
+            throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
     if (WIFEXITED(status)) return WEXITSTATUS(status);
     return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
@@ -74,7 +75,7 @@ void add_report_command(CLI::App& app) {
         const std::string old_path = env_or("PYTHONPATH", "");
         const std::string path = analysis + (old_path.empty() ? "" : ":" + old_path);
         setenv("PYTHONPATH", path.c_str(), 1);
-        std::vector<std::string> args = {k_python, "-m", "sfx_analysis", "report",
+        std::vector<std::string> args = {k_python,    "-m", "sfx_analysis", "report",
                                          options->db, "-o", options->output};
         if (options->quiet) args.push_back("--quiet");
         const int code = run(args);
