@@ -303,7 +303,8 @@ def plot_pareto(store: Store, directory: str) -> Plot:
 
 
 def accuracy_rows(points: pd.DataFrame) -> pd.DataFrame:
-    """Points whose configuration was run at two or more fidelities (`sfx accuracy`), with
+    """Points whose configuration was run at two or more fidelities (a sweep with `fidelity`
+    as an axis), with
     `error.measured`: |fps - fps at full fidelity| / fps at full fidelity, when a full row
     exists."""
     if "host_seconds" not in points.columns or "fps" not in points.columns:
@@ -328,7 +329,8 @@ def plot_error_vs_host_time(store: Store, directory: str) -> Plot:
     data = accuracy_rows(store.points)
     if data.empty:
         plot.skipped = ("no accuracy rows: no configuration in the store was run at more than "
-                        "one fidelity (`sfx accuracy` writes them)")
+                        "one fidelity (sweep with `fidelity` as an axis; `sfx accuracy --plot` draws "
+                        "the same for one point)")
         return plot
     estimate = data["error.relative"].where(data["error.relative"] >= 0) \
         if "error.relative" in data.columns else pd.Series(np.nan, index=data.index)
