@@ -17,6 +17,7 @@
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
+#include "sweeps/point_group.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
@@ -90,12 +91,7 @@ int main(int argc, char** argv) {
     const Scene scene = load_scene(scene_name);
     settings.max_depth = scene.max_depth;
     const Bvh bvh(scene);
-    WorkloadShape shape;
-    shape.features = scene.features();
-    shape.triangles = scene.triangles.size();
-    shape.spheres = scene.spheres.size();
-    shape.bvh_nodes = bvh.nodes().size();
-    shape.tile = settings.tile;
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     std::printf("scene %s %ux%u x %u spp, tile %u, width 16, 32 banks, %d repetitions (median)\n",
                 scene_name.c_str(), settings.width, settings.height, spp, settings.tile, reps);
 

@@ -36,16 +36,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 
-WorkloadShape shape_of(const Scene& scene, const Bvh& bvh, const RenderSettings& settings) {
-    WorkloadShape shape;
-    shape.features = scene.features();
-    shape.features.max_depth = settings.max_depth;
-    shape.triangles = scene.triangles.size();
-    shape.spheres = scene.spheres.size();
-    shape.bvh_nodes = bvh.nodes().size();
-    shape.tile = settings.tile;
-    return shape;
-}
 
 // Ideal utilization at configuration i's width from the counted trace.
 void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
@@ -158,7 +148,7 @@ private:
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
-    const WorkloadShape shape = shape_of(scene, bvh, settings);
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
     if (!(opt.fraction > 0.0 && opt.fraction <= 1.0))
         throw InputError("command line", 0, "--sample-fraction", "must lie in (0, 1]");
@@ -286,6 +276,17 @@ PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSet
 
 }  // namespace
 
+WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSettings& settings) {
+    WorkloadShape shape;
+    shape.features = scene.features();
+    shape.features.max_depth = settings.max_depth;
+    shape.triangles = scene.triangles.size();
+    shape.spheres = scene.spheres.size();
+    shape.bvh_nodes = bvh.nodes().size();
+    shape.tile = settings.tile;
+    return shape;
+}
+
 uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs) {
     const uint64_t bytes_per_ray = ray_record_bytes(features);
     uint64_t smallest = UINT64_MAX;
@@ -312,7 +313,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const SamplingOptions& sampling) {
     if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);
     const auto start = std::chrono::steady_clock::now();
-    const WorkloadShape shape = shape_of(scene, bvh, settings);
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
 
     std::vector<uint32_t> widths;

@@ -8,12 +8,16 @@
 
 #include "hw_model/hw_config.h"
 #include "hw_model/prediction.h"
+#include "hw_model/workload_shape.h"
 #include "kernels/bvh.h"
 #include "kernels/render.h"
 #include "sweeps/sampling.h"
 #include "workloads/scene.h"
 
 namespace sfx {
+
+// What the hardware model needs to know of a workload besides its trace.
+WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSettings& settings);
 
 // The largest tile whose stream fits every configuration's ray buffer: tile^2 * bytes per ray
 // <= buffer bytes.

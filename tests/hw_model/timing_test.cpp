@@ -149,12 +149,7 @@ TEST_CASE("The hardware model never changes the image; more banks never slower; 
         c.name = "banks" + std::to_string(banks);
         configs.push_back(c);
     }
-    WorkloadShape shape;
-    shape.features = scene.features();
-    shape.triangles = scene.triangles.size();
-    shape.spheres = scene.spheres.size();
-    shape.bvh_nodes = bvh.nodes().size();
-    shape.tile = settings.tile;
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     const RenderResult plain = render_stream(scene, bvh, settings, nullptr);
     {
         SystemcTiming timing(configs, shape);

@@ -57,12 +57,7 @@ TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity tota
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
     const RenderSettings settings = small_settings(scene);
-    WorkloadShape shape;
-    shape.features = scene.features();
-    shape.triangles = scene.triangles.size();
-    shape.spheres = scene.spheres.size();
-    shape.bvh_nodes = bvh.nodes().size();
-    shape.tile = settings.tile;
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     SystemcTiming timing({HwConfig{}}, shape);
     PassCycles passes(timing);
     render_stream(scene, bvh, settings, &passes);
