@@ -12,15 +12,7 @@ cleanup() {
   if [ -n "${KEEP:-}" ]; then echo "kept $work"; else rm -rf "$work"; fi
 }
 trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do echo "== $f"; tail -n 30 "$f"; done
-  exit 1
-}
-wait_for() {
-  local deadline=$((SECONDS + $1)); shift
-  until "$@"; do [ $SECONDS -lt $deadline ] || return 1; sleep 0.1; done
-}
+. "$(dirname "$0")/test_lib.sh"
 db="$work/results.db"
 rows() { [ -s "$db" ] && sqlite3 "$db" "SELECT count(*) FROM points" 2>/dev/null || echo 0; }
 
