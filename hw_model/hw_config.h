@@ -73,7 +73,10 @@ struct ScratchpadConfig {
     uint32_t ports = 2;  // the paper: dual-ported
 
     template <class V> void visit(V& v) {
-        v.param("kib", kib, "KiB", "scratchpad for intermediate results", 1u, 1u << 16);
+        v.param("kib", kib, "KiB",
+                "scratchpad capacity for intermediate results (area only: the timing model "
+                "prices its ports, not its size)",
+                1u, 1u << 16);
         v.param("ports", ports, "ports", "scratchpad ports", 1u, 8u);
     }
 };
