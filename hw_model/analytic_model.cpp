@@ -6,6 +6,7 @@
 #include <numeric>
 #include <vector>
 
+#include "hw_model/cache_model.h"
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
 
@@ -17,7 +18,8 @@ TraceProfile::TraceProfile(const WorkloadShape& shape) {
     m_map.spheres = shape.spheres;
     // Data sizes do not depend on the datapath latencies: any configuration's table will do.
     const OpCostTable costs(RayRecordLayout(shape.features), DatapathConfig{});
-    for (uint32_t k = 0; k < k_op_kind_count; ++k) m_scene_bytes.push_back(costs[OpKind(k)].scene_bytes);
+    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        m_scene_bytes.push_back(costs[OpKind(k)].scene_bytes);
     // Nodes, triangles, spheres, then a few materials (shading ops name a material kind).
     const uint64_t bytes = m_map.address(OpKind::material_filter, 0) + 64 * m_map.material_bytes;
     const uint64_t words = bytes / k_line_bytes / 64 + 2;
@@ -49,7 +51,8 @@ void TraceProfile::op(const StreamOp& op) {
     ++b.fetches;
     ++m_footprint.fetches;
     const uint64_t address = m_map.address(op.kind, op.object);
-    for (uint64_t line = address / k_line_bytes; line <= (address + bytes - 1) / k_line_bytes; ++line) {
+    for (uint64_t line = address / k_line_bytes; line <= (address + bytes - 1) / k_line_bytes;
+         ++line) {
         if (mark(m_pass_lines, line)) {
             ++m_footprint.pass_distinct;
             m_pass_touched.push_back(line >> 6);
@@ -133,7 +136,8 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
     const TraceProfile::Footprint& f = profile.footprint();
     const double fetches = double(f.fetches);
     const double line = TraceProfile::k_line_bytes;
-    const double pass_bytes = line * double(f.pass_distinct) / double(std::max<uint64_t>(1, profile.passes()));
+    const double pass_bytes =
+        line * double(f.pass_distinct) / double(std::max<uint64_t>(1, profile.passes()));
     const double frame_bytes = line * double(f.frame_distinct);
     const double first_in_pass = double(f.pass_distinct), first_in_frame = double(f.frame_distinct);
     if (fetches == 0) return 0.0;
@@ -147,12 +151,14 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
         const double miss = compulsory + (first_touch - compulsory) * (1.0 - survives) +
                             (1.0 - first_touch) * (1.0 - retouch_hits);
         const double global_miss = std::min(previous_miss, std::max(0.0, miss));  // inclusive
-        cycles += (previous_miss - global_miss) * level.hit_latency_cycles;
+        cycles +=
+            (previous_miss - global_miss) * double(ns_to_cycles(level.hit_latency_ns, core_mhz));
         previous_miss = global_miss;
     }
     const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
     const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
-    return cycles + previous_miss * (double(memory.dram_latency_cycles) + transfer);
+    return cycles +
+           previous_miss * (double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer);
 }
 
 }  // namespace
@@ -189,7 +195,13 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     t.passes = profile.passes();
     double total_cycles = 0.0;
     StallCycles stalls_sum;
-    double stall_values[7] = {};  // fractional sums, rounded once at the end
+    // Fractional sums in unit-cycles, rounded once at the end: conflict, alignment, address,
+    // partition, scene memory, interconnect, pipeline fill, unit idle.
+    double stall_values[8] = {};
+    const double units = double(std::max(1u, c.simd.units));
+    const double agu_rate = double(c.agu.count) * c.agu.addresses_per_cycle;
+    const double occupancy = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
+    const bool programmable = c.datapath.issue == "programmable";
     for (const auto& [key, bucket] : profile.buckets()) {
         const auto& [secondary, kind, length] = key;
         if (length == 0) continue;
@@ -198,76 +210,90 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double pass_rate = double(bucket.passed) / (ops * double(length));
         const uint64_t groups = (uint64_t(length) + n - 1) / n;
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
-        // Per op: exact id-stream and compute work; expected conflicts.
-        double busy = 0.0, conflict = 0.0, align = 0.0, first_group = 0.0, accesses = 0.0;
+        const double gathers = double(p.gather_words.size());
+        const double busy =
+            programmable ? double(p.compute_instructions) : double(c.datapath.initiation_interval);
+        // The cycle model's pipeline in closed form. Groups spread over the units; each round
+        // of them costs the slowest of execution, the access side's issue, and the shared
+        // address units and interconnect. An op that partitions holds the next op back: the
+        // next op's first fetch, this op's last result and the partition are exposed.
+        const double sharing = std::min(units, double(groups));
+        const double rounds = std::ceil(double(groups) / sharing);
+        double align = 0.0, conflict = 0.0, accesses = 0.0, round_sum = 0.0, addr_sum = 0.0,
+               ic_sum = 0.0;
+        double first_fetch = 0.0;
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const RayBufferModel::Contiguous ids = buffer.access_contiguous(g * n, lanes);
-            busy += double(ids.cycles - ids.alignment_cycles);
-            align += double(ids.alignment_cycles);
-            const double ideal = double((lanes + c.ray_buffer.banks - 1) / c.ray_buffer.banks);
-            const double per_request = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
-            const double gathers = double(p.gather_words.size());
-            busy += gathers * ideal * per_request;
-            conflict += gathers * group_conflicts(lanes, sparsity) * per_request;
-            accesses += gathers;
-            if (g == 0) first_group = busy + conflict + align;
+            // Scatters of the passing lanes share the address units, interconnect and banks.
             const double scattering = std::round(pass_rate * lanes);
-            if (scattering >= 1.0 && !p.scatter_words.empty()) {
-                const double s = double(p.scatter_words.size());
-                busy += s * std::ceil(scattering / c.ray_buffer.banks) * per_request;
-                conflict += s * group_conflicts(uint32_t(scattering), sparsity) * per_request;
-                accesses += s;
-            }
+            const double scatter_words =
+                scattering >= 1.0 ? scattering * double(p.scatter_words.size()) : 0.0;
+            const double words = double(lanes) * gathers + scatter_words;
+            const double conflicts = group_conflicts(lanes, sparsity) * occupancy;
+            const double access =
+                double(ids.cycles) + gathers * occupancy + conflicts +
+                (scatter_words > 0 ? double(p.scatter_words.size()) * occupancy : 0.0);
+            const double addresses = sharing * words / agu_rate;
+            const double wires = sharing * words / words_per_core_cycle;
+            round_sum += std::max({busy, access, addresses, wires});
+            addr_sum += std::max(0.0, addresses - std::max(busy, access));
+            ic_sum += std::max(0.0, wires - std::max({busy, access, addresses}));
+            align += double(ids.alignment_cycles);
+            conflict += conflicts;
+            accesses += gathers;
+            if (g == 0)
+                first_fetch = double(ids.cycles) + std::ceil(double(lanes) / agu_rate) +
+                              std::max(0.0, gathers - 1.0) + conflicts + double(buffer.latency()) +
+                              (fill_bank - buffer.fill_cycles());
+            if (scattering >= 1.0 && !p.scatter_words.empty())
+                accesses += double(p.scatter_words.size());
         }
-        busy += double(groups) * p.compute_instructions;
-        const double data = busy + conflict + align;
-        const double words = double(length) * double(p.gather_words.size() + 1) +
-                             pass_rate * length * double(p.scatter_words.size());
-        const double address = std::ceil(words / (double(c.agu.count) * c.agu.addresses_per_cycle));
-        const double address_stall = std::max(0.0, address - data);
-        // A fetch overlaps the first group's id read and gathers.
-        const double memory_stall =
-            p.scene_bytes ? std::max(0.0, fetch_cycles - first_group) * double(bucket.fetches) / ops
-                          : 0.0;
+        const double per_round = round_sum / double(groups);
+        const double exec = rounds * per_round;
+        const double tail = std::max(0.0, double(p.latency_cycles) - busy) + 1.0;
         double compare = 0.0, moves = 0.0;
         if (p.partitions) {
-            compare = std::ceil(double(length) / c.partition.lanes_per_cycle);
+            compare = std::ceil(double(length) / (double(n) * c.partition.comparators_per_lane));
             moves = std::ceil(expected_moved_ids(length, pass_rate) / n);
         }
-        const double fill = double(p.latency_cycles) + fill_bank;
-        const double scratch = std::ceil(2.0 * double(groups) / c.scratchpad.ports);
-        const double interconnect =
-            (c.interconnect.contention
-                 ? std::max(0.0, std::ceil(2.0 * words / words_per_core_cycle) - data)
-                 : 0.0) +
-            std::max(0.0, scratch - data);
-        // Average cycles of one op of this bucket.
-        const double op_cycles =
-            data + fill + address_stall + memory_stall + compare + moves + interconnect;
+        const double bubble = p.partitions ? first_fetch + tail + compare + moves : 0.0;
+        // Scene data is requested at dispatch (or prefetch_depth ops earlier): what the first
+        // fetch and the earlier ops do not cover shows.
+        const double memory_stall =
+            p.scene_bytes
+                ? std::max(0.0, fetch_cycles - first_fetch -
+                                    double(c.scene_memory.prefetch_depth) * (exec + bubble)) *
+                      double(bucket.fetches) / ops
+                : 0.0;
+        const double op_cycles = exec + bubble + memory_stall;
 
         total_cycles += ops * op_cycles;
-        stall_values[0] += ops * conflict;
-        stall_values[1] += ops * align;
-        stall_values[2] += ops * address_stall;
-        stall_values[3] += ops * (compare + moves);
-        stall_values[4] += ops * memory_stall;
-        stall_values[5] += ops * interconnect;
-        stall_values[6] += ops * fill;
+        // Unit-cycles: busy ones issue instructions; the rest are charged to their causes.
+        const double busy_units = double(groups) * busy;
+        const double fetch_excess = ops * sharing * std::max(0.0, exec - rounds * busy);
+        const double excess_parts = std::max(1e-9, align + conflict + addr_sum + ic_sum);
+        stall_values[0] += fetch_excess * conflict / excess_parts;
+        stall_values[1] += fetch_excess * align / excess_parts;
+        stall_values[2] += fetch_excess * addr_sum / excess_parts;
+        stall_values[5] += fetch_excess * ic_sum / excess_parts;
+        stall_values[3] += ops * units * (compare + moves);
+        stall_values[4] += ops * units * memory_stall;
+        stall_values[6] += ops * units * (p.partitions ? first_fetch + tail : 0.0);
+        stall_values[7] += ops * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
         StageTiming& stage = t.stages[secondary][uint32_t(stage_of(kind))];
         stage.ops += bucket.ops;
         stage.lanes += bucket.ops * length;
         stage.groups += bucket.ops * groups;
-        stage.busy_cycles += uint64_t(std::llround(ops * busy));
-        stage.stall_cycles += uint64_t(std::llround(ops * (op_cycles - busy)));
-        t.mix.load += uint64_t(ops * double(groups) + double(p.scene_bytes ? bucket.fetches : 0));
+        stage.busy_cycles += uint64_t(std::llround(ops * busy_units));
+        stage.stall_cycles += uint64_t(std::llround(ops * (op_cycles * units - busy_units)));
+        t.mix.load += uint64_t(ops * double(groups) * double(1 + p.gather_words.size()) +
+                               double(p.scene_bytes ? bucket.fetches : 0));
         t.mix.compute += uint64_t(ops * double(groups) * p.compute_instructions);
         t.mix.scatter_gather += uint64_t(std::llround(ops * accesses));
         t.mix.partition += uint64_t(ops * compare);
         t.mix.store += uint64_t(ops * moves);
-        if (kind == OpKind::camera || kind == OpKind::lambertian_direct ||
-            kind == OpKind::lambertian_indirect || kind == OpKind::dielectric || kind == OpKind::glossy)
-            t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
+        if (p.pushes_rays) t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
         t.field_accesses += uint64_t(std::llround(ops * accesses));
     }
     stalls_sum.bank_conflict = uint64_t(std::llround(stall_values[0]));
@@ -277,6 +303,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     stalls_sum.scene_memory = uint64_t(std::llround(stall_values[4]));
     stalls_sum.interconnect = uint64_t(std::llround(stall_values[5]));
     stalls_sum.pipeline_fill = uint64_t(std::llround(stall_values[6]));
+    stalls_sum.unit_idle = uint64_t(std::llround(stall_values[7]));
     t.stalls = stalls_sum;
     t.cycles = uint64_t(std::llround(total_cycles));
     return t;

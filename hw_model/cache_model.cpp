@@ -8,7 +8,8 @@ namespace sfx {
 
 SetAssociativeCache::SetAssociativeCache(const CacheLevelConfig& config) : m_config(config) {
     const uint64_t lines = uint64_t(config.kib) * 1024 / config.line_bytes;
-    if (config.ways == 0 || lines % config.ways != 0 || (config.line_bytes & (config.line_bytes - 1)))
+    if (config.ways == 0 || lines % config.ways != 0 ||
+        (config.line_bytes & (config.line_bytes - 1)))
         throw std::invalid_argument("cache " + config.name + ": bad geometry");
     m_ways = config.ways;
     m_sets = uint32_t(lines / config.ways);
@@ -73,43 +74,78 @@ bool SetAssociativeCache::access(uint64_t address) {
     return false;
 }
 
-SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz)
-    : m_dram_latency(config.dram_latency_cycles) {
-    for (const CacheLevelConfig& level : config.caches) m_levels.emplace_back(level);
+uint64_t ns_to_cycles(double ns, double mhz) {
+    return uint64_t(std::ceil(ns * mhz / 1000.0 - 1e-9));
+}
+
+SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores)
+    : m_config(config),
+      m_dram_latency(ns_to_cycles(config.dram_latency_ns, core_mhz)),
+      // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
+      m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz) {
+    for (const CacheLevelConfig& level : config.caches) {
+        m_levels.emplace_back(level.shared ? 1 : std::max(1u, cores), SetAssociativeCache(level));
+        m_latency.push_back(ns_to_cycles(level.hit_latency_ns, core_mhz));
+    }
     m_line_bytes = config.caches.empty() ? 64 : config.caches.back().line_bytes;
-    // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
-    const double bytes_per_cycle = config.dram_bandwidth_gbps * 1000.0 / core_mhz;
-    m_dram_cycles_per_line = double(m_line_bytes) / bytes_per_cycle;
+}
+
+SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
+    std::vector<SetAssociativeCache>& v = m_levels[level];
+    return v[v.size() == 1 ? 0 : core % v.size()];
+}
+
+uint64_t SceneMemoryModel::hits(uint32_t level) const {
+    uint64_t n = 0;
+    for (const SetAssociativeCache& c : m_levels[level]) n += c.hits();
+    return n;
+}
+
+uint64_t SceneMemoryModel::misses(uint32_t level) const {
+    uint64_t n = 0;
+    for (const SetAssociativeCache& c : m_levels[level]) n += c.misses();
+    return n;
 }
 
 void SceneMemoryModel::clear() {
-    for (SetAssociativeCache& c : m_levels) c.clear();
+    for (auto& level : m_levels)
+        for (SetAssociativeCache& c : level) c.clear();
+    m_dram = RateServer(m_dram.per_cycle());
     m_dram_reads = m_requests = 0;
 }
 
-uint64_t SceneMemoryModel::read(uint64_t address, uint32_t bytes) {
+void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {
+    if (bytes == 0) return;
+    for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
+         ++line)
+        for (uint32_t level = 0; level < m_levels.size(); ++level)
+            if (instance(level, core).access(line * m_line_bytes)) break;
+}
+
+uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now) {
     ++m_requests;
-    if (bytes == 0) return 0;
+    if (bytes == 0) return now;
     const uint64_t first = address / m_line_bytes, last = (address + bytes - 1) / m_line_bytes;
-    uint64_t worst = 0;
-    double transfer = 0.0;
+    uint64_t arrival = now;
     for (uint64_t line = first; line <= last; ++line) {
-        uint64_t latency = m_dram_latency;
+        uint64_t ready = 0;
         bool from_dram = true;
-        for (SetAssociativeCache& level : m_levels) {  // inclusive: every level is filled
-            if (level.access(line * m_line_bytes)) {
-                latency = level.config().hit_latency_cycles;
+        for (uint32_t level = 0; level < m_levels.size(); ++level) {  // inclusive: all filled
+            if (instance(level, core).access(line * m_line_bytes)) {
+                ready = now + m_latency[level];
                 from_dram = false;
                 break;
             }
         }
         if (from_dram) {
             ++m_dram_reads;
-            transfer += m_dram_cycles_per_line;
+            // The line leaves DRAM after its latency, then occupies the channel for its transfer.
+            const double start = m_dram.serve(double(now + m_dram_latency), double(m_line_bytes));
+            ready = uint64_t(std::ceil(start + double(m_line_bytes) / m_dram.per_cycle() - 1e-9));
         }
-        worst = std::max(worst, latency);
+        arrival = std::max(arrival, ready);
     }
-    return worst + uint64_t(std::ceil(transfer));
+    return arrival;
 }
 
 }  // namespace sfx

@@ -13,44 +13,73 @@
 
 namespace sfx {
 
-struct ClockConfig {
-    double core_mhz = 500.0;
-    double interconnect_mhz = 500.0;
+// Every default below is the paper's machine (Gribble & Ramani 2008, "G&R" below) and names
+// its source: a sentence of G&R, another reference, or "assumed" where no source gives a value
+// (hw_model/presets/gr08.hw.yaml repeats each source beside the value).
 
-    template <class V> void visit(V& v) {
+struct ClockConfig {
+    double core_mhz = 500.0;  // G&R 3.3: "a conservative frequency of 500 MHz at 90 nm"
+    double interconnect_mhz =
+        500.0;  // G&R 3.3: the same 500 MHz "to accommodate the flexible interconnect"
+
+    template <class V>
+    void visit(V& v) {
         v.param("core_mhz", core_mhz, "MHz", "core (SIMD, address, partition) clock", 1.0, 1e5);
         v.param("interconnect_mhz", interconnect_mhz, "MHz",
-                "interconnect clock (the paper: 500 MHz, conservative for 90 nm)", 1.0, 1e5);
+                "interconnect clock (its own clock domain)", 1.0, 1e5);
     }
 };
 
 struct SimdConfig {
-    uint32_t width = 16;
+    uint32_t width = 16;  // G&R Table 5 and 3.3 ("a SIMD width of 16")
+    // G&R 3.3: the 32 banks "sustain 32 different SIMD data fetch operations at the same time",
+    // built "to efficiently support a large number of SIMD units": 32 lanes of fetch per cycle
+    // are two 16-wide units (docs/paper-reading.md checks this against Tables 1 and 6).
+    uint32_t units = 2;
 
-    template <class V> void visit(V& v) {
-        v.param("width", width, "lanes", "SIMD lanes per operation", 1u, 64u);
+    template <class V>
+    void visit(V& v) {
+        v.param("width", width, "lanes", "SIMD lanes per unit", 1u, 64u);
+        v.param("units", units, "units",
+                "SIMD units per core; they share the core's banked ray buffers and address units",
+                1u, 64u);
+    }
+};
+
+struct CoreConfig {
+    uint32_t count = 1;  // G&R 3.3 simulates one core; 5.2 proposes replicating it
+
+    template <class V>
+    void visit(V& v) {
+        v.param("count", count, "cores",
+                "homogeneous cores, each with its own ray buffers, SIMD units and L1; tiles are "
+                "scheduled across them; lower scene caches and DRAM bandwidth are shared",
+                1u, 256u);
     }
 };
 
 struct RayBufferConfig {
-    uint32_t kib = 512;   // per buffer
-    uint32_t buffers = 2;  // current and next generation
-    uint32_t banks = 32;
-    uint32_t line_words = 16;  // 32-bit words per bank line; widths that don't divide it stall
-    uint32_t access_latency_cycles = 2;
-    bool pipelined = true;
-    std::string layout = "soa";  // ray records as structure of arrays (the paper) or array of structs
+    uint32_t kib = 512;        // G&R 3.3: "two buffers (512 KB each)"
+    uint32_t buffers = 2;      // G&R 3.3: "for current and next-generation rays"
+    uint32_t banks = 32;       // G&R 3.3: "banked into 32 16 KB buffers"
+    uint32_t line_words = 16;  // G&R 4.1: alignment overhead at widths 8 and 12 "due to the
+                               // larger line size", "minimal for a SIMD width of 16"
+    uint32_t access_latency_cycles = 2;  // G&R 3.3: "Data access requires two cycles,
+    bool pipelined = true;               //  but the operations are pipelined"
+    std::string layout = "soa";          // G&R Fig. 5: one array per field (org_x, org_y, ...)
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.param("kib", kib, "KiB", "size of one ray buffer", 1u, 1u << 20);
         v.param("buffers", buffers, "buffers", "ray buffers (current and next generation)", 2u, 8u);
         v.param("banks", banks, "banks", "banks per ray buffer; must divide kib", 1u, 1024u);
         v.param("line_words", line_words, "words", "32-bit words per bank line", 1u, 256u);
-        v.param("access_latency_cycles", access_latency_cycles, "cycles",
-                "bank access latency", 1u, 64u);
-        v.param("pipelined", pipelined, "", "bank accesses overlap (one issue per cycle)");
+        v.param("access_latency_cycles", access_latency_cycles, "cycles", "bank access latency", 1u,
+                64u);
+        v.param("pipelined", pipelined, "",
+                "a bank accepts one request per cycle (else one per access latency)");
         v.choice("layout", layout, {"soa", "aos"},
                  "ray records: soa puts a field of consecutive slots in consecutive banks; aos "
                  "puts slot * record words + field word in bank (that word mod banks)");
@@ -58,52 +87,66 @@ struct RayBufferConfig {
 };
 
 struct AguConfig {
-    uint32_t count = 32;  // the paper: one per bank
-    uint32_t addresses_per_cycle = 1;
+    uint32_t count = 32;  // G&R 3.3: "Each bank is also supported by an address generator unit"
+    uint32_t addresses_per_cycle = 1;  // assumed: one integer add (field base + slot) per cycle
+    // Assumed: G&R 3.3 says address and data computations "occur in parallel" without a depth;
+    // two groups per SIMD unit lets one group's gathers overlap the previous one's compute.
+    uint32_t queue_depth = 2;
 
-    template <class V> void visit(V& v) {
-        v.param("count", count, "units", "address-generation units", 1u, 1024u);
+    template <class V>
+    void visit(V& v) {
+        v.param("count", count, "units", "address-generation units per core", 1u, 1024u);
         v.param("addresses_per_cycle", addresses_per_cycle, "addresses/cycle",
-                "addresses each unit computes per cycle", 1u, 64u);
+                "addresses each unit computes per cycle (one per gathered or scattered lane word)",
+                1u, 64u);
+        v.param("queue_depth", queue_depth, "groups",
+                "fetched lane groups the access side may run ahead of each SIMD unit", 1u, 1024u);
     }
 };
 
 struct ScratchpadConfig {
-    uint32_t kib = 64;
-    uint32_t ports = 2;  // the paper: dual-ported
+    uint32_t kib = 64;   // assumed: G&R 3.3 names "a dual ported scratch pad" without a size
+    uint32_t ports = 2;  // G&R 3.3: "dual ported"
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.param("kib", kib, "KiB",
                 "scratchpad capacity for intermediate results (area only: the timing model "
                 "prices its ports, not its size)",
                 1u, 1u << 16);
-        v.param("ports", ports, "ports", "scratchpad ports", 1u, 8u);
+        v.param("ports", ports, "ports", "scratchpad ports (filter masks pass through them)", 1u,
+                8u);
     }
 };
 
 struct PartitionConfig {
-    std::string kind = "in_place_compare";
-    uint32_t lanes_per_cycle = 16;
+    std::string kind = "in_place_compare";  // G&R 3.3: "SIMD comparator units", in place
+    uint32_t comparators_per_lane = 1;      // G&R 3.3: SIMD comparators, i.e. one per lane
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.choice("kind", kind, {"in_place_compare"},
-                 "partition algorithm (the paper: SIMD comparators, in place)");
-        v.param("lanes_per_cycle", lanes_per_cycle, "lanes/cycle",
-                "mask lanes the partition unit consumes per cycle", 1u, 1024u);
+                 "partition algorithm (SIMD comparators, in place)");
+        v.param("comparators_per_lane", comparators_per_lane, "comparators/lane",
+                "mask lanes compared per cycle, per SIMD lane", 1u, 64u);
     }
 };
 
 struct InterconnectConfig {
-    uint32_t mux_levels = 2;
-    uint32_t width_words = 16;
+    uint32_t mux_levels = 2;  // assumed: 32 banks reach a unit through two levels of muxes
+    // G&R 3.3: the interconnect "sustains the bandwidth requirements of the address fetch and
+    // execution units": one word from each of the 32 banks per cycle.
+    uint32_t width_words = 32;
     bool contention = true;
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.param("mux_levels", mux_levels, "levels",
-                "pipelined multiplexer levels data crosses once per operation", 1u, 16u);
-        v.param("width_words", width_words, "words/cycle", "words moved per interconnect cycle",
-                1u, 1024u);
-        v.param("contention", contention, "", "model contention between address and data traffic");
+                "pipelined multiplexer levels between a bank and a SIMD unit", 1u, 16u);
+        v.param("width_words", width_words, "words/cycle",
+                "words moved per interconnect cycle, shared by every unit of a core", 1u, 1024u);
+        v.param("contention", contention, "",
+                "transfers queue for the interconnect (false: unlimited bandwidth)");
     }
 };
 
@@ -112,49 +155,66 @@ struct CacheLevelConfig {
     uint32_t kib = 32;
     uint32_t line_bytes = 64;
     uint32_t ways = 8;
-    uint32_t hit_latency_cycles = 4;
+    double hit_latency_ns = 1.4;
+    bool shared = false;  // one instance for all cores (else one per core)
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.param("name", name, "", "level name, used in stat names");
         v.param("kib", kib, "KiB", "capacity", 1u, 1u << 20);
         v.param("line_bytes", line_bytes, "bytes", "line size (a power of two)", 4u, 4096u);
         v.param("ways", ways, "ways", "associativity (pseudo-LRU replacement)", 1u, 64u);
-        v.param("hit_latency_cycles", hit_latency_cycles, "cycles", "hit latency", 1u, 10000u);
+        v.param("hit_latency_ns", hit_latency_ns, "ns",
+                "hit latency (rounded up to whole core cycles)", 0.01, 1e5);
+        v.param("shared", shared, "", "one level shared by all cores (else private per core)");
     }
 };
 
 struct SceneMemoryConfig {
-    // Bikker's hierarchy: 32 KiB / 256 KiB / 2 MiB, 8/8/16-way, 4:11:39:107 cycles.
-    std::vector<CacheLevelConfig> caches = {{"l1", 32, 64, 8, 4},
-                                            {"l2", 256, 64, 8, 11},
-                                            {"l3", 2048, 64, 16, 39}};
-    uint32_t dram_latency_cycles = 107;
-    double dram_bandwidth_gbps = 25.6;
+    // Bikker (seed 000), Fig. 1: 32 KiB / 256 KiB / 2 MiB, 8/8/16-way, latencies 4:11:39:107
+    // cycles of his Xeon X5670 at 2.93 GHz (Intel's specification), i.e. 1.4 / 3.8 / 13.3 /
+    // 36.5 ns; L1 and L2 are per core on that chip, L3 is shared.
+    std::vector<CacheLevelConfig> caches = {{"l1", 32, 64, 8, 1.4, false},
+                                            {"l2", 256, 64, 8, 3.8, false},
+                                            {"l3", 2048, 64, 16, 13.3, true}};
+    double dram_latency_ns = 36.5;
+    double dram_bandwidth_gbps = 25.6;  // assumed: three DDR3-1066 channels, an X5670 configuration
+    // Assumed: G&R describe no prefetch. 0: an op's scene data is requested when it dispatches.
+    uint32_t prefetch_depth = 0;
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.list("caches", caches, "scene-data cache levels, nearest first");
-        v.param("dram_latency_cycles", dram_latency_cycles, "cycles", "DRAM access latency", 1u,
-                100000u);
-        v.param("dram_bandwidth_gbps", dram_bandwidth_gbps, "GB/s", "DRAM bandwidth", 0.001, 1e4);
+        v.param("dram_latency_ns", dram_latency_ns, "ns", "DRAM access latency", 0.01, 1e6);
+        v.param("dram_bandwidth_gbps", dram_bandwidth_gbps, "GB/s",
+                "DRAM bandwidth, shared by all cores", 0.001, 1e4);
+        v.param("prefetch_depth", prefetch_depth, "ops",
+                "stream operations ahead of dispatch whose scene data is requested early (the "
+                "traversal order makes the next nodes known)",
+                0u, 1024u);
     }
 };
 
-// Latency of one operation on one group of lanes in the SIMD datapath (pipelined: a new group
-// issues every cycle; the latency is paid once per dependent chain).
+// The SIMD datapath. `programmable`: filters are programs of SIMD instructions (G&R 3.3: filter
+// tests "implemented as C++ functors" compiled for the SIMD architecture), issued one per
+// cycle, the op's dependent-chain latency paid once per group before its mask is known.
+// `pipelined`: fixed-function filter pipelines accept a group every `initiation_interval`
+// cycles. Instruction counts and chain depths come from the op table (hw_model/op_costs.cpp).
 struct DatapathConfig {
-    uint32_t box_test_cycles = 6;
-    uint32_t triangle_test_cycles = 12;
-    uint32_t sphere_test_cycles = 10;
-    uint32_t shade_cycles = 8;
-    uint32_t camera_cycles = 6;
+    std::string issue = "programmable";
+    uint32_t fp_latency_cycles = 2;  // assumed: a 90 nm single-precision adder or multiplier at
+                                     // 500 MHz (2 ns per cycle) in two pipeline stages
+    uint32_t initiation_interval = 1;
 
-    template <class V> void visit(V& v) {
-        v.param("box_test_cycles", box_test_cycles, "cycles", "ray/box slab test", 1u, 1000u);
-        v.param("triangle_test_cycles", triangle_test_cycles, "cycles", "ray/triangle test", 1u,
-                1000u);
-        v.param("sphere_test_cycles", sphere_test_cycles, "cycles", "ray/sphere test", 1u, 1000u);
-        v.param("shade_cycles", shade_cycles, "cycles", "one shading filter step", 1u, 1000u);
-        v.param("camera_cycles", camera_cycles, "cycles", "primary ray generation", 1u, 1000u);
+    template <class V>
+    void visit(V& v) {
+        v.choice("issue", issue, {"programmable", "pipelined"},
+                 "programmable: instruction count per group; pipelined: one group per "
+                 "initiation interval");
+        v.param("fp_latency_cycles", fp_latency_cycles, "cycles",
+                "latency of one dependent floating-point step", 1u, 64u);
+        v.param("initiation_interval", initiation_interval, "cycles",
+                "cycles between groups entering a pipelined filter datapath", 1u, 64u);
     }
 };
 
@@ -163,6 +223,7 @@ struct HwConfig {
     std::string name = "gr08";
     ClockConfig clock;
     SimdConfig simd;
+    CoreConfig cores;
     RayBufferConfig ray_buffer;
     AguConfig agu;
     ScratchpadConfig scratchpad;
@@ -171,11 +232,13 @@ struct HwConfig {
     SceneMemoryConfig scene_memory;
     DatapathConfig datapath;
 
-    template <class V> void visit(V& v) {
+    template <class V>
+    void visit(V& v) {
         v.param("version", version, "", "configuration format version", 1u, 1u);
         v.param("name", name, "", "configuration name");
         v.group("clock", clock);
         v.group("simd", simd);
+        v.group("cores", cores);
         v.group("ray_buffer", ray_buffer);
         v.group("agu", agu);
         v.group("scratchpad", scratchpad);

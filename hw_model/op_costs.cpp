@@ -31,56 +31,52 @@ std::vector<uint32_t> words_of(const RayRecordLayout& layout,
 }  // namespace
 
 OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
+    // `instructions`: SIMD instructions per lane group on ray data (Table 5's "comp"); `chain`:
+    // the longest dependent chain of them, paid once per group at d.fp_latency_cycles per step
+    // before the group's mask is known. Intersection counts are the floating-point, compare and
+    // select operations of kernels/intersect.h's scalar code per lane (the box test is G&R
+    // Fig. 5's slab test; the triangle test is watertight, with its plane distance in double).
+    // Shading counts are estimates from kernels/materials.h and kernels/path.h, not exact.
     auto set = [&](OpKind k, std::initializer_list<const char*> gather,
                    std::initializer_list<const char*> scatter, uint32_t instructions,
-                   uint32_t latency, uint32_t scene_bytes, bool partitions) {
+                   uint32_t chain, uint32_t scene_bytes) {
         OpProfile& p = m_profiles[size_t(k)];
         p.gather_words = words_of(l, gather);
         p.scatter_words = words_of(l, scatter);
         p.compute_instructions = instructions;
-        p.latency_cycles = latency;
+        p.chain_steps = chain;
+        p.latency_cycles = chain * d.fp_latency_cycles;
         p.scene_bytes = scene_bytes;
-        p.partitions = partitions;
+        p.partitions = op_info(k).partitions;
+        p.pushes_rays = op_info(k).pushes_rays;
     };
     // A ray record written whole: the camera and every shader that pushes a new ray.
-    const auto whole_ray = {"origin", "direction", "inverse_direction", "t_max", "hit_primitive",
-                            "pixel_sample", "throughput", "radiance", "state"};
-    // Instruction counts are SIMD instructions per lane group on ray data (Table 5's "comp"):
-    // slab test 6 sub + 6 mul + 6 min/max + compare; watertight triangle ~30; and so on.
-    set(OpKind::camera, {"pixel_sample"}, whole_ray, 24, d.camera_cycles, 0, false);
-    set(OpKind::box_test, {"origin", "inverse_direction", "t_max"}, {}, 19, d.box_test_cycles, 32,
-        true);
+    const auto whole_ray = {"origin",     "direction",     "inverse_direction",
+                            "t_max",      "hit_primitive", "pixel_sample",
+                            "throughput", "radiance",      "state"};
+    const auto hit = {"origin",           "direction",    "hit_t",      "hit_primitive",
+                      "hit_barycentrics", "pixel_sample", "throughput", "state"};
+    // Scene bytes: a 32-byte BVH node, a triangle's three vertices (36), a sphere (16), a
+    // 64-byte material record (hw_model/op_costs.h, SceneDataMap).
+    set(OpKind::camera, {"pixel_sample"}, whole_ray, 24, 8, 0);
+    set(OpKind::box_test, {"origin", "inverse_direction", "t_max"}, {}, 34, 9, 32);
     set(OpKind::triangle_test, {"origin", "direction", "t_max"},
-        {"t_max", "hit_primitive", "hit_t", "hit_barycentrics"}, 32, d.triangle_test_cycles, 36,
-        false);
+        {"t_max", "hit_primitive", "hit_t", "hit_barycentrics"}, 96, 12, 36);
     set(OpKind::sphere_test, {"origin", "direction", "t_max"}, {"t_max", "hit_primitive", "hit_t"},
-        22, d.sphere_test_cycles, 16, false);
-    set(OpKind::shadow_filter, {"state", "hit_primitive", "throughput", "radiance"}, {"radiance"}, 5,
-        d.shade_cycles, 0, true);
-    set(OpKind::miss_filter, {"hit_primitive", "throughput", "radiance"}, {"radiance"}, 5,
-        d.shade_cycles, 0, true);
+        51, 16, 16);
+    set(OpKind::shadow_filter, {"state", "hit_primitive", "throughput", "radiance"}, {"radiance"},
+        5, 2, 0);
+    set(OpKind::miss_filter, {"hit_primitive", "throughput", "radiance"}, {"radiance"}, 5, 2, 0);
     set(OpKind::emission_filter, {"hit_primitive", "hit_material", "state", "throughput"},
-        {"radiance"}, 6, d.shade_cycles, 64, true);
-    set(OpKind::depth_filter, {"state"}, {}, 2, d.shade_cycles, 0, true);
-    set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, 2, d.shade_cycles, 64, true);
-    set(OpKind::ambient, {"throughput", "radiance"}, {"radiance"}, 6, d.shade_cycles, 64, false);
-    set(OpKind::lambertian_choice, {"pixel_sample", "state"}, {}, 12, d.shade_cycles, 0, true);
-    set(OpKind::lambertian_direct,
-        {"origin", "direction", "hit_t", "hit_primitive", "hit_barycentrics", "pixel_sample",
-         "throughput", "state"},
-        whole_ray, 96, d.shade_cycles, 36 + 64, false);
-    set(OpKind::lambertian_indirect,
-        {"origin", "direction", "hit_t", "hit_primitive", "hit_barycentrics", "pixel_sample",
-         "throughput", "state"},
-        whole_ray, 64, d.shade_cycles, 64, false);
-    set(OpKind::dielectric,
-        {"origin", "direction", "hit_t", "hit_primitive", "hit_barycentrics", "pixel_sample",
-         "throughput", "state"},
-        whole_ray, 72, d.shade_cycles, 64, false);
-    set(OpKind::glossy,
-        {"origin", "direction", "hit_t", "hit_primitive", "hit_barycentrics", "pixel_sample",
-         "throughput", "state"},
-        whole_ray, 110, d.shade_cycles, 64, false);
+        {"radiance"}, 6, 3, 64);
+    set(OpKind::depth_filter, {"state"}, {}, 2, 1, 0);
+    set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, 2, 1, 64);
+    set(OpKind::ambient, {"throughput", "radiance"}, {"radiance"}, 6, 2, 64);
+    set(OpKind::lambertian_choice, {"pixel_sample", "state"}, {}, 12, 6, 0);
+    set(OpKind::lambertian_direct, hit, whole_ray, 96, 16, 36 + 64);
+    set(OpKind::lambertian_indirect, hit, whole_ray, 64, 14, 64);
+    set(OpKind::dielectric, hit, whole_ray, 72, 16, 64);
+    set(OpKind::glossy, hit, whole_ray, 110, 18, 64);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
@@ -89,11 +85,14 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     const uint64_t spheres_base = triangles_base + triangles * triangle_bytes;
     const uint64_t materials_base = spheres_base + spheres * sphere_bytes;
     switch (kind) {
-        case OpKind::box_test: return uint64_t(object) * node_bytes;
-        case OpKind::triangle_test: return triangles_base + uint64_t(object) * triangle_bytes;
+        case OpKind::box_test:
+            return uint64_t(object) * node_bytes;
+        case OpKind::triangle_test:
+            return triangles_base + uint64_t(object) * triangle_bytes;
         case OpKind::sphere_test:
             return spheres_base + (uint64_t(object) - triangles) * sphere_bytes;
-        default: return materials_base + uint64_t(object) * material_bytes;
+        default:
+            return materials_base + uint64_t(object) * material_bytes;
     }
 }
 

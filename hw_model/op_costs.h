@@ -20,14 +20,14 @@ namespace sfx {
 // Word offsets of the ray-record fields (structure of arrays: field word w of slot s is at
 // w * capacity + s). Fields a scene does not need are absent (offset -1).
 class RayRecordLayout {
-public:
+  public:
     explicit RayRecordLayout(const FeatureSet& features);
     uint32_t words() const { return m_words; }
     uint32_t bytes() const { return m_words * 4; }
     // Word offsets of a named field (empty when the scene has no such field).
     const std::vector<uint32_t>& field(const std::string& name) const;
 
-private:
+  private:
     uint32_t m_words = 0;
     std::vector<std::pair<std::string, std::vector<uint32_t>>> m_fields;
     std::vector<uint32_t> m_none;
@@ -37,18 +37,20 @@ struct OpProfile {
     std::vector<uint32_t> gather_words;   // gathered for every lane
     std::vector<uint32_t> scatter_words;  // scattered for passing lanes
     uint32_t compute_instructions = 1;    // SIMD instructions per lane group
-    uint32_t latency_cycles = 1;          // datapath pipeline depth, paid once per op
+    uint32_t chain_steps = 1;             // longest dependent chain of those instructions
+    uint32_t latency_cycles = 1;          // chain_steps * fp latency: paid once per group
     uint32_t scene_bytes = 0;             // scene data fetched once per op (broadcast operand)
-    bool partitions = false;              // the mask partitions the stream in place
+    bool partitions = false;              // the mask partitions the stream in place (op table)
+    bool pushes_rays = false;             // passing lanes write the next generation (op table)
 };
 
 // One profile per OpKind for a scene's layout and a configuration's datapath.
 class OpCostTable {
-public:
+  public:
     OpCostTable(const RayRecordLayout& layout, const DatapathConfig& datapath);
     const OpProfile& operator[](OpKind kind) const { return m_profiles[size_t(kind)]; }
 
-private:
+  private:
     std::array<OpProfile, k_op_kind_count> m_profiles;
 };
 

@@ -8,9 +8,12 @@ namespace sfx {
 
 const char* to_string(Fidelity f) {
     switch (f) {
-        case Fidelity::analytic: return "analytic";
-        case Fidelity::sampled: return "sampled";
-        case Fidelity::full: return "full";
+        case Fidelity::analytic:
+            return "analytic";
+        case Fidelity::sampled:
+            return "sampled";
+        case Fidelity::full:
+            return "full";
     }
     return "?";
 }
@@ -30,6 +33,7 @@ StallCycles& StallCycles::operator+=(const StallCycles& o) {
     scene_memory += o.scene_memory;
     interconnect += o.interconnect;
     pipeline_fill += o.pipeline_fill;
+    unit_idle += o.unit_idle;
     return *this;
 }
 
@@ -74,7 +78,8 @@ FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
 
 namespace {
 // Applies f(counter of this, counter of o) to every counter of a FrameTiming pair.
-template <class F> void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
+template <class F>
+void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
     f(t.cycles, o.cycles);
     f(t.stalls.bank_conflict, o.stalls.bank_conflict);
     f(t.stalls.alignment, o.stalls.alignment);
@@ -83,6 +88,7 @@ template <class F> void for_each_counter(FrameTiming& t, const FrameTiming& o, F
     f(t.stalls.scene_memory, o.stalls.scene_memory);
     f(t.stalls.interconnect, o.stalls.interconnect);
     f(t.stalls.pipeline_fill, o.stalls.pipeline_fill);
+    f(t.stalls.unit_idle, o.stalls.unit_idle);
     f(t.mix.load, o.mix.load);
     f(t.mix.store, o.mix.store);
     f(t.mix.compute, o.mix.compute);
@@ -121,8 +127,12 @@ FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b) {
     return d;
 }
 
+double Prediction::frame_cycles() const {
+    return double(timing.cycles) / double(std::max(1u, config.cores.count));
+}
+
 double Prediction::frame_seconds() const {
-    return double(timing.cycles) / (config.clock.core_mhz * 1e6);
+    return frame_cycles() / (config.clock.core_mhz * 1e6);
 }
 
 double Prediction::fps() const {
@@ -131,7 +141,9 @@ double Prediction::fps() const {
 }
 
 namespace {
-double ratio(double a, double b) { return b > 0.0 ? a / b : 0.0; }
+double ratio(double a, double b) {
+    return b > 0.0 ? a / b : 0.0;
+}
 }  // namespace
 
 std::vector<Stat> Prediction::stats() const {
@@ -140,10 +152,11 @@ std::vector<Stat> Prediction::stats() const {
         s.push_back({std::move(name), value, std::move(unit), std::move(description)});
     };
     add("fps", fps(), "frames/s", "predicted frame rate");
-    add("frame_cycles", double(timing.cycles), "cycles", "core cycles per frame");
+    add("frame_cycles", frame_cycles(), "cycles", "cycles per frame (core-cycles over cores)");
     add("frame_seconds", frame_seconds(), "s", "predicted time per frame");
     add("host_seconds", host_seconds, "s", "host time to obtain this prediction");
-    add("error.relative", error_relative, "", "relative half-width of the frame-cycle interval (<0: unknown)");
+    add("error.relative", error_relative, "",
+        "relative half-width of the frame-cycle interval (<0: unknown)");
     add("passes.total", double(total_passes), "passes", "tile passes in the frame");
     add("passes.timed", double(sample_passes), "passes", "tile passes timed by the model");
     add("tile", double(tile), "pixels", "tile edge: the initial stream is tile^2 rays");
@@ -171,38 +184,56 @@ std::vector<Stat> Prediction::stats() const {
             add("ideal_simd_utilization." + kind + "." + st, ideal_utilization[sec][k], "",
                 "ideal SIMD utilization, " + kind + " rays");
         }
-        add("stage_cycles." + st, double(all.busy_cycles + all.stall_cycles), "cycles",
-            "cycles spent in the " + st + " stage");
+        add("stage_cycles." + st,
+            double(all.busy_cycles + all.stall_cycles) /
+                double(std::max(1u, config.simd.units) * std::max(1u, config.cores.count)),
+            "cycles", "cycles spent in the " + st + " stage");
         add("stream_length." + st, ratio(double(all.lanes), double(all.ops)), "rays",
             "average stream length of the stage's operations");
     }
 
+    // Stall and stage cycles are SIMD-unit cycles; shown per unit of the frame, so that the
+    // causes and the busy cycles of a stage add up to the frame's cycles.
+    const double unit_scale =
+        1.0 / double(std::max(1u, config.simd.units) * std::max(1u, config.cores.count));
     const StallCycles& st = timing.stalls;
-    add("stall_cycles.bank_conflict", double(st.bank_conflict), "cycles", "waiting on a busy ray-buffer bank");
-    add("stall_cycles.alignment", double(st.alignment), "cycles", "SIMD groups not aligned to buffer lines");
-    add("stall_cycles.address_fetch", double(st.address_fetch), "cycles", "address generation behind the data path");
-    add("stall_cycles.partition", double(st.partition), "cycles", "in-place stream partition");
-    add("stall_cycles.scene_memory", double(st.scene_memory), "cycles", "waiting for scene data");
-    add("stall_cycles.interconnect", double(st.interconnect), "cycles", "interconnect contention");
-    add("stall_cycles.pipeline_fill", double(st.pipeline_fill), "cycles", "pipeline latency per operation");
-    add("stall_cycles.total", double(st.total()), "cycles", "all stall cycles");
+    auto stall = [&](const char* name, uint64_t v, const char* what) {
+        add(std::string("stall_cycles.") + name, double(v) * unit_scale, "cycles", what);
+    };
+    stall("bank_conflict", st.bank_conflict, "waiting on a busy ray-buffer bank");
+    stall("alignment", st.alignment, "SIMD groups not aligned to buffer lines");
+    stall("address_fetch", st.address_fetch, "address generation behind the data path");
+    stall("partition", st.partition, "in-place stream partition");
+    stall("scene_memory", st.scene_memory, "waiting for scene data");
+    stall("interconnect", st.interconnect, "interconnect contention");
+    stall("pipeline_fill", st.pipeline_fill, "waiting out bank, interconnect and datapath latency");
+    stall("unit_idle", st.unit_idle, "a SIMD unit with no group released to it");
+    stall("total", st.total(), "all stall cycles");
 
     const double mix_total = double(timing.mix.total());
-    add("op_mix.load_percent", 100.0 * ratio(double(timing.mix.load), mix_total), "%", "loads (Table 5)");
-    add("op_mix.store_percent", 100.0 * ratio(double(timing.mix.store), mix_total), "%", "stores (Table 5)");
-    add("op_mix.compute_percent", 100.0 * ratio(double(timing.mix.compute), mix_total), "%", "compute on ray data (Table 5)");
-    add("op_mix.scatter_gather_percent", 100.0 * ratio(double(timing.mix.scatter_gather), mix_total), "%", "scatters and gathers (Table 5)");
-    add("op_mix.partition_percent", 100.0 * ratio(double(timing.mix.partition), mix_total), "%", "partition (Table 5)");
+    add("op_mix.load_percent", 100.0 * ratio(double(timing.mix.load), mix_total), "%",
+        "loads (Table 5)");
+    add("op_mix.store_percent", 100.0 * ratio(double(timing.mix.store), mix_total), "%",
+        "stores (Table 5)");
+    add("op_mix.compute_percent", 100.0 * ratio(double(timing.mix.compute), mix_total), "%",
+        "compute on ray data (Table 5)");
+    add("op_mix.scatter_gather_percent",
+        100.0 * ratio(double(timing.mix.scatter_gather), mix_total), "%",
+        "scatters and gathers (Table 5)");
+    add("op_mix.partition_percent", 100.0 * ratio(double(timing.mix.partition), mix_total), "%",
+        "partition (Table 5)");
     add("op_mix.instructions", mix_total, "instructions", "SIMD instructions per frame");
 
-    add("ray_buffer.bank_conflict_rate", ratio(double(timing.conflicted_accesses), double(timing.field_accesses)), "",
+    add("ray_buffer.bank_conflict_rate",
+        ratio(double(timing.conflicted_accesses), double(timing.field_accesses)), "",
         "share of field accesses that waited on a bank");
     for (size_t i = 0; i < timing.cache_hits.size() && i < config.scene_memory.caches.size(); ++i) {
         const double h = double(timing.cache_hits[i]), m = double(timing.cache_misses[i]);
         add("scene_cache." + config.scene_memory.caches[i].name + ".hit_rate", ratio(h, h + m), "",
             "hit rate of scene-data cache level " + config.scene_memory.caches[i].name);
     }
-    add("scene_memory.dram_reads", double(timing.dram_reads), "lines", "scene-data lines read from DRAM");
+    add("scene_memory.dram_reads", double(timing.dram_reads), "lines",
+        "scene-data lines read from DRAM");
     return s;
 }
 

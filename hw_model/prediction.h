@@ -23,20 +23,21 @@ struct StallCycles {
     uint64_t partition = 0;      // in-place partition after a filter
     uint64_t scene_memory = 0;   // waiting for a node, primitive or material
     uint64_t interconnect = 0;   // address and data words contending for the interconnect
-    uint64_t pipeline_fill = 0;  // datapath and bank latency paid once per operation
+    uint64_t pipeline_fill = 0;  // waiting out bank, interconnect and datapath latencies
+    uint64_t unit_idle = 0;      // a SIMD unit with no group released to it (too few groups)
 
     uint64_t total() const {
-        return bank_conflict + alignment + address_fetch + partition + scene_memory +
-               interconnect + pipeline_fill;
+        return bank_conflict + alignment + address_fetch + partition + scene_memory + interconnect +
+               pipeline_fill + unit_idle;
     }
     StallCycles& operator+=(const StallCycles& o);
 };
 
 // SIMD instructions by class, as the paper's Table 5 counts them.
 struct OpMix {
-    uint64_t load = 0;            // id-stream reads and scene-data reads (address integer ops subsumed)
-    uint64_t store = 0;           // id-stream writes (the next generation's ids, partition moves)
-    uint64_t compute = 0;         // arithmetic on ray data
+    uint64_t load = 0;     // id-stream reads and scene-data reads (address integer ops subsumed)
+    uint64_t store = 0;    // id-stream writes (the next generation's ids, partition moves)
+    uint64_t compute = 0;  // arithmetic on ray data
     uint64_t scatter_gather = 0;  // ray-record gathers and conditional scatters
     uint64_t partition = 0;       // comparator passes of the partition unit
 
@@ -44,22 +45,24 @@ struct OpMix {
     OpMix& operator+=(const OpMix& o);
 };
 
+// Cycle counters of SIMD units are summed over the units of every core (unit-cycles): per pass,
+// busy plus stall cycles of all stages equal units x the pass's cycles.
 struct StageTiming {
     uint64_t ops = 0;
     uint64_t lanes = 0;        // useful lanes (stream lengths)
     uint64_t groups = 0;       // lane groups issued: sum of ceil(len / width)
-    uint64_t busy_cycles = 0;  // cycles issuing work (no stalls)
+    uint64_t busy_cycles = 0;  // unit-cycles issuing work (no stalls)
     uint64_t stall_cycles = 0;
     StageTiming& operator+=(const StageTiming& o);
 };
 
 struct FrameTiming {
-    uint64_t cycles = 0;
+    uint64_t cycles = 0;  // summed over passes, each on the core that ran it (core-cycles)
     StallCycles stalls;
     OpMix mix;
-    StageTiming stages[2][k_op_stage_count];  // [secondary][stage]
-    uint64_t field_accesses = 0;          // one field word for one lane group
-    uint64_t conflicted_accesses = 0;     // of those, how many waited on a bank
+    StageTiming stages[2][k_op_stage_count];         // [secondary][stage]
+    uint64_t field_accesses = 0;                     // one field word for one lane group
+    uint64_t conflicted_accesses = 0;                // of those, how many waited on a bank
     std::vector<uint64_t> cache_hits, cache_misses;  // per scene-cache level
     uint64_t dram_reads = 0;
     uint64_t passes = 0;
@@ -94,6 +97,8 @@ struct Prediction {
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)
     uint64_t total_passes = 0;
 
+    // The frame's cycles: passes' core-cycles over the cores (tiles keep every core busy).
+    double frame_cycles() const;
     double frame_seconds() const;
     double fps() const;
     // Every stat with its dotted name, unit and description; the JSON and result columns.

@@ -59,7 +59,8 @@ uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length) {
 PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint32_t length,
                              uint32_t moved_ids) {
     PartitionCost p;
-    p.compare_cycles = (uint64_t(length) + config.lanes_per_cycle - 1) / config.lanes_per_cycle;
+    const uint64_t per_cycle = uint64_t(width) * config.comparators_per_lane;
+    p.compare_cycles = (uint64_t(length) + per_cycle - 1) / per_cycle;
     p.moved_ids = moved_ids;
     p.move_cycles = (p.moved_ids + width - 1) / width;
     return p;

@@ -77,7 +77,7 @@ inline uint64_t address_cycles(const AguConfig& agu, uint64_t addresses) {
 }
 
 // In-place partition of a stream by its mask (SIMD comparators, Sec. 3.3): the comparator pass
-// consumes lanes_per_cycle mask bits per cycle; then every id that must move (a passing id
+// compares width * comparators_per_lane mask lanes per cycle; then every id that must move (a passing id
 // behind a failing one, in a stable partition) is written once, `width` ids per cycle.
 struct PartitionCost {
     uint64_t compare_cycles = 0;

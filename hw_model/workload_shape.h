@@ -24,24 +24,39 @@ struct WorkloadShape {
 };
 
 inline std::array<bool, k_op_kind_count> WorkloadShape::needed_kinds() const {
-    std::array<bool, k_op_kind_count> k{};
-    auto need = [&](OpKind kind, bool on) { k[size_t(kind)] = on; };
     const bool lights = features.light_count > 0;
-    need(OpKind::camera, true);
-    need(OpKind::box_test, true);
-    need(OpKind::triangle_test, features.triangles);
-    need(OpKind::sphere_test, features.spheres);
-    need(OpKind::shadow_filter, lights);
-    need(OpKind::miss_filter, true);
-    need(OpKind::emission_filter, true);
-    need(OpKind::depth_filter, true);
-    need(OpKind::material_filter, true);
-    need(OpKind::ambient, features.ambient);
-    need(OpKind::lambertian_choice, features.lambertian);
-    need(OpKind::lambertian_direct, features.lambertian && lights);
-    need(OpKind::lambertian_indirect, features.lambertian);
-    need(OpKind::dielectric, features.dielectric);
-    need(OpKind::glossy, features.glossy);
+    std::array<bool, k_op_kind_count> k{};
+    for (uint32_t i = 0; i < k_op_kind_count; ++i) {
+        switch (k_op_kinds[i].feature) {
+            case OpFeature::always:
+                k[i] = true;
+                break;
+            case OpFeature::triangles:
+                k[i] = features.triangles;
+                break;
+            case OpFeature::spheres:
+                k[i] = features.spheres;
+                break;
+            case OpFeature::lights:
+                k[i] = lights;
+                break;
+            case OpFeature::ambient:
+                k[i] = features.ambient;
+                break;
+            case OpFeature::lambertian:
+                k[i] = features.lambertian;
+                break;
+            case OpFeature::lambertian_and_lights:
+                k[i] = features.lambertian && lights;
+                break;
+            case OpFeature::dielectric:
+                k[i] = features.dielectric;
+                break;
+            case OpFeature::glossy:
+                k[i] = features.glossy;
+                break;
+        }
+    }
     return k;
 }
 

@@ -16,37 +16,6 @@ const char* to_string(OpStage stage) {
     return "?";
 }
 
-const char* to_string(OpKind kind) {
-    switch (kind) {
-        case OpKind::camera: return "camera";
-        case OpKind::box_test: return "box_test";
-        case OpKind::triangle_test: return "triangle_test";
-        case OpKind::sphere_test: return "sphere_test";
-        case OpKind::shadow_filter: return "shadow_filter";
-        case OpKind::miss_filter: return "miss_filter";
-        case OpKind::emission_filter: return "emission_filter";
-        case OpKind::depth_filter: return "depth_filter";
-        case OpKind::material_filter: return "material_filter";
-        case OpKind::ambient: return "ambient";
-        case OpKind::lambertian_choice: return "lambertian_choice";
-        case OpKind::lambertian_direct: return "lambertian_direct";
-        case OpKind::lambertian_indirect: return "lambertian_indirect";
-        case OpKind::dielectric: return "dielectric";
-        case OpKind::glossy: return "glossy";
-        case OpKind::count: break;
-    }
-    return "?";
-}
-
-OpStage stage_of(OpKind kind) {
-    switch (kind) {
-        case OpKind::box_test: return OpStage::traversal;
-        case OpKind::triangle_test:
-        case OpKind::sphere_test: return OpStage::intersection;
-        default: return OpStage::shading;
-    }
-}
-
 // FNV-1a over the bytes that decide a trace.
 namespace {
 struct Fnv {

@@ -25,26 +25,74 @@ const char* to_string(OpStage stage);
 
 // What one stream operation does. Shading kinds are the Fig. 4 filter stack, in stack order.
 enum class OpKind : uint8_t {
-    camera,            // shading: generate the tile's primary rays (object: none)
-    box_test,          // traversal: ray/box filter (object: BVH node index)
-    triangle_test,     // intersection: ray/triangle test (object: global primitive id)
-    sphere_test,       // intersection: ray/sphere test (object: global primitive id)
-    shadow_filter,     // shading: extract shadow rays (passed); each adds its light unless occluded
-    miss_filter,       // shading: extract rays that left the scene; passed = miss
-    emission_filter,   // shading: light hits; passed = the hit surface is emissive
-    depth_filter,      // shading: passed = the path may scatter (bounce < max depth)
-    material_filter,   // shading: passed = the hit material is `object` (material id)
-    ambient,           // shading: add the constant ambient term; all pass
-    lambertian_choice, // shading: passed = samples direct light (else indirect)
-    lambertian_direct, // shading: passed = a shadow ray was pushed to the next generation
-    lambertian_indirect, // shading: passed = a bounce ray was pushed
-    dielectric,        // shading: passed = a reflected or refracted ray was pushed
-    glossy,            // shading: passed = a glossy bounce ray was pushed
+    camera,           // shading: generate the tile's primary rays (object: none)
+    box_test,         // traversal: ray/box filter (object: BVH node index)
+    triangle_test,    // intersection: ray/triangle test (object: global primitive id)
+    sphere_test,      // intersection: ray/sphere test (object: global primitive id)
+    shadow_filter,    // shading: extract shadow rays (passed); each adds its light unless occluded
+    miss_filter,      // shading: extract rays that left the scene; passed = miss
+    emission_filter,  // shading: light hits; passed = the hit surface is emissive
+    depth_filter,     // shading: passed = the path may scatter (bounce < max depth)
+    material_filter,  // shading: passed = the hit material is `object` (material id)
+    ambient,          // shading: add the constant ambient term; all pass
+    lambertian_choice,    // shading: passed = samples direct light (else indirect)
+    lambertian_direct,    // shading: passed = a shadow ray was pushed to the next generation
+    lambertian_indirect,  // shading: passed = a bounce ray was pushed
+    dielectric,           // shading: passed = a reflected or refracted ray was pushed
+    glossy,               // shading: passed = a glossy bounce ray was pushed
     count
 };
 constexpr uint32_t k_op_kind_count = uint32_t(OpKind::count);
-const char* to_string(OpKind kind);
-OpStage stage_of(OpKind kind);
+
+// Which scene feature makes a kind of operation exist (model only what a scene needs).
+enum class OpFeature : uint8_t {
+    always,
+    triangles,
+    spheres,
+    lights,
+    ambient,
+    lambertian,
+    lambertian_and_lights,
+    dielectric,
+    glossy
+};
+
+// The op table: everything about a kind of operation that does not depend on the hardware, in
+// one place, read by the tracer's users and every timing model (the hardware's cost profile of
+// each kind lives in hw_model/op_costs.cpp, keyed by the same enum).
+struct OpKindInfo {
+    const char* name;
+    OpStage stage;
+    bool partitions;   // the filter's mask partitions the stream in place (G&R 3.1)
+    bool pushes_rays;  // passing lanes write a ray (and its id) to the next-generation buffer
+    OpFeature feature;
+};
+inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
+    {"camera", OpStage::shading, false, true, OpFeature::always},
+    {"box_test", OpStage::traversal, true, false, OpFeature::always},
+    {"triangle_test", OpStage::intersection, false, false, OpFeature::triangles},
+    {"sphere_test", OpStage::intersection, false, false, OpFeature::spheres},
+    {"shadow_filter", OpStage::shading, true, false, OpFeature::lights},
+    {"miss_filter", OpStage::shading, true, false, OpFeature::always},
+    {"emission_filter", OpStage::shading, true, false, OpFeature::always},
+    {"depth_filter", OpStage::shading, true, false, OpFeature::always},
+    {"material_filter", OpStage::shading, true, false, OpFeature::always},
+    {"ambient", OpStage::shading, false, false, OpFeature::ambient},
+    {"lambertian_choice", OpStage::shading, true, false, OpFeature::lambertian},
+    {"lambertian_direct", OpStage::shading, false, true, OpFeature::lambertian_and_lights},
+    {"lambertian_indirect", OpStage::shading, false, true, OpFeature::lambertian},
+    {"dielectric", OpStage::shading, false, true, OpFeature::dielectric},
+    {"glossy", OpStage::shading, false, true, OpFeature::glossy},
+};
+inline const OpKindInfo& op_info(OpKind kind) {
+    return k_op_kinds[size_t(kind)];
+}
+inline const char* to_string(OpKind kind) {
+    return kind < OpKind::count ? op_info(kind).name : "?";
+}
+inline OpStage stage_of(OpKind kind) {
+    return op_info(kind).stage;
+}
 
 constexpr uint32_t k_no_object = 0xffffffffu;
 
@@ -62,11 +110,11 @@ struct StreamOp {
 
 // One tile pass: one sample of every pixel of a tile, traced breadth-first to the end.
 struct TilePass {
-    uint32_t tile = 0;        // index into make_tiles(width, height, tile_size)
+    uint32_t tile = 0;  // index into make_tiles(width, height, tile_size)
     uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     uint32_t sample = 0;
-    uint32_t slot_count = 0;  // ray slots in the buffer: (x1-x0)*(y1-y0); slot = path
-    uint32_t generations = 0; // set at end_pass: how many generations were traced
+    uint32_t slot_count = 0;   // ray slots in the buffer: (x1-x0)*(y1-y0); slot = path
+    uint32_t generations = 0;  // set at end_pass: how many generations were traced
 };
 
 // What a trace is of; written at the head of a trace file.
@@ -83,7 +131,7 @@ uint64_t scene_hash(const Scene& scene);
 
 // Receives a trace. Calls come from one thread at a time, in tile order, sample order.
 class TraceSink {
-public:
+  public:
     virtual ~TraceSink() = default;
     virtual void begin_frame(const TraceHeader&) {}
     virtual void begin_pass(const TilePass&) {}
@@ -95,13 +143,13 @@ public:
 // Counts lanes and ops: op counts, stream-length histograms and the ideal SIMD utilization
 // for many widths at once, per stage, for primary (generation 0) and secondary rays apart.
 class CountingSink : public TraceSink {
-public:
+  public:
     struct StageCounts {
         uint64_t ops = 0;
-        uint64_t lanes = 0;    // sum of stream lengths
-        uint64_t passed = 0;   // sum of pass counts
-        std::vector<uint64_t> groups;      // per width: sum of ceil(len / width)
-        std::vector<uint64_t> histogram;   // stream lengths in buckets [2^k, 2^(k+1)), k < 32
+        uint64_t lanes = 0;               // sum of stream lengths
+        uint64_t passed = 0;              // sum of pass counts
+        std::vector<uint64_t> groups;     // per width: sum of ceil(len / width)
+        std::vector<uint64_t> histogram;  // stream lengths in buckets [2^k, 2^(k+1)), k < 32
 
         // Ideal utilization at widths[i]: lanes / (width * groups).
         double utilization(size_t width_index, uint32_t width) const;
@@ -127,7 +175,7 @@ public:
 
     CountingSink& operator+=(const CountingSink& o);
 
-private:
+  private:
     std::vector<uint32_t> m_widths;
     StageCounts m_stages[2][k_op_stage_count];
     uint64_t m_kind_ops[k_op_kind_count] = {};
@@ -137,7 +185,7 @@ private:
 
 // Writes the trace to a binary file (format in trace.cpp); memory stays one op at a time.
 class TraceFileWriter : public TraceSink {
-public:
+  public:
     explicit TraceFileWriter(const std::string& path);
     ~TraceFileWriter() override;
     void begin_frame(const TraceHeader& h) override;
@@ -147,7 +195,7 @@ public:
     void end_frame() override;
     uint64_t bytes_written() const { return m_bytes; }
 
-private:
+  private:
     void write(const void* data, size_t n);
     std::string m_path, m_tmp;
     std::FILE* m_file = nullptr;
@@ -161,7 +209,7 @@ TraceHeader read_trace_file(const std::string& path, TraceSink& sink);
 // Keeps one tile pass in memory and replays it into a sink (used to order traces of passes
 // traced on several threads; also handy in tests).
 class TraceRecorder : public TraceSink {
-public:
+  public:
     void begin_pass(const TilePass& p) override;
     void op(const StreamOp& op) override;
     void end_pass(const TilePass& p) override;
@@ -169,7 +217,7 @@ public:
     void clear();
     size_t op_count() const { return m_ops.size(); }
 
-private:
+  private:
     struct Record {
         OpKind kind;
         OpStage stage;

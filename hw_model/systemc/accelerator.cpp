@@ -2,44 +2,58 @@
 
 namespace sfx {
 
-Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c, const WorkloadShape& shape,
-                         std::shared_ptr<SharedSceneMemory> scene_memory)
-    : sc_module(name) {
+Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c,
+                         const WorkloadShape& shape)
+    : sc_module(name),
+      m_config(c),
+      m_costs(RayRecordLayout(shape.features), c.datapath),
+      m_scene_memory(
+          std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz, c.cores.count)) {
     const RayRecordLayout layout(shape.features);
     const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());
-    m_ray_buffer = std::make_unique<RayBufferUnit>("ray_buffer", c.ray_buffer, layout.words(),
-                                                   std::max(capacity, shape.slots()));
-    m_address = std::make_unique<AddressUnit>("agu", c.agu);
-    m_simd = std::make_unique<SimdUnit>("simd", shape.needed_kinds());
-    m_partition = std::make_unique<PartitionUnit>("partition", c.partition, c.simd.width);
-    m_scratchpad = std::make_unique<ScratchpadUnit>("scratchpad", c.scratchpad);
-    m_interconnect = std::make_unique<InterconnectUnit>("interconnect", c.interconnect, c.clock);
-    m_scene_memory = std::make_unique<SceneMemoryUnit>("scene_memory", std::move(scene_memory));
-    SceneDataMap map;
-    map.nodes = shape.bvh_nodes;
-    map.triangles = shape.triangles;
-    map.spheres = shape.spheres;
-    m_sequencer = std::make_unique<Sequencer>("sequencer", OpCostTable(layout, c.datapath), map,
-                                              c.simd.width, c.clock.core_mhz);
-    m_sequencer->ray_buffer(*m_ray_buffer);
-    m_sequencer->address(*m_address);
-    m_sequencer->simd(*m_simd);
-    m_sequencer->partition(*m_partition);
-    m_sequencer->scratchpad(*m_scratchpad);
-    m_sequencer->interconnect(*m_interconnect);
-    m_sequencer->scene_memory(*m_scene_memory);
+    m_map.nodes = shape.bvh_nodes;
+    m_map.triangles = shape.triangles;
+    m_map.spheres = shape.spheres;
+    for (uint32_t i = 0; i < c.cores.count; ++i)
+        m_cores.push_back(std::make_unique<Core>(
+            ("core_" + std::to_string(i)).c_str(), c, m_costs, m_map, layout.words(),
+            std::max(capacity, shape.slots()), i, m_scene_memory, *this));
+}
+
+void Accelerator::enqueue(std::shared_ptr<const PassBuffer> pass) {
+    m_queue.push_back(std::move(pass));
+    m_work.notify(sc_core::SC_ZERO_TIME);
+}
+
+std::shared_ptr<const PassBuffer> Accelerator::next_pass() {
+    while (m_queue.empty()) sc_core::wait(m_work);
+    std::shared_ptr<const PassBuffer> p = std::move(m_queue.front());
+    m_queue.pop_front();
+    return p;
+}
+
+void Accelerator::pass_done(const FrameTiming& timing) {
+    m_timing += timing;
+}
+
+void Accelerator::warm(const PassBuffer& pass) {
+    for (size_t i = 0; i < pass.size(); ++i) {
+        const StreamOp op = pass.at(i);
+        const OpProfile& p = m_costs[op.kind];
+        if (p.scene_bytes && op.object != k_no_object && op.length)
+            m_scene_memory->warm(0, m_map.address(op.kind, op.object), p.scene_bytes);
+    }
 }
 
 FrameTiming Accelerator::timing() const {
-    FrameTiming t = m_sequencer->timing();
-    const SceneMemoryModel& memory = m_scene_memory->model();
+    FrameTiming t = m_timing;
     t.cache_hits.clear();
     t.cache_misses.clear();
-    for (const SetAssociativeCache& level : memory.levels()) {
-        t.cache_hits.push_back(level.hits());
-        t.cache_misses.push_back(level.misses());
+    for (uint32_t level = 0; level < m_scene_memory->level_count(); ++level) {
+        t.cache_hits.push_back(m_scene_memory->hits(level));
+        t.cache_misses.push_back(m_scene_memory->misses(level));
     }
-    t.dram_reads = memory.dram_reads();
+    t.dram_reads = m_scene_memory->dram_reads();
     return t;
 }
 

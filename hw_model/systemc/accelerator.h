@@ -1,41 +1,44 @@
 #pragma once
-// One accelerator: the units of Sec. 3.3 for one hardware configuration, wired to a sequencer.
-// Only the function units the scene needs are elaborated.
+// One hardware configuration: `cores.count` cores (each with its own ray buffers, address
+// units, SIMD units and partition unit) sharing the scene-data memory's shared levels and its
+// DRAM bandwidth. Passes queue here; an idle core takes the next one (tiles are scheduled
+// across cores in order). Only the cores' processes run; nothing ticks.
 
+#include <deque>
 #include <memory>
+#include <vector>
 
-#include "hw_model/systemc/address_unit.h"
-#include "hw_model/systemc/interconnect_unit.h"
-#include "hw_model/systemc/partition_unit.h"
-#include "hw_model/systemc/ray_buffer_unit.h"
-#include "hw_model/systemc/scene_memory_unit.h"
-#include "hw_model/systemc/scratchpad_unit.h"
-#include "hw_model/systemc/sequencer.h"
-#include "hw_model/systemc/simd_unit.h"
+#include "hw_model/systemc/units.h"
 #include "hw_model/workload_shape.h"
 
 namespace sfx {
 
-class Accelerator : public sc_core::sc_module {
-public:
-    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape,
-                std::shared_ptr<SharedSceneMemory> scene_memory);
+class Accelerator : public sc_core::sc_module, public PassSource {
+  public:
+    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape);
 
-    void start(const PassBuffer* pass) { m_sequencer->start(pass); }
-    void set_warming(bool warming) { m_sequencer->set_warming(warming); }
-    // The frame so far, with the scene-cache counters filled in.
+    // Queues a pass for the next idle core (runs when the simulation does).
+    void enqueue(std::shared_ptr<const PassBuffer> pass);
+    // Warming: the pass's scene data only passes through the caches; no time is counted.
+    void warm(const PassBuffer& pass);
+    // The frame so far (every finished pass), with the scene-cache counters filled in.
     FrameTiming timing() const;
-    const SimdUnit& simd() const { return *m_simd; }
+    const HwConfig& config() const { return m_config; }
+    uint32_t core_count() const { return uint32_t(m_cores.size()); }
+    const Core& core(uint32_t i) const { return *m_cores[i]; }
 
-private:
-    std::unique_ptr<RayBufferUnit> m_ray_buffer;
-    std::unique_ptr<AddressUnit> m_address;
-    std::unique_ptr<SimdUnit> m_simd;
-    std::unique_ptr<PartitionUnit> m_partition;
-    std::unique_ptr<ScratchpadUnit> m_scratchpad;
-    std::unique_ptr<InterconnectUnit> m_interconnect;
-    std::unique_ptr<SceneMemoryUnit> m_scene_memory;
-    std::unique_ptr<Sequencer> m_sequencer;
+    std::shared_ptr<const PassBuffer> next_pass() override;
+    void pass_done(const FrameTiming& timing) override;
+
+  private:
+    HwConfig m_config;
+    OpCostTable m_costs;
+    SceneDataMap m_map;
+    std::shared_ptr<SceneMemoryModel> m_scene_memory;
+    std::vector<std::unique_ptr<Core>> m_cores;
+    std::deque<std::shared_ptr<const PassBuffer>> m_queue;
+    sc_core::sc_event m_work;
+    FrameTiming m_timing;
 };
 
 }  // namespace sfx

@@ -1,10 +1,8 @@
 #include "hw_model/systemc/systemc_timing.h"
 
 #include <atomic>
-#include <map>
 #include <cstdlib>
 #include <stdexcept>
-
 #include <tlm>
 
 #include "hw_model/systemc/accelerator.h"
@@ -34,24 +32,14 @@ SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const Workloa
         throw std::logic_error("one SystemcTiming at a time: SystemC has one simulation context");
     try {
         new_simulation_context();
-        std::map<std::string, std::shared_ptr<SharedSceneMemory>> by_config;
         for (size_t i = 0; i < configs.size(); ++i) {
-            HwConfig memory_only;  // the key: the scene-memory parameters and the core clock
-            memory_only.scene_memory = configs[i].scene_memory;
-            memory_only.clock.core_mhz = configs[i].clock.core_mhz;
-            auto& memory = by_config[dump_hw_config(memory_only)];
-            if (!memory) {
-                memory = std::make_shared<SharedSceneMemory>(configs[i].scene_memory,
-                                                             configs[i].clock.core_mhz);
-                m_memories.push_back(memory);
-            }
             m_accelerators.push_back(std::make_unique<Accelerator>(
-                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape, memory));
+                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape));
+            m_batch = std::max(m_batch, configs[i].cores.count);
         }
-        sc_core::sc_start(sc_core::SC_ZERO_TIME);  // end elaboration; threads wait for passes
+        sc_core::sc_start(sc_core::SC_ZERO_TIME);  // end elaboration; processes wait for passes
     } catch (...) {
         m_accelerators.clear();
-        m_memories.clear();
         g_in_use = false;
         throw;
     }
@@ -59,21 +47,40 @@ SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const Workloa
 
 SystemcTiming::~SystemcTiming() {
     m_accelerators.clear();
-    m_memories.clear();
     g_in_use = false;
 }
 
+void SystemcTiming::begin_pass(const TilePass& p) {
+    m_pass = std::make_shared<PassBuffer>();
+    m_pass->begin_pass(p);
+}
+
 void SystemcTiming::end_pass(const TilePass& p) {
-    m_pass.end_pass(p);
-    for (auto& m : m_memories) m->begin_pass(m_pass.size());
-    for (auto& a : m_accelerators) a->start(&m_pass);
-    sc_core::sc_start();  // until every sequencer waits for the next pass
+    m_pass->end_pass(p);
+    if (m_warming) {
+        for (auto& a : m_accelerators) a->warm(*m_pass);
+        return;
+    }
+    m_held.push_back(std::move(m_pass));
+    if (m_held.size() >= m_batch) flush();
+}
+
+void SystemcTiming::flush() {
+    if (m_held.empty()) return;
+    for (auto& a : m_accelerators)
+        for (const auto& pass : m_held) a->enqueue(pass);
+    m_held.clear();
+    sc_core::sc_start();  // until every core waits for its next pass
 }
 
 void SystemcTiming::set_warming(bool warming) {
-    for (auto& a : m_accelerators) a->set_warming(warming);
+    flush();  // warming passes follow the timed ones they come after
+    m_warming = warming;
 }
 
-FrameTiming SystemcTiming::timing(size_t config) const { return m_accelerators[config]->timing(); }
+FrameTiming SystemcTiming::timing(size_t config) {
+    flush();
+    return m_accelerators[config]->timing();
+}
 
 }  // namespace sfx

@@ -8,6 +8,11 @@
 // and one kernel run per pass advances every accelerator (bench/hw_model_bench measures the
 // cost of each extra configuration). Each SystemcTiming starts a fresh simulation context, so
 // a process can time one point group after another; only one may exist at a time.
+//
+// Cores: passes are held until there are as many as the largest configuration has cores, then
+// queued to every accelerator at once and simulated together, so that the cores of a
+// configuration run side by side and contend for the shared scene memory. Reading a timing
+// runs what is held first.
 
 #include <memory>
 #include <vector>
@@ -20,29 +25,34 @@
 namespace sfx {
 
 class Accelerator;
-class SharedSceneMemory;
 
 class SystemcTiming : public TraceSink {
-public:
+  public:
     SystemcTiming(const std::vector<HwConfig>& configs, const WorkloadShape& shape);
     ~SystemcTiming() override;
     SystemcTiming(const SystemcTiming&) = delete;
     SystemcTiming& operator=(const SystemcTiming&) = delete;
 
-    void begin_pass(const TilePass& p) override { m_pass.begin_pass(p); }
-    void op(const StreamOp& op) override { m_pass.op(op); }
+    void begin_pass(const TilePass& p) override;
+    void op(const StreamOp& op) override { m_pass->op(op); }
     void end_pass(const TilePass& p) override;
+    void end_frame() override { flush(); }
 
     // While warming, passes only warm the scene-data caches; no time is counted.
     void set_warming(bool warming);
 
     size_t configs() const { return m_accelerators.size(); }
-    FrameTiming timing(size_t config) const;
+    // The frame so far on configuration `config` (runs the passes held back first).
+    FrameTiming timing(size_t config);
     const Accelerator& accelerator(size_t config) const { return *m_accelerators[config]; }
+    // Simulates every pass held back.
+    void flush();
 
-private:
-    PassBuffer m_pass;
-    std::vector<std::shared_ptr<SharedSceneMemory>> m_memories;  // one per distinct memory config
+  private:
+    std::shared_ptr<PassBuffer> m_pass;
+    std::vector<std::shared_ptr<const PassBuffer>> m_held;
+    uint32_t m_batch = 1;  // the most cores of any configuration
+    bool m_warming = false;
     std::vector<std::unique_ptr<Accelerator>> m_accelerators;
 };
 

@@ -1,8 +1,8 @@
 // Scene-data caches: hits, misses, pseudo-LRU eviction and latencies on crafted address streams.
 
-#include <catch2/catch.hpp>
-
 #include "hw_model/cache_model.h"
+
+#include <catch2/catch.hpp>
 
 using namespace sfx;
 
@@ -10,19 +10,19 @@ TEST_CASE("A cache hits on a line it holds and misses on a new one", "[hw_model]
     SetAssociativeCache c({"l1", 1, 64, 2, 4});  // 16 lines, 8 sets of 2 ways
     CHECK_FALSE(c.access(0));
     CHECK(c.access(0));
-    CHECK(c.access(63));       // same line
+    CHECK(c.access(63));        // same line
     CHECK_FALSE(c.access(64));  // next line
     CHECK(c.hits() == 2);
     CHECK(c.misses() == 2);
 }
 
 TEST_CASE("Pseudo-LRU evicts the line not recently used", "[hw_model][cache]") {
-    SetAssociativeCache c({"l1", 1, 64, 4, 4});  // 16 lines: 4 sets of 4 ways
-    const uint64_t set_stride = 4 * 64;         // addresses mapping to set 0
+    SetAssociativeCache c({"l1", 1, 64, 4, 4});                 // 16 lines: 4 sets of 4 ways
+    const uint64_t set_stride = 4 * 64;                         // addresses mapping to set 0
     for (uint64_t i = 0; i < 4; ++i) c.access(i * set_stride);  // fill ways 0..3
-    CHECK(c.access(0));                  // way 0 recently used
-    CHECK(c.access(1 * set_stride));     // way 1 recently used
-    CHECK_FALSE(c.access(4 * set_stride));  // evicts from ways 2/3, not 0 or 1
+    CHECK(c.access(0));                                         // way 0 recently used
+    CHECK(c.access(1 * set_stride));                            // way 1 recently used
+    CHECK_FALSE(c.access(4 * set_stride));                      // evicts from ways 2/3, not 0 or 1
     CHECK(c.access(0));
     CHECK(c.access(1 * set_stride));
     // Cyclic access over more lines than ways always misses.
@@ -36,16 +36,40 @@ TEST_CASE("Pseudo-LRU evicts the line not recently used", "[hw_model][cache]") {
 
 TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",
           "[hw_model][cache]") {
-    SceneMemoryConfig config;  // l1 4, l2 11, l3 39 cycles, DRAM 107
+    SceneMemoryConfig config;       // at 500 MHz (2 ns): l1 1.4 ns -> 1, l2 3.8 -> 2, l3 13.3 -> 7
+    config.dram_latency_ns = 36.5;  // -> 19 cycles
     config.dram_bandwidth_gbps = 32.0;  // at 500 MHz: 64 bytes per cycle, one cycle per line
     SceneMemoryModel memory(config, 500.0);
-    CHECK(memory.read(4096, 32) == 107 + 1);  // cold: DRAM
-    CHECK(memory.read(4096, 32) == 4);        // now in L1
-    CHECK(memory.read(4096 + 60, 8) == 107 + 1);  // straddles into a cold line: the slower one
+    CHECK(memory.read(4096, 32) == 19 + 1);  // cold: DRAM
+    CHECK(memory.read(4096, 32) == 1);       // now in L1
+    // Straddles into a cold line: the slower one, which also waits for the channel (every read
+    // here is issued at cycle 0, and the first line holds the channel until cycle 20).
+    CHECK(memory.read(4096 + 60, 8) == 19 + 2);
     CHECK(memory.dram_reads() == 2);
-    CHECK(memory.levels()[0].hits() == 2);  // the warm line, twice
+    CHECK(memory.hits(0) == 2);  // the warm line, twice
     // Evict from L1 only (32 KiB, 8-way: 64 sets): 9 lines in one L1 set, then re-read.
     const uint64_t l1_set_stride = 64 * 64;
     for (uint64_t i = 1; i <= 9; ++i) memory.read(4096 + i * l1_set_stride, 4);
-    CHECK(memory.read(4096, 4) == 11);  // from L2
+    CHECK(memory.read(4096, 4) == 2);  // from L2
+}
+
+TEST_CASE("DRAM bandwidth is shared: lines queue for the channel", "[hw_model][cache]") {
+    SceneMemoryConfig config;
+    config.caches.clear();
+    config.dram_latency_ns = 20.0;     // 10 cycles at 500 MHz
+    config.dram_bandwidth_gbps = 8.0;  // 16 bytes per cycle: a 64-byte line takes 4 cycles
+    SceneMemoryModel memory(config, 500.0, 2);
+    CHECK(memory.read(0, 0, 64, 100) == 100 + 10 + 4);
+    CHECK(memory.read(1, 4096, 64, 100) == 100 + 10 + 8);  // the other core's line waits
+    CHECK(ns_to_cycles(2.0, 500.0) == 1);
+    CHECK(ns_to_cycles(2.1, 500.0) == 2);
+}
+
+TEST_CASE("Private levels are per core; shared levels see every core", "[hw_model][cache]") {
+    SceneMemoryConfig config;  // l1, l2 private; l3 shared
+    SceneMemoryModel memory(config, 500.0, 2);
+    const uint64_t cold = memory.read(0, 8192, 4, 0);
+    CHECK(memory.read(0, 8192, 4, 1000) == 1000 + 1);  // core 0's L1
+    CHECK(memory.read(1, 8192, 4, 2000) == 2000 + 7);  // core 1 finds it in the shared L3
+    CHECK(cold > 7);
 }

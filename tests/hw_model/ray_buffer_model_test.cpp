@@ -60,7 +60,7 @@ TEST_CASE("Contiguous streams: widths that do not divide the line stall", "[hw_m
 
 TEST_CASE("Partition: compare pass plus one write per moved id", "[hw_model]") {
     PartitionConfig c;
-    c.lanes_per_cycle = 16;
+    c.comparators_per_lane = 1;  // width lanes per cycle
     const std::vector<uint8_t> sorted = {1, 1, 1, 0, 0};
     CHECK(partition_cost(c, 8, sorted.data(), 5).moved_ids == 0);
     CHECK(partition_cost(c, 8, sorted.data(), 5).cycles() == 1);

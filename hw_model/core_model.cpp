@@ -1,0 +1,296 @@
+#include "hw_model/core_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sfx {
+namespace {
+
+uint64_t ceil_cycle(double t) {
+    return uint64_t(std::ceil(t - 1e-9));
+}
+
+uint64_t overlap(uint64_t a0, uint64_t a1, uint64_t b0, uint64_t b1) {
+    const uint64_t lo = std::max(a0, b0), hi = std::min(a1, b1);
+    return hi > lo ? hi - lo : 0;
+}
+
+}  // namespace
+
+CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const SceneDataMap& map,
+                     uint32_t record_words, uint32_t slot_capacity, uint32_t core_index,
+                     std::shared_ptr<SceneMemoryModel> scene_memory)
+    : m_config(config),
+      m_costs(costs),
+      m_map(map),
+      m_core(core_index),
+      m_layout(config.ray_buffer, record_words, slot_capacity),
+      m_banks(2 * size_t(config.ray_buffer.banks)),
+      m_agu(double(config.agu.count) * config.agu.addresses_per_cycle),
+      m_interconnect(double(config.interconnect.width_words) * config.clock.interconnect_mhz /
+                     config.clock.core_mhz),
+      m_scratchpad(double(config.scratchpad.ports)),
+      m_crossing_cycles(uint64_t(std::ceil(config.interconnect.mux_levels * config.clock.core_mhz /
+                                               config.clock.interconnect_mhz -
+                                           1e-9))),
+      m_scene_memory(std::move(scene_memory)),
+      m_unit_free(config.simd.units, 0),
+      m_unit_stage(config.simd.units, 0) {}
+
+const OpProfile& CoreModel::profile(uint32_t op) const {
+    return m_costs[m_pass->at(op).kind];
+}
+
+void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
+    m_pass = pass;
+    m_pass_start = now;
+    const size_t n = pass->size();
+    m_scene_ready.assign(n, 0);
+    m_groups_left.assign(n, 0);
+    m_op_completion.assign(n, now);
+    std::fill(m_unit_free.begin(), m_unit_free.end(), now);
+    m_partition_free = std::max(m_partition_free, now);
+    m_timing = FrameTiming();
+    m_timing.passes = 1;
+}
+
+void CoreModel::dispatch_op(uint32_t index) {
+    const StreamOp op = m_pass->at(index);
+    const OpProfile& p = m_costs[op.kind];
+    const uint32_t n = width();
+    const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
+    m_groups_left[index] = uint32_t(groups);
+    StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
+    stage.ops += 1;
+    stage.lanes += op.length;
+    stage.groups += groups;
+    // The op mix in Table 5's classes. G&R 4.1: "the integer operations required by address
+    // fetch are subsumed by the load and store operations": a gathered word's address vector
+    // is a load, a scattered word's a store.
+    const bool fetches = p.scene_bytes && op.object != k_no_object;
+    OpMix& mix = m_timing.mix;
+    mix.load += groups * (1 + p.gather_words.size()) + (fetches ? 1 : 0);
+    mix.compute += groups * p.compute_instructions;
+    mix.scatter_gather += groups * p.gather_words.size();
+    if (p.partitions) {
+        const PartitionCost part =
+            partition_cost(m_config.partition, n, op.length, m_pass->moved_ids(index));
+        mix.partition += part.compare_cycles;
+        mix.store += part.move_cycles;
+    }
+    if (p.pushes_rays) mix.store += (uint64_t(op.pass_count) + n - 1) / n;
+}
+
+void CoreModel::request_scene(uint32_t index, uint64_t now) {
+    const StreamOp op = m_pass->at(index);
+    const OpProfile& p = m_costs[op.kind];
+    if (!p.scene_bytes || op.object == k_no_object || op.length == 0) {
+        m_scene_ready[index] = 0;
+        return;
+    }
+    m_scene_ready[index] =
+        m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
+}
+
+uint64_t CoreModel::book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
+                              uint64_t issue, uint64_t& conflict_cycles) {
+    const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
+    SlotServer* banks = &m_banks[size_t(buffer) * m_layout.banks()];
+    uint64_t last = issue;
+    for (uint32_t i = 0; i < lanes; ++i)
+        last = std::max(last, banks[m_layout.bank_of(word, slots[i])].book(issue, occupancy));
+    // Without conflicts the busiest bank serves ceil(lanes / banks) requests back to back.
+    const uint64_t ideal =
+        issue + (uint64_t(lanes + m_layout.banks() - 1) / m_layout.banks() - 1) * occupancy;
+    if (last > ideal) conflict_cycles += last - ideal;
+    return last;
+}
+
+uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,
+                               const uint32_t* slots, uint32_t lanes, uint64_t issue,
+                               const std::vector<uint64_t>* ready_at, uint64_t& conflict_cycles,
+                               uint64_t& address_cycles) {
+    uint64_t last_grant = issue, at = issue;
+    for (size_t w = 0; w < words.size(); ++w) {
+        if (w > 0) at += 1;  // one word's requests leave the access side per cycle
+        if (ready_at) {
+            const uint64_t addresses = (*ready_at)[w];
+            if (addresses > at) {
+                if (w > 0) address_cycles += addresses - at;
+                at = addresses;
+            }
+        }
+        uint64_t conflicts = 0;
+        last_grant = std::max(last_grant, book_word(buffer, words[w], slots, lanes, at, conflicts));
+        // A conflict delays this word; later words queue behind it in the same banks, so only
+        // the growth of the last grant is charged, once.
+        (void)conflicts;
+    }
+    const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
+    const uint64_t ideal =
+        at + (uint64_t(lanes + m_layout.banks() - 1) / m_layout.banks() - 1) * occupancy;
+    if (last_grant > ideal) conflict_cycles += last_grant - ideal;
+    return last_grant;
+}
+
+uint64_t CoreModel::cross(uint64_t ready, uint64_t words, uint64_t& wait_cycles) {
+    if (words == 0) return ready;
+    const double rate = m_interconnect.per_cycle();
+    // An idle interconnect moves them in ceil(words / rate) cycles.
+    const uint64_t alone = ready + ceil_cycle(double(words) / rate) - 1;
+    const uint64_t last =
+        m_config.interconnect.contention ? m_interconnect.serve(ready, double(words)) : alone;
+    if (last > alone) wait_cycles += last - alone;
+    return last + 1 + m_crossing_cycles;
+}
+
+uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
+    const StreamOp op = m_pass->at(t.op);
+    const OpProfile& p = m_costs[op.kind];
+    const uint32_t* slots = op.slots + t.first;
+    const uint32_t buffer = op.generation % 2;
+    // The group's ids: a contiguous run of the id stream, one buffer line per cycle.
+    const RayBufferModel::Contiguous ids = m_layout.access_contiguous(t.first, t.lanes);
+    t.alignment = ids.alignment_cycles;
+    const uint64_t ids_done = now + ids.cycles;
+    const size_t gathers = p.gather_words.size();
+    if (gathers == 0) {
+        t.data_ready = ids_done;
+        return ids_done;
+    }
+    // Addresses: one per gathered lane word, on the core's address-generation units, which
+    // every SIMD unit's access side shares; a word's requests leave the cycle after its
+    // addresses are done. What a busier pool adds over an idle one is address stall.
+    const double per_cycle = m_agu.per_cycle();
+    std::vector<uint64_t> ready_at(gathers);
+    for (size_t w = 0; w < gathers; ++w) {
+        const uint64_t done = m_agu.serve(ids_done, double(t.lanes)) + 1;
+        const uint64_t alone = ids_done + ceil_cycle(double((w + 1) * t.lanes) / per_cycle);
+        if (w == 0 && done > alone) t.address += done - alone;
+        ready_at[w] = done;
+    }
+    const uint64_t first_issue = ready_at[0];
+    const uint64_t last_grant = book_words(buffer, p.gather_words, slots, t.lanes, first_issue,
+                                           &ready_at, t.conflict, t.address);
+    const uint64_t out = last_grant + m_layout.latency();
+    // The gathered words cross the interconnect as they leave the banks.
+    const uint64_t arrival =
+        cross(first_issue + m_layout.latency(), uint64_t(t.lanes) * gathers, t.interconnect);
+    t.data_ready = std::max(out + m_crossing_cycles, arrival);
+    m_timing.field_accesses += gathers;
+    const uint64_t issue_done = first_issue + gathers;  // the last word's requests have left
+    return std::max(issue_done, ids_done);
+}
+
+CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint64_t now) {
+    const StreamOp op = m_pass->at(t.op);
+    const OpProfile& p = m_costs[op.kind];
+    StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
+    Executed e;
+    e.start = std::max(now, t.data_ready);
+    if (p.scene_bytes && op.object != k_no_object) e.start = std::max(e.start, m_scene_ready[t.op]);
+    charge_idle(unit, m_unit_free[unit], e.start, t, stage);
+
+    const bool programmable = m_config.datapath.issue == "programmable";
+    const uint64_t busy =
+        programmable ? p.compute_instructions : m_config.datapath.initiation_interval;
+    e.issue_end = e.start + busy;
+    const uint64_t result =
+        e.start + (programmable ? std::max<uint64_t>(busy, p.latency_cycles) : p.latency_cycles);
+    stage.busy_cycles += busy;
+    m_unit_free[unit] = e.issue_end;
+    m_unit_stage[unit] = uint8_t((op.generation > 0) * k_op_stage_count + uint32_t(op.stage));
+
+    // The mask goes through the scratchpad to the partition unit.
+    e.completion = m_scratchpad.serve(result, 1.0) + 1;
+    // Conditional scatters of the passing lanes: into the current buffer, or the next
+    // generation's for an op that pushes rays.
+    if (!p.scatter_words.empty()) {
+        m_scratch.clear();
+        for (uint32_t i = 0; i < t.lanes; ++i)
+            if (op.passed[t.first + i]) m_scratch.push_back(op.slots[t.first + i]);
+        if (!m_scratch.empty()) {
+            const uint32_t lanes = uint32_t(m_scratch.size());
+            const size_t words = p.scatter_words.size();
+            const uint64_t addresses = m_agu.serve(result, double(lanes) * double(words)) + 1;
+            uint64_t waits = 0, conflicts = 0, unused = 0;
+            const uint64_t at_banks = cross(addresses, uint64_t(lanes) * words, waits);
+            const uint32_t buffer = (op.generation + (p.pushes_rays ? 1 : 0)) % 2;
+            const uint64_t last = book_words(buffer, p.scatter_words, m_scratch.data(), lanes,
+                                             at_banks, nullptr, conflicts, unused);
+            e.completion = std::max(e.completion, last + 1);
+            m_timing.field_accesses += words;
+            m_timing.mix.scatter_gather += words;
+        }
+    }
+    m_op_completion[t.op] = std::max(m_op_completion[t.op], e.completion);
+    if (--m_groups_left[t.op] == 0) {
+        e.op_done = true;
+        e.op_completion = m_op_completion[t.op];
+    }
+    return e;
+}
+
+void CoreModel::charge_idle(uint32_t unit, uint64_t from, uint64_t start, const GroupToken& t,
+                            StageTiming& stage) {
+    if (start <= from) return;
+    const uint64_t idle = start - from;
+    StallCycles& s = m_timing.stalls;
+    stage.stall_cycles += idle;
+    (void)unit;
+    // 1. The dispatcher held this op for the previous op's partition.
+    const uint64_t part = overlap(from, start, t.partition_start, t.partition_end);
+    s.partition += part;
+    uint64_t rest = idle - part;
+    // 2. Before the group was released: waiting for the previous op's masks (when it waited on
+    //    a partition) or for work at all (fewer groups in flight than units).
+    const uint64_t released = std::max(from, std::min(start, t.dispatched));
+    const uint64_t before = std::min(rest, released - from > part ? released - from - part : 0);
+    if (t.partition_end > 0)
+        s.pipeline_fill += before;
+    else
+        s.unit_idle += before;
+    rest -= before;
+    // 3. Scene data later than the ray data.
+    const uint64_t ready = m_scene_ready[t.op];
+    const uint64_t data_or_idle = std::max(released, t.data_ready);
+    const uint64_t scene = ready > data_or_idle ? std::min(rest, ready - data_or_idle) : 0;
+    s.scene_memory += scene;
+    rest -= scene;
+    // 4. The fetch's excess over an ideal fetch, by cause; what remains is its ideal latency.
+    const uint64_t excess = t.alignment + t.conflict + t.address + t.interconnect;
+    if (excess > 0 && rest > 0) {
+        const uint64_t take = std::min(rest, excess);
+        const uint64_t a = take * t.alignment / excess, c = take * t.conflict / excess,
+                       d = take * t.address / excess;
+        s.alignment += a;
+        s.bank_conflict += c;
+        s.address_fetch += d;
+        s.interconnect += take - a - c - d;
+        rest -= take;
+    }
+    s.pipeline_fill += rest;
+}
+
+uint64_t CoreModel::partition(uint32_t index, uint64_t ready) {
+    const StreamOp op = m_pass->at(index);
+    const PartitionCost part =
+        partition_cost(m_config.partition, width(), op.length, m_pass->moved_ids(index));
+    const uint64_t start = std::max(ready, m_partition_free);
+    m_partition_free = start + part.cycles();
+    return m_partition_free;
+}
+
+FrameTiming CoreModel::end_pass(uint64_t end) {
+    for (uint32_t u = 0; u < units(); ++u) {
+        if (end <= m_unit_free[u]) continue;
+        const uint64_t tail = end - m_unit_free[u];
+        const uint8_t st = m_unit_stage[u];
+        m_timing.stages[st / k_op_stage_count][st % k_op_stage_count].stall_cycles += tail;
+        m_timing.stalls.pipeline_fill += tail;
+    }
+    m_timing.cycles = end - m_pass_start;
+    return m_timing;
+}
+
+}  // namespace sfx

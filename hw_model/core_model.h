@@ -1,0 +1,122 @@
+#pragma once
+// The arithmetic of one core of the machine, in plain C++: what a lane group's fetch, a SIMD
+// unit's execution of it and an op's partition cost on the core's shared resources (banks,
+// address-generation units, interconnect, scratchpad, scene memory), and where every SIMD
+// unit's cycles went. The SystemC processes (hw_model/systemc) decide *when* each step runs
+// (a dispatcher, a fetch and an execute process per SIMD unit, a partition unit); this class
+// prices a step at the cycle a process asks, so the order of requests in flight decides the
+// conflicts. Tests drive it directly, without a kernel.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "hw_model/cache_model.h"
+#include "hw_model/hw_config.h"
+#include "hw_model/machine_resources.h"
+#include "hw_model/op_costs.h"
+#include "hw_model/pass_buffer.h"
+#include "hw_model/prediction.h"
+
+namespace sfx {
+
+// One lane group of one op on its way through a core.
+struct GroupToken {
+    uint32_t op = 0;     // index in the pass
+    uint32_t first = 0;  // first position in the op's stream
+    uint32_t lanes = 0;
+    bool last = false;  // the op's last group
+    // The partition the dispatcher waited on before releasing this op (first group only).
+    uint64_t partition_start = 0, partition_end = 0;
+    uint64_t dispatched = 0;  // cycle the dispatcher released the group
+    // Filled by the fetch: when the gathered words reach the SIMD unit, and the excess cycles
+    // of the fetch over a conflict-free, aligned, unthrottled one, by cause.
+    uint64_t data_ready = 0;
+    uint64_t alignment = 0, conflict = 0, address = 0, interconnect = 0;
+};
+
+class CoreModel {
+  public:
+    CoreModel(const HwConfig& config, const OpCostTable& costs, const SceneDataMap& map,
+              uint32_t record_words, uint32_t slot_capacity, uint32_t core_index,
+              std::shared_ptr<SceneMemoryModel> scene_memory);
+
+    // A pass starts at `now`; per-op state is sized for it.
+    void begin_pass(const PassBuffer* pass, uint64_t now);
+    // Counts an op as it is dispatched (ops, lanes, groups, the op mix).
+    void dispatch_op(uint32_t op);
+    // Requests op's scene data (a node, primitive or material) at `now`.
+    void request_scene(uint32_t op, uint64_t now);
+
+    // The access side of a group at `now`: id-stream read, address generation, gathers through
+    // the banks and the interconnect. Fills token.data_ready and the excess causes; returns the
+    // cycle the access side may start the next group.
+    uint64_t fetch(GroupToken& token, uint64_t now);
+
+    struct Executed {
+        uint64_t start = 0;       // first issue cycle
+        uint64_t issue_end = 0;   // the unit may issue the next group from here
+        uint64_t completion = 0;  // mask known and scatters done
+        bool op_done = false;     // this was the op's last outstanding group
+        uint64_t op_completion = 0;
+    };
+    // A SIMD unit executes a fetched group; `unit_free` is when it finished issuing its previous
+    // group, `now` >= unit_free. Books the scatters and the mask's scratchpad write and charges
+    // the unit's idle cycles before `start` to their causes.
+    Executed execute(const GroupToken& token, uint32_t unit, uint64_t now);
+
+    // The partition unit compacts op's stream once every group's mask is known (`ready`);
+    // returns the cycle its ids are in place.
+    uint64_t partition(uint32_t op, uint64_t ready);
+
+    // The pass ends at `end` (every op done); returns its timing (SIMD units' tails charged).
+    FrameTiming end_pass(uint64_t end);
+
+    const HwConfig& config() const { return m_config; }
+    uint32_t units() const { return m_config.simd.units; }
+    uint32_t width() const { return m_config.simd.width; }
+    const OpProfile& profile(uint32_t op) const;
+    const PassBuffer& pass() const { return *m_pass; }
+    uint64_t scene_ready(uint32_t op) const { return m_scene_ready[op]; }
+
+  private:
+    // Books one field word for each of `lanes` slots of `buffer` (0: current generation, 1:
+    // next), the requests issued at `issue`; returns the last grant and adds waiting cycles.
+    uint64_t book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
+                       uint64_t issue, uint64_t& conflict_cycles);
+    // Books `words` for the lanes, one word per cycle at the earliest; returns the cycle the
+    // last word's data is out of its bank.
+    // `ready_at[w]`, when given, is the first cycle word w's addresses can be used.
+    uint64_t book_words(uint32_t buffer, const std::vector<uint32_t>& words, const uint32_t* slots,
+                        uint32_t lanes, uint64_t issue, const std::vector<uint64_t>* ready_at,
+                        uint64_t& conflict_cycles, uint64_t& address_cycles);
+    // Books the interconnect for `words` words ready at `ready`; returns the cycle the last
+    // has crossed, and adds the cycles spent waiting for it beyond an idle interconnect.
+    uint64_t cross(uint64_t ready, uint64_t words, uint64_t& wait_cycles);
+    void charge_idle(uint32_t unit, uint64_t idle_from, uint64_t start, const GroupToken& token,
+                     StageTiming& stage);
+
+    HwConfig m_config;
+    OpCostTable m_costs;
+    SceneDataMap m_map;
+    uint32_t m_core;
+    RayBufferModel m_layout;
+    std::vector<SlotServer> m_banks;  // buffers * banks
+    CapacityServer m_agu, m_interconnect, m_scratchpad;
+    double m_interconnect_cycles_per_core_cycle;
+    uint64_t m_crossing_cycles;
+    std::shared_ptr<SceneMemoryModel> m_scene_memory;
+
+    const PassBuffer* m_pass = nullptr;
+    uint64_t m_pass_start = 0;
+    std::vector<uint64_t> m_scene_ready;    // per op
+    std::vector<uint32_t> m_groups_left;    // per op
+    std::vector<uint64_t> m_op_completion;  // per op: latest group completion so far
+    std::vector<uint64_t> m_unit_free;      // per SIMD unit
+    std::vector<uint8_t> m_unit_stage;  // per SIMD unit: [secondary * 3 + stage] of its last group
+    uint64_t m_partition_free = 0;
+    FrameTiming m_timing;  // the current pass
+    std::vector<uint32_t> m_scratch;
+};
+
+}  // namespace sfx
