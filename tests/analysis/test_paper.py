@@ -202,12 +202,14 @@ def test_missing_cells_are_named(tmp_path):
 def test_resolution_note_and_most_accurate_point(tmp_path):
     points = paper_points()
     points.append(paper_point("conference", 64, 16, fps_factor=3.0, fidelity="full"))
-    points.append(paper_point("temple", 32, 8, **{"workload.width": 64, "workload.height": 64,
-                                                  "fidelity": "analytic"}))
+    points.append(paper_point("temple", 32, 8, fps_factor=5.0, fidelity="full",
+                              **{"workload.width": 64, "workload.height": 64}))
     check = build(tmp_path, points)
     header, rows = rows_of(check, "table6")
     conf = next(r for r in rows if r[:3] == ["16", "64", "conference (conf)"])
     assert conf[header.index("error")] == "+200.0 %"    # the full-fidelity point wins
+    temple = next(r for r in rows if r[:3] == ["8", "32", "temple (kala)"])
+    assert temple[header.index("error")] == "0.0 %"     # the paper's resolution wins over full
     assert any("not at the paper's 1024x1024" in n for n in check.notes)
     assert any("several points fit a cell" in n for n in check.notes)
 
