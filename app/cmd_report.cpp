@@ -76,7 +76,8 @@ void add_report_command(CLI::App& app) {
                   "with --paper: `sfx trace-stats conference --json` output, for the trace-side "
                   "target")
         ->check(CLI::ExistingFile);
-    c->callback([options] {
+    CLI::Option* output = c->get_option("-o");
+    c->callback([options, output] {
         struct stat st;
         if (stat(options->db.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
             throw InputError(options->db, 0, "db", "no such results store");
@@ -87,6 +88,10 @@ void add_report_command(CLI::App& app) {
         setenv("PYTHONPATH", path.c_str(), 1);
         if (!options->trace_stats.empty() && options->paper.empty())
             throw InputError("command line", 0, "--trace-stats", "only used with --paper");
+        if (!options->paper.empty() && output->count() > 0)
+            throw InputError("command line", 0, "-o",
+                             "--paper writes its page instead of the report directory; run "
+                             "sfx report twice for both");
         std::vector<std::string> args = {k_python, "-m", "sfx_analysis"};
         if (options->paper.empty()) {
             args.insert(args.end(), {"report", options->db, "-o", options->output});

@@ -799,8 +799,9 @@ def html_section(store: Store) -> str:
     out.append(_html_table(check.summary))
     out.append(_html_table(_targets_block(check.targets)))
     if check.missing:
-        out.append(f"<p>{len(check.missing)} cell(s) missing: {e('; '.join(check.missing))}. "
-                   f"{e(MISSING_HINT)}.</p>")
+        out.append(f"<details><summary>{len(check.missing)} cell(s) missing: "
+                   f"{e(MISSING_HINT)}.</summary><ul>" +
+                   "".join(f"<li>{e(m)}</li>" for m in check.missing) + "</ul></details>")
     out += [_html_table(b) for b in check.blocks]
     return "\n".join(out)
 

@@ -270,7 +270,13 @@ def test_paper_check_end_to_end(tmp_path):
     assert "not at the paper's 1024x1024" in text
     assert re.search(r"\| trace side: .* \| not evaluated \|", text)
     assert 'id="paper-check"' in (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
-    # Bad arguments: exit 2, nothing written.
+    # An existing store is never replaced unasked; bad arguments: exit 2, nothing written.
+    before = page.read_text(encoding="utf-8")
+    done = subprocess.run([os.path.join(REPO, "scripts", "paper-check"), "--no-build",
+                           "--store", str(store), "--page", str(page)],
+                          capture_output=True, text=True, timeout=60, env=env)
+    assert done.returncode == 2 and "--resume" in done.stderr
+    assert page.read_text(encoding="utf-8") == before and store.exists()
     done = subprocess.run([os.path.join(REPO, "scripts", "paper-check"), "--no-build", "--page"],
                           capture_output=True, text=True, timeout=60, env=env)
     assert done.returncode == 2 and "--page needs a value" in done.stderr
