@@ -98,8 +98,6 @@ OP_MIX_TOLERANCE_POINTS = 6.0
 SMALL_BUFFER_TOLERANCE_POINTS = 10.0
 TRACE_OPS_TOLERANCE_PERCENT = 10.0
 
-STALL_CAUSES = ["bank_conflict", "alignment", "address_fetch", "partition", "scene_memory",
-                "interconnect", "pipeline_fill"]
 MISSING = "—"
 
 
@@ -342,12 +340,16 @@ def _fps(cells: Cells, out: List[Cell]) -> Block:
                          paper, ours, relative_error(ours, paper))
                 out.append(c)
                 frame = None if ours is None else ours / PAPER_SPP
+                interval = value(row, "error.relative")
                 rows.append([str(width), str(tile), _scene_text(scene), _role_text(scene),
-                             _f(paper, 2), _f(ours, 3), _err(c), _f(frame, 4)])
+                             _f(paper, 2), _f(ours, 3),
+                             MISSING if interval is None or interval < 0 else
+                             f"±{100 * interval:.1f} %", _err(c), _f(frame, 4)])
     return Block("table6", "Table 6: frame rate, 1-spp passes over the image per second",
-                 "Ours is fps x spp (the store's fps is per frame of its spp); the last column "
+                 "Ours is fps x spp (the store's fps is per frame of its spp), with the relative "
+                 "half-width of its interval (sampled fidelity; — when unknown); the last column "
                  "is ours per 64-spp frame, the other reading (docs/paper-reading.md).",
-                 ["width", "tile", "scene", "cell", "paper", "ours", "error",
+                 ["width", "tile", "scene", "cell", "paper", "ours", "ours interval", "error",
                   "ours per 64-spp frame"], rows)
 
 
@@ -465,14 +467,17 @@ def _reading() -> Block:
 # --- Targets --------------------------------------------------------------------------------
 
 def _stall_pointer(cells: Cells, keys: Sequence[Tuple[str, int, int]]) -> str:
-    """The stall cause taking the largest share of frame cycles over the given cells."""
-    shares: Dict[str, List[float]] = {c: [] for c in STALL_CAUSES}
+    """The stall causes taking the largest share of frame cycles over the given cells (whatever
+    stall_cycles.* the model of the day reports)."""
+    causes = [c[len("stall_cycles."):] for c in cells.points.columns
+              if c.startswith("stall_cycles.") and c != "stall_cycles.total"]
+    shares: Dict[str, List[float]] = {c: [] for c in causes}
     for scene, tile, width in keys:
         row = cells.get(scene, tile, width)
         cycles = value(row, "frame_cycles")
         if not cycles:
             continue
-        for cause in STALL_CAUSES:
+        for cause in causes:
             v = value(row, f"stall_cycles.{cause}")
             if v is not None:
                 shares[cause].append(100.0 * v / cycles)
