@@ -1,5 +1,6 @@
-// sfx report DB -o DIR: tables and plots from a results store. The work is Python
-// (analysis/sfx_analysis, pandas and matplotlib); this command only finds it and runs it.
+// sfx report DB -o DIR: tables and plots from a results store; sfx report DB --paper PAGE.md: the
+// comparison with the paper (docs/paper-check.md). The work is Python (analysis/sfx_analysis,
+// pandas and matplotlib); this command only finds it and runs it.
 
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -60,13 +61,23 @@ void add_report_command(CLI::App& app) {
         std::string db;
         std::string output = "report";
         bool quiet = false;
+        std::string paper;        // --paper PAGE.md: the paper check instead of the report
+        std::string trace_stats;  // sfx trace-stats conference --json, for the trace target
     };
     auto options = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand("report", "tables and plots from a results store (HTML)");
     c->add_option("db", options->db, "results store written by sfx sweep")->required();
     c->add_option("-o,--output", options->output, "report directory (default: report)");
     c->add_flag("--quiet", options->quiet, "print only where the files are");
-    c->callback([options] {
+    c->add_option("--paper", options->paper,
+                  "write the comparison with the paper's tables (Markdown) to this file instead "
+                  "of the report (docs/paper-check.md; see scripts/paper-check)");
+    c->add_option("--trace-stats", options->trace_stats,
+                  "with --paper: `sfx trace-stats conference --json` output, for the trace-side "
+                  "target")
+        ->check(CLI::ExistingFile);
+    CLI::Option* output = c->get_option("-o");
+    c->callback([options, output] {
         struct stat st;
         if (stat(options->db.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
             throw InputError(options->db, 0, "db", "no such results store");
@@ -75,8 +86,20 @@ void add_report_command(CLI::App& app) {
         const std::string old_path = env_or("PYTHONPATH", "");
         const std::string path = analysis + (old_path.empty() ? "" : ":" + old_path);
         setenv("PYTHONPATH", path.c_str(), 1);
-        std::vector<std::string> args = {k_python,    "-m", "sfx_analysis", "report",
-                                         options->db, "-o", options->output};
+        if (!options->trace_stats.empty() && options->paper.empty())
+            throw InputError("command line", 0, "--trace-stats", "only used with --paper");
+        if (!options->paper.empty() && output->count() > 0)
+            throw InputError("command line", 0, "-o",
+                             "--paper writes its page instead of the report directory; run "
+                             "sfx report twice for both");
+        std::vector<std::string> args = {k_python, "-m", "sfx_analysis"};
+        if (options->paper.empty()) {
+            args.insert(args.end(), {"report", options->db, "-o", options->output});
+        } else {
+            args.insert(args.end(), {"paper", options->db, "-o", options->paper});
+            if (!options->trace_stats.empty())
+                args.insert(args.end(), {"--trace-stats", options->trace_stats});
+        }
         if (options->quiet) args.push_back("--quiet");
         const int code = run(args);
         // The exit code passes through: 2 for a store that cannot be reported on.

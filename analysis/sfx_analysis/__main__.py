@@ -1,5 +1,6 @@
-"""Command line: `python3 -m sfx_analysis report DB -o DIR` and `python3 -m sfx_analysis tables
-DB`. A store that cannot be reported on prints one line and exits 2 (no traceback)."""
+"""Command line: `python3 -m sfx_analysis report DB -o DIR`, `python3 -m sfx_analysis tables DB`
+and `python3 -m sfx_analysis paper DB -o PAGE.md`. A store that cannot be reported on prints one
+line and exits 2 (no traceback)."""
 
 from __future__ import annotations
 
@@ -44,6 +45,32 @@ def _tables(args) -> int:
     return 0
 
 
+def _paper(args) -> int:
+    from . import paper
+
+    store = load_store(args.db)
+    trace = None
+    if args.trace_stats:
+        try:
+            trace = paper.load_trace_stats(args.trace_stats)
+        except (OSError, ValueError) as e:
+            raise StoreError(f"{args.trace_stats}: cannot read trace statistics ({e})") from None
+    check = paper.build(store, trace)
+    try:
+        paper.write_page(check, args.output, args.command)
+    except OSError as e:
+        raise StoreError(f"{args.output}: cannot write the page ({e.strerror})") from None
+    if not args.quiet:
+        print(paper.to_markdown_summary(check))
+    for m in check.missing[:5]:
+        print(f"sfx report: note: missing cell: {m}", file=sys.stderr)
+    if len(check.missing) > 5:
+        print(f"sfx report: note: ... and {len(check.missing) - 5} more missing cells (listed "
+              f"in the page)", file=sys.stderr)
+    print(f"paper check: {os.path.abspath(args.output)}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="sfx_analysis",
                                      description="tables, plots and a report from a results store")
@@ -53,6 +80,14 @@ def main(argv=None) -> int:
     r.add_argument("-o", "--output", default="report", help="report directory (default: report)")
     r.add_argument("--quiet", action="store_true", help="print only where the files are")
     r.set_defaults(run=_report)
+    pp = sub.add_parser("paper", help="the paper check page (docs/paper-check.md) in Markdown")
+    pp.add_argument("db")
+    pp.add_argument("-o", "--output", required=True, help="page to write (Markdown)")
+    pp.add_argument("--trace-stats", help="`sfx trace-stats conference --json` output, for the "
+                                          "trace-side target")
+    pp.add_argument("--command", default="", help="the command named on the page as its source")
+    pp.add_argument("--quiet", action="store_true", help="print only where the page is")
+    pp.set_defaults(run=_paper)
     t = sub.add_parser("tables", help="the paper's Tables 2-6 in Markdown on stdout")
     t.add_argument("db")
     t.set_defaults(run=_tables)

@@ -140,6 +140,22 @@ TEST_CASE("every shipped scene loads", "[workloads]") {
     CHECK(furnace.spheres.size() == 1);
 }
 
+TEST_CASE("atrium-ambient is atrium with a constant ambient term (the paper's rtrt, Sec. 4.2)",
+          "[workloads]") {
+    const Scene atrium = load_scene("atrium");
+    const Scene rtrt = load_scene("atrium-ambient");
+    CHECK(rtrt.name == "atrium-ambient");
+    CHECK(rtrt.primitive_count() == atrium.primitive_count());
+    CHECK(rtrt.lights.size() == atrium.lights.size());
+    CHECK(rtrt.materials.size() == atrium.materials.size());
+    CHECK(rtrt.max_depth == atrium.max_depth);
+    CHECK(rtrt.camera.eye == atrium.camera.eye);
+    CHECK(is_black(atrium.ambient));
+    CHECK(!is_black(rtrt.ambient));
+    CHECK(rtrt.features().ambient);
+    CHECK(!atrium.features().ambient);
+}
+
 TEST_CASE("paper-class scenes match Table 1 (primitives within 10%, lights exactly)", "[workloads]") {
     struct Expect {
         const char* name;
