@@ -333,3 +333,33 @@ TEST_CASE("Tile auto is the largest stream that fits; a tile that does not fit i
     CHECK_NOTHROW(check_tile_fits(64, all, {big}, "--tile"));  // the paper: 384 KiB of rays
     CHECK_THROWS_AS(check_tile_fits(64, all, {small}, "--tile"), InputError);
 }
+
+TEST_CASE("Calibrated analytic fidelity lies within its interval of cycle level at non-default "
+          "settings",
+          "[hw_model]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings settings;
+    settings.width = settings.height = 64;
+    settings.spp = 4;
+    settings.tile = 16;
+    settings.max_depth = scene.max_depth;
+    settings.threads = 2;
+    HwConfig c;
+    c.name = "nondefault";
+    c.simd.units = 2;
+    c.cores.count = 4;
+    c.simd.width = 12;
+    c.ray_buffer.kib = 256;
+    c.scene_memory.prefetch_depth = 0;
+    SamplingOptions options;
+    options.calibration_fraction = 0.25;  // 16 of the 64 passes, a systematic sample
+    const PointGroupResult full = run_point_group(scene, bvh, settings, {c}, Fidelity::full);
+    const PointGroupResult analytic =
+        run_point_group(scene, bvh, settings, {c}, Fidelity::analytic, options);
+    const Prediction& a = analytic.predictions[0];
+    const double error = a.frame_cycles() / full.predictions[0].frame_cycles() - 1.0;
+    INFO("analytic/full - 1 = " << error << ", stated interval +-" << a.error_relative);
+    REQUIRE(a.error_relative > 0.0);
+    CHECK(std::abs(error) <= a.error_relative);
+}
