@@ -221,7 +221,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double rounds = std::ceil(double(groups) / sharing);
         double align = 0.0, conflict = 0.0, accesses = 0.0, round_sum = 0.0, addr_sum = 0.0,
                ic_sum = 0.0;
-        double first_fetch = 0.0;
+        double first_fetch = 0.0, scatter_addresses = 0.0;
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const RayBufferModel::Contiguous ids = buffer.access_contiguous(g * n, lanes);
@@ -246,8 +246,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                 first_fetch = double(ids.cycles) + std::ceil(double(lanes) / agu_rate) +
                               std::max(0.0, gathers - 1.0) + conflicts + double(buffer.latency()) +
                               (fill_bank - buffer.fill_cycles());
-            if (scattering >= 1.0 && !p.scatter_words.empty())
+            if (scattering >= 1.0 && !p.scatter_words.empty()) {
                 accesses += double(p.scatter_words.size());
+                scatter_addresses += double(p.scatter_words.size());
+            }
         }
         const double per_round = round_sum / double(groups);
         const double exec = rounds * per_round;
@@ -292,7 +294,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         t.mix.compute += uint64_t(ops * double(groups) * p.compute_instructions);
         t.mix.scatter_gather += uint64_t(std::llround(ops * accesses));
         t.mix.partition += uint64_t(ops * compare);
-        t.mix.store += uint64_t(ops * moves);
+        t.mix.store += uint64_t(ops * moves + ops * scatter_addresses);
         if (p.pushes_rays) t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
         t.field_accesses += uint64_t(std::llround(ops * accesses));
     }

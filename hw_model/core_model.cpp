@@ -221,6 +221,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
             e.completion = std::max(e.completion, last + 1);
             m_timing.field_accesses += words;
             m_timing.mix.scatter_gather += words;
+            m_timing.mix.store += words;  // each scattered word's address vector
         }
     }
     m_op_completion[t.op] = std::max(m_op_completion[t.op], e.completion);
