@@ -162,7 +162,8 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     // every SIMD unit's access side shares; a word's requests leave the cycle after its
     // addresses are done. What a busier pool adds over an idle one is address stall.
     const double per_cycle = m_agu.per_cycle();
-    std::vector<uint64_t> ready_at(gathers);
+    std::vector<uint64_t>& ready_at = m_ready_at;
+    ready_at.resize(gathers);
     for (size_t w = 0; w < gathers; ++w) {
         const uint64_t done = m_agu.serve(ids_done, double(t.lanes)) + 1;
         const uint64_t alone = ids_done + ceil_cycle(double((w + 1) * t.lanes) / per_cycle);

@@ -117,6 +117,7 @@ class CoreModel {
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;
+    std::vector<uint64_t> m_ready_at;
 };
 
 }  // namespace sfx

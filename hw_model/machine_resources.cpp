@@ -29,7 +29,7 @@ void SlotServer::slide_to(uint64_t last) {
     }
 }
 
-uint64_t SlotServer::book(uint64_t ready, uint32_t occupancy) {
+uint64_t SlotServer::book_slow(uint64_t ready, uint32_t occupancy) {
     if (occupancy == 0) occupancy = 1;
     // Cycles before the window were forgotten when a later booking moved it: never book them.
     uint64_t cycle = ready > m_base ? ready : m_base;

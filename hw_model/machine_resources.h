@@ -19,10 +19,24 @@ class SlotServer {
     static constexpr uint32_t k_window = 512;
 
     // The first cycle >= ready from which `occupancy` cycles are free; books them.
-    uint64_t book(uint64_t ready, uint32_t occupancy = 1);
+    uint64_t book(uint64_t ready, uint32_t occupancy = 1) {
+        // The common case, a free bank inside the window, without the general search.
+        if (occupancy == 1 && ready >= m_base && ready < m_base + k_window) {
+            const uint64_t offset = ready - m_base;
+            uint64_t& word = m_bits[(m_head + offset / 64) % k_words];
+            const uint64_t bit = uint64_t(1) << (offset % 64);
+            if (!(word & bit)) {
+                word |= bit;
+                ++m_bookings;
+                return ready;
+            }
+        }
+        return book_slow(ready, occupancy);
+    }
     uint64_t bookings() const { return m_bookings; }
 
   private:
+    uint64_t book_slow(uint64_t ready, uint32_t occupancy);
     bool is_free(uint64_t cycle) const;
     void mark(uint64_t cycle);
     void slide_to(uint64_t last);  // moves the window forward until `last` lies in it
