@@ -127,7 +127,8 @@ public:
         for (size_t i = 0; i < n; ++i) s2 += (y[i] - r * x[i]) * (y[i] - r * x[i]);
         s2 /= double(n - 1);
         const double f = double(n) / double(std::max<uint64_t>(n, m_unit));
-        const double half = normal_quantile_two_sided(confidence) *
+        // Student's t with n - 1 degrees of freedom: the calibration sample may be small.
+        const double half = student_t_quantile_two_sided(confidence, double(n - 1)) *
                             std::sqrt((1.0 - f) * s2 / double(n)) / mean_x;
         return {r, half / r};
     }
