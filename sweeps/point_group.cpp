@@ -1,16 +1,16 @@
 #include "sweeps/point_group.h"
 
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <thread>
-#include <cmath>
 
 #include "hw_model/analytic_model.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/stream/stream_tracer.h"
+#include "workloads/host_clock.h"
 #include "workloads/input_error.h"
 #include "workloads/ray_layout.h"
 
@@ -30,12 +30,6 @@ public:
 private:
     std::vector<TraceSink*> m_sinks;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-
 
 // Ideal utilization at configuration i's width from the counted trace.
 void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
@@ -148,7 +142,7 @@ private:
 
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
     if (!(opt.fraction > 0.0 && opt.fraction <= 1.0))
@@ -313,7 +307,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
                                  const SamplingOptions& sampling) {
     if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
 
@@ -341,7 +335,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     const double shared_seconds = seconds_since(start);
 
     for (size_t i = 0; i < configs.size(); ++i) {
-        const auto model_start = std::chrono::steady_clock::now();
+        const auto model_start = HostClock::now();
         Prediction p;
         p.config = configs[i];
         p.fidelity = fidelity;
