@@ -282,26 +282,6 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     return shape;
 }
 
-uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs) {
-    const uint64_t bytes_per_ray = ray_record_bytes(features);
-    uint64_t smallest = UINT64_MAX;
-    for (const HwConfig& c : configs) smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
-    return uint32_t(std::sqrt(double(smallest / bytes_per_ray)));
-}
-
-void check_tile_fits(uint32_t tile, const FeatureSet& features,
-                     const std::vector<HwConfig>& configs, const std::string& key) {
-    const uint64_t need = uint64_t(tile) * tile * ray_record_bytes(features);
-    for (const HwConfig& c : configs)
-        if (need > uint64_t(c.ray_buffer.kib) * 1024)
-            throw InputError("command line", 0, key,
-                             "a " + std::to_string(tile) + "x" + std::to_string(tile) +
-                                 " stream needs " + std::to_string((need + 1023) / 1024) +
-                                 " KiB of ray data; configuration '" + c.name + "' has " +
-                                 std::to_string(c.ray_buffer.kib) + " KiB buffers (largest tile: " +
-                                 std::to_string(largest_fitting_tile(features, {c})) + ")");
-}
-
 PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,

@@ -90,7 +90,7 @@ TEST_CASE("Axes expand as a cross product, last axis fastest, zip groups move to
     REQUIRE(s.groups.size() == 3);
     for (const PointGroup& g : s.groups) {
         REQUIRE(g.points.size() == 2);
-        CHECK(s.points[g.points[0]].workload.same_render(s.points[g.points[1]].workload));
+        CHECK(s.points[g.points[0]].workload == s.points[g.points[1]].workload);
         CHECK(s.points[g.points[0]].hw.simd.width != s.points[g.points[1]].hw.simd.width);
     }
 }
@@ -141,7 +141,7 @@ TEST_CASE("Point YAML round-trips and its key depends on values and nothing else
         CHECK(p.key == point_key(p.config_yaml));
         const ParsedPoint back = parse_point_config(p.config_yaml, "row");
         CHECK(dump_hw_config(back.hw) == dump_hw_config(p.hw));
-        CHECK(back.workload.same_render(p.workload));
+        CHECK(back.workload == p.workload);
         CHECK(back.fidelity == p.fidelity);
         CHECK(point_config_yaml(back.hw, back.workload, back.fidelity) == p.config_yaml);
     }
@@ -157,6 +157,17 @@ TEST_CASE("Point YAML round-trips and its key depends on values and nothing else
     two.scene_memory.caches.pop_back();
     const std::string yaml = point_config_yaml(two, s.points[0].workload, Fidelity::full);
     CHECK(parse_point_config(yaml, "row").hw.scene_memory.caches.size() == 2);
+}
+
+TEST_CASE("A point's workload YAML keeps its text (stored keys stay valid)", "[sweeps]") {
+    const Sweep s = parse(std::string(k_head) + "axes:\n  workload.seed: [7]\n");
+    REQUIRE(s.points.size() == 1);
+    const std::string& yaml = s.points[0].config_yaml;
+    const std::string workload =
+        "workload:\n  scene: \"cornell\"\n  width: 16\n  height: 16\n  spp: 1\n  depth: 3\n"
+        "  tile: 8\n  seed: 7\nfidelity: analytic\n";
+    REQUIRE(yaml.size() > workload.size());
+    CHECK(yaml.substr(yaml.size() - workload.size()) == workload);
 }
 
 TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
