@@ -67,9 +67,7 @@ void add_accuracy_command(CLI::App& app) {
     c->callback([o] {
         const std::vector<HwConfig> configs = {load_hw_config(o->hw)};
         const Scene scene = load_scene(o->scene);
-        RenderSettings settings = o->workload.resolve(scene);
-        if (o->workload.tile == "auto") settings.tile = largest_fitting_tile(scene.features(), configs);
-        check_tile_fits(settings.tile, scene.features(), configs, "--tile");
+        const RenderSettings settings = o->workload.resolve(scene, configs);
         if (!o->plot.empty() && (o->plot.size() < 5 || o->plot.substr(o->plot.size() - 4) != ".png"))
             throw InputError("command line", 0, "--plot", "expected a .png path, got '" + o->plot + "'");
         const Bvh bvh(scene);

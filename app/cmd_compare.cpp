@@ -177,11 +177,7 @@ void add_compare_command(CLI::App& app) {
         if (o->scene.empty()) throw InputError("command line", 0, "--scene", "required with two hardware files");
         const std::vector<HwConfig> configs = {load_hw_config(o->a), load_hw_config(o->b)};
         const Scene scene = load_scene(o->scene);
-        RenderSettings settings = o->workload.resolve(scene);
-        FeatureSet features = scene.features();
-        features.max_depth = settings.max_depth;
-        if (o->workload.tile == "auto") settings.tile = largest_fitting_tile(features, configs);
-        check_tile_fits(settings.tile, features, configs, "--tile");
+        const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
         const PointGroupResult r = run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
         const Prediction& pa = r.predictions[0];

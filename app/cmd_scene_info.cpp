@@ -1,13 +1,13 @@
 // sfx scene-info SCENE: what a scene is made of and what it asks of a tracer and of hardware:
 // primitive, light and material counts, the feature set, bytes per ray, BVH statistics, memory.
 
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "kernels/bvh.h"
+#include "workloads/host_clock.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 
@@ -25,14 +25,12 @@ void add_scene_info_command(CLI::App& app) {
     c->add_flag("--json", options->json, "print one JSON document");
     c->add_flag("--ray-layout", options->layout, "also list the ray record's fields");
     c->callback([options] {
-        using clock = std::chrono::steady_clock;
-        const auto t0 = clock::now();
+        const auto load_start = HostClock::now();
         const Scene scene = load_scene(options->scene);
-        const auto t1 = clock::now();
+        const double load_seconds = seconds_since(load_start);
+        const auto build_start = HostClock::now();
         const Bvh bvh(scene);
-        const auto t2 = clock::now();
-        const double load_seconds = std::chrono::duration<double>(t1 - t0).count();
-        const double build_seconds = std::chrono::duration<double>(t2 - t1).count();
+        const double build_seconds = seconds_since(build_start);
         const BvhStats st = bvh.stats();
         const FeatureSet features = scene.features();
         const auto fields = ray_record_fields(features);

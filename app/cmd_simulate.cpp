@@ -105,10 +105,7 @@ void add_simulate_command(CLI::App& app) {
         std::vector<HwConfig> configs;
         for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
         const Scene scene = load_scene(o->scene);
-        RenderSettings settings = o->workload.resolve(scene);
-        FeatureSet features = scene.features();
-        if (o->workload.tile == "auto") settings.tile = largest_fitting_tile(features, configs);
-        check_tile_fits(settings.tile, features, configs, "--tile");
+        const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
         const PointGroupResult r =
             run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity),

@@ -9,9 +9,8 @@
 #endif
 
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <iterator>
@@ -25,6 +24,7 @@
 #include "sweeps/group_runner.h"
 #include "sweeps/results_store.h"
 #include "sweeps/sweep.h"
+#include "workloads/host_clock.h"
 #include "workloads/input_error.h"
 
 namespace sfx {
@@ -61,8 +61,7 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
 class Progress {
 public:
     Progress(size_t total, bool enabled)
-        : m_total(total), m_enabled(enabled), m_tty(isatty(2)),
-          m_start(std::chrono::steady_clock::now()) {}
+        : m_total(total), m_enabled(enabled), m_tty(isatty(2)), m_start(HostClock::now()) {}
     void started(const std::string& label) {
         m_current = label;
         if (m_tty) draw();
@@ -82,9 +81,7 @@ public:
     void finish() {
         if (m_enabled && m_tty) std::cerr << "\r\033[K";
     }
-    double elapsed() const {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
-    }
+    double elapsed() const { return seconds_since(m_start); }
 
 private:
     std::string eta() const {
@@ -104,7 +101,7 @@ private:
 
     size_t m_total, m_done = 0;
     bool m_enabled, m_tty;
-    std::chrono::steady_clock::time_point m_start;
+    HostClock::time_point m_start;
     std::string m_current;
 };
 

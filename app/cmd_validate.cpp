@@ -5,7 +5,6 @@
 // a new target (the stream tracer against the reference tracer) is one more function and one
 // more name in k_targets.
 
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -17,6 +16,7 @@
 #include "kernels/embree/embree_check.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/stream_tracer.h"
+#include "workloads/host_clock.h"
 #include "workloads/input_error.h"
 #include "workloads/scene_loader.h"
 
@@ -35,11 +35,6 @@ struct ValidateOptions {
 
 const std::vector<std::string> k_targets = {"reference", "embree"};
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 std::string format_rate(double r) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.2e", r);
@@ -48,7 +43,7 @@ std::string format_rate(double r) {
 
 // Returns true on pass.
 bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
-                             const RenderSettings& settings, Clock::time_point start,
+                             const RenderSettings& settings, HostClock::time_point start,
                              double load_seconds) {
     // The check holds every ray and hit in memory, ~90 bytes a ray: 10M rays is ~1 GB.
     if (o.rays == 0 || o.rays > 10000000)
@@ -56,7 +51,7 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
                          "expected 1..10000000, got " + std::to_string(o.rays));
     if (!(o.ulps >= 0.f && o.ulps <= 1e6f))
         throw InputError("command line", 0, "--ulps", "expected 0..1e6, got " + std::to_string(o.ulps));
-    const auto bvh_start = Clock::now();
+    const auto bvh_start = HostClock::now();
     const Bvh bvh(scene);
     const double bvh_seconds = seconds_since(bvh_start);
 
@@ -181,9 +176,9 @@ struct HitRecordChecker : RayObserver {
 // The stream tracer against the reference tracer: the whole image bit for bit, the ray
 // counts, and the per-ray hit records of every ray of up to `o.rays` rays' worth of passes.
 bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
-                                const RenderSettings& settings, Clock::time_point start,
+                                const RenderSettings& settings, HostClock::time_point start,
                                 double load_seconds) {
-    const auto bvh_start = Clock::now();
+    const auto bvh_start = HostClock::now();
     const Bvh bvh(scene);
     const double bvh_seconds = seconds_since(bvh_start);
     const RenderResult ref = render_reference(scene, bvh, settings);
@@ -208,7 +203,7 @@ bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
                            ref.stats.shadow_rays == st.stats.shadow_rays &&
                            ref.stats.nonfinite_paths == st.stats.nonfinite_paths;
     // Hit records: passes of tiles spread over the image, every ray, until o.rays are checked.
-    const auto hits_start = Clock::now();
+    const auto hits_start = HostClock::now();
     HitRecordChecker checker(bvh);
     const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
     StreamTracer tracer(scene, bvh, settings);
@@ -298,7 +293,7 @@ void add_validate_command(CLI::App& app) {
     // with the other commands but do not change the embree check.
     options->workload.add_to(c);
     c->callback([options] {
-        const auto start = Clock::now();
+        const auto start = HostClock::now();
         const Scene scene = load_scene(options->scene);
         const double load_seconds = seconds_since(start);
         const RenderSettings settings = options->workload.resolve(scene);

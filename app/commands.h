@@ -7,6 +7,7 @@
 
 #include "kernels/render.h"
 #include "sweeps/sampling.h"
+#include "sweeps/workload_config.h"
 #include "workloads/scene.h"
 
 namespace sfx {
@@ -21,8 +22,11 @@ struct WorkloadFlags {
     uint32_t threads = 0;
 
     void add_to(CLI::App* command);
-    // Resolves against the scene; throws InputError (key = the flag) on a bad value.
-    RenderSettings resolve(const Scene& scene) const;
+    // The workload the flags give for `scene`; throws InputError (key = the flag) on a bad value.
+    WorkloadConfig config(const std::string& scene) const;
+    // Resolved against the scene and the configurations the command times (resolve_workload:
+    // the scene's depth, tile auto, the tile checked against every configuration).
+    RenderSettings resolve(const Scene& scene, const std::vector<HwConfig>& configs = {}) const;
 };
 
 // Sampling flags shared by the commands that predict at sampled fidelity.

@@ -8,7 +8,6 @@
 // Usage: sfx_bench_hw_model [scene] [WxH] [spp] [repetitions]
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -20,16 +19,12 @@
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
+#include "workloads/host_clock.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
-using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double seconds(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -55,9 +50,9 @@ double empty_clocked_seconds(uint64_t cycles) {
     sc_core::sc_clock clock("clock", 2, sc_core::SC_NS);
     EmptyClocked m("empty");
     m.clk(clock);
-    const auto t0 = Clock::now();
+    const auto t0 = HostClock::now();
     sc_core::sc_start(double(2 * cycles), sc_core::SC_NS);
-    return seconds(t0);
+    return seconds_since(t0);
 }
 
 // Records every pass of a render so timing can be measured without the tracer.
@@ -121,13 +116,13 @@ int main(int argc, char** argv) {
         std::vector<double> model_s, empty_s;
         uint64_t cycles = 0;
         for (int r = 0; r < reps; ++r) {
-            const auto t0 = Clock::now();
+            const auto t0 = HostClock::now();
             {
                 SystemcTiming timing({c}, shape);
                 recorded.replay(timing);
                 cycles = timing.timing(0).cycles / c.cores.count;
             }
-            model_s.push_back(seconds(t0));
+            model_s.push_back(seconds_since(t0));
             empty_s.push_back(empty_clocked_seconds(cycles));
         }
         const double model_rate = double(cycles) / median(model_s);
@@ -153,11 +148,11 @@ int main(int argc, char** argv) {
     std::vector<std::vector<double>> samples(configs.size());
     for (int r = 0; r < reps; ++r)
         for (size_t k = 1; k <= configs.size(); ++k) {
-            const auto t0 = Clock::now();
+            const auto t0 = HostClock::now();
             SystemcTiming timing(std::vector<HwConfig>(configs.begin(), configs.begin() + k),
                                  shape);
             render_stream(scene, bvh, settings, &timing);
-            samples[k - 1].push_back(seconds(t0));
+            samples[k - 1].push_back(seconds_since(t0));
         }
     std::vector<double> group_s(configs.size());
     for (size_t k = 1; k <= configs.size(); ++k) {

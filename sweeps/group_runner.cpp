@@ -35,23 +35,16 @@ std::vector<PointRun> run_group(const nlohmann::json& spec) {
         // The key is computed here, with this sfx's version: a worker running another version
         // produces other keys, which the client rejects.
         keys.push_back(point_key(p.get<std::string>()));
-        if (!points.back().workload.same_render(points.front().workload) ||
+        if (points.back().workload != points.front().workload ||
             points.back().fidelity != points.front().fidelity)
             throw InputError(file, 0, "points[" + std::to_string(i) + "]",
                              "a group's points must share scene, resolution, spp, depth, tile, seed and fidelity");
     }
-    const WorkloadPoint& w = points.front().workload;
+    const WorkloadConfig& w = points.front().workload;
     const std::string started = iso8601_now();
     const Scene scene = load_scene(w.scene);
     const Bvh bvh(scene);
-    RenderSettings settings;
-    settings.width = w.width;
-    settings.height = w.height;
-    settings.spp = w.spp;
-    settings.max_depth = w.depth;
-    settings.tile = w.tile;
-    settings.seed = w.seed;
-    settings.threads = threads;
+    const RenderSettings settings = w.render_settings(threads);
     std::vector<HwConfig> configs;
     for (const ParsedPoint& p : points) configs.push_back(p.hw);
     const PointGroupResult result = run_point_group(scene, bvh, settings, configs, points.front().fidelity);

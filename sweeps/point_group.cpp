@@ -1,16 +1,16 @@
 #include "sweeps/point_group.h"
 
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <thread>
-#include <cmath>
 
 #include "hw_model/analytic_model.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/stream/stream_tracer.h"
+#include "workloads/host_clock.h"
 #include "workloads/input_error.h"
 #include "workloads/ray_layout.h"
 
@@ -30,12 +30,6 @@ public:
 private:
     std::vector<TraceSink*> m_sinks;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-
 
 // Ideal utilization at configuration i's width from the counted trace.
 void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
@@ -127,7 +121,8 @@ public:
         for (size_t i = 0; i < n; ++i) s2 += (y[i] - r * x[i]) * (y[i] - r * x[i]);
         s2 /= double(n - 1);
         const double f = double(n) / double(std::max<uint64_t>(n, m_unit));
-        const double half = normal_quantile_two_sided(confidence) *
+        // Student's t with n - 1 degrees of freedom: the calibration sample may be small.
+        const double half = student_t_quantile_two_sided(confidence, double(n - 1)) *
                             std::sqrt((1.0 - f) * s2 / double(n)) / mean_x;
         return {r, half / r};
     }
@@ -147,7 +142,7 @@ private:
 
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
     if (!(opt.fraction > 0.0 && opt.fraction <= 1.0))
@@ -287,32 +282,12 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     return shape;
 }
 
-uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs) {
-    const uint64_t bytes_per_ray = ray_record_bytes(features);
-    uint64_t smallest = UINT64_MAX;
-    for (const HwConfig& c : configs) smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
-    return uint32_t(std::sqrt(double(smallest / bytes_per_ray)));
-}
-
-void check_tile_fits(uint32_t tile, const FeatureSet& features,
-                     const std::vector<HwConfig>& configs, const std::string& key) {
-    const uint64_t need = uint64_t(tile) * tile * ray_record_bytes(features);
-    for (const HwConfig& c : configs)
-        if (need > uint64_t(c.ray_buffer.kib) * 1024)
-            throw InputError("command line", 0, key,
-                             "a " + std::to_string(tile) + "x" + std::to_string(tile) +
-                                 " stream needs " + std::to_string((need + 1023) / 1024) +
-                                 " KiB of ray data; configuration '" + c.name + "' has " +
-                                 std::to_string(c.ray_buffer.kib) + " KiB buffers (largest tile: " +
-                                 std::to_string(largest_fitting_tile(features, {c})) + ")");
-}
-
 PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
                                  const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
                                  const SamplingOptions& sampling) {
     if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
 
@@ -340,7 +315,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     const double shared_seconds = seconds_since(start);
 
     for (size_t i = 0; i < configs.size(); ++i) {
-        const auto model_start = std::chrono::steady_clock::now();
+        const auto model_start = HostClock::now();
         Prediction p;
         p.config = configs[i];
         p.fidelity = fidelity;

@@ -12,20 +12,13 @@
 #include "kernels/bvh.h"
 #include "kernels/render.h"
 #include "sweeps/sampling.h"
+#include "sweeps/workload_config.h"
 #include "workloads/scene.h"
 
 namespace sfx {
 
 // What the hardware model needs to know of a workload besides its trace.
 WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSettings& settings);
-
-// The largest tile whose stream fits every configuration's ray buffer: tile^2 * bytes per ray
-// <= buffer bytes.
-uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs);
-// Checks an explicit tile against every configuration; throws InputError(key) if one cannot
-// hold the stream.
-void check_tile_fits(uint32_t tile, const FeatureSet& features,
-                     const std::vector<HwConfig>& configs, const std::string& key);
 
 struct PointGroupResult {
     std::vector<Prediction> predictions;  // one per configuration, in order

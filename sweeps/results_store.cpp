@@ -79,11 +79,15 @@ private:
     sqlite3_stmt* m_stmt = nullptr;
 };
 
-const char* const k_fixed_columns =
-    "key TEXT PRIMARY KEY, sfx_version TEXT, sweep TEXT, point_index INTEGER, started_at TEXT, "
-    "finished_at TEXT, config_yaml TEXT, \"workload.scene\" TEXT, \"workload.width\" INTEGER, "
-    "\"workload.height\" INTEGER, \"workload.spp\" INTEGER, \"workload.depth\" INTEGER, "
-    "\"workload.tile\" INTEGER, \"workload.seed\" INTEGER, fidelity TEXT";
+// The columns every row has; the workload's come from WorkloadConfig's visit().
+std::string fixed_columns() {
+    std::string sql =
+        "key TEXT PRIMARY KEY, sfx_version TEXT, sweep TEXT, point_index INTEGER, started_at TEXT, "
+        "finished_at TEXT, config_yaml TEXT";
+    for (const WorkloadColumn& c : workload_columns(WorkloadConfig{}))
+        sql += ", " + sql_quote_identifier(c.name) + (c.integer ? " INTEGER" : " TEXT");
+    return sql + ", fidelity TEXT";
+}
 
 std::string csv_field(const std::string& s) {
     if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -143,7 +147,7 @@ ResultsStore::ResultsStore(const std::string& path) : m_path(path) {
         exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
         exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
              std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
-        exec(std::string("CREATE TABLE IF NOT EXISTS points(") + k_fixed_columns + ")");
+        exec(std::string("CREATE TABLE IF NOT EXISTS points(") + fixed_columns() + ")");
         exec("COMMIT");
     } catch (const InputError&) {
         sqlite3_close(m_db);
@@ -203,11 +207,11 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
         // Another process may have added columns since we looked: re-read inside the lock.
         m_columns.clear();
         for (const std::string& c : columns()) m_columns.insert(c);
-        std::vector<std::string> names = {"key", "sfx_version", "sweep", "point_index", "started_at",
-                                          "finished_at", "config_yaml", "workload.scene",
-                                          "workload.width", "workload.height", "workload.spp",
-                                          "workload.depth", "workload.tile", "workload.seed",
-                                          "fidelity"};
+        const std::vector<WorkloadColumn> workload = workload_columns(point.workload);
+        std::vector<std::string> names = {"key",        "sfx_version", "sweep",      "point_index",
+                                          "started_at", "finished_at", "config_yaml"};
+        for (const WorkloadColumn& c : workload) names.push_back(c.name);
+        names.push_back("fidelity");
         for (const auto& [name, numeric] : hw_columns) {
             ensure_column("hw." + name, numeric ? "REAL" : "TEXT");
             names.push_back("hw." + name);
@@ -233,13 +237,12 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
         insert.bind(i++, run.started_at);
         insert.bind(i++, run.finished_at);
         insert.bind(i++, point.config_yaml);
-        insert.bind(i++, point.workload.scene);
-        insert.bind_int(i++, point.workload.width);
-        insert.bind_int(i++, point.workload.height);
-        insert.bind_int(i++, point.workload.spp);
-        insert.bind_int(i++, point.workload.depth);
-        insert.bind_int(i++, point.workload.tile);
-        insert.bind_int(i++, int64_t(point.workload.seed));
+        for (const WorkloadColumn& c : workload) {
+            if (c.integer)
+                insert.bind_int(i++, c.number);
+            else
+                insert.bind(i++, c.text);
+        }
         insert.bind(i++, std::string(to_string(point.fidelity)));
         for (size_t k = 0; k < hw_columns.size(); ++k) {
             if (hw_columns[k].second) insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));

@@ -1,6 +1,8 @@
 #include "sweeps/sampling.h"
 
 #include <algorithm>
+#include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -68,17 +70,25 @@ std::vector<uint32_t> StratifiedSampler::grow_to(uint64_t total) {
     return added;
 }
 
-double normal_quantile_two_sided(double confidence) {
+namespace {
+void check_confidence(double confidence) {
     if (!(confidence > 0.0 && confidence < 1.0))
         throw std::invalid_argument("confidence must lie in (0, 1)");
-    // Solve erfc(z / sqrt 2) = 1 - confidence by bisection: monotone, and exact enough.
-    const double tail = 1.0 - confidence;
-    double lo = 0.0, hi = 40.0;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (std::erfc(mid / std::sqrt(2.0)) > tail ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
+}
+}  // namespace
+
+double normal_quantile_two_sided(double confidence) {
+    check_confidence(confidence);
+    return boost::math::quantile(boost::math::complement(boost::math::normal_distribution<double>(),
+                                                         (1.0 - confidence) / 2));
+}
+
+double student_t_quantile_two_sided(double confidence, double degrees_of_freedom) {
+    check_confidence(confidence);
+    if (!(degrees_of_freedom > 0.0))
+        throw std::invalid_argument("degrees of freedom must be positive");
+    return boost::math::quantile(boost::math::complement(
+        boost::math::students_t_distribution<double>(degrees_of_freedom), (1.0 - confidence) / 2));
 }
 
 Estimate estimate_total(const Stratification& strata, const std::vector<uint32_t>& units,
@@ -100,7 +110,7 @@ Estimate estimate_total(const Stratification& strata, const std::vector<uint32_t
     Estimate e;
     e.population = strata.stratum_of.size();
     e.sampled = units.size();
-    double variance = 0.0;
+    double variance = 0.0, dof_denominator = 0.0;
     for (uint32_t h = 0; h < strata.strata; ++h) {
         const double big_n = double(sizes[h]);
         if (big_n == 0.0) continue;
@@ -109,10 +119,16 @@ Estimate estimate_total(const Stratification& strata, const std::vector<uint32_t
         e.total += big_n * mean;
         if (n[h] >= 2) {
             const double s2 = sum2[h] / double(n[h] - 1);
-            variance += big_n * big_n * (1.0 - double(n[h]) / big_n) * s2 / double(n[h]);
+            const double term = big_n * big_n * (1.0 - double(n[h]) / big_n) * s2 / double(n[h]);
+            variance += term;
+            dof_denominator += term * term / double(n[h] - 1);
         }
     }
-    e.half_width = normal_quantile_two_sided(confidence) * std::sqrt(variance);
+    if (variance > 0.0) {
+        e.degrees_of_freedom = variance * variance / dof_denominator;
+        e.half_width =
+            student_t_quantile_two_sided(confidence, e.degrees_of_freedom) * std::sqrt(variance);
+    }
     return e;
 }
 

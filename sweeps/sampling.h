@@ -62,17 +62,24 @@ private:
 struct Estimate {
     double total = 0.0;       // estimated population total
     double half_width = 0.0;  // of the confidence interval for the total
+    double degrees_of_freedom = 0.0;  // of the Student t the interval uses (Satterthwaite)
     uint64_t sampled = 0, population = 0;
 
     double relative() const { return total > 0.0 ? half_width / total : 0.0; }
 };
 
 // Stratified estimate of a population total from observed (unit, value) pairs, with the
-// finite-population correction: Var = sum_h N_h^2 (1 - n_h/N_h) s_h^2 / n_h.
+// finite-population correction: Var = sum_h a_h s_h^2, a_h = N_h^2 (1 - n_h/N_h) / n_h. The
+// interval is Student's t with Satterthwaite's effective degrees of freedom,
+// (sum_h a_h s_h^2)^2 / sum_h (a_h s_h^2)^2 / (n_h - 1): with two or three passes per stratum
+// a normal z is far too narrow; with many it is the normal interval.
 Estimate estimate_total(const Stratification& strata, const std::vector<uint32_t>& units,
                         const std::vector<double>& values, double confidence);
 
 // Two-sided standard-normal quantile: z with P(|Z| <= z) = confidence.
 double normal_quantile_two_sided(double confidence);
+// Two-sided Student t quantile: t with P(|T| <= t) = confidence for `degrees_of_freedom` > 0
+// (need not be whole).
+double student_t_quantile_two_sided(double confidence, double degrees_of_freedom);
 
 }  // namespace sfx

@@ -1,6 +1,6 @@
 #pragma once
-// SHA-256 (FIPS 180-4) of a byte string, as lower-case hex: the results store's point key.
-// Small and self-contained so the store does not pull in a crypto library.
+// SHA-256 of a byte string, as lower-case hex: the results store's point key (OpenSSL's EVP
+// digest does the hashing).
 
 #include <string>
 

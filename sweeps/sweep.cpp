@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -16,9 +17,9 @@
 #include "sweeps/point_group.h"
 #include "sweeps/sha256.h"
 #include "workloads/input_error.h"
-#include "workloads/strict_number.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
+#include "workloads/strict_number.h"
 
 #ifndef SFX_VERSION
 #define SFX_VERSION "unknown"
@@ -36,20 +37,16 @@ constexpr size_t k_max_points = 1000000;  // a typo in a range should not eat th
 
 int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
 
-// The message of an InputError without its "file:line: key: " prefix, to re-throw it with
-// the sweep's location.
 // Checks a mapping's keys against an allowed list: unknown and duplicate keys are errors.
 void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
-                std::initializer_list<const char*> allowed) {
+                const std::vector<std::string>& allowed) {
     std::set<std::string> seen;
     for (const auto& kv : map) {
         const std::string key = kv.first.as<std::string>();
         const std::string dotted = prefix.empty() ? key : prefix + "." + key;
-        bool ok = false;
-        for (const char* a : allowed) ok |= key == a;
-        if (!ok) {
+        if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
             std::string list;
-            for (const char* a : allowed) list += list.empty() ? a : std::string(", ") + a;
+            for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
             throw InputError(file, line_of(kv.first), dotted, "unknown key (expected one of: " + list + ")");
         }
         if (!seen.insert(key).second) throw InputError(file, line_of(kv.first), dotted, "duplicate key");
@@ -60,15 +57,6 @@ std::string scalar(const YAML::Node& n, const std::string& file, const std::stri
     if (!n.IsScalar()) throw InputError(file, line_of(n), key, "expected a single value");
     return n.Scalar();
 }
-
-// The workload before resolution against a scene: depth -1 is the scene's, tile 0 is auto.
-struct WorkloadSpec {
-    std::string scene;
-    uint32_t width = 256, height = 256, spp = 4;
-    int64_t depth = -1;
-    uint32_t tile = 32;
-    uint64_t seed = 0;
-};
 
 // A scene given as a plain name is a built-in; anything else is a path relative to the sweep.
 std::string resolve_scene_name(const std::string& value, const std::string& base_dir) {
@@ -81,51 +69,13 @@ std::string resolve_scene_name(const std::string& value, const std::string& base
     return p.lexically_normal().string();
 }
 
-uint32_t parse_bounded(const std::string& value, uint64_t lo, uint64_t hi, const std::string& file,
-                       int line, const std::string& key) {
-    uint64_t v = 0;
-    if (!parse_unsigned(value, v) || v < lo || v > hi)
-        throw InputError(file, line, key, "expected an integer in [" + std::to_string(lo) + ", " +
-                                              std::to_string(hi) + "], got '" + value + "'");
-    return uint32_t(v);
-}
-
-// Sets one workload field from scalar text; `key` names it in errors.
-void set_workload(WorkloadSpec& w, const std::string& field, const std::string& value,
+// Sets one workload field from scalar text (through WorkloadConfig's visit); a scene given
+// as a path is taken relative to `base_dir`. `key` names it in errors.
+void set_workload(WorkloadConfig& w, const std::string& field, const std::string& value,
                   const std::string& base_dir, const std::string& file, int line,
                   const std::string& key) {
-    if (field == "scene") {
-        if (value.empty()) throw InputError(file, line, key, "expected a scene name or path");
-        w.scene = resolve_scene_name(value, base_dir);
-    } else if (field == "res") {
-        unsigned width = 0, height = 0;
-        char tail = 0;
-        if (std::sscanf(value.c_str(), "%ux%u%c", &width, &height, &tail) != 2 || width == 0 ||
-            height == 0 || width > 65536 || height > 65536)
-            throw InputError(file, line, key, "expected WxH with 1..65536, got '" + value + "'");
-        w.width = width;
-        w.height = height;
-    } else if (field == "width") {
-        w.width = parse_bounded(value, 1, 65536, file, line, key);
-    } else if (field == "height") {
-        w.height = parse_bounded(value, 1, 65536, file, line, key);
-    } else if (field == "spp") {
-        w.spp = parse_bounded(value, 1, 1u << 20, file, line, key);
-    } else if (field == "depth") {
-        w.depth = parse_bounded(value, 0, 1000, file, line, key);
-    } else if (field == "tile") {
-        w.tile = value == "auto" ? 0 : parse_bounded(value, 1, 4096, file, line, key);
-        if (value != "auto" && w.tile == 0)
-            throw InputError(file, line, key, "expected 1..4096 or auto");
-    } else if (field == "seed") {
-        uint64_t v = 0;
-        if (!parse_unsigned(value, v))
-            throw InputError(file, line, key, "expected a non-negative integer, got '" + value + "'");
-        w.seed = v;
-    } else {
-        throw InputError(file, line, key,
-                         "no such workload field (scene, res, width, height, spp, depth, tile, seed)");
-    }
+    set_workload_field(w, field, value, file, line, key);
+    if (field == "scene") w.scene = resolve_scene_name(value, base_dir);
 }
 
 Fidelity parse_fidelity_at(const std::string& value, const std::string& file, int line,
@@ -210,11 +160,6 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     }
 }
 
-struct SceneInfo {
-    FeatureSet features;
-    uint32_t max_depth = 0;
-};
-
 class SweepParser {
 public:
     SweepParser(std::string file, std::string base_dir)
@@ -278,7 +223,9 @@ private:
         const YAML::Node w = root["workload"];
         if (!w) throw InputError(m_file, 1, "workload", "missing (at least workload.scene)");
         if (!w.IsMap()) throw InputError(m_file, line_of(w), "workload", "expected a mapping");
-        check_keys(w, m_file, "workload", {"scene", "res", "width", "height", "spp", "depth", "tile", "seed"});
+        std::vector<std::string> allowed = workload_field_names();
+        allowed.push_back("res");
+        check_keys(w, m_file, "workload", allowed);
         if (!w["scene"]) throw InputError(m_file, line_of(w), "workload.scene", "missing");
         if (w["res"] && (w["width"] || w["height"]))
             throw InputError(m_file, line_of(w["res"]), "workload.res", "give res or width/height, not both");
@@ -370,7 +317,7 @@ private:
             throw InputError(m_file, line_of(axes), "axes.workload.res", "give res or width/height axes, not both");
     }
 
-    void apply(const Axis& axis, size_t i, HwConfig& hw, WorkloadSpec& w, Fidelity& f,
+    void apply(const Axis& axis, size_t i, HwConfig& hw, WorkloadConfig& w, Fidelity& f,
                bool scratch) const {
         const std::string key = "axes." + axis.path;
         const std::string& value = axis.values[i];
@@ -380,10 +327,10 @@ private:
             HwConfig& target = scratch ? (copy = hw) : hw;
             set_hw_at(target, axis.field, value, m_file, line, key);
         } else if (axis.kind == Axis::workload) {
-            WorkloadSpec copy;
-            WorkloadSpec& target = scratch ? (copy = w) : w;
+            WorkloadConfig copy;
+            WorkloadConfig& target = scratch ? (copy = w) : w;
             set_workload(target, axis.field, value, m_base_dir, m_file, line, key);
-            if (scratch && axis.field == "scene") scene_info(target.scene, line, key);
+            if (scratch && axis.field == "scene") scene_features(target.scene, line, key);
         } else {
             const Fidelity parsed = parse_fidelity_at(value, m_file, line, key);
             if (!scratch) f = parsed;
@@ -437,13 +384,13 @@ private:
         }
     }
 
-    const SceneInfo& scene_info(const std::string& scene, int line, const std::string& key) const {
+    const FeatureSet& scene_features(const std::string& scene, int line,
+                                     const std::string& key) const {
         auto it = m_scenes.find(scene);
         if (it != m_scenes.end()) return it->second;
         try {
             const Scene s = load_scene(scene);
-            SceneInfo info{s.features(), s.max_depth};
-            return m_scenes.emplace(scene, info).first->second;
+            return m_scenes.emplace(scene, s.features()).first->second;
         } catch (const InputError& e) {
             if (e.file() == scene && e.line() == 0) throw InputError(m_file, line, key, e.message());
             throw;  // an error inside the scene file names that file
@@ -458,13 +405,13 @@ private:
                 throw InputError(m_file, line_of_axes(), "axes", "more than " + std::to_string(k_max_points) + " points");
         }
         std::map<std::string, size_t> by_key;
-        std::vector<std::pair<WorkloadPoint, Fidelity>> group_keys;
+        std::vector<std::pair<WorkloadConfig, Fidelity>> group_keys;
         std::vector<size_t> at(m_dimensions.size(), 0);
         for (size_t n = 0; n < total; ++n) {
             SweepPoint p;
             p.index = n;
             p.hw = m_base;
-            WorkloadSpec w = m_workload;
+            WorkloadConfig w = m_workload;
             p.fidelity = m_fidelity;
             HwLineMap lines = m_hw_lines;
             std::map<std::string, int> workload_lines = m_workload_lines;
@@ -485,8 +432,8 @@ private:
             } else {
                 by_key[p.key] = sweep.points.size();
                 size_t g = 0;
-                while (g < group_keys.size() && !(group_keys[g].second == p.fidelity &&
-                                                  group_keys[g].first.same_render(p.workload)))
+                while (g < group_keys.size() &&
+                       !(group_keys[g].second == p.fidelity && group_keys[g].first == p.workload))
                     ++g;
                 if (g == group_keys.size()) {
                     group_keys.emplace_back(p.workload, p.fidelity);
@@ -521,50 +468,35 @@ private:
         }
     }
 
-    WorkloadPoint resolve(const WorkloadSpec& w, const SweepPoint& p,
-                          const std::map<std::string, int>& lines) const {
+    WorkloadConfig resolve(const WorkloadConfig& w, const SweepPoint& p,
+                           const std::map<std::string, int>& lines) const {
         auto line = [&](const char* field) {
             auto it = lines.find(field);
             return it == lines.end() ? 0 : it->second;
         };
-        const SceneInfo& info = scene_info(w.scene, line("scene"), "workload.scene");
-        WorkloadPoint r;
-        r.scene = w.scene;
-        r.width = w.width;
-        r.height = w.height;
-        r.spp = w.spp;
-        r.depth = w.depth < 0 ? info.max_depth : uint32_t(w.depth);
-        r.seed = w.seed;
-        FeatureSet features = info.features;
-        features.max_depth = r.depth;  // as run_point_group sees it
+        const FeatureSet& features = scene_features(w.scene, line("scene"), "workload.scene");
         // tile: auto is resolved per point (its own buffer), so a buffer-size axis changes
         // the tile; points then group by the resolved tile.
-        r.tile = w.tile ? w.tile : largest_fitting_tile(features, {p.hw});
-        if (r.tile == 0)
-            throw InputError(m_file, line("tile"), "workload.tile",
-                             "not even one ray record fits the ray buffer at point " +
-                                 std::to_string(p.index) + " (" + describe(p) + ")");
         try {
-            check_tile_fits(r.tile, features, {p.hw}, "workload.tile");
+            return resolve_workload(w, features, {p.hw}, "workload.tile").config;
         } catch (const InputError& e) {
             throw InputError(m_file, line("tile"), "workload.tile",
                              e.message() + " (at point " + std::to_string(p.index) + ": " +
                                  describe(p) + ")");
         }
-        return r;
     }
 
     std::string m_file, m_base_dir;
     HwConfig m_base;
     HwLineMap m_hw_lines;
-    WorkloadSpec m_workload;
+    WorkloadConfig m_workload;
     std::map<std::string, int> m_workload_lines;
     Fidelity m_fidelity = Fidelity::full;
     std::vector<Axis> m_axes;
     std::vector<int> m_dimension_of;
     std::vector<std::vector<size_t>> m_zips;
     std::vector<std::vector<size_t>> m_dimensions;  // axes moving together, outermost first
-    mutable std::map<std::string, SceneInfo> m_scenes;
+    mutable std::map<std::string, FeatureSet> m_scenes;
 };
 
 }  // namespace
@@ -583,19 +515,29 @@ Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets) 
     return parse_sweep(text.str(), path, dir.string(), sets);
 }
 
-std::string point_config_yaml(const HwConfig& hw, const WorkloadPoint& w, Fidelity fidelity) {
+namespace {
+// Writes each workload field as YAML: the scene double-quoted, numbers as they are.
+struct WorkloadYamlWriter {
+    YAML::Emitter& out;
+    void text(const char* name, std::string& value, const char*) {
+        out << YAML::Key << name << YAML::Value << YAML::DoubleQuoted << value;
+    }
+    template <class T>
+    void param(const char* name, T& value, const char*, const char*, uint64_t, uint64_t,
+               const char* = nullptr) {
+        out << YAML::Key << name << YAML::Value << value;
+    }
+};
+}  // namespace
+
+std::string point_config_yaml(const HwConfig& hw, const WorkloadConfig& w, Fidelity fidelity) {
     // Values only, in a fixed order: the key must not change when a description does.
     // dump_hw_config's text read back drops its comments and keeps its scalars verbatim.
     YAML::Emitter out;
     out << YAML::BeginMap << YAML::Key << "hw" << YAML::Value << YAML::Load(dump_hw_config(hw));
     out << YAML::Key << "workload" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "scene" << YAML::Value << YAML::DoubleQuoted << w.scene;
-    out << YAML::Key << "width" << YAML::Value << w.width;
-    out << YAML::Key << "height" << YAML::Value << w.height;
-    out << YAML::Key << "spp" << YAML::Value << w.spp;
-    out << YAML::Key << "depth" << YAML::Value << w.depth;
-    out << YAML::Key << "tile" << YAML::Value << w.tile;
-    out << YAML::Key << "seed" << YAML::Value << w.seed;
+    WorkloadYamlWriter writer{out};
+    const_cast<WorkloadConfig&>(w).visit(writer);  // the writer only reads
     out << YAML::EndMap;
     out << YAML::Key << "fidelity" << YAML::Value << to_string(fidelity);
     out << YAML::EndMap;
@@ -624,23 +566,16 @@ ParsedPoint parse_point_config(const std::string& text, const std::string& file)
 
     const YAML::Node w = root["workload"];
     if (!w.IsMap()) throw InputError(file, line_of(w), "workload", "expected a mapping");
-    check_keys(w, file, "workload", {"scene", "width", "height", "spp", "depth", "tile", "seed"});
-    WorkloadSpec spec;
-    for (const char* k : {"scene", "width", "height", "spp", "depth", "tile", "seed"}) {
-        const std::string key = std::string("workload.") + k;
+    const std::vector<std::string> fields = workload_field_names();
+    check_keys(w, file, "workload", fields);
+    for (const std::string& k : fields) {
+        const std::string key = "workload." + k;
         if (!w[k]) throw InputError(file, line_of(w), key, "missing");
         // The scene is stored resolved (a built-in name or an absolute path): taken as is.
-        if (key == "workload.scene") spec.scene = scalar(w[k], file, key);
-        else set_workload(spec, k, scalar(w[k], file, key), "", file, line_of(w[k]), key);
+        set_workload_field(p.workload, k, scalar(w[k], file, key), file, line_of(w[k]), key);
     }
-    if (spec.tile == 0) throw InputError(file, line_of(w["tile"]), "workload.tile", "must be resolved, not auto");
-    p.workload.scene = spec.scene;
-    p.workload.width = spec.width;
-    p.workload.height = spec.height;
-    p.workload.spp = spec.spp;
-    p.workload.depth = uint32_t(spec.depth);
-    p.workload.tile = spec.tile;
-    p.workload.seed = spec.seed;
+    if (p.workload.tile == WorkloadConfig::k_auto_tile)
+        throw InputError(file, line_of(w["tile"]), "workload.tile", "must be resolved, not auto");
     p.fidelity = parse_fidelity_at(scalar(root["fidelity"], file, "fidelity"), file,
                                    line_of(root["fidelity"]), "fidelity");
     return p;

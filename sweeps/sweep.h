@@ -14,28 +14,17 @@
 
 #include "hw_model/hw_config.h"
 #include "hw_model/prediction.h"
+#include "sweeps/workload_config.h"
 
 namespace sfx {
 
 // The version stamped on every stored row (and part of every point key).
 const char* sfx_version();
 
-// A fully resolved workload: no "auto", no "the scene's depth".
-struct WorkloadPoint {
-    std::string scene;  // a built-in scene name, or an absolute path
-    uint32_t width = 256, height = 256, spp = 4, depth = 3, tile = 32;
-    uint64_t seed = 0;
-
-    bool same_render(const WorkloadPoint& o) const {
-        return scene == o.scene && width == o.width && height == o.height && spp == o.spp &&
-               depth == o.depth && tile == o.tile && seed == o.seed;
-    }
-};
-
 struct SweepPoint {
     size_t index = 0;  // position in the sweep's expansion
     HwConfig hw;
-    WorkloadPoint workload;
+    WorkloadConfig workload;  // resolved: no "auto", no "the scene's depth"
     Fidelity fidelity = Fidelity::full;
     // The value of each axis at this point, e.g. {"hw.simd.width", "8"}, for tables.
     std::vector<std::pair<std::string, std::string>> axis_values;
@@ -66,12 +55,13 @@ Sweep parse_sweep(const std::string& yaml_text, const std::string& file_name,
 
 // One point as YAML (comment-free, so the key depends on values only) and its store key:
 // hex SHA-256 of (config_yaml + "\n" + sfx version).
-std::string point_config_yaml(const HwConfig& hw, const WorkloadPoint& workload, Fidelity fidelity);
+std::string point_config_yaml(const HwConfig& hw, const WorkloadConfig& workload,
+                              Fidelity fidelity);
 std::string point_key(const std::string& config_yaml);
 
 struct ParsedPoint {
     HwConfig hw;
-    WorkloadPoint workload;
+    WorkloadConfig workload;
     Fidelity fidelity = Fidelity::full;
 };
 // The inverse of point_config_yaml (strict): what a worker runs from.

@@ -2,7 +2,6 @@
 
 #include <embree3/rtcore.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <iomanip>
@@ -15,16 +14,11 @@
 #include "kernels/intersect.h"
 #include "kernels/render.h"
 #include "kernels/sampling.h"
+#include "workloads/host_clock.h"
 
 namespace sfx {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 bool in_range(float x) {
     return std::fabs(x) <= EmbreeScene::k_coordinate_limit;
@@ -44,7 +38,7 @@ void record_error(void* user, RTCError code, const char* message) {
 // EmbreeScene Method Definitions
 
 EmbreeScene::EmbreeScene(const Scene& scene) {
-    const auto start = Clock::now();
+    const auto start = HostClock::now();
     // One build thread: Embree's tree, and so which of two equal-t primitives it reports, must
     // not depend on the machine or on --threads. Queries run on the caller's threads anyway.
     m_device = rtcNewDevice("threads=1");
@@ -468,7 +462,7 @@ EmbreeAgreement check_against_embree(const Scene& scene, const Bvh& bvh,
     result.excluded_primitives = embree->excluded_primitives();
     result.embree_build_seconds = embree->build_seconds();
 
-    const auto start = Clock::now();
+    const auto start = HostClock::now();
     const uint64_t n_diffuse = options.rays / 2;
     const uint64_t n_primary = options.rays - n_diffuse;
     const uint64_t pixels = uint64_t(options.width) * options.height;

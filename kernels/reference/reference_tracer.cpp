@@ -1,9 +1,9 @@
 #include "kernels/reference/reference_tracer.h"
 
-#include <chrono>
 #include <mutex>
 
 #include "kernels/camera.h"
+#include "workloads/host_clock.h"
 
 namespace sfx {
 
@@ -35,7 +35,7 @@ Vec3 trace_reference_path(const Scene& scene, const Bvh& bvh, const RenderSettin
 }
 
 RenderResult render_reference(const Scene& scene, const Bvh& bvh, const RenderSettings& settings) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     const CameraFrame camera(scene.camera, settings.width, settings.height);
     RenderResult result;
     result.image = Image(settings.width, settings.height);
@@ -57,8 +57,7 @@ RenderResult render_reference(const Scene& scene, const Bvh& bvh, const RenderSe
         std::lock_guard<std::mutex> lock(stats_mutex);
         result.stats += local;
     });
-    result.stats.host_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.stats.host_seconds = seconds_since(start);
     return result;
 }
 

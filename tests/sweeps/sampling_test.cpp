@@ -46,9 +46,33 @@ RenderSettings small_settings(const Scene& scene) {
 
 }  // namespace
 
-TEST_CASE("Normal quantiles", "[sampling]") {
+TEST_CASE("Normal and Student t quantiles", "[sampling]") {
     CHECK(normal_quantile_two_sided(0.95) == Approx(1.959964).epsilon(1e-5));
     CHECK(normal_quantile_two_sided(0.997) == Approx(2.967738).epsilon(1e-5));
+    // Tables: t(0.975; 1) = 12.7062, t(0.975; 10) = 2.2281; large df tends to z.
+    CHECK(student_t_quantile_two_sided(0.95, 1) == Approx(12.7062).epsilon(1e-5));
+    CHECK(student_t_quantile_two_sided(0.95, 10) == Approx(2.2281).epsilon(1e-4));
+    CHECK(student_t_quantile_two_sided(0.997, 1e7) == Approx(2.967738).epsilon(1e-5));
+    CHECK_THROWS(student_t_quantile_two_sided(0.95, 0));
+    CHECK_THROWS(normal_quantile_two_sided(1.0));
+}
+
+TEST_CASE("Stratified estimate: Satterthwaite degrees of freedom", "[sampling]") {
+    // Two strata of 10 units, 2 sampled each: a_h = N^2 (1 - n/N) / n = 40 for both.
+    Stratification strata;
+    strata.strata = 2;
+    strata.stratum_of = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    // Equal variances (s^2 = 2 in both): df = (2 v)^2 / (2 v^2 / 1) = 2, the pooled n - strata.
+    const Estimate equal = estimate_total(strata, {0, 1, 10, 11}, {1, 3, 5, 7}, 0.95);
+    CHECK(equal.degrees_of_freedom == Approx(2.0));
+    CHECK(equal.total == Approx(10 * 2 + 10 * 6));
+    CHECK(equal.half_width == Approx(student_t_quantile_two_sided(0.95, 2) * std::sqrt(160.0)));
+    // One stratum carries all the variance: df is that stratum's n - 1 = 1.
+    const Estimate one = estimate_total(strata, {0, 1, 10, 11}, {1, 3, 5, 5}, 0.95);
+    CHECK(one.degrees_of_freedom == Approx(1.0));
+    // No variance at all: no interval.
+    const Estimate none = estimate_total(strata, {0, 1, 10, 11}, {4, 4, 5, 5}, 0.95);
+    CHECK(none.half_width == 0.0);
 }
 
 TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity total in >= 97 of "
@@ -79,7 +103,7 @@ TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity tota
         for (uint64_t seed = 1; seed <= 100; ++seed) {
             StratifiedSampler sampler(strata, seed);
             const std::vector<uint32_t> units =
-                sampler.grow_to(uint64_t(std::ceil(fraction * population.size())));
+                sampler.grow_to(uint64_t(std::ceil(fraction * double(population.size()))));
             std::vector<double> values;
             for (uint32_t u : units) values.push_back(population[u]);
             const Estimate e = estimate_total(strata, units, values, 0.997);
@@ -88,12 +112,17 @@ TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity tota
         }
         return sum / 100.0;
     };
-    int covered_small = 0, covered_mid = 0, covered_large = 0;
+    int covered_two = 0, covered_small = 0, covered_mid = 0, covered_large = 0;
+    // Two passes per stratum (8 of 512): where a normal z interval is far too narrow.
+    const double two = mean_half_width(8.0 / double(population.size()), covered_two);
     const double small = mean_half_width(0.05, covered_small);
     const double mid = mean_half_width(0.2, covered_mid);
     const double large = mean_half_width(0.5, covered_large);
-    INFO("coverage " << covered_small << " " << covered_mid << " " << covered_large
-                     << "; half-widths " << small << " " << mid << " " << large);
+    INFO("coverage " << covered_two << " " << covered_small << " " << covered_mid << " "
+                     << covered_large << "; half-widths " << two << " " << small << " " << mid
+                     << " " << large);
+    CHECK(covered_two >= 97);
+    CHECK(two > small);
     CHECK(covered_small >= 97);
     CHECK(covered_mid >= 97);
     CHECK(covered_large >= 97);

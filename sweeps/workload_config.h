@@ -1,0 +1,91 @@
+#pragma once
+// The workload configuration: what is rendered (scene, resolution, samples, depth, tile, seed).
+// One struct whose visit() names every field with its unit, description and range, as
+// HwConfig's does; that visit() is the one list of workload fields behind the strict parsing
+// (sweep files, `--set`, stored point configurations, command-line flags), the point YAML, the
+// store's `workload.*` columns and the sweep's `workload.*` axes. resolve_workload() is the one
+// place that turns "the scene's depth" and `tile: auto` into numbers and checks the tile fits.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hw_model/hw_config.h"
+#include "kernels/render.h"
+#include "workloads/scene.h"
+
+namespace sfx {
+
+struct WorkloadConfig {
+    static constexpr int64_t k_scene_depth = -1;  // depth: the scene's own max_depth
+    static constexpr uint32_t k_auto_tile = 0;    // tile: auto
+
+    std::string scene;  // a built-in scene name or a path (absolute in a sweep's points)
+    uint32_t width = 256;
+    uint32_t height = 256;
+    uint32_t spp = 4;
+    int64_t depth = k_scene_depth;
+    uint32_t tile = 32;
+    uint64_t seed = 0;
+
+    // `special` names the word that stands for the field's sentinel value ("auto" for the tile).
+    template <class V>
+    void visit(V& v) {
+        v.text("scene", scene, "a built-in scene name or a scene file");
+        v.param("width", width, "pixels", "image width", 1, 65536);
+        v.param("height", height, "pixels", "image height", 1, 65536);
+        v.param("spp", spp, "samples", "samples per pixel", 1, 1u << 20);
+        v.param("depth", depth, "bounces", "bounces after the camera ray (default: the scene's)", 0,
+                1000);
+        v.param("tile", tile, "pixels",
+                "tile edge: the stream holds tile^2 rays (auto: the largest that fits the ray "
+                "buffer)",
+                1, 4096, "auto");
+        v.param("seed", seed, "", "random seed", 0, UINT64_MAX);
+    }
+
+    bool resolved() const { return depth >= 0 && tile != k_auto_tile; }
+    // The tracers' settings of a resolved configuration.
+    RenderSettings render_settings(uint32_t threads = 0) const;
+    // Same render: every field equal.
+    bool operator==(const WorkloadConfig& o) const;
+    bool operator!=(const WorkloadConfig& o) const { return !(*this == o); }
+};
+
+// The field names in visit() order; "res" (WxH, both width and height) is accepted besides.
+std::vector<std::string> workload_field_names();
+// Sets one field (or "res") from text, strictly: InputError(file, line, key) on an unknown
+// field or a bad value. A scene is taken as given.
+void set_workload_field(WorkloadConfig& w, const std::string& field, const std::string& value,
+                        const std::string& file, int line, const std::string& key);
+
+// One `workload.<field>` column of the results store: INTEGER for numbers, TEXT for the scene.
+struct WorkloadColumn {
+    std::string name;
+    bool integer = false;
+    int64_t number = 0;
+    std::string text;
+};
+std::vector<WorkloadColumn> workload_columns(const WorkloadConfig& w);
+
+// The largest tile whose stream fits every configuration's ray buffer: tile^2 * bytes per ray
+// <= buffer bytes.
+uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs);
+// Checks a tile against every configuration; throws InputError(key) if one cannot hold the
+// stream.
+void check_tile_fits(uint32_t tile, const FeatureSet& features,
+                     const std::vector<HwConfig>& configs, const std::string& key);
+
+struct ResolvedWorkload {
+    WorkloadConfig config;  // resolved(): a number for depth and tile
+    FeatureSet features;    // the scene's, with max_depth the resolved depth (as the model sees it)
+};
+// Depth -1 becomes the scene's max_depth; tile auto becomes the largest tile that fits every
+// configuration's ray buffer (64 when no configuration is given: the largest the paper's
+// buffers hold); then the tile is checked against every configuration. Errors are
+// InputError("command line", 0, tile_key, ...); callers with a file re-throw them with theirs.
+ResolvedWorkload resolve_workload(const WorkloadConfig& w, const FeatureSet& scene_features,
+                                  const std::vector<HwConfig>& configs,
+                                  const std::string& tile_key);
+
+}  // namespace sfx
