@@ -12,6 +12,7 @@ from typing import Callable, List
 from . import paper as paper_module
 from . import plots as plots_module
 from . import tables as tables_module
+from .progress import Steps
 from .slicing import SCENE, TILE, WIDTH
 from .store import Store, StoreError, for_display, load_store
 
@@ -141,6 +142,9 @@ def _index_html(store: Store, tables, plots, title: str) -> str:
 
 
 def write_report(db: str, directory: str) -> Report:
+    # Steps for a progress bar: the store, the tables, each plot, the files.
+    steps = Steps(3 + len(plots_module.PLOTTERS))
+    steps.start("reading the store")
     store = load_store(db)
     try:
         os.makedirs(directory, exist_ok=True)
@@ -150,8 +154,13 @@ def write_report(db: str, directory: str) -> Report:
     if not os.path.isdir(directory):
         raise StoreError(f"{directory}: not a directory")
 
+    steps.start("tables")
     tables = tables_module.build_tables(store)
-    plots = plots_module.make_plots(store, directory)
+    plots = []
+    for plotter in plots_module.PLOTTERS:
+        steps.start("plot " + plotter.__name__[len("plot_"):])
+        plots.append(plotter(store, directory))
+    steps.start("writing the files")
     title = f"sfx report: {os.path.basename(db)}"
 
     tables_md = os.path.join(directory, "tables.md")
@@ -165,4 +174,5 @@ def write_report(db: str, directory: str) -> Report:
     index = os.path.join(directory, "index.html")
     with open(index, "w", encoding="utf-8") as f:
         f.write(_index_html(store, tables, plots, title))
+    steps.finish()
     return Report(directory, index, tables_md, points_csv, tables, plots, store)
