@@ -1,6 +1,6 @@
 """The report's plots (PNG, matplotlib's Agg backend). A plot with no data is skipped with a
 reason, never drawn empty. Error bars show fps × error.relative where the model reported an
-interval (error.relative >= 0)."""
+interval (error.relative > 0)."""
 
 from __future__ import annotations
 
@@ -58,10 +58,11 @@ def _save(fig, directory: str, name: str) -> str:
 
 
 def _fps_error(frame: pd.DataFrame) -> pd.Series:
-    """Half-width of the fps interval: fps × error.relative where known, NaN elsewhere."""
+    """Half-width of the fps interval: fps × error.relative where the model reported a
+    non-zero interval, NaN elsewhere (full fidelity is exact: no bar)."""
     if "error.relative" not in frame.columns:
         return pd.Series(np.nan, index=frame.index)
-    rel = frame["error.relative"].where(frame["error.relative"] >= 0)
+    rel = frame["error.relative"].where(frame["error.relative"] > 0)
     return frame["fps"] * rel
 
 
@@ -136,7 +137,8 @@ def plot_utilization_vs_width(store: Store, directory: str) -> Plot:
     panels = [(s, t) for s in sorted(data[SCENE].unique())
               for t in sorted(data[data[SCENE] == s][TILE].unique())]
     tiles = sorted(data[TILE].unique())
-    fig, axes = _subplots(len(panels), ncols=len(tiles) if len(tiles) > 1 else 3)
+    # A row per scene while the tiles fit on one; three columns beyond that.
+    fig, axes = _subplots(len(panels), ncols=len(tiles) if 1 < len(tiles) <= 4 else 3)
     colors = {s: f"C{i}" for i, s in enumerate(STAGES)}
     for ax, (scene, tile) in zip(axes, panels):
         d = data[(data[SCENE] == scene) & (data[TILE] == tile)].sort_values(WIDTH)
