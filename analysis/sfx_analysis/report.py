@@ -21,7 +21,9 @@ body { font-family: sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 
        color: #222; }
 h1 { font-size: 1.6em; } h2 { margin-top: 2em; border-bottom: 1px solid #ccc; }
 table.paper { border-collapse: collapse; margin: 1.5em 0 0.5em; }
-table.paper caption { text-align: left; padding-bottom: 0.4em; max-width: 800px; }
+table.paper { display: block; }  /* a block: the caption is not squeezed to the table */
+table.paper caption { display: block; text-align: left; padding-bottom: 0.4em;
+                      max-width: 800px; }
 table.paper th, table.paper td { border: 1px solid #bbb; padding: 0.2em 0.7em;
                                  text-align: right; }
 table.paper tr.section th { text-align: left; background: #f0f0f0; font-style: italic; }
