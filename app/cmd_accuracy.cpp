@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/progress.h"
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
 #include "workloads/input_error.h"
@@ -75,13 +76,23 @@ void add_accuracy_command(CLI::App& app) {
         base.target_error = 0.0;
 
         std::vector<AccuracyRow> rows;
+        const size_t levels = 7;  // the run() calls below
         auto run = [&](const std::string& name, Fidelity f, const SamplingOptions& s) {
-            std::cerr << "accuracy: " << name << "...\n";
+            // Each level from scratch: its own bar, in the tile passes it traces.
+            Progress progress("accuracy", 0, "tile passes");
+            progress.set_label(name + " (" + std::to_string(rows.size() + 1) + "/" +
+                               std::to_string(levels) + ")");
             AccuracyRow row;
             row.fidelity = name;
             row.sample_fraction = s.fraction;
             row.target_error = s.target_error;
-            row.prediction = run_point_group(scene, bvh, settings, configs, f, s).predictions[0];
+            row.prediction = run_point_group(scene, bvh, settings, configs, f, s,
+                                             [&](uint64_t done, uint64_t total) {
+                                                 progress.set_total(total);
+                                                 progress.set_done(done);
+                                             })
+                                 .predictions[0];
+            progress.finish();
             // The share of tile passes timed at cycle level (analytic: its calibration sample).
             row.sample_fraction = double(row.prediction.sample_passes) /
                                   double(std::max<uint64_t>(1, row.prediction.total_passes));

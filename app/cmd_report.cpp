@@ -1,7 +1,8 @@
 // sfx report DB -o DIR: tables and plots from a results store; sfx report DB --paper PAGE.md: the
 // comparison with the paper (docs/paper-check.md). The work is Python (analysis/sfx_analysis,
-// pandas and matplotlib); this command only finds it and runs it.
+// pandas and matplotlib); this command finds it, runs it and shows its progress.
 
+#include <poll.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,10 +12,12 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "app/commands.h"
+#include "app/progress.h"
 #include "workloads/input_error.h"
 
 #ifndef SFX_ANALYSIS_DIR
@@ -32,20 +35,81 @@ std::string env_or(const char* name, const std::string& fallback) {
     return v && *v ? std::string(v) : fallback;
 }
 
-// Runs argv, waits, returns its exit code (128 + signal when killed).
-int run(const std::vector<std::string>& args) {
+// Writes all of data to fd (the child's output passed through).
+void write_all(int fd, const char* data, size_t size) {
+    while (size > 0) {
+        const ssize_t n = write(fd, data, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return;
+        data += n;
+        size -= size_t(n);
+    }
+}
+
+// Runs argv, waits, returns its exit code (128 + signal when killed). The child reports its
+// steps as "DONE TOTAL LABEL" lines on the pipe named by SFX_PROGRESS_FD (see
+// analysis/sfx_analysis/progress.py), drawn here by the progress display all sfx commands
+// share; its stdout and stderr come through pipes too, so the bar is cleared before its output.
+int run(const std::vector<std::string>& args, Progress& progress) {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
     std::cout.flush();
+    int steps[2], out[2], err[2];
+    if (pipe(steps) != 0 || pipe(out) != 0 || pipe(err) != 0)
+        throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+    setenv("SFX_PROGRESS_FD", std::to_string(steps[1]).c_str(), 1);
     const pid_t pid = fork();
     if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
     if (pid == 0) {
+        dup2(out[1], 1);
+        dup2(err[1], 2);
+        for (int fd : {steps[0], out[0], out[1], err[0], err[1]}) close(fd);
         execv(argv[0], argv.data());
         std::cerr << "sfx report: cannot run " << args[0] << ": " << std::strerror(errno)
                   << " (install python3-pandas python3-matplotlib: ./scripts/install-deps)\n";
         _exit(127);
     }
+    for (int fd : {steps[1], out[1], err[1]}) close(fd);
+    // fds[1] and fds[2] are passed through to this process's fd 1 and 2.
+    std::vector<pollfd> fds = {{steps[0], POLLIN, 0}, {out[0], POLLIN, 0}, {err[0], POLLIN, 0}};
+    std::string pending;  // step lines not yet complete
+    char buffer[4096];
+    for (size_t open = fds.size(); open > 0;) {
+        if (poll(fds.data(), fds.size(), -1) < 0) {
+            if (errno == EINTR) continue;
+            throw std::runtime_error(std::string("poll: ") + std::strerror(errno));
+        }
+        for (size_t i = 0; i < fds.size(); ++i) {
+            if (fds[i].fd < 0 || !(fds[i].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+            const ssize_t n = read(fds[i].fd, buffer, sizeof buffer);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                close(fds[i].fd);
+                fds[i].fd = -1;
+                --open;
+                continue;
+            }
+            if (i > 0) {
+                progress.clear();
+                write_all(int(i), buffer, size_t(n));
+                continue;
+            }
+            pending.append(buffer, size_t(n));
+            for (size_t end; (end = pending.find('\n')) != std::string::npos;
+                 pending.erase(0, end + 1)) {
+                std::istringstream line(pending.substr(0, end));
+                uint64_t done = 0, total = 0;
+                std::string label;
+                if (!(line >> done >> total)) continue;
+                std::getline(line >> std::ws, label);
+                progress.set_total(total);
+                progress.set_done(done);
+                progress.set_label(label);  // draws at once on a terminal
+            }
+        }
+    }
+    progress.finish();
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
         if (errno != EINTR)
@@ -101,7 +165,8 @@ void add_report_command(CLI::App& app) {
                 args.insert(args.end(), {"--trace-stats", options->trace_stats});
         }
         if (options->quiet) args.push_back("--quiet");
-        const int code = run(args);
+        Progress progress("report", 0, "steps");
+        const int code = run(args, progress);
         // The exit code passes through: 2 for a store that cannot be reported on.
         if (code != 0) std::exit(code);
     });

@@ -2,11 +2,12 @@
 // and operation mix. Several configurations share one functional render (trace once, time many).
 
 #include <iomanip>
-#include <sstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "app/commands.h"
+#include "app/progress.h"
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
 #include "workloads/input_error.h"
@@ -107,9 +108,16 @@ void add_simulate_command(CLI::App& app) {
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
+        Progress progress("simulate", 0, "tile passes");
+        progress.set_label(o->fidelity + " fidelity, " + std::to_string(configs.size()) +
+                           (configs.size() == 1 ? " configuration" : " configurations"));
         const PointGroupResult r =
             run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity),
-                            o->sampling.resolve(settings.seed));
+                            o->sampling.resolve(settings.seed), [&](uint64_t done, uint64_t total) {
+                                progress.set_total(total);
+                                progress.set_done(done);
+                            });
+        progress.finish();
         if (o->json) {
             if (r.predictions.size() == 1) {
                 std::cout << prediction_json(r.predictions[0]).dump(2) << "\n";

@@ -9,6 +9,7 @@
 #endif
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -20,6 +21,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/progress.h"
 #include "sweeps/engine.h"
 #include "sweeps/group_runner.h"
 #include "sweeps/results_store.h"
@@ -36,14 +38,6 @@ std::string fixed(double v, int digits) {
     return s.str();
 }
 
-std::string duration_text(double seconds) {
-    if (!(seconds >= 0) || seconds > 1e7) return "?";
-    const long s = long(std::lround(seconds));
-    if (s < 60) return std::to_string(s) + "s";
-    if (s < 3600) return std::to_string(s / 60) + "m" + (s % 60 < 10 ? "0" : "") + std::to_string(s % 60) + "s";
-    return std::to_string(s / 3600) + "h" + (s % 3600 / 60 < 10 ? "0" : "") + std::to_string(s % 3600 / 60) + "m";
-}
-
 std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
     const SweepPoint& p = sweep.points[points.front()];
     std::string scene = p.workload.scene;
@@ -55,55 +49,6 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
            to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
            (points.size() == 1 ? "" : "s") + ")";
 }
-
-// Points done / total, ETA and the current group: rewritten in place on a terminal, one line
-// per finished group otherwise (logs, CI).
-class Progress {
-public:
-    Progress(size_t total, bool enabled)
-        : m_total(total), m_enabled(enabled), m_tty(isatty(2)), m_start(HostClock::now()) {}
-    void started(const std::string& label) {
-        m_current = label;
-        if (m_tty) draw();
-    }
-    void points_done(size_t n) { m_done += n; }
-    void group_finished(const std::string& label, bool ok) {
-        if (!m_enabled) return;
-        if (m_tty) {
-            if (!ok) std::cerr << "\r\033[K";
-            draw();
-        } else {
-            std::cerr << "sweep: " << (ok ? "done " : "FAILED ") << label << "  [" << m_done << "/"
-                      << m_total << " points, " << duration_text(elapsed()) << " elapsed, ETA "
-                      << eta() << "]\n";
-        }
-    }
-    void finish() {
-        if (m_enabled && m_tty) std::cerr << "\r\033[K";
-    }
-    double elapsed() const { return seconds_since(m_start); }
-
-private:
-    std::string eta() const {
-        if (m_done == 0) return "?";
-        return duration_text(elapsed() / double(m_done) * double(m_total - m_done));
-    }
-    void draw() {
-        if (!m_enabled) return;
-        const int bar = 24;
-        const int filled = m_total ? int(bar * m_done / m_total) : bar;
-        std::string line = "[" + std::string(size_t(filled), '#') + std::string(size_t(bar - filled), '.') + "] " +
-                           std::to_string(m_done) + "/" + std::to_string(m_total) + " ETA " + eta() + "  " +
-                           m_current;
-        if (line.size() > 110) line.resize(110);
-        std::cerr << "\r\033[K" << line << std::flush;
-    }
-
-    size_t m_total, m_done = 0;
-    bool m_enabled, m_tty;
-    HostClock::time_point m_start;
-    std::string m_current;
-};
 
 struct Failure {
     size_t group;
@@ -227,12 +172,14 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
                                                                std::to_string(group_threads) + " threads"
                                                          : "Dask at " + scheduler)
                   << "\n";
-    Progress progress(pending_points, true);
+    // Points done / total, ETA and the running group: a bar on a terminal, else one line per
+    // finished group.
+    Progress progress("sweep", pending_points, "points", 0.0);
     std::set<std::string> ran;
     std::vector<Failure> failures;
     std::vector<size_t> rows_of_group(sweep.groups.size(), 0);
     EngineEvents events;
-    events.started = [&](size_t g) { progress.started(group_label(sweep, pending[g])); };
+    events.started = [&](size_t g) { progress.set_label(group_label(sweep, pending[g])); };
     events.row = [&](size_t g, const PointRun& run) {
         auto it = point_of_key.find(run.key);
         if (it == point_of_key.end() ||
@@ -243,18 +190,24 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
         store.write_point(sweep.points[it->second], sweep.name, run);
         if (ran.insert(run.key).second) {
             ++rows_of_group[g];
-            progress.points_done(1);
+            progress.advance(1);
         }
     };
     events.finished = [&](size_t g) {
         if (rows_of_group[g] != pending[g].size())
             failures.push_back({g, 1, "returned " + std::to_string(rows_of_group[g]) + " of " +
                                           std::to_string(pending[g].size()) + " rows"});
-        progress.group_finished(group_label(sweep, pending[g]), true);
+        if (!progress.terminal())
+            progress.log("sweep: done " + group_label(sweep, pending[g]) + "  " +
+                         progress.status());
     };
     events.failed = [&](size_t g, int code, const std::string& message) {
         failures.push_back({g, code, message});
-        progress.group_finished(group_label(sweep, pending[g]), false);
+        if (progress.terminal())
+            progress.clear();
+        else
+            progress.log("sweep: FAILED " + group_label(sweep, pending[g]) + "  " +
+                         progress.status());
     };
     if (!todo.empty()) {
         if (engine == "local") run_local(todo, parallel, self_executable(), events);

@@ -44,6 +44,19 @@ void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t wi
     }
 }
 
+// Counts finished passes for a PassProgress (the trace arrives in order, one pass at a time).
+class ProgressSink : public TraceSink {
+public:
+    ProgressSink(const PassProgress& progress, uint64_t total)
+        : m_progress(progress), m_total(total) {}
+    void op(const StreamOp&) override {}
+    void end_pass(const TilePass&) override { m_progress(++m_done, m_total); }
+
+private:
+    const PassProgress& m_progress;
+    uint64_t m_total, m_done = 0;
+};
+
 // Sums the lanes of a pass: the pilot's cost estimate of a tile.
 class LaneCounter : public TraceSink {
 public:
@@ -141,7 +154,8 @@ private:
 };
 
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
-                             const std::vector<HwConfig>& configs, const SamplingOptions& opt) {
+                             const std::vector<HwConfig>& configs, const SamplingOptions& opt,
+                             const PassProgress& progress) {
     const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
@@ -228,6 +242,7 @@ PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSet
                     per_unit[c].push_back(timing_between(before[c], timing.timing(c)));
                 sampled.push_back(batch[first + i]);
             }
+            if (progress) progress(sampled.size(), std::max<uint64_t>(target, sampled.size()));
         }
         double worst = 0.0;
         for (size_t c = 0; c < configs.size(); ++c) {
@@ -282,11 +297,11 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     return shape;
 }
 
-PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
-                                 const RenderSettings& settings,
+PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
-                                 const SamplingOptions& sampling) {
-    if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);
+                                 const SamplingOptions& sampling, const PassProgress& progress) {
+    if (fidelity == Fidelity::sampled)
+        return run_sampled(scene, bvh, settings, configs, sampling, progress);
     const auto start = HostClock::now();
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
     check_tile_fits(settings.tile, shape.features, configs, "--tile");
@@ -309,6 +324,14 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     } else {
         systemc = std::make_unique<SystemcTiming>(configs, shape);
         fan.add(systemc.get());
+    }
+    std::unique_ptr<ProgressSink> progress_sink;  // last: counts a pass once it is timed
+    if (progress) {
+        const uint64_t passes =
+            uint64_t(make_tiles(settings.width, settings.height, settings.tile).size()) *
+            settings.spp;
+        progress_sink = std::make_unique<ProgressSink>(progress, passes);
+        fan.add(progress_sink.get());
     }
     PointGroupResult result;
     result.render = render_stream(scene, bvh, settings, &fan).stats;

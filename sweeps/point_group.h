@@ -3,6 +3,7 @@
 // tracer, its trace timed on every hardware configuration of the group (trace once, time
 // many). This is where the tracer and the hardware model meet; neither knows the other.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,12 +27,16 @@ struct PointGroupResult {
     double host_seconds = 0.0;            // the whole group
 };
 
+// Told (tile passes done, tile passes to do) as the work advances, from one thread at a
+// time; the total of a sampled run grows when it adapts to a target error.
+using PassProgress = std::function<void(uint64_t done, uint64_t total)>;
+
 // Analytic: the closed form over the whole frame's trace. Full: every tile pass at cycle
 // level. Sampled: a stratified sample of tile passes at cycle level (see sweeps/sampling.h),
 // extrapolated with a confidence interval on frame cycles.
-PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
-                                 const RenderSettings& settings,
+PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
-                                 const SamplingOptions& sampling = {});
+                                 const SamplingOptions& sampling = {},
+                                 const PassProgress& progress = {});
 
 }  // namespace sfx

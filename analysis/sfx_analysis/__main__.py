@@ -8,6 +8,7 @@ import argparse
 import os
 import sys
 
+from .slicing import fidelity_rank
 from .store import StoreError, load_store
 from .tables import build_tables, tables_markdown, to_markdown
 
@@ -21,6 +22,8 @@ def _report(args) -> int:
     if not args.quiet:
         fps = [t for t in report.tables if t.ident.startswith("table6")]
         if fps:
+            # The block at the most accurate fidelity (the sweep's reference) is printed.
+            fps.sort(key=lambda t: -fidelity_rank(str(t.context.get("fidelity", "full"))))
             print(to_markdown(fps[0]))
             if len(fps) > 1:
                 print(f"({len(fps) - 1} more block(s) of Table 6, one per configuration, in "

@@ -1,6 +1,6 @@
 """The report's plots (PNG, matplotlib's Agg backend). A plot with no data is skipped with a
 reason, never drawn empty. Error bars show fps × error.relative where the model reported an
-interval (error.relative >= 0)."""
+interval (error.relative > 0)."""
 
 from __future__ import annotations
 
@@ -58,10 +58,11 @@ def _save(fig, directory: str, name: str) -> str:
 
 
 def _fps_error(frame: pd.DataFrame) -> pd.Series:
-    """Half-width of the fps interval: fps × error.relative where known, NaN elsewhere."""
+    """Half-width of the fps interval: fps × error.relative where the model reported a
+    non-zero interval, NaN elsewhere (full fidelity is exact: no bar)."""
     if "error.relative" not in frame.columns:
         return pd.Series(np.nan, index=frame.index)
-    rel = frame["error.relative"].where(frame["error.relative"] >= 0)
+    rel = frame["error.relative"].where(frame["error.relative"] > 0)
     return frame["fps"] * rel
 
 
@@ -136,7 +137,8 @@ def plot_utilization_vs_width(store: Store, directory: str) -> Plot:
     panels = [(s, t) for s in sorted(data[SCENE].unique())
               for t in sorted(data[data[SCENE] == s][TILE].unique())]
     tiles = sorted(data[TILE].unique())
-    fig, axes = _subplots(len(panels), ncols=len(tiles) if len(tiles) > 1 else 3)
+    # A row per scene while the tiles fit on one; three columns beyond that.
+    fig, axes = _subplots(len(panels), ncols=len(tiles) if 1 < len(tiles) <= 4 else 3)
     colors = {s: f"C{i}" for i, s in enumerate(STAGES)}
     for ax, (scene, tile) in zip(axes, panels):
         d = data[(data[SCENE] == scene) & (data[TILE] == tile)].sort_values(WIDTH)
@@ -186,7 +188,8 @@ def plot_stalls(store: Store, directory: str) -> Plot:
             bottom += v
         ax.set_xticks(x)
         ax.set_xticklabels([f"N={_n(w)}\n{_n(t)}×{_n(t)}" for t, w in zip(d[TILE], d[WIDTH])],
-                           fontsize="small")
+                           fontsize="small" if len(d) <= 8 else "x-small",
+                           rotation=0 if len(d) <= 8 else 90)
         ax.set_title(scene)
         ax.set_xlabel("SIMD width, tile")
         ax.set_ylabel(f"stall cycles per frame [{unit}]")
@@ -201,6 +204,13 @@ def plot_stalls(store: Store, directory: str) -> Plot:
     return plot
 
 
+def _best_tile_per_buffer(data: pd.DataFrame) -> pd.DataFrame:
+    """Per scene, SIMD width and ray-buffer size, the row with the highest fps over the tiles
+    the store has (a buffer holds any tile up to the largest that fits: `tile: auto`)."""
+    best = data.sort_values("fps", ascending=False, kind="mergesort")
+    return best.drop_duplicates(subset=[SCENE, WIDTH, KIB], keep="first")
+
+
 def plot_fps_vs_buffer(store: Store, directory: str) -> Plot:
     plot = Plot("fps_vs_buffer", "Predicted frame rate against ray-buffer size")
     data = _with(store.points, ["fps", KIB])
@@ -208,33 +218,56 @@ def plot_fps_vs_buffer(store: Store, directory: str) -> Plot:
         plot.skipped = f"the store has no fps or {KIB} values"
         return plot
     context, data = dominant_context(data, TABLE_KEY + [KIB])
-    if data.groupby(TABLE_KEY)[KIB].nunique().max() < 2:
-        sizes = ", ".join(_n(k) for k in sorted(data[KIB].unique()))
-        plot.skipped = f"needs two ray-buffer sizes for one configuration; the store has " \
-                       f"{sizes} KiB"
-        return plot
+    # A fixed tile at several buffer sizes gives one line per (tile, width); a tile that
+    # follows the buffer (`tile: auto`, the paper's question) one line per width through the
+    # best tile at each size.
+    fixed_tile = data.groupby(TABLE_KEY)[KIB].nunique().max() >= 2
+    if not fixed_tile:
+        if data.groupby([SCENE, WIDTH])[KIB].nunique().max() < 2:
+            sizes = ", ".join(_n(k) for k in sorted(data[KIB].unique()))
+            plot.skipped = f"needs two ray-buffer sizes for one scene and SIMD width; the " \
+                           f"store has {sizes} KiB"
+            return plot
+        data = _best_tile_per_buffer(data)
     scenes = sorted(data[SCENE].unique())
     fig, axes = _subplots(len(scenes))
     any_error = False
     for ax, scene in zip(axes, scenes):
         at_scene = data[data[SCENE] == scene]
-        for (tile, width), d in at_scene.groupby([TILE, WIDTH]):
+        lines = at_scene.groupby([TILE, WIDTH]) if fixed_tile else at_scene.groupby(WIDTH)
+        for key, d in lines:
             d = d.sort_values(KIB)
-            any_error |= _line_with_errors(ax, d[KIB], d["fps"], _fps_error(d),
-                                           label=f"N={_n(width)}, {_n(tile)}×{_n(tile)}")
+            if fixed_tile:
+                tile, width = key
+                label = f"N={_n(width)}, {_n(tile)}×{_n(tile)}"
+            else:
+                label = f"N={_n(key)}"
+            if len(d) < 2:
+                continue
+            any_error |= _line_with_errors(ax, d[KIB], d["fps"], _fps_error(d), label=label)
+            if not fixed_tile:
+                for _, r in d.iterrows():
+                    ax.annotate(f"{_n(r[TILE])}²", (r[KIB], r["fps"]),
+                                textcoords="offset points", xytext=(4, -10),
+                                fontsize="x-small")
         ax.set_xscale("log", base=2)
         ticks = sorted(at_scene[KIB].unique())
         ax.set_xticks(ticks)
         ax.set_xticklabels([_n(t) for t in ticks])
+        ax.minorticks_off()
         ax.set_title(scene)
         ax.set_xlabel("ray-buffer size [KiB per buffer]")
         ax.set_ylabel("predicted fps [frames/s]")
         ax.set_ylim(bottom=0)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize="x-small")
+        ax.legend(fontsize="x-small", loc="lower right")
     fig.suptitle(plot.title)
     plot.file = _save(fig, directory, plot.name)
-    plot.caption = ("One line per SIMD width and tile." +
+    plot.caption = (("One line per SIMD width and tile: what a bigger buffer buys at a fixed "
+                     "stream size." if fixed_tile else
+                     "One line per SIMD width through the best tile the store has at each "
+                     "buffer size (labels: the tile); a bigger buffer holds a longer initial "
+                     "stream, which keeps the SIMD lanes fuller.") +
                     (" Error bars: the model's fps interval." if any_error else "") +
                     _context_caption(context))
     return plot

@@ -7,11 +7,12 @@ import datetime
 import html
 import os
 from dataclasses import dataclass
-from typing import List
+from typing import Callable, List
 
 from . import paper as paper_module
 from . import plots as plots_module
 from . import tables as tables_module
+from .progress import Steps
 from .slicing import SCENE, TILE, WIDTH
 from .store import Store, StoreError, for_display, load_store
 
@@ -20,7 +21,9 @@ body { font-family: sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 
        color: #222; }
 h1 { font-size: 1.6em; } h2 { margin-top: 2em; border-bottom: 1px solid #ccc; }
 table.paper { border-collapse: collapse; margin: 1.5em 0 0.5em; }
-table.paper caption { text-align: left; padding-bottom: 0.4em; max-width: 800px; }
+table.paper { display: block; }  /* a block: the caption is not squeezed to the table */
+table.paper caption { display: block; text-align: left; padding-bottom: 0.4em;
+                      max-width: 800px; }
 table.paper th, table.paper td { border: 1px solid #bbb; padding: 0.2em 0.7em;
                                  text-align: right; }
 table.paper tr.section th { text-align: left; background: #f0f0f0; font-style: italic; }
@@ -49,8 +52,10 @@ class Report:
 
 
 def _values(store: Store, column: str) -> str:
-    values = sorted(store.points[column].dropna().unique(), key=str) \
-        if column in store.points.columns else []
+    values = list(store.points[column].dropna().unique()) if column in store.points.columns \
+        else []
+    # Numbers in numeric order (32 before 104), text alphabetically.
+    values.sort(key=lambda v: (0, float(v), "") if not isinstance(v, str) else (1, 0.0, v))
     texts = []
     for v in values:
         f = v if isinstance(v, str) else float(v)
@@ -72,11 +77,9 @@ def _summary_rows(store: Store) -> List[tuple]:
     return rows
 
 
-def _index_html(store: Store, tables, plots, title: str) -> str:
+def _summary_section(store: Store, tables, plots) -> str:
     e = html.escape
-    out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-           f"<title>{e(title)}</title>", f"<style>{_CSS}</style>", "</head><body>",
-           f"<h1>{e(title)}</h1>", '<table class="summary">']
+    out = ['<table class="summary">']
     for k, v in _summary_rows(store):
         out.append(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>")
     out.append("</table>")
@@ -85,8 +88,12 @@ def _index_html(store: Store, tables, plots, title: str) -> str:
     out.append('<p>Also here: <a href="tables.md">tables.md</a> (the tables in Markdown) and '
                '<a href="points.csv">points.csv</a> (every point, one row each, units in the '
                'column names).</p>')
+    return "\n".join(out)
 
-    out.append("<h2>Plots</h2>")
+
+def _plots_section(store: Store, tables, plots) -> str:
+    e = html.escape
+    out = ["<h2>Plots</h2>"]
     drawn = [p for p in plots if p.file]
     skipped = [p for p in plots if not p.file]
     for p in drawn:
@@ -97,14 +104,39 @@ def _index_html(store: Store, tables, plots, title: str) -> str:
         for p in skipped:
             out.append(f"<li><b>{e(p.title)}</b>: {e(p.skipped)}</li>")
         out.append("</ul>")
+    return "\n".join(out)
 
-    out.append("<h2>Tables</h2>")
-    out.append("<p>In the layout of Gribble &amp; Ramani, <i>Coherent Ray Tracing via Stream "
-               "Filtering</i> (RT 2008), Tables 2&ndash;6, from the points in this store. "
-               f"{tables_module.MISSING} marks a cell the store has no value for.</p>")
+
+def _tables_section(store: Store, tables, plots) -> str:
+    out = ["<h2>Tables</h2>",
+           "<p>In the layout of Gribble &amp; Ramani, <i>Coherent Ray Tracing via Stream "
+           "Filtering</i> (RT 2008), Tables 2&ndash;6, from the points in this store. "
+           f"{tables_module.MISSING} marks a cell the store has no value for.</p>"]
     for t in tables:
         out.append(tables_module.to_html(t))
-    out.append(paper_module.html_section(store))  # empty without the paper's scenes
+    return "\n".join(out)
+
+
+def _paper_section(store: Store, tables, plots) -> str:
+    return paper_module.html_section(store)  # empty without the paper's scenes
+
+
+# The page, top to bottom: each section is a function (store, tables, plots) -> HTML. A new
+# kind of answer adds its function here.
+SECTIONS: List[Callable[[Store, list, list], str]] = [
+    _summary_section,
+    _plots_section,
+    _tables_section,
+    _paper_section,
+]
+
+
+def _index_html(store: Store, tables, plots, title: str) -> str:
+    e = html.escape
+    out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+           f"<title>{e(title)}</title>", f"<style>{_CSS}</style>", "</head><body>",
+           f"<h1>{e(title)}</h1>"]
+    out.extend(section(store, tables, plots) for section in SECTIONS)
     generated = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     out.append(f"<p><small>Generated by sfx_analysis on {e(generated)}.</small></p>")
     out.append("</body></html>")
@@ -112,6 +144,9 @@ def _index_html(store: Store, tables, plots, title: str) -> str:
 
 
 def write_report(db: str, directory: str) -> Report:
+    # Steps for a progress bar: the store, the tables, each plot, the files.
+    steps = Steps(3 + len(plots_module.PLOTTERS))
+    steps.start("reading the store")
     store = load_store(db)
     try:
         os.makedirs(directory, exist_ok=True)
@@ -121,8 +156,13 @@ def write_report(db: str, directory: str) -> Report:
     if not os.path.isdir(directory):
         raise StoreError(f"{directory}: not a directory")
 
+    steps.start("tables")
     tables = tables_module.build_tables(store)
-    plots = plots_module.make_plots(store, directory)
+    plots = []
+    for plotter in plots_module.PLOTTERS:
+        steps.start("plot " + plotter.__name__[len("plot_"):])
+        plots.append(plotter(store, directory))
+    steps.start("writing the files")
     title = f"sfx report: {os.path.basename(db)}"
 
     tables_md = os.path.join(directory, "tables.md")
@@ -136,4 +176,5 @@ def write_report(db: str, directory: str) -> Report:
     index = os.path.join(directory, "index.html")
     with open(index, "w", encoding="utf-8") as f:
         f.write(_index_html(store, tables, plots, title))
+    steps.finish()
     return Report(directory, index, tables_md, points_csv, tables, plots, store)

@@ -88,6 +88,16 @@ def grid_points(kibs=(512.0,)):
             for kib in kibs]
 
 
+def accuracy_store(tmp_path):
+    """Every plot of the report has data: two ray-buffer sizes, and one configuration at three
+    fidelities."""
+    points = grid_points(kibs=(128.0, 512.0))
+    for fidelity, fps, err, host in [("sampled", 26.0, 0.05, 0.5), ("full", 25.0, 0.0, 5.0)]:
+        points.append(point("rtrt", 32, 16, 512.0, fps=fps, fidelity=fidelity,
+                            **{"error.relative": err, "host_seconds": host}))
+    return write_store(str(tmp_path / "acc.db"), points)
+
+
 @pytest.fixture
 def grid_store(tmp_path):
     return write_store(str(tmp_path / "grid.db"), grid_points())

@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from conftest import grid_points, point, write_store
+from conftest import accuracy_store, grid_points, point, write_store
 from sfx_analysis.plots import pareto_front
 from sfx_analysis.report import write_report
 
@@ -20,14 +20,6 @@ def png_size(path):
         head = f.read(24)
     assert head[:8] == PNG_SIGNATURE and head[12:16] == b"IHDR"
     return struct.unpack(">II", head[16:24])
-
-
-def accuracy_store(tmp_path):
-    points = grid_points(kibs=(128.0, 512.0))
-    for fidelity, fps, err, host in [("sampled", 26.0, 0.05, 0.5), ("full", 25.0, 0.0, 5.0)]:
-        points.append(point("rtrt", 32, 16, 512.0, fps=fps, fidelity=fidelity,
-                            **{"error.relative": err, "host_seconds": host}))
-    return write_store(str(tmp_path / "acc.db"), points)
 
 
 def test_every_plot_drawn_and_valid(tmp_path):
@@ -60,6 +52,21 @@ def test_index_references_only_existing_files(tmp_path):
     assert "<table" in html and "Table 6" in html
     # Seven tables per context; contexts: 128 KiB analytic, 512 KiB at each of three fidelities.
     assert open(report.tables_md, encoding="utf-8").read().count("### Table") == 28
+
+
+def test_fps_vs_buffer_when_the_tile_follows_the_buffer(tmp_path):
+    # tile: auto: each buffer size has its own tile, so no (scene, tile, width) has two sizes;
+    # the plot draws one line per width through the best tile at each size.
+    points = [point(scene, tile, width, kib)
+              for scene in ["rtrt", "conference"] for width in [8, 16]
+              for kib, tile in [(128.0, 36), (256.0, 52), (512.0, 73)]]
+    report = write_report(write_store(str(tmp_path / "auto.db"), points), str(tmp_path / "r"))
+    plot = {p.name: p for p in report.plots}["fps_vs_buffer"]
+    assert plot.file and "best tile" in plot.caption, plot.skipped
+    one_size = [point("rtrt", tile, 16, 512.0) for tile in [32, 64]]
+    report = write_report(write_store(str(tmp_path / "one.db"), one_size), str(tmp_path / "r1"))
+    plot = {p.name: p for p in report.plots}["fps_vs_buffer"]
+    assert plot.file is None and "two ray-buffer sizes" in plot.skipped
 
 
 def test_pareto_front():

@@ -224,7 +224,8 @@ TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
 }
 
 TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {
-    const std::map<std::string, size_t> expected = {{"quickstart", 16},
+    const std::map<std::string, size_t> expected = {{"quickstart", 48},
+                                                    {"quickstart-buffer", 16},
                                                     {"paper-table6", 18},
                                                     {"buffer-size", 16},
                                                     {"width-scan", 192}};
@@ -243,8 +244,14 @@ TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {
     }
     CHECK(found == expected.size());
     const Sweep q = load_sweep(SFX_SOURCE_DIR "/sweeps/quickstart.sweep.yaml");
-    CHECK(q.groups.size() == 4);  // scenes x tiles; the widths share renders
+    CHECK(q.groups.size() == 12);  // scenes x tiles x fidelities; the widths share renders
     std::set<std::string> scenes;
     for (const SweepPoint& p : q.points) scenes.insert(p.workload.scene);
     CHECK(scenes.size() == 2);
+    // The buffer sweep: tile auto gives each buffer size its own tile, so its own render.
+    const Sweep b = load_sweep(SFX_SOURCE_DIR "/sweeps/quickstart-buffer.sweep.yaml");
+    CHECK(b.groups.size() == 8);
+    std::set<uint32_t> tiles;
+    for (const SweepPoint& p : b.points) tiles.insert(p.workload.tile);
+    CHECK(tiles == std::set<uint32_t>{36, 52, 73, 104});
 }
