@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "sweeps/group_runner.h"
+#include "tests/temp_dir.h"
 #include "sweeps/results_store.h"
 #include "sweeps/store_compare.h"
 #include "sweeps/sweep.h"
@@ -21,16 +22,6 @@ using namespace sfx;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("sfx-store-test-" + std::to_string(getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
 
 Sweep small_sweep(const std::string& fidelity = "analytic") {
     return parse_sweep("version: 1\nhw: gr08.hw.yaml\n"
