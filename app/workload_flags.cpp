@@ -10,7 +10,7 @@ namespace sfx {
 void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--res", res, "image size WxH")->capture_default_str();
     c->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
-    c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
+    depth_flag = c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
     c->add_option("--threads", threads, "worker threads (0: all cores)")->capture_default_str();
@@ -26,9 +26,9 @@ RenderSettings WorkloadFlags::resolve(const Scene& scene) const {
     s.width = w;
     s.height = h;
     s.spp = spp;
-    if (depth < -1 || depth > 1000)
+    if (depth > 1000)
         throw InputError("command line", 0, "--depth", "expected 0..1000, got " + std::to_string(depth));
-    s.max_depth = depth < 0 ? scene.max_depth : uint32_t(depth);
+    s.max_depth = depth_flag && depth_flag->count() ? depth : scene.max_depth;
     if (tile == "auto") {
         s.tile = 64;  // the largest the paper's buffers hold; the hardware model refines this
     } else {
