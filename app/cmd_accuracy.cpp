@@ -15,6 +15,7 @@
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 #include "workloads/scene_loader.h"
 
 #ifndef SFX_ACCURACY_PLOT
@@ -71,6 +72,7 @@ void add_accuracy_command(CLI::App& app) {
         const RenderSettings settings = o->workload.resolve(scene, configs);
         if (!o->plot.empty() && (o->plot.size() < 5 || o->plot.substr(o->plot.size() - 4) != ".png"))
             throw InputError("command line", 0, "--plot", "expected a .png path, got '" + o->plot + "'");
+        if (!o->plot.empty()) check_output_file(o->plot, "--plot");
         const Bvh bvh(scene);
         SamplingOptions base = o->sampling.resolve(settings.seed);
         base.target_error = 0.0;

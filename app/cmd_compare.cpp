@@ -121,7 +121,7 @@ nlohmann::ordered_json largest_json(const std::vector<Row>& rows) {
 void compare_stored(const std::string& db, const std::string& sel_a, const std::string& sel_b, bool json) {
     if (sel_a.empty() || sel_b.empty())
         throw InputError("command line", 0, sel_a.empty() ? "--a" : "--b", "--store needs --a and --b selections");
-    const ResultsStore store(db);
+    const ResultsStore store(db, ResultsStore::Access::read_only);
     const StoreComparison c = compare_store(store, parse_selection(sel_a, "--a"), parse_selection(sel_b, "--b"));
     const std::vector<Row> rows = comparison_rows(c.mean_a, c.mean_b);
     if (json) {

@@ -9,6 +9,7 @@
 #include "kernels/stream/stream_tracer.h"
 #include "workloads/input_error.h"
 #include "workloads/scene_loader.h"
+#include "workloads/user_files.h"
 
 namespace sfx {
 
@@ -34,21 +35,27 @@ void add_render_command(CLI::App& app) {
     c->add_flag("--json", options->json, "print one JSON document");
     options->workload.add_to(c);
     c->callback([options] {
-        const Scene scene = load_scene(options->scene);
-        const RenderSettings settings = options->workload.resolve(scene);
         if (options->output.size() < 5 || options->output.substr(options->output.size() - 4) != ".png")
             throw InputError("command line", 0, "--output", "expected a .png path, got '" + options->output + "'");
-        const Bvh bvh(scene);
         if (!options->trace.empty() && options->tracer != "stream")
             throw InputError("command line", 0, "--trace", "needs --tracer stream");
+        // Every output is checked before the render, and all appear together or none does.
+        const std::string pfm = options->output.substr(0, options->output.size() - 4) + ".pfm";
+        OutputFiles outputs;
+        const std::string png_temp = outputs.add(options->output, "--output");
+        const std::string pfm_temp = outputs.add(pfm, "--output (the PFM beside it)");
+        const std::string trace_temp = options->trace.empty() ? "" : outputs.add(options->trace, "--trace");
+        const Scene scene = load_scene(options->scene);
+        const RenderSettings settings = options->workload.resolve(scene);
+        const Bvh bvh(scene);
         std::unique_ptr<TraceFileWriter> writer;
-        if (!options->trace.empty()) writer = std::make_unique<TraceFileWriter>(options->trace);
+        if (!options->trace.empty()) writer = std::make_unique<TraceFileWriter>(trace_temp);
         const RenderResult result = options->tracer == "stream"
                                         ? render_stream(scene, bvh, settings, writer.get())
                                         : render_reference(scene, bvh, settings);
-        const std::string pfm = options->output.substr(0, options->output.size() - 4) + ".pfm";
-        write_png(result.image, options->output);
-        write_pfm(result.image, pfm);
+        write_png(result.image, png_temp);
+        write_pfm(result.image, pfm_temp);
+        outputs.commit();
         const Vec3 mean = result.image.mean();
         if (options->json) {
             nlohmann::json j;

@@ -28,6 +28,7 @@
 #include "sweeps/sweep.h"
 #include "workloads/host_clock.h"
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 
 namespace sfx {
 namespace {
@@ -120,7 +121,10 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
                uint32_t threads, const std::vector<std::string>& sets, bool dry_run, bool json) {
     if (engine == "dask" && scheduler.empty())
         throw InputError("command line", 0, "--scheduler", "--engine dask needs --scheduler tcp://HOST:PORT");
-    // Everything is checked before the store is opened: a bad sweep writes nothing.
+    // Everything is checked before the store is opened: a bad sweep writes nothing, and an
+    // output that cannot be written fails now, not after the sweep has run.
+    if (!csv.empty()) check_output_file(csv, "--csv");
+    if (!store_path.empty() && access(store_path.c_str(), F_OK) != 0) check_output_file(store_path, "--store");
     const Sweep sweep = load_sweep(path, sets);
     if (dry_run) {
         if (json) {

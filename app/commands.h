@@ -16,7 +16,8 @@ namespace sfx {
 struct WorkloadFlags {
     std::string res = "256x256";
     uint32_t spp = 4;
-    int depth = -1;  // -1: the scene's own max_depth
+    uint32_t depth = 0;  // used only when --depth is given; else the scene's own max_depth
+    const CLI::Option* depth_flag = nullptr;
     std::string tile = "32";
     uint64_t seed = 0;
     uint32_t threads = 0;
@@ -52,5 +53,9 @@ void add_accuracy_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);  // also the hidden run-group
 void add_compare_command(CLI::App& app);
 void add_report_command(CLI::App& app);
+
+// After every command is added: each number flag must be plain decimal text in its type's
+// range (no sign wrapping, clamping, octal, hex, NaN or infinity).
+void strict_number_flags(CLI::App& app);
 
 }  // namespace sfx

@@ -1,7 +1,9 @@
 // sfx: a design-space explorer for stream-filtering ray-tracing hardware.
 // Thin: parses, calls the libraries, prints. Bad input exits 2 with file, line and key.
 
+#include <algorithm>
 #include <iostream>
+#include <vector>
 
 #include "app/commands.h"
 #include "workloads/input_error.h"
@@ -9,6 +11,42 @@
 // libsystemc.so defines main() and calls sc_main(); sfx has its own main(), so this is never
 // called, but the library needs the symbol to link.
 extern "C" int sc_main(int, char**) { return 0; }
+
+namespace {
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+            diagonal = up;
+        }
+    }
+    return row[b.size()];
+}
+
+// CLI11 says only "argument was not expected"; name the command and the nearest one.
+bool unknown_command(const CLI::App& app, const std::string& word) {
+    if (word.empty() || word[0] == '-') return false;
+    std::string nearest;
+    size_t best = std::string::npos;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+        if (sub->check_name(word)) return false;
+        if (sub->get_group().empty()) continue;  // hidden (run-group)
+        const size_t d = edit_distance(word, sub->get_name());
+        if (d < best) best = d, nearest = sub->get_name();
+    }
+    std::cerr << "sfx: error: unknown command '" << word << "'";
+    if (best <= std::max<size_t>(2, word.size() / 3)) std::cerr << " (did you mean '" << nearest << "'?)";
+    std::cerr << "; see sfx --help\n";
+    return true;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"sfx: hardware design-space explorer for stream-filtering ray tracing"};
@@ -22,6 +60,8 @@ int main(int argc, char** argv) {
     sfx::add_sweep_command(app);
     sfx::add_compare_command(app);
     sfx::add_report_command(app);
+    sfx::strict_number_flags(app);
+    if (argc > 1 && unknown_command(app, argv[1])) return 2;
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -10,7 +10,7 @@ namespace sfx {
 void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--res", res, "image size WxH")->capture_default_str();
     c->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
-    c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
+    depth_flag = c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
     c->add_option("--threads", threads, "worker threads (0: all cores)")->capture_default_str();
@@ -21,7 +21,7 @@ WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
     w.scene = scene;
     set_workload_field(w, "res", res, "command line", 0, "--res");
     set_workload_field(w, "spp", std::to_string(spp), "command line", 0, "--spp");
-    if (depth != -1)
+    if (depth_flag && depth_flag->count())
         set_workload_field(w, "depth", std::to_string(depth), "command line", 0, "--depth");
     set_workload_field(w, "tile", tile, "command line", 0, "--tile");
     set_workload_field(w, "seed", std::to_string(seed), "command line", 0, "--seed");

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 #include "workloads/strict_number.h"
 
 namespace sfx {
@@ -130,7 +131,8 @@ private:
         return true;
     }
 
-    const YAML::Node& m_node;
+    // A copy (a handle): group() and list() pass temporaries.
+    const YAML::Node m_node;
     std::string m_file, m_prefix;
     HwLineMap& m_lines;
     std::set<std::string> m_seen;
@@ -305,12 +307,7 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
 }
 
 HwConfig parse_hw_config(const std::string& text, const std::string& file) {
-    YAML::Node root;
-    try {
-        root = YAML::Load(text);
-    } catch (const YAML::Exception& e) {
-        throw InputError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", e.msg);
-    }
+    const YAML::Node root = parse_yaml_document(text, file);
     HwConfig config;
     HwLineMap lines;
     YamlReader reader(root, file, "", lines);
@@ -321,11 +318,7 @@ HwConfig parse_hw_config(const std::string& text, const std::string& file) {
 }
 
 HwConfig load_hw_config(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw InputError(path, 0, "", "cannot read hardware configuration");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_hw_config(text.str(), path);
+    return parse_hw_config(read_input_file(path, "hardware configuration"), path);
 }
 
 std::string dump_hw_config(const HwConfig& config) {

@@ -1,15 +1,22 @@
 #include "sweeps/results_store.h"
 
 #include <sqlite3.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <thread>
 
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 #include "workloads/strict_number.h"
 
 namespace sfx {
@@ -116,9 +123,60 @@ std::string iso8601_now() {
     return buf;
 }
 
-ResultsStore::ResultsStore(const std::string& path) : m_path(path) {
-    if (sqlite3_open_v2(path.c_str(), &m_db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
-        SQLITE_OK) {
+namespace {
+
+// Tests only (tests/sweeps/kill_resume.sh): SFX_TEST_HOLD_COMMIT_MS keeps the write
+// transaction open that long before COMMIT, after saying so on stderr, so that a kill -9 can
+// land inside it.
+void hold_before_commit_for_tests(const std::string& key) {
+    static const char* hold = std::getenv("SFX_TEST_HOLD_COMMIT_MS");
+    if (!hold || !*hold) return;
+    std::fprintf(stderr, "sfx-test: inside the write transaction of %s\n", key.c_str());
+    std::fflush(stderr);
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::atol(hold)));
+}
+
+// A path as the path part of an SQLite URI: '?' and '#' and '%' escaped, made absolute.
+std::string sqlite_uri_path(const std::string& path) {
+    const std::string abs = std::filesystem::absolute(path).string();
+    std::string out;
+    for (char c : abs) {
+        if (c == '?' || c == '#' || c == '%') {
+            char buf[4];
+            std::snprintf(buf, sizeof buf, "%%%02X", static_cast<unsigned char>(c));
+            out += buf;
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+bool directory_writable(const std::string& path) {
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    return ::access(dir.empty() ? "." : dir.c_str(), W_OK | X_OK) == 0;
+}
+
+bool file_nonempty(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0 && st.st_size > 0;
+}
+
+}  // namespace
+
+ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path) {
+    const bool read_only = access == Access::read_only;
+    if (::access(path.c_str(), F_OK) == 0) check_regular_file(path, "results store");
+    else if (read_only) throw InputError(path, 0, "--store", "no such results store");
+    // A read-only directory: SQLite cannot create the write-ahead log's index (-shm) beside
+    // the store. With no log left to replay (a finished sweep leaves none) the file alone is
+    // the whole store, and `immutable` reads it without the index.
+    const bool immutable = read_only && !directory_writable(path) && !file_nonempty(path + "-wal");
+    const std::string uri = "file:" + sqlite_uri_path(path) +
+                            (read_only ? (immutable ? "?mode=ro&immutable=1" : "?mode=ro") : "");
+    const int flags = (read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
+                      SQLITE_OPEN_URI;
+    if (sqlite3_open_v2(uri.c_str(), &m_db, flags, nullptr) != SQLITE_OK) {
         const std::string msg = m_db ? sqlite3_errmsg(m_db) : "out of memory";
         sqlite3_close(m_db);
         m_db = nullptr;
@@ -128,12 +186,21 @@ ResultsStore::ResultsStore(const std::string& path) : m_path(path) {
     sqlite3_busy_timeout(m_db, 30000);
     try {
         // Is this a SQLite file at all, and ours? (A text file fails on the first query.)
-        Statement probe(m_db, "SELECT name FROM sqlite_master WHERE type='table' AND name='meta'");
-        const bool has_meta = probe.step();
-        // WAL: a reader never blocks the writer; NORMAL sync still survives a killed process
-        // (only a power loss may drop the last transactions, never part of one).
-        exec("PRAGMA journal_mode=WAL");
-        exec("PRAGMA synchronous=NORMAL");
+        // Nothing is written before the answer is yes: another program's database stays untouched.
+        std::vector<std::string> tables;
+        {
+            Statement probe(m_db, "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name");
+            while (probe.step()) tables.push_back(reinterpret_cast<const char*>(sqlite3_column_text(probe.get(), 0)));
+        }
+        const bool has_meta = std::find(tables.begin(), tables.end(), "meta") != tables.end();
+        const bool has_points = std::find(tables.begin(), tables.end(), "points") != tables.end();
+        if (!tables.empty() && (!has_meta || !has_points)) {
+            std::string list;
+            for (const std::string& t : tables) list += (list.empty() ? "" : ", ") + t;
+            throw InputError(path, 0, "--store",
+                             "an SQLite database but not an sfx results store (its tables: " + list +
+                                 "; a store has meta and points); left untouched");
+        }
         if (has_meta) {
             Statement v(m_db, "SELECT value FROM meta WHERE key='schema_version'");
             const std::string version =
@@ -143,18 +210,30 @@ ResultsStore::ResultsStore(const std::string& path) : m_path(path) {
                                  "results store has schema version '" + version + "'; this sfx writes " +
                                      std::to_string(k_schema_version));
         }
-        exec("BEGIN IMMEDIATE");
-        exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
-        exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
-             std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
-        exec(std::string("CREATE TABLE IF NOT EXISTS points(") + fixed_columns() + ")");
-        exec("COMMIT");
+        if (read_only) {
+            if (tables.empty()) throw InputError(path, 0, "--store", "an empty file, not a results store");
+        } else {
+            // WAL: a reader never blocks the writer; NORMAL sync still survives a killed
+            // process (only a power loss may drop the last transactions, never part of one).
+            exec("PRAGMA journal_mode=WAL");
+            exec("PRAGMA synchronous=NORMAL");
+            exec("BEGIN IMMEDIATE");
+            exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
+            exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
+                 std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
+            exec(std::string("CREATE TABLE IF NOT EXISTS points(") + fixed_columns() + ")");
+            exec("COMMIT");
+        }
     } catch (const InputError&) {
         sqlite3_close(m_db);
         throw;
     } catch (const std::exception& e) {
         sqlite3_close(m_db);
-        throw InputError(path, 0, "--store", std::string("not a usable results store: ") + e.what());
+        std::string what = e.what();
+        if (read_only && !directory_writable(path) && file_nonempty(path + "-wal"))
+            what += " (the store's write-ahead log holds unfinished writes, and its directory is "
+                    "read-only: run sfx sweep on it once where it is writable, or copy it)";
+        throw InputError(path, 0, "--store", "not a usable results store: " + what);
     }
     for (const std::string& c : columns()) m_columns.insert(c);
 }
@@ -254,6 +333,7 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
         }
         insert.step();
         const bool inserted = sqlite3_changes(m_db) == 1;
+        hold_before_commit_for_tests(point.key);
         exec("COMMIT");
         return inserted;
     } catch (...) {
@@ -297,8 +377,10 @@ std::vector<ResultsStore::RowValues> ResultsStore::rows() const {
 }
 
 void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std::string>& keys) const {
-    std::ofstream out(csv_path);
-    if (!out) throw InputError(csv_path, 0, "--csv", "cannot write the CSV file");
+    OutputFiles outputs;  // whole or not at all
+    const std::string temp = outputs.add(csv_path, "--csv");
+    std::ofstream out(temp);
+    if (!out) throw InputError("command line", 0, "--csv", "cannot write '" + csv_path + "'");
     std::vector<std::string> cols;
     for (const std::string& c : columns())
         if (c != "config_yaml") cols.push_back(c);
@@ -332,7 +414,9 @@ void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std
             write_rows(s);
         }
     }
-    if (!out) throw InputError(csv_path, 0, "--csv", "error writing the CSV file");
+    out.close();
+    if (!out) throw InputError("command line", 0, "--csv", "error writing '" + csv_path + "'");
+    outputs.commit();
 }
 
 }  // namespace sfx

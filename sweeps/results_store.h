@@ -33,8 +33,11 @@ class ResultsStore {
 public:
     static constexpr int k_schema_version = 1;
 
-    // Opens or creates the store; throws InputError if the file is not a version-1 store.
-    explicit ResultsStore(const std::string& path);
+    enum class Access { read_write, read_only };
+    // Opens or creates the store; throws InputError if the file is not a version-1 store
+    // (another SQLite database is refused before anything is written to it). read_only
+    // never writes and works in a read-only directory.
+    explicit ResultsStore(const std::string& path, Access access = Access::read_write);
     ~ResultsStore();
     ResultsStore(const ResultsStore&) = delete;
     ResultsStore& operator=(const ResultsStore&) = delete;

@@ -44,17 +44,29 @@ Transform Transform::rotate_y(float degrees, const Vec3& translate) {
 
 // ---- SceneBuilder -------------------------------------------------------------------------
 
+void SceneBuilder::expect(uint64_t more) const {
+    const uint64_t have = m_scene.triangles.size() + m_scene.spheres.size();
+    if (more > k_max_primitives || have + more > k_max_primitives)
+        throw TooManyPrimitives("more than " + std::to_string(k_max_primitives) + " primitives (" +
+                                std::to_string(have) + " so far, " + std::to_string(more) +
+                                " more asked for)");
+}
+
 uint32_t SceneBuilder::add_vertex(const Vec3& p) {
+    if (m_scene.positions.size() >= 3 * k_max_primitives)
+        throw TooManyPrimitives("more than " + std::to_string(3 * k_max_primitives) + " vertices");
     m_scene.positions.push_back(p);
     return uint32_t(m_scene.positions.size() - 1);
 }
 
 void SceneBuilder::add_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t material) {
+    expect(1);
     m_scene.triangles.push_back(Triangle{a, b, c, material});
     m_triangle_objects.push_back(m_object);
 }
 
 void SceneBuilder::add_sphere(const Vec3& center, float radius, uint32_t material) {
+    expect(1);
     m_scene.spheres.push_back(Sphere{center, radius, material});
     m_sphere_objects.push_back(m_object);
 }
@@ -794,6 +806,7 @@ void build_temple(const GeneratorInput& in, SceneBuilder& b) {
     const uint32_t rocks = c.n("rubble_stones");
     const uint32_t rock_levels = c.n("rubble_detail");
     const uint32_t piles = 40;
+    b.expect(uint64_t(rocks) * (shapes::icosphere(rock_levels).indices.size() / 3));
     for (uint32_t i = 0; i < rocks; ++i) {
         const uint32_t pile = uint32_t(hash_float(seed, i, 50) * float(piles));
         float px, pz;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <map>
 #include <string>
 #include <vector>
@@ -30,11 +31,24 @@ struct Transform {
     static Transform rotate_y(float degrees, const Vec3& translate = Vec3(0.f));
 };
 
+// Thrown by SceneBuilder past k_max_primitives: generator parameters that are each in range
+// can together ask for more memory than the machine has.
+struct TooManyPrimitives : std::length_error {
+    using std::length_error::length_error;
+};
+
 // Appends primitives to a scene. Every primitive belongs to the current object; an object with
 // an emissive material is one area light, so begin_object() before each light.
 class SceneBuilder {
 public:
+    // 16 times the largest shipped scene; about 1.5 GB with its BVH.
+    static constexpr uint64_t k_max_primitives = uint64_t(1) << 25;
+
     explicit SceneBuilder(Scene& scene) : m_scene(scene) {}
+
+    // Throws TooManyPrimitives now if `more` primitives would pass the limit: generators
+    // call it before a large loop, so that the error comes up front.
+    void expect(uint64_t more) const;
 
     uint32_t begin_object() { return ++m_object; }
     uint32_t object() const { return m_object; }

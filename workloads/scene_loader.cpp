@@ -16,6 +16,7 @@
 
 #include "workloads/generators.h"
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 #include "workloads/mesh_import.h"
 
 #ifndef SFX_SCENE_DIR
@@ -212,14 +213,7 @@ public:
 
     Scene parse() {
         const Reader& r = m_reader;
-        YAML::Node loaded;
-        try {
-            loaded = YAML::LoadFile(r.file());
-        } catch (const YAML::BadFile&) {
-            throw InputError(r.file(), 0, "", "cannot open the file");
-        } catch (const YAML::ParserException& e) {
-            throw InputError(r.file(), e.mark.line + 1, "", "YAML syntax error: " + e.msg);
-        }
+        const YAML::Node loaded = parse_yaml_document(read_input_file(r.file(), "scene file"), r.file());
         const YAML::Node& root = loaded;  // const: lookups of missing keys must not insert them
         if (!root.IsMap()) throw InputError(r.file(), 1, "", "expected a mapping at the top level");
         r.check_map(root, "",
@@ -333,11 +327,20 @@ private:
             TriangleMesh mesh;
             try {
                 mesh = import_mesh(full.string());
+                b.expect(mesh.triangle_count());
+            } catch (const InputError& e) {
+                r.fail(node["file"], path + ".file", "mesh '" + full.string() + "': " + e.message());
             } catch (const std::exception& e) {
                 r.fail(node["file"], path + ".file", "mesh '" + full.string() + "': " + e.what());
             }
             const uint32_t base = uint32_t(b.scene().positions.size());
-            for (const Vec3& p : mesh.positions) b.add_vertex(xf.apply(p));
+            for (size_t v = 0; v < mesh.positions.size(); ++v) {
+                const Vec3 p = xf.apply(mesh.positions[v]);
+                if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                    r.fail(node["transform"], path + ".transform",
+                           "moves vertex " + std::to_string(v) + " of '" + full.string() + "' out of float range");
+                b.add_vertex(p);
+            }
             for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
                 b.add_triangle(base + mesh.indices[t], base + mesh.indices[t + 1], base + mesh.indices[t + 2], m);
         } else if (type == "generator") {
@@ -375,7 +378,15 @@ private:
         r.check_map(roles, path + ".materials", role_set, role_set);
         for (const std::string& role : g->material_roles)
             in.materials[role] = material(roles[role], path + ".materials." + role);
-        g->build(in, b);
+        try {
+            g->build(in, b);
+        } catch (const TooManyPrimitives& e) {
+            std::string given;  // the parameters this file sets: together they ask too much
+            for (const GeneratorParam& p : g->params)
+                if (node[p.name]) given += (given.empty() ? "" : ", ") + p.name + ": " + node[p.name].Scalar();
+            r.fail(node, path, "generator " + name + " would make " + e.what() +
+                                   (given.empty() ? std::string() : " with " + given) + "; lower them");
+        }
     }
 
     Reader m_reader;
@@ -394,9 +405,12 @@ const char* const k_shipped[] = {"cornell", "furnace", "atrium", "conference", "
 
 Scene load_scene(const std::string& name_or_path) {
     std::error_code ec;
-    if (fs::is_regular_file(name_or_path, ec)) return SceneParser(name_or_path).parse();
     const bool plain_name = name_or_path.find('/') == std::string::npos &&
                             name_or_path.find(".yaml") == std::string::npos && !name_or_path.empty();
+    // Anything else that exists is read as a path (and refused there if it is not a regular
+    // file); a directory that happens to share a built-in scene's name is not.
+    const fs::file_status st = fs::status(name_or_path, ec);
+    if (fs::exists(st) && !(plain_name && fs::is_directory(st))) return SceneParser(name_or_path).parse();
     if (plain_name) {
         const fs::path p = scene_dir() / (name_or_path + ".scene.yaml");
         if (fs::is_regular_file(p, ec)) return SceneParser(p.string()).parse();

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import sqlite3
+import urllib.parse
 from dataclasses import dataclass, field
 from typing import List
 
@@ -53,10 +54,23 @@ def _connect_read_only(path: str) -> sqlite3.Connection:
         raise StoreError(f"{path}: no such file")
     if os.path.isdir(path):
         raise StoreError(f"{path}: is a directory, not a results store")
+    if not os.path.isfile(path):
+        raise StoreError(f"{path}: not a regular file, not a results store")
+    # In a read-only directory SQLite cannot create the write-ahead log's index beside the
+    # store; with no log left to replay the file alone is the whole store ("immutable").
+    wal = path + "-wal"
+    read_only_dir = not os.access(os.path.dirname(os.path.abspath(path)), os.W_OK | os.X_OK)
+    pending_wal = os.path.exists(wal) and os.path.getsize(wal) > 0
+    mode = "mode=ro&immutable=1" if read_only_dir and not pending_wal else "mode=ro"
+    uri = "file:" + urllib.parse.quote(os.path.abspath(path)) + "?" + mode
     try:
-        con = sqlite3.connect(f"file:{os.path.abspath(path)}?mode=ro", uri=True)
+        con = sqlite3.connect(uri, uri=True)
         con.execute("SELECT name FROM sqlite_master").fetchall()
     except sqlite3.DatabaseError as e:
+        if read_only_dir and pending_wal:
+            raise StoreError(f"{path}: its write-ahead log holds unfinished writes and its "
+                             f"directory is read-only ({e}): run sfx sweep on it once where it "
+                             f"is writable, or copy it") from None
         raise StoreError(f"{path}: not an SQLite results store ({e})") from None
     return con
 

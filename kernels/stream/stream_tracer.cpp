@@ -155,7 +155,7 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
                 const bool sphere = scene.is_sphere(prim);
-                const Triangle& tri = scene.triangles[sphere ? 0 : prim];
+                const Triangle tri = sphere ? Triangle{} : scene.triangles[prim];
                 const Vec3 p0 = sphere ? Vec3() : scene.positions[tri.v0];
                 const Vec3 p1 = sphere ? Vec3() : scene.positions[tri.v1];
                 const Vec3 p2 = sphere ? Vec3() : scene.positions[tri.v2];

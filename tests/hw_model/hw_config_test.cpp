@@ -99,3 +99,15 @@ TEST_CASE("Parameters are flattened to dotted names and set by path", "[hw_confi
     CHECK_THROWS_AS(set_hw_param(c, "simd.width", "65"), InputError);
     CHECK_THROWS_AS(set_hw_param(c, "ray_buffer.pipelined", "yes"), InputError);
 }
+
+TEST_CASE("Keys that are lists or maps, and second documents, are input errors", "[hw_config]") {
+    const InputError list_key = parse_error("version: 1\n? [a]\n: 1\n");
+    CHECK(list_key.line() == 2);
+    CHECK(list_key.key() == "[a]");
+    const InputError nested = parse_error("simd:\n  ? {x: 1}\n  : 2\n");
+    CHECK(nested.line() == 2);
+    CHECK(nested.key() == "simd.{x: 1}");
+    const InputError second = parse_error("simd:\n  width: 8\n---\nsimd:\n  width: 4\n");
+    CHECK(second.line() == 4);
+    CHECK(std::string(second.what()).find("second YAML document") != std::string::npos);
+}

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# kill_resume.sh SFX SWEEP: starts `sfx sweep` in the background, kills it with SIGKILL once
-# the store holds at least one row but the sweep is not done, re-runs it, and checks with
-# sqlite3 that every point is stored exactly once and the store is intact; a third run must
-# find nothing to do. Every wait is bounded; whatever it started is killed on exit.
+# kill_resume.sh SFX SWEEP [in-commit]: starts `sfx sweep` in the background, kills it with
+# SIGKILL once the store holds at least one row but the sweep is not done, re-runs it, and
+# checks with sqlite3 that every point is stored exactly once and the store is intact; a third
+# run must find nothing to do. With in-commit, the kill lands inside the store's write
+# transaction (held open by the test-only SFX_TEST_HOLD_COMMIT_MS), after a first row is
+# committed. Every wait is bounded; whatever it started is killed on exit.
 set -euo pipefail
-sfx=$1 sweep=$2
+sfx=$1 sweep=$2 mode=${3:-}
 work=$(mktemp -d "${TMPDIR:-/tmp}/sfx-kill-test.XXXXXX")
 pid=
 cleanup() {
@@ -18,10 +20,19 @@ rows() { [ -s "$db" ] && sqlite3 "$db" "SELECT count(*) FROM points" 2>/dev/null
 
 total=$("$sfx" sweep "$sweep" --dry-run --json | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["points"])')
 # One group at a time, so that rows arrive one group after another.
-setsid "$sfx" sweep "$sweep" --store "$db" --jobs 1 >"$work/first.log" 2>&1 &
+hold=
+[ "$mode" = in-commit ] && hold=20000
+SFX_TEST_HOLD_COMMIT_MS=$hold setsid "$sfx" sweep "$sweep" --store "$db" --jobs 1 >"$work/first.log" 2>&1 &
 pid=$!
-has_rows() { [ "$(rows)" -ge 1 ]; }
-wait_for 120 has_rows || fail "no row was stored in 120 s"
+if [ "$mode" = in-commit ]; then
+  # The first row commits after 20 s; the kill lands while the second is held uncommitted.
+  second_write() { [ "$(grep -c '^sfx-test: inside the write transaction' "$work/first.log")" -ge 2 ]; }
+  wait_for 200 second_write || fail "no second write transaction began in 200 s"
+  held=$(grep '^sfx-test: inside the write transaction' "$work/first.log" | tail -1 | awk '{print $NF}')
+else
+  has_rows() { [ "$(rows)" -ge 1 ]; }
+  wait_for 120 has_rows || fail "no row was stored in 120 s"
+fi
 kill -9 "$pid" 2>/dev/null || fail "the sweep had already finished: nothing was interrupted"
 wait "$pid" 2>/dev/null && fail "the sweep was not killed" || true
 # Its `sfx run-group` child dies with it (PR_SET_PDEATHSIG), leaving no orphan render.
@@ -31,6 +42,13 @@ wait_for 10 no_orphan || fail "the killed sweep left its render running"
 pid=
 before=$(rows)
 [ "$before" -lt "$total" ] || fail "all $total points were stored before the kill"
+if [ "$mode" = in-commit ]; then
+  [ "$before" = 1 ] || fail "expected exactly the first row committed, found $before"
+  [ "$(sqlite3 "$db" "SELECT count(*) FROM points WHERE key='$held'")" = 0 ] ||
+    fail "the row whose transaction was killed is stored"
+  [ "$(sqlite3 "$db" "PRAGMA integrity_check")" = ok ] || fail "integrity check failed right after the kill"
+  echo "killed the sweep inside the write transaction of $held"
+fi
 echo "killed the sweep with $before of $total points stored"
 
 "$sfx" sweep "$sweep" --store "$db" >"$work/second.log" 2>&1 || fail "the re-run failed"

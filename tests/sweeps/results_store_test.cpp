@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "sweeps/group_runner.h"
+#include "tests/temp_dir.h"
 #include "sweeps/results_store.h"
 #include "sweeps/store_compare.h"
 #include "sweeps/sweep.h"
@@ -21,16 +22,6 @@ using namespace sfx;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        path = fs::temp_directory_path() / ("sfx-store-test-" + std::to_string(getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
 
 Sweep small_sweep(const std::string& fidelity = "analytic") {
     return parse_sweep("version: 1\nhw: gr08.hw.yaml\n"
@@ -183,4 +174,27 @@ TEST_CASE("Two store selections are matched on every other input and compared by
                                   parse_selection("hw.simd.width=16", "--b")),
                     InputError);
     CHECK_THROWS_AS(parse_selection("hw.simd.width", "--a"), InputError);
+}
+
+TEST_CASE("Another program's SQLite database is refused and left untouched", "[sweeps]") {
+    TempDir dir;
+    const std::string db = (dir.path / "other.db").string();
+    sqlite3* h = nullptr;
+    REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
+    REQUIRE(sqlite3_exec(h, "CREATE TABLE t(x); INSERT INTO t VALUES (1)", nullptr, nullptr, nullptr) == SQLITE_OK);
+    sqlite3_close(h);
+    auto bytes = [&] {
+        std::ifstream in(db, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string before = bytes();
+    CHECK_THROWS_WITH(ResultsStore(db), Catch::Contains("not an sfx results store (its tables: t;"));
+    CHECK_THROWS_WITH(ResultsStore(db, ResultsStore::Access::read_only),
+                      Catch::Contains("not an sfx results store"));
+    CHECK(bytes() == before);
+    CHECK_FALSE(fs::exists(db + "-wal"));
+    // Read-only never creates a store.
+    CHECK_THROWS_WITH(ResultsStore((dir.path / "none.db").string(), ResultsStore::Access::read_only),
+                      Catch::Contains("no such results store"));
+    CHECK_FALSE(fs::exists(dir.path / "none.db"));
 }

@@ -179,3 +179,22 @@ TEST_CASE("paper-class scenes match Table 1 (primitives within 10%, lights exact
         CHECK(s.max_depth == 3);
     }
 }
+
+TEST_CASE("generator parameters that together ask too much are refused up front", "[workloads]") {
+    Scene scene;
+    SceneBuilder b(scene);
+    CHECK_THROWS_AS(b.expect(SceneBuilder::k_max_primitives + 1), TooManyPrimitives);
+    CHECK_NOTHROW(b.expect(SceneBuilder::k_max_primitives));
+    // The temple refuses before building anything: 10^6 stones of 81,920 triangles each.
+    const GeneratorInfo* temple = find_generator("temple");
+    REQUIRE(temple);
+    GeneratorInput in;
+    for (const GeneratorParam& p : temple->params) in.params[p.name] = p.value;
+    for (const std::string& role : temple->material_roles) in.materials[role] = 0;
+    in.params["rubble_stones"] = 1000000;
+    in.params["rubble_detail"] = 6;
+    Scene big;
+    SceneBuilder bb(big);
+    CHECK_THROWS_AS(temple->build(in, bb), TooManyPrimitives);
+    CHECK(big.triangles.size() < 4000000);  // only the hall before the rubble was built
+}

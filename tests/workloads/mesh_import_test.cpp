@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "tests/temp_dir.h"
 #include "workloads/mesh_import.h"
 #include "workloads/scene_loader.h"
 
@@ -13,10 +14,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// This process's own directory: CTest runs the cases in parallel processes.
 fs::path test_dir() {
-    const fs::path dir = fs::temp_directory_path() / "sfx_mesh_import_test";
-    fs::create_directories(dir / "meshes");
-    return dir;
+    static const TempDir dir("sfx-mesh-import-test");
+    fs::create_directories(dir.path / "meshes");
+    return dir.path;
 }
 
 // A unit square made of one quad face (triangulated on import) plus one triangle.

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "tests/temp_dir.h"
 #include "workloads/input_error.h"
 #include "workloads/scene_loader.h"
 
@@ -16,13 +17,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh file under the system temp dir; removed by the destructor.
+// A file in this process's own temporary directory (files of one test refer to each other by
+// relative path); removed by the destructor.
 struct TempFile {
     fs::path path;
     TempFile(const std::string& name, const std::string& text) {
-        const fs::path dir = fs::temp_directory_path() / "sfx_workloads_test";
-        fs::create_directories(dir);
-        path = dir / name;
+        static const TempDir dir("sfx-scene-loader-test");
+        path = dir.path / name;
         std::ofstream(path) << text;
     }
     ~TempFile() {
@@ -243,8 +244,8 @@ TEST_CASE("scene loader: a bad mesh names the scene file, line, key and mesh pat
 }
 
 TEST_CASE("scene loader: SFX_SCENE_DIR overrides where named scenes are found", "[workloads]") {
-    const fs::path dir = fs::temp_directory_path() / "sfx_scene_dir_test";
-    fs::create_directories(dir);
+    const TempDir temp("sfx-scene-dir-test");
+    const fs::path& dir = temp.path;
     std::ofstream(dir / "tiny.scene.yaml")
         << "version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
            "materials: [{name: a, kind: lambertian}]\n"
