@@ -4,10 +4,11 @@
 //   counting sink, and Embree 3 rtcIntersect1 (robust scene, via EmbreeScene),
 // for primary rays and diffuse-bounce rays, with ratios; then whole-frame path tracing,
 // reference against stream (trace off / counting). Not a test: speeds vary by machine.
-// Times are thread CPU seconds, best of N, so other processes on the machine matter less.
+// Times are thread CPU seconds, median of N (default 5), so other processes on the machine matter less.
 //
 // Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N]    (default: conference 512x512)
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -34,15 +35,16 @@ double thread_seconds() {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-// Best of `repeat` runs, in thread CPU seconds (every run here stays on the calling thread).
-double best_seconds(int repeat, const std::function<void()>& run) {
-    double best = 1e30;
+// Median of `repeat` runs, in thread CPU seconds (every run here stays on the calling thread).
+double median_seconds(int repeat, const std::function<void()>& run) {
+    std::vector<double> times;
     for (int i = 0; i < repeat; ++i) {
         const double t0 = thread_seconds();
         run();
-        best = std::min(best, thread_seconds() - t0);
+        times.push_back(thread_seconds() - t0);
     }
-    return best;
+    std::sort(times.begin(), times.end());
+    return times[times.size() / 2];
 }
 
 // Camera rays in tile order (64 x 64 tiles, one sample), so a 4096-ray stream is one tile.
@@ -110,7 +112,7 @@ void report(const char* name, size_t rays, double seconds, double embree_rate) {
 int main(int argc, char** argv) {
     std::string scene_name = "conference";
     uint32_t w = 512, h = 512;
-    int repeat = 3;
+    int repeat = 5;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--res" && i + 1 < argc) {
@@ -127,7 +129,7 @@ int main(int argc, char** argv) {
     const Scene scene = load_scene(scene_name);
     const Bvh bvh(scene);
     const EmbreeScene embree(scene);
-    std::printf("scene %s: %u primitives; %ux%u rays per set; best of %d; one thread\n",
+    std::printf("scene %s: %u primitives; %ux%u rays per set; median of %d; one thread\n",
                 scene.name.c_str(), scene.primitive_count(), w, h, repeat);
 
     const std::vector<Ray> primary = primary_rays(scene, w, h);
@@ -137,16 +139,16 @@ int main(int argc, char** argv) {
           {"diffuse-bounce rays", &diffuse}}) {
         std::printf("\n%s (%zu)\n", label, rays->size());
         std::vector<Hit> ref(rays->size()), st, em(rays->size());
-        const double t_embree = best_seconds(repeat, [&] {
+        const double t_embree = median_seconds(repeat, [&] {
             for (size_t i = 0; i < rays->size(); ++i) em[i] = embree.intersect((*rays)[i]);
         });
-        const double t_ref = best_seconds(repeat, [&] {
+        const double t_ref = median_seconds(repeat, [&] {
             for (size_t i = 0; i < rays->size(); ++i) ref[i] = bvh.intersect((*rays)[i]);
         });
-        const double t_stream = best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st); });
+        const double t_stream = median_seconds(repeat, [&] { stream_intersect(bvh, *rays, st); });
         CountingSink counts({8, 16});
         const double t_counting =
-            best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st, &counts); });
+            median_seconds(repeat, [&] { stream_intersect(bvh, *rays, st, &counts); });
         size_t differ = 0, embree_differ = 0;
         for (size_t i = 0; i < rays->size(); ++i) {
             differ += std::memcmp(&ref[i], &st[i], sizeof(Hit)) != 0;
@@ -183,11 +185,11 @@ int main(int argc, char** argv) {
     settings.threads = 1;
     RenderResult ref_frame, st_frame;
     const double f_ref =
-        best_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
+        median_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
     const double f_st =
-        best_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
+        median_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
     CountingSink counts({8, 16});
-    const double f_count = best_seconds(1, [&] { render_stream(scene, bvh, settings, &counts); });
+    const double f_count = median_seconds(repeat, [&] { render_stream(scene, bvh, settings, &counts); });
     const bool same = std::memcmp(ref_frame.image.pixels.data(), st_frame.image.pixels.data(),
                                   ref_frame.image.pixels.size() * sizeof(Vec3)) == 0;
     const size_t n = ref_frame.stats.rays();
