@@ -19,6 +19,7 @@ struct WorkloadFlags {
     std::string tile = "32";
     uint64_t seed = 0;
     uint32_t threads = 0;
+    std::string isa = "auto";
 
     void add_to(CLI::App* command);
     // Resolves against the scene; throws InputError (key = the flag) on a bad value.

@@ -14,6 +14,10 @@ void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
     c->add_option("--threads", threads, "worker threads (0: all cores)")->capture_default_str();
+    c->add_option("--isa", isa,
+                  "host SIMD back end of the stream filters: auto|avx512|avx2|scalar (never "
+                  "changes the image or the trace)")
+        ->capture_default_str();
 }
 
 RenderSettings WorkloadFlags::resolve(const Scene& scene) const {
@@ -39,6 +43,7 @@ RenderSettings WorkloadFlags::resolve(const Scene& scene) const {
     }
     s.seed = seed;
     s.threads = threads;
+    s.isa = resolve_isa(parse_isa(isa, "--isa"), "--isa");
     return s;
 }
 

@@ -35,6 +35,30 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Forwards to a timing model and adds up the seconds spent in its pass and frame calls (where
+// it simulates), so the host time splits into render and timing. Ops are not timed (a clock
+// read per op would cost more than the op's copy): their recording counts as render time.
+class TimedSink : public TraceSink {
+public:
+    explicit TimedSink(TraceSink& inner) : m_inner(inner) {}
+    void begin_frame(const TraceHeader& h) override { timed([&] { m_inner.begin_frame(h); }); }
+    void begin_pass(const TilePass& p) override { timed([&] { m_inner.begin_pass(p); }); }
+    void op(const StreamOp& o) override { m_inner.op(o); }
+    void end_pass(const TilePass& p) override { timed([&] { m_inner.end_pass(p); }); }
+    void end_frame() override { timed([&] { m_inner.end_frame(); }); }
+    double seconds() const { return m_seconds; }
+
+private:
+    template <class F>
+    void timed(F&& f) {
+        const auto start = std::chrono::steady_clock::now();
+        f();
+        m_seconds += seconds_since(start);
+    }
+    TraceSink& m_inner;
+    double m_seconds = 0.0;
+};
+
 
 
 // Ideal utilization at configuration i's width from the counted trace.
@@ -323,6 +347,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
     fan.add(&counts);
     TraceProfile profile(shape);
     std::unique_ptr<SystemcTiming> systemc;
+    std::unique_ptr<TimedSink> timed_systemc;
     std::unique_ptr<AnalyticCalibration> calibration;
     if (fidelity == Fidelity::analytic) {
         fan.add(&profile);
@@ -333,11 +358,13 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
         }
     } else {
         systemc = std::make_unique<SystemcTiming>(configs, shape);
-        fan.add(systemc.get());
+        timed_systemc = std::make_unique<TimedSink>(*systemc);
+        fan.add(timed_systemc.get());
     }
     PointGroupResult result;
     result.render = render_stream(scene, bvh, settings, &fan).stats;
     const double shared_seconds = seconds_since(start);
+    result.timing_seconds = timed_systemc ? timed_systemc->seconds() : 0.0;
 
     for (size_t i = 0; i < configs.size(); ++i) {
         const auto model_start = std::chrono::steady_clock::now();

@@ -56,6 +56,12 @@ Isa resolve_isa(Isa requested, const std::string& flag) {
     return requested;
 }
 
+std::string describe_isa(Isa isa) {
+    const Isa resolved = isa == Isa::automatic ? best_isa() : isa;
+    return std::string(isa_name(resolved)) + " (" + std::to_string(isa_width(resolved)) +
+           (resolved == Isa::scalar ? " lane)" : " lanes)");
+}
+
 std::vector<Isa> supported_isas() {
     std::vector<Isa> out{Isa::scalar};
     for (Isa isa : {Isa::avx2, Isa::avx512})

@@ -24,5 +24,6 @@ Isa best_isa();               // the widest supported
 // automatic -> best_isa(); an unsupported request throws InputError naming `flag`.
 Isa resolve_isa(Isa requested, const std::string& flag = "--isa");
 std::vector<Isa> supported_isas();  // scalar first, then wider ones the machine has
+std::string describe_isa(Isa isa);  // "avx512 (16 lanes)"; automatic: what it resolves to
 
 }  // namespace sfx
