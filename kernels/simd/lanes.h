@@ -54,6 +54,13 @@ SFX_LANES_INLINE vfloat<Width> broadcast(float x) {
     if constexpr (Width == 1) {
         return x;
     } else {
+        // An element loop would compile to Width masked inserts; say "broadcast".
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) return vfloat<Width>(_mm512_set1_ps(x));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vfloat<Width>(_mm256_set1_ps(x));
+#endif
         vfloat<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = x;
         return v;
@@ -64,6 +71,12 @@ SFX_LANES_INLINE vint<Width> broadcast_int(int32_t x) {
     if constexpr (Width == 1) {
         return x;
     } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) return vint<Width>(_mm512_set1_epi32(x));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vint<Width>(_mm256_set1_epi32(x));
+#endif
         vint<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = x;
         return v;
@@ -76,6 +89,13 @@ SFX_LANES_INLINE vint<Width> lane_index() {
     if constexpr (Width == 1) {
         return 0;
     } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vint<Width>(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vint<Width>(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+#endif
         vint<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = l;
         return v;
@@ -147,6 +167,10 @@ SFX_LANES_INLINE vbool<Width> from_bits(uint32_t b) {
     if constexpr (Width == 1) {
         return (b & 1u) != 0;
     } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vbool<Width>(_mm512_maskz_mov_epi32(__mmask16(b), _mm512_set1_epi32(-1)));
+#endif
         const vint<Width> one = broadcast_int<Width>(1);
         return ((broadcast_int<Width>(int32_t(b)) >> lane_index<Width>()) & one) == one;
     }
