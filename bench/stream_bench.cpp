@@ -4,15 +4,17 @@
 //   counting sink, and Embree 3 rtcIntersect1 (robust scene, via EmbreeScene),
 // for primary rays and diffuse-bounce rays, with ratios; then whole-frame path tracing,
 // reference against stream (trace off / counting). Not a test: speeds vary by machine.
-// Times are thread CPU seconds, median of N (default 5), so other processes on the machine matter less.
+// Times are thread CPU seconds, median of N (default 5), so other processes on the machine matter
+// less.
 //
-// Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa X]    (default: conference 512x512)
+// Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa X]    (default: conference
+// 512x512)
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <string>
 
@@ -26,7 +28,6 @@
 using namespace sfx;
 
 namespace {
-
 
 // CPU seconds of this thread: on a shared machine, wall time measures the neighbours too.
 double thread_seconds() {
@@ -123,7 +124,9 @@ int main(int argc, char** argv) {
         } else if (a == "--repeat" && i + 1 < argc) {
             repeat = std::max(1, std::atoi(argv[++i]));
         } else if (a == "-h" || a == "--help") {
-            std::printf("usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa auto|avx512|avx2|scalar]\n");
+            std::printf(
+                "usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa "
+                "auto|avx512|avx2|scalar]\n");
             return 0;
         } else {
             scene_name = a;
@@ -181,20 +184,23 @@ int main(int argc, char** argv) {
             report((name + ", counting sink").c_str(), rays->size(), t_counting[k].second,
                    embree_rate);
         }
-        std::printf("  stream hits differing from reference (all back ends): %zu; "
-                    "primitive differs from Embree's: %zu\n",
-                    differ, embree_differ);
+        std::printf(
+            "  stream hits differing from reference (all back ends): %zu; "
+            "primitive differs from Embree's: %zu\n",
+            differ, embree_differ);
         uint64_t boxes = 0, prims = 0;
         for (const Ray& r : *rays) count_reference_tests(bvh, r, boxes, prims);
         const double n = double(rays->size()), runs = double(repeat);
-        std::printf("  tests per ray: reference %.1f box, %.1f primitive; stream %.1f box, %.1f "
-                    "primitive in ops of %.1f and %.1f rays on average\n",
-                    double(boxes) / n, double(prims) / n,
-                    double(counts.kind_lanes(OpKind::box_test)) / runs / n,
-                    double(counts.kind_lanes(OpKind::triangle_test) +
-                           counts.kind_lanes(OpKind::sphere_test)) / runs / n,
-                    counts.stage(false, OpStage::traversal).average_length(),
-                    counts.stage(false, OpStage::intersection).average_length());
+        std::printf(
+            "  tests per ray: reference %.1f box, %.1f primitive; stream %.1f box, %.1f "
+            "primitive in ops of %.1f and %.1f rays on average\n",
+            double(boxes) / n, double(prims) / n,
+            double(counts.kind_lanes(OpKind::box_test)) / runs / n,
+            double(counts.kind_lanes(OpKind::triangle_test) +
+                   counts.kind_lanes(OpKind::sphere_test)) /
+                runs / n,
+            counts.stage(false, OpStage::traversal).average_length(),
+            counts.stage(false, OpStage::intersection).average_length());
     }
 
     // Whole frames: path tracing with all generations, shading included.

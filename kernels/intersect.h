@@ -162,8 +162,7 @@ inline TrianglePlaneCheck check_triangle_plane(const Vec3& org, const Vec3& dir,
                  e1z = double(p1.z) - double(p0.z);
     const double e2x = double(p2.x) - double(p0.x), e2y = double(p2.y) - double(p0.y),
                  e2z = double(p2.z) - double(p0.z);
-    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z,
-                 nz = e1x * e2y - e1y * e2x;
+    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
     TrianglePlaneCheck c;
     c.degenerate = nx == 0.0 && ny == 0.0 && nz == 0.0;
     const double num = nx * (double(p0.x) - double(org.x)) + ny * (double(p0.y) - double(org.y)) +
@@ -188,9 +187,8 @@ inline bool triangle_is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p
 // - Degenerate (zero-area) triangles never hit. In sheared ray space collinear vertices are no
 //   longer exactly collinear, so the determinant alone does not catch them.
 // Both double-precision checks run only for candidates that passed every float test.
-inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1,
-                               const Vec3& p2, float t_max, float& t_out, float& u_out,
-                               float& v_out) {
+inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                               float t_max, float& t_out, float& u_out, float& v_out) {
     const float org[3] = {r.org.x, r.org.y, r.org.z};
     const ShearedTriangle<1> s = shear_triangle<1>(org, r.kx, r.ky, r.kz, r.sx, r.sy, p0, p1, p2);
     const float ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
@@ -260,13 +258,27 @@ inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, 
     const float t_near_origin = c / q, t_other = q / a;
     float t0 = on_surface ? INFINITY : t_near_origin, t1 = t_other;
     if (t0 > t1) std::swap(t0, t1);
-    if (t0 > 0.f && t0 <= t_max) { t_out = t0; return true; }
-    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) { t_out = t1; return true; }
+    if (t0 > 0.f && t0 <= t_max) {
+        t_out = t0;
+        return true;
+    }
+    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) {
+        t_out = t1;
+        return true;
+    }
     return false;
 }
 
-inline uint32_t float_bits(float f) { uint32_t i; std::memcpy(&i, &f, 4); return i; }
-inline float bits_float(uint32_t i) { float f; std::memcpy(&f, &i, 4); return f; }
+inline uint32_t float_bits(float f) {
+    uint32_t i;
+    std::memcpy(&i, &f, 4);
+    return i;
+}
+inline float bits_float(uint32_t i) {
+    float f;
+    std::memcpy(&f, &i, 4);
+    return f;
+}
 
 // Waechter & Binder: move p off the surface along n (the side the new ray leaves from),
 // by a fixed number of ulps far from the origin and by a fixed distance near it.
@@ -292,8 +304,10 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n)
     const Vec3 offset = n * d;
     Vec3 out = p + offset;
     for (int a = 0; a < 3; ++a) {
-        if (offset[a] > 0.f) out[a] = std::nextafter(out[a], INFINITY);
-        else if (offset[a] < 0.f) out[a] = std::nextafter(out[a], -INFINITY);
+        if (offset[a] > 0.f)
+            out[a] = std::nextafter(out[a], INFINITY);
+        else if (offset[a] < 0.f)
+            out[a] = std::nextafter(out[a], -INFINITY);
     }
     return out;
 }
@@ -301,8 +315,8 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n)
 // Error bounds of surface points, for offset_ray_origin(p, p_error, n).
 // A point p0 w + p1 u + p2 v: any weights summing to 1 give a point of the plane, and
 // w = 1 - u - v makes the sum 1 to a rounding, so the error is the weighted sum's (pbrt-v4).
-inline Vec3 triangle_point_error(const Vec3& p0, const Vec3& p1, const Vec3& p2, float w,
-                                 float u, float v) {
+inline Vec3 triangle_point_error(const Vec3& p0, const Vec3& p1, const Vec3& p2, float w, float u,
+                                 float v) {
     return (abs(p0 * w) + abs(p1 * u) + abs(p2 * v)) * gamma_bound(7);
 }
 // A point center + n * radius with n normalized in float.
@@ -313,8 +327,8 @@ inline Vec3 sphere_point_error(const Vec3& center, const Vec3& n, float radius) 
 // Surface data at a hit, computed the same way by every tracer.
 struct SurfaceHit {
     Vec3 position;
-    Vec3 position_error;  // |position - true surface point| <= position_error, per component
-    Vec3 normal;  // geometric, unit length, facing against the incoming ray
+    Vec3 position_error;     // |position - true surface point| <= position_error, per component
+    Vec3 normal;             // geometric, unit length, facing against the incoming ray
     bool front_face = true;  // the ray arrived from the side the stored normal points to
     uint32_t material = 0;
 };

@@ -6,19 +6,26 @@ namespace sfx {
 
 const char* isa_name(Isa isa) {
     switch (isa) {
-    case Isa::automatic: return "auto";
-    case Isa::scalar: return "scalar";
-    case Isa::avx2: return "avx2";
-    case Isa::avx512: return "avx512";
+        case Isa::automatic:
+            return "auto";
+        case Isa::scalar:
+            return "scalar";
+        case Isa::avx2:
+            return "avx2";
+        case Isa::avx512:
+            return "avx512";
     }
     return "?";
 }
 
 uint32_t isa_width(Isa isa) {
     switch (isa) {
-    case Isa::avx512: return 16;
-    case Isa::avx2: return 8;
-    default: return 1;
+        case Isa::avx512:
+            return 16;
+        case Isa::avx2:
+            return 8;
+        default:
+            return 1;
     }
 }
 
@@ -33,11 +40,13 @@ bool isa_supported(Isa isa) {
     // libgcc's cpuid checks also ask the OS (XGETBV) whether it saves the wide registers.
     __builtin_cpu_init();
     switch (isa) {
-    case Isa::avx512:
-        return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-               __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512vbmi2");
-    case Isa::avx2: return __builtin_cpu_supports("avx2");
-    default: return true;
+        case Isa::avx512:
+            return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+                   __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512vbmi2");
+        case Isa::avx2:
+            return __builtin_cpu_supports("avx2");
+        default:
+            return true;
     }
 }
 

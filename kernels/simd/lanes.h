@@ -91,7 +91,8 @@ SFX_LANES_INLINE vint<Width> lane_index() {
     } else {
 #if defined(__AVX512F__)
         if constexpr (Width == 16)
-            return vint<Width>(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+            return vint<Width>(
+                _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) return vint<Width>(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
@@ -111,18 +112,24 @@ SFX_LANES_INLINE Value select(Mask m, Value a, Value b) {
 // Per-lane logic on masks (for Width 1 the operators of bool).
 template <class Mask>
 SFX_LANES_INLINE Mask mask_and(Mask a, Mask b) {
-    if constexpr (sizeof(Mask) == 1) return a && b;
-    else return a & b;
+    if constexpr (sizeof(Mask) == 1)
+        return a && b;
+    else
+        return a & b;
 }
 template <class Mask>
 SFX_LANES_INLINE Mask mask_or(Mask a, Mask b) {
-    if constexpr (sizeof(Mask) == 1) return a || b;
-    else return a | b;
+    if constexpr (sizeof(Mask) == 1)
+        return a || b;
+    else
+        return a | b;
 }
 template <class Mask>
 SFX_LANES_INLINE Mask mask_not(Mask a) {
-    if constexpr (sizeof(Mask) == 1) return !a;
-    else return ~a;
+    if constexpr (sizeof(Mask) == 1)
+        return !a;
+    else
+        return ~a;
 }
 
 // The sign bit of each lane (true for -0 and -inf, as std::signbit).
@@ -206,7 +213,7 @@ SFX_LANES_INLINE vfloat<Width> gather(const float* base, vint<Width> index) {
 #if defined(__AVX512F__)
         if constexpr (Width == 16)
             return vfloat<Width>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), __mmask16(0xffff),
-                                                             __m512i(index), base, 4));
+                                                          __m512i(index), base, 4));
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8)
@@ -224,8 +231,8 @@ SFX_LANES_INLINE vint<Width> gather_int(const int32_t* base, vint<Width> index) 
     } else {
 #if defined(__AVX512F__)
         if constexpr (Width == 16)
-            return vint<Width>(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xffff),
-                                                              __m512i(index), base, 4));
+            return vint<Width>(_mm512_mask_i32gather_epi32(
+                _mm512_setzero_si512(), __mmask16(0xffff), __m512i(index), base, 4));
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8)
@@ -265,8 +272,8 @@ SFX_LANES_INLINE uint32_t compress_store(uint32_t mask_bits, vint<Width> values,
     } else {
 #if defined(__AVX512F__)
         if constexpr (Width == 16) {  // vpcompressd into a register, then one plain store
-            _mm512_storeu_si512(out, _mm512_maskz_compress_epi32(__mmask16(mask_bits),
-                                                                 __m512i(values)));
+            _mm512_storeu_si512(out,
+                                _mm512_maskz_compress_epi32(__mmask16(mask_bits), __m512i(values)));
             return uint32_t(__builtin_popcount(mask_bits));
         }
 #endif
@@ -307,15 +314,16 @@ template <int Width>
 SFX_LANES_INLINE uint32_t load_mask_bytes(const uint8_t* mask) {
 #if defined(__AVX512BW__) && defined(__AVX512VL__)
     if constexpr (Width == 16)
-        return uint32_t(_mm_test_epi8_mask(
-            _mm_loadu_si128(reinterpret_cast<const __m128i*>(mask)), _mm_set1_epi8(-1)));
+        return uint32_t(_mm_test_epi8_mask(_mm_loadu_si128(reinterpret_cast<const __m128i*>(mask)),
+                                           _mm_set1_epi8(-1)));
 #endif
 #if defined(__AVX2__)
     if constexpr (Width == 8) {
         uint64_t b;
         __builtin_memcpy(&b, mask, 8);
-        return uint32_t(_mm_movemask_epi8(_mm_cmpgt_epi8(_mm_cvtsi64_si128(int64_t(b)),
-                                                         _mm_setzero_si128()))) & 255u;
+        return uint32_t(_mm_movemask_epi8(
+                   _mm_cmpgt_epi8(_mm_cvtsi64_si128(int64_t(b)), _mm_setzero_si128()))) &
+               255u;
     }
 #endif
     uint32_t r = 0;

@@ -53,16 +53,18 @@ struct SinkTrace {
 // back end's compress. Without a trace nothing needs the mask, so the test and the partition
 // run in one pass. ids, mask and scratch have k_stream_padding elements of room past n.
 template <class Trace, class Test>
-inline uint32_t filter(const StreamKernels& kernels, Trace& trace, OpKind kind,
-                       uint16_t generation, uint32_t object, uint32_t* ids, uint32_t n,
-                       uint8_t* mask, uint32_t* scratch, Test&& test) {
+inline uint32_t filter(const StreamKernels& kernels, Trace& trace, OpKind kind, uint16_t generation,
+                       uint32_t object, uint32_t* ids, uint32_t n, uint8_t* mask, uint32_t* scratch,
+                       Test&& test) {
     if (n == 0) return 0;
     if constexpr (!Trace::k_enabled) {
         uint32_t front = 0, back = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint32_t id = ids[i];
-            if (test(id)) ids[front++] = id;  // front <= i: never overwrites an unread id
-            else scratch[back++] = id;
+            if (test(id))
+                ids[front++] = id;  // front <= i: never overwrites an unread id
+            else
+                scratch[back++] = id;
         }
         if (front != 0)
             for (uint32_t i = 0; i < back; ++i) ids[front + i] = scratch[i];

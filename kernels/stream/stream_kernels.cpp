@@ -10,9 +10,12 @@ const StreamKernels& stream_kernels_avx512();  // stream_kernels_avx512.cpp
 const StreamKernels& stream_kernels(Isa isa) {
     static const StreamKernels scalar = scalar_kernels::make_kernels<1>(Isa::scalar);
     switch (isa) {
-    case Isa::avx512: return stream_kernels_avx512();
-    case Isa::avx2: return stream_kernels_avx2();
-    default: return scalar;
+        case Isa::avx512:
+            return stream_kernels_avx512();
+        case Isa::avx2:
+            return stream_kernels_avx2();
+        default:
+            return scalar;
     }
 }
 

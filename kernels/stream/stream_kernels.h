@@ -47,8 +47,8 @@ struct StreamKernels {
     // Writes mask[i] (0/1, input order) when mask is not null. Adds to `negative` the passing
     // rays whose direction is negative on `axis` (the front-child vote). Returns the passing count.
     uint32_t (*box_filter)(const TraversalRay* rays, const Bounds3& box, int axis,
-                           const uint32_t* ids, uint32_t n, uint32_t* pass_out,
-                           uint32_t* fail_out, uint8_t* mask, uint32_t& negative);
+                           const uint32_t* ids, uint32_t n, uint32_t* pass_out, uint32_t* fail_out,
+                           uint8_t* mask, uint32_t& negative);
 
     // The float stage of the watertight test of ids[0, n) against one triangle: writes the
     // positions i (in order) that it does not reject to `positions`; returns their count.

@@ -86,8 +86,7 @@ uint32_t box_filter(const TraversalRay* rays, const Bounds3& box, int axis, cons
 
 template <int Width>
 uint32_t triangle_candidates(const TraversalRay* rays, const Vec3& p0, const Vec3& p1,
-                             const Vec3& p2, const uint32_t* ids, uint32_t n,
-                             uint32_t* positions) {
+                             const Vec3& p2, const uint32_t* ids, uint32_t n, uint32_t* positions) {
     namespace f = traversal_field;
     const float* base = reinterpret_cast<const float*>(rays);
     const int32_t* base_int = reinterpret_cast<const int32_t*>(rays);

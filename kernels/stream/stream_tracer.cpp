@@ -21,10 +21,10 @@ namespace {
 struct RayBuffers {
     uint32_t capacity = 0;
     std::vector<PathState> path;
-    std::vector<Ray> ray[2];          // current and next generation
+    std::vector<Ray> ray[2];  // current and next generation
     std::vector<TraversalRay> trav;
     std::vector<Hit> hit;
-    std::vector<uint8_t> any_hit;     // shadow ray: any hit in (0, t_max) occludes it
+    std::vector<uint8_t> any_hit;  // shadow ray: any hit in (0, t_max) occludes it
     std::vector<SurfaceHit> surf;
     // Id lists and masks have k_stream_padding elements of room: compress writes whole vectors.
     std::vector<uint32_t> ids, next_ids, trav_ids, scratch, scratch2, positions;
@@ -133,8 +133,8 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 // rejects most lanes; the full test runs on the candidates it leaves.
                 const Triangle& tri = scene.triangles[prim];
                 const uint32_t candidates = kernels.triangle_candidates(
-                    rays, scene.positions[tri.v0], scene.positions[tri.v1],
-                    scene.positions[tri.v2], ids, k, positions);
+                    rays, scene.positions[tri.v0], scene.positions[tri.v1], scene.positions[tri.v2],
+                    ids, k, positions);
                 if constexpr (Trace::k_enabled) std::fill(mask, mask + k, uint8_t(0));
                 uint32_t passed = 0;
                 for (uint32_t j = 0; j < candidates; ++j) {
@@ -183,7 +183,10 @@ struct StreamTracer::Impl {
     RayBuffers b;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
-        : scene(s), bvh(h), settings(r), kernels(stream_kernels(resolve_isa(r.isa))),
+        : scene(s),
+          bvh(h),
+          settings(r),
+          kernels(stream_kernels(resolve_isa(r.isa))),
           camera(s.camera, r.width, r.height),
           material_rays(s.materials.size(), 0) {}
 
@@ -193,14 +196,17 @@ struct StreamTracer::Impl {
 };
 
 template <class Trace>
-void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t sample,
-                             Vec3* sums, RenderStats& stats, Trace& trace, TraceSink* sink,
+void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
+                             RenderStats& stats, Trace& trace, TraceSink* sink,
                              RayObserver* observer) {
     const uint32_t w = rect.x1 - rect.x0, h = rect.y1 - rect.y0, count = w * h;
     b.ensure(count);
     TilePass info;
     info.tile = tile_index;
-    info.x0 = rect.x0; info.y0 = rect.y0; info.x1 = rect.x1; info.y1 = rect.y1;
+    info.x0 = rect.x0;
+    info.y0 = rect.y0;
+    info.x1 = rect.x1;
+    info.y1 = rect.y1;
     info.sample = sample;
     info.slot_count = count;
     if constexpr (Trace::k_enabled) sink->begin_pass(info);
@@ -246,25 +252,24 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         uint32_t* next_ids = b.next_ids.data();
         auto run_filter = [&](OpKind kind, uint32_t object, uint32_t* s, uint32_t len,
                               auto&& test) {
-            return filter(kernels, trace, kind, generation, object, s, len, mask, scratch,
-                                        test);
+            return filter(kernels, trace, kind, generation, object, s, len, mask, scratch, test);
         };
         uint32_t* s = ids;
         uint32_t len = n;
-        const uint32_t shadows = run_filter(OpKind::shadow_filter, k_no_object, s, len,
-                                            [&](uint32_t id) {
-            if (!any_hit[id]) return false;
-            finish_shadow(path[id], hit[id].valid());
-            return true;
-        });
+        const uint32_t shadows =
+            run_filter(OpKind::shadow_filter, k_no_object, s, len, [&](uint32_t id) {
+                if (!any_hit[id]) return false;
+                finish_shadow(path[id], hit[id].valid());
+                return true;
+            });
         s += shadows;
         len -= shadows;
-        const uint32_t misses = run_filter(OpKind::miss_filter, k_no_object, s, len,
-                                           [&](uint32_t id) {
-            if (hit[id].valid()) return false;
-            shade_miss(path[id], scene);
-            return true;
-        });
+        const uint32_t misses =
+            run_filter(OpKind::miss_filter, k_no_object, s, len, [&](uint32_t id) {
+                if (hit[id].valid()) return false;
+                shade_miss(path[id], scene);
+                return true;
+            });
         s += misses;
         len -= misses;
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
@@ -320,8 +325,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                 if (!ambient)  // with ambient light, the indirect group ends here
                     run_filter(OpKind::lambertian_indirect, k_no_object, s + direct, g - direct,
                                [&](uint32_t id) {
-                                   if (!lambertian_indirect(path[id], scene, material(id),
-                                                            surf[id], next[id]))
+                                   if (!lambertian_indirect(path[id], scene, material(id), surf[id],
+                                                            next[id]))
                                        return false;
                                    push(id, false);
                                    return true;
@@ -383,8 +388,8 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
     RenderResult result;
     result.image = Image(settings.width, settings.height);
     const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
-    uint32_t threads = settings.threads ? settings.threads
-                                        : std::max(1u, std::thread::hardware_concurrency());
+    uint32_t threads =
+        settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
     threads = std::min<uint32_t>(threads, uint32_t(tiles.size()));
     if (sink) {
         TraceHeader header;

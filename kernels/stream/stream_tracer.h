@@ -25,13 +25,13 @@ namespace sfx {
 
 // Sees every traced ray of a pass with its result (tests compare hit records through it).
 class RayObserver {
-public:
+  public:
     virtual ~RayObserver() = default;
     virtual void ray(const PathState& path, const Ray& ray, const Hit& hit, bool occluded) = 0;
 };
 
 class StreamTracer {
-public:
+  public:
     StreamTracer(const Scene& scene, const Bvh& bvh, const RenderSettings& settings);
     ~StreamTracer();
     StreamTracer(const StreamTracer&) = delete;
@@ -43,7 +43,7 @@ public:
     void trace_pass(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
                     RenderStats& stats, TraceSink* sink, RayObserver* observer = nullptr);
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
 };

@@ -21,7 +21,9 @@ struct OpLog : TraceSink {
     std::string bytes;
     uint64_t ops = 0;
     template <class T>
-    void put(const T& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); }
+    void put(const T& v) {
+        bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+    }
     void begin_pass(const TilePass& p) override {
         put(p.tile);
         put(p.sample);
@@ -64,8 +66,8 @@ RenderSettings settings_for(const Scene& s, uint32_t tile, uint32_t threads) {
 
 TEST_CASE("The workload trace is identical for every back end (ops, slots, masks)",
           "[stream][simd]") {
-    for (const test::Variant v : {test::Variant::lights, test::Variant::ambient,
-                                  test::Variant::emissive_sphere}) {
+    for (const test::Variant v :
+         {test::Variant::lights, test::Variant::ambient, test::Variant::emissive_sphere}) {
         const Scene s = test::box_scene(v);
         const Bvh bvh(s);
         for (uint32_t tile : {4u, 16u})
@@ -123,8 +125,7 @@ TEST_CASE("stream_intersect gives the same hits and trace for every back end", "
     }
 }
 
-TEST_CASE("Back ends: auto picks the widest the CPU has; an unsupported one is refused",
-          "[simd]") {
+TEST_CASE("Back ends: auto picks the widest the CPU has; an unsupported one is refused", "[simd]") {
     CHECK(resolve_isa(Isa::automatic) == best_isa());
     CHECK(resolve_isa(Isa::scalar) == Isa::scalar);
     CHECK(supported_isas().front() == Isa::scalar);

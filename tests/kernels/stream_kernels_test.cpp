@@ -4,6 +4,8 @@
 // signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
 // stage, and the compress. Streams of odd lengths exercise partial groups.
 
+#include "kernels/stream/stream_kernels.h"
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <numeric>
@@ -11,7 +13,6 @@
 
 #include "kernels/rng.h"
 #include "kernels/simd/lanes.h"
-#include "kernels/stream/stream_kernels.h"
 
 using namespace sfx;
 
@@ -71,16 +72,17 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
                 }
                 if (k % 2 == 0 && !box.empty()) ray.dir = box.center() - ray.org;  // aim at it
                 if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
-                rays.push_back({RayPrecomp(ray), t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]});
+                rays.push_back(
+                    {RayPrecomp(ray), t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]});
             }
             const int axis = int(i % 3);
             const std::vector<uint32_t> ids = shuffled_ids(n, i);
             std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
             std::vector<uint8_t> mask(n + k_stream_padding, 7);
             uint32_t negative = 0;
-            const uint32_t passed = kernels.box_filter(rays.data(), box, axis, ids.data(), n,
-                                                       pass.data(), fail.data(), mask.data(),
-                                                       negative);
+            const uint32_t passed =
+                kernels.box_filter(rays.data(), box, axis, ids.data(), n, pass.data(), fail.data(),
+                                   mask.data(), negative);
             std::vector<uint32_t> want_pass, want_fail;
             uint32_t want_negative = 0;
             for (uint32_t l = 0; l < n; ++l) {
@@ -99,9 +101,9 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             // In place, without a mask: the passing prefix is the same.
             std::vector<uint32_t> in_place = ids;
             uint32_t negative2 = 0;
-            const uint32_t passed2 = kernels.box_filter(rays.data(), box, axis, in_place.data(), n,
-                                                        in_place.data(), fail.data(), nullptr,
-                                                        negative2);
+            const uint32_t passed2 =
+                kernels.box_filter(rays.data(), box, axis, in_place.data(), n, in_place.data(),
+                                   fail.data(), nullptr, negative2);
             order_errors += !tail_intact(in_place, n);
             order_errors += passed2 != passed ||
                             !std::equal(want_pass.begin(), want_pass.end(), in_place.begin()) ||
@@ -151,8 +153,8 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
             differ += c != c_scalar || !std::equal(got.begin(), got.begin() + c, want.begin());
             for (uint32_t l = 0; l < n; ++l) {
                 float t, u, v;
-                const bool hit = intersect_triangle(rays[ids[l]].pre, p[0], p[1], p[2], INFINITY,
-                                                    t, u, v);
+                const bool hit =
+                    intersect_triangle(rays[ids[l]].pre, p[0], p[1], p[2], INFINITY, t, u, v);
                 const bool kept = std::find(got.begin(), got.begin() + c, l) != got.begin() + c;
                 lost_hits += hit && !kept;
                 total_hits += hit;
