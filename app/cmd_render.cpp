@@ -36,10 +36,8 @@ void add_render_command(CLI::App& app) {
     c->callback([options] {
         const Scene scene = load_scene(options->scene);
         const RenderSettings settings = options->workload.resolve(scene);
-        if (options->output.size() < 5 ||
-            options->output.substr(options->output.size() - 4) != ".png")
-            throw InputError("command line", 0, "--output",
-                             "expected a .png path, got '" + options->output + "'");
+        if (options->output.size() < 5 || options->output.substr(options->output.size() - 4) != ".png")
+            throw InputError("command line", 0, "--output", "expected a .png path, got '" + options->output + "'");
         const Bvh bvh(scene);
         if (!options->trace.empty() && options->tracer != "stream")
             throw InputError("command line", 0, "--trace", "needs --tracer stream");
@@ -84,8 +82,7 @@ void add_render_command(CLI::App& app) {
                       << ", shadow " << result.stats.shadow_rays << ")\n"
                       << "nonfinite paths  " << result.stats.nonfinite_paths << "\n"
                       << "host seconds     " << result.stats.host_seconds << "\n"
-                      << "mrays/s          "
-                      << result.stats.rays() / result.stats.host_seconds * 1e-6 << "\n"
+                      << "mrays/s          " << result.stats.rays() / result.stats.host_seconds * 1e-6 << "\n"
                       << "wrote            " << options->output << ", " << pfm
                       << (writer ? ", " + options->trace + " (" +
                                        std::to_string(writer->bytes_written()) + " bytes)"

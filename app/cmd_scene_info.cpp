@@ -105,9 +105,8 @@ void add_scene_info_command(CLI::App& app) {
                     scene.positions.size());
         std::printf("lights             %zu (%llu emissive primitives)\n", scene.lights.size(),
                     (unsigned long long)light_primitives);
-        std::printf(
-            "materials          %zu (lambertian %u, dielectric %u, glossy %u; emissive %u)\n",
-            scene.materials.size(), kinds[0], kinds[1], kinds[2], emissive);
+        std::printf("materials          %zu (lambertian %u, dielectric %u, glossy %u; emissive %u)\n",
+                    scene.materials.size(), kinds[0], kinds[1], kinds[2], emissive);
         std::printf("features           %s\n", features.describe().c_str());
         std::printf("ray record         %u bytes (%u KiB for 64x64 rays)\n", ray_bytes,
                     ray_bytes * 4096 / 1024);
@@ -125,10 +124,9 @@ void add_scene_info_command(CLI::App& app) {
         std::printf("memory             geometry %s, bvh %s, total %s\n", mib(geometry).c_str(),
                     mib(st.bytes).c_str(), mib(geometry + st.bytes).c_str());
         std::printf("load seconds       %.3f\n", load_seconds);
-        std::printf(
-            "stream back end    %s (widest this CPU runs; --isa on the rendering "
-            "commands)\n",
-            describe_isa(Isa::automatic).c_str());
+        std::printf("stream back end    %s (widest this CPU runs; --isa on the rendering "
+                    "commands)\n",
+                    describe_isa(Isa::automatic).c_str());
     });
 }
 

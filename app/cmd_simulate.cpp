@@ -2,9 +2,9 @@
 // and operation mix. Several configurations share one functional render (trace once, time many).
 
 #include <iomanip>
+#include <sstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "app/commands.h"
 #include "kernels/bvh.h"
@@ -55,8 +55,7 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
                               "scene_memory", "interconnect", "pipeline_fill"}) {
         row(std::string("stall ") + cause + " (% of cycles)", [&](const Prediction& p) {
             return fixed(100 * stat(p, std::string("stall_cycles.") + cause) /
-                             std::max(1.0, double(p.timing.cycles)),
-                         1);
+                             std::max(1.0, double(p.timing.cycles)), 1);
         });
     }
     for (const char* m : {"load", "store", "compute", "scatter_gather", "partition"}) {
@@ -75,8 +74,7 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
     }
     row("host seconds", [&](const Prediction& p) { return fixed(p.host_seconds, 3); });
     row("error estimate (interval)", [&](const Prediction& p) {
-        return p.error_relative < 0 ? std::string("unknown")
-                                    : "+-" + fixed(100 * p.error_relative, 2) + "%";
+        return p.error_relative < 0 ? std::string("unknown") : "+-" + fixed(100 * p.error_relative, 2) + "%";
     });
     row("tile passes timed", [&](const Prediction& p) {
         return std::to_string(p.sample_passes) + "/" + std::to_string(p.total_passes);
@@ -93,8 +91,7 @@ void add_simulate_command(CLI::App& app) {
         SamplingFlags sampling;
     };
     auto o = std::make_shared<Options>();
-    CLI::App* c = app.add_subcommand(
-        "simulate", "predict frame rate and utilization of hardware configurations");
+    CLI::App* c = app.add_subcommand("simulate", "predict frame rate and utilization of hardware configurations");
     c->add_option("hw", o->hw, "hardware configuration files (*.hw.yaml); several share one render")
         ->required();
     c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();

@@ -55,8 +55,7 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
         throw InputError("command line", 0, "--rays",
                          "expected 1..10000000, got " + std::to_string(o.rays));
     if (!(o.ulps >= 0.f && o.ulps <= 1e6f))
-        throw InputError("command line", 0, "--ulps",
-                         "expected 0..1e6, got " + std::to_string(o.ulps));
+        throw InputError("command line", 0, "--ulps", "expected 0..1e6, got " + std::to_string(o.ulps));
     const auto bvh_start = Clock::now();
     const Bvh bvh(scene);
     const double bvh_seconds = seconds_since(bvh_start);
@@ -88,10 +87,9 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
         j["tolerance.edge"] = options.tolerance.edge;
         j["rays"] = o.rays;
         j["diffuse_sources"] = a.diffuse_sources;
-        for (const auto& [name, c] :
-             {std::pair<std::string, const ClassCounts*>{"primary", &primary},
-              {"diffuse", &diffuse},
-              {"total", &total}}) {
+        for (const auto& [name, c] : {std::pair<std::string, const ClassCounts*>{"primary", &primary},
+                                      {"diffuse", &diffuse},
+                                      {"total", &total}}) {
             for (size_t k = 0; k < k_hit_class_count; ++k)
                 j[name + "." + to_string(HitClass(k))] = c->by_class[k];
             j[name + ".filtered"] = c->filtered;
@@ -119,10 +117,9 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
     std::printf("scene            %s (%u triangles, %zu spheres; %u left out of Embree)\n",
                 scene.name.c_str(), scene.triangle_count(), scene.spheres.size(),
                 a.excluded_primitives);
-    std::printf(
-        "rays             %llu: primary at %ux%u, diffuse from %llu primary hits, seed %llu\n",
-        (unsigned long long)o.rays, settings.width, settings.height,
-        (unsigned long long)a.diffuse_sources, (unsigned long long)settings.seed);
+    std::printf("rays             %llu: primary at %ux%u, diffuse from %llu primary hits, seed %llu\n",
+                (unsigned long long)o.rays, settings.width, settings.height,
+                (unsigned long long)a.diffuse_sources, (unsigned long long)settings.seed);
     std::printf("\n%-18s %12s %12s %12s %10s\n", "class", "primary", "diffuse", "total", "rate");
     auto row = [&](const char* name, uint64_t p, uint64_t d, uint64_t t) {
         const double rate = total.traced() ? double(t) / double(total.traced()) : 0.0;
@@ -130,8 +127,8 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
                     (unsigned long long)d, (unsigned long long)t, format_rate(rate).c_str());
     };
     for (size_t k = 0; k < k_hit_class_count; ++k) {
-        const std::string name =
-            std::string(to_string(HitClass(k))) + (is_explained(HitClass(k)) ? "" : " *");
+        const std::string name = std::string(to_string(HitClass(k))) +
+                                 (is_explained(HitClass(k)) ? "" : " *");
         row(name.c_str(), primary.by_class[k], diffuse.by_class[k], total.by_class[k]);
     }
     row("traced", primary.traced(), diffuse.traced(), total.traced());
@@ -141,11 +138,9 @@ bool validate_against_embree(const ValidateOptions& o, const Scene& scene,
                 (unsigned long long)primary.filtered, (unsigned long long)diffuse.filtered,
                 (unsigned long long)total.filtered, "");
     std::printf("(* unexplained; filtered: NaN/Inf/out of Embree's range, not traced)\n");
-    std::printf(
-        "tolerance        %g ulps or %g relative, times 1/|cos| of the hit angle; "
-        "edge %g\n",
-        double(options.tolerance.ulps), double(options.tolerance.relative),
-        double(options.tolerance.edge));
+    std::printf("tolerance        %g ulps or %g relative, times 1/|cos| of the hit angle; "
+                "edge %g\n", double(options.tolerance.ulps), double(options.tolerance.relative),
+                double(options.tolerance.edge));
     std::printf("\nunexplained rate %s (limit %s): %s\n", format_rate(a.unexplained_rate()).c_str(),
                 format_rate(a.max_unexplained_rate).c_str(), a.pass() ? "PASS" : "FAIL");
     std::printf("host seconds     %.2f (load %.2f, sfx bvh %.2f, embree build %.2f, trace %.2f)\n",
@@ -171,7 +166,8 @@ struct HitRecordChecker : RayObserver {
         } else {
             const Hit ref = bvh.intersect(ray);
             same = ref.prim == hit.prim && float_bits(ref.t) == float_bits(hit.t) &&
-                   float_bits(ref.u) == float_bits(hit.u) && float_bits(ref.v) == float_bits(hit.v);
+                   float_bits(ref.u) == float_bits(hit.u) &&
+                   float_bits(ref.v) == float_bits(hit.v);
         }
         if (same) return;
         ++mismatches;
@@ -202,8 +198,8 @@ bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
             if (++differing <= 5) {
                 char buf[160];
                 std::snprintf(buf, sizeof buf,
-                              "(%u, %u): reference %.9g %.9g %.9g, stream %.9g %.9g %.9g", x, y,
-                              a.x, a.y, a.z, b.x, b.y, b.z);
+                          "(%u, %u): reference %.9g %.9g %.9g, stream %.9g %.9g %.9g", x, y, a.x,
+                          a.y, a.z, b.x, b.y, b.z);
                 pixel_examples.push_back(buf);
             }
         }
@@ -272,11 +268,10 @@ bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
                 (unsigned long long)checker.checked, (unsigned long long)checker.mismatches);
     for (const std::string& e : checker.examples) std::printf("  %s\n", e.c_str());
     std::printf("result           %s\n", pass ? "PASS (bit-identical)" : "FAIL");
-    std::printf(
-        "host seconds     %.2f (load %.2f, bvh %.2f, reference %.2f, stream %.2f, "
-        "hit records %.2f)\n",
-        total_seconds, load_seconds, bvh_seconds, ref.stats.host_seconds, st.stats.host_seconds,
-        hits_seconds);
+    std::printf("host seconds     %.2f (load %.2f, bvh %.2f, reference %.2f, stream %.2f, "
+                "hit records %.2f)\n",
+                total_seconds, load_seconds, bvh_seconds, ref.stats.host_seconds,
+                st.stats.host_seconds, hits_seconds);
     return pass;
 }
 

@@ -9,9 +9,7 @@ namespace sfx {
 
 void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--res", res, "image size WxH")->capture_default_str();
-    c->add_option("--spp", spp, "samples per pixel")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+    c->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
     c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
@@ -26,24 +24,21 @@ RenderSettings WorkloadFlags::resolve(const Scene& scene) const {
     RenderSettings s;
     unsigned w = 0, h = 0;
     char tail = 0;
-    if (std::sscanf(res.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 65536 ||
-        h > 65536)
-        throw InputError("command line", 0, "--res",
-                         "expected WxH with 1..65536, got '" + res + "'");
+    if (std::sscanf(res.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 ||
+        w > 65536 || h > 65536)
+        throw InputError("command line", 0, "--res", "expected WxH with 1..65536, got '" + res + "'");
     s.width = w;
     s.height = h;
     s.spp = spp;
     if (depth < -1 || depth > 1000)
-        throw InputError("command line", 0, "--depth",
-                         "expected 0..1000, got " + std::to_string(depth));
+        throw InputError("command line", 0, "--depth", "expected 0..1000, got " + std::to_string(depth));
     s.max_depth = depth < 0 ? scene.max_depth : uint32_t(depth);
     if (tile == "auto") {
         s.tile = 64;  // the largest the paper's buffers hold; the hardware model refines this
     } else {
         unsigned t = 0;
         if (std::sscanf(tile.c_str(), "%u%c", &t, &tail) != 1 || t == 0 || t > 4096)
-            throw InputError("command line", 0, "--tile",
-                             "expected 1..4096 or auto, got '" + tile + "'");
+            throw InputError("command line", 0, "--tile", "expected 1..4096 or auto, got '" + tile + "'");
         s.tile = t;
     }
     s.seed = seed;
@@ -62,8 +57,7 @@ double parse_fraction(const std::string& text, const std::string& key) {
     }
     double v = 0.0;
     if (!parse_finite(t, v) || !(v * scale > 0.0) || v * scale > 1.0)
-        throw InputError("command line", 0, key,
-                         "expected a fraction in (0, 1] or a percentage, got '" + text + "'");
+        throw InputError("command line", 0, key, "expected a fraction in (0, 1] or a percentage, got '" + text + "'");
     return v * scale;
 }
 }  // namespace
@@ -71,13 +65,11 @@ double parse_fraction(const std::string& text, const std::string& key) {
 void SamplingFlags::add_to(CLI::App* c) {
     c->add_option("--sample-fraction", fraction, "sampled fidelity: share of tile passes timed")
         ->capture_default_str();
-    c->add_option(
-        "--target-error", target_error,
-        "sampled fidelity: sample until the interval's relative half-width is below this");
+    c->add_option("--target-error", target_error,
+                  "sampled fidelity: sample until the interval's relative half-width is below this");
     c->add_option("--confidence", confidence, "sampled fidelity: two-sided confidence level")
         ->capture_default_str();
-    c->add_option("--warmup-passes", warmup_passes,
-                  "sampled fidelity: passes replayed into the caches first")
+    c->add_option("--warmup-passes", warmup_passes, "sampled fidelity: passes replayed into the caches first")
         ->capture_default_str();
     c->add_option("--strata", strata, "sampled fidelity: strata of tiles")->capture_default_str();
     c->add_option("--calibration", calibration,
@@ -91,8 +83,7 @@ SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
     o.fraction = parse_fraction(fraction, "--sample-fraction");
     if (!target_error.empty()) o.target_error = parse_fraction(target_error, "--target-error");
     o.confidence = parse_fraction(confidence, "--confidence");
-    if (o.confidence >= 1.0)
-        throw InputError("command line", 0, "--confidence", "must be below 100%");
+    if (o.confidence >= 1.0) throw InputError("command line", 0, "--confidence", "must be below 100%");
     if (strata == 0) throw InputError("command line", 0, "--strata", "must be at least 1");
     o.calibration_fraction = calibration == "0" || calibration == "0%"
                                  ? 0.0

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <cmath>
 
 #include "hw_model/analytic_model.h"
 #include "hw_model/pass_buffer.h"
@@ -19,25 +19,15 @@ namespace {
 
 // Forwards every trace call to several sinks.
 class FanOutSink : public TraceSink {
-  public:
+public:
     void add(TraceSink* s) { m_sinks.push_back(s); }
-    void begin_frame(const TraceHeader& h) override {
-        for (auto* s : m_sinks) s->begin_frame(h);
-    }
-    void begin_pass(const TilePass& p) override {
-        for (auto* s : m_sinks) s->begin_pass(p);
-    }
-    void op(const StreamOp& o) override {
-        for (auto* s : m_sinks) s->op(o);
-    }
-    void end_pass(const TilePass& p) override {
-        for (auto* s : m_sinks) s->end_pass(p);
-    }
-    void end_frame() override {
-        for (auto* s : m_sinks) s->end_frame();
-    }
+    void begin_frame(const TraceHeader& h) override { for (auto* s : m_sinks) s->begin_frame(h); }
+    void begin_pass(const TilePass& p) override { for (auto* s : m_sinks) s->begin_pass(p); }
+    void op(const StreamOp& o) override { for (auto* s : m_sinks) s->op(o); }
+    void end_pass(const TilePass& p) override { for (auto* s : m_sinks) s->end_pass(p); }
+    void end_frame() override { for (auto* s : m_sinks) s->end_frame(); }
 
-  private:
+private:
     std::vector<TraceSink*> m_sinks;
 };
 
@@ -49,24 +39,16 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 // it simulates), so the host time splits into render and timing. Ops are not timed (a clock
 // read per op would cost more than the op's copy): their recording counts as render time.
 class TimedSink : public TraceSink {
-  public:
+public:
     explicit TimedSink(TraceSink& inner) : m_inner(inner) {}
-    void begin_frame(const TraceHeader& h) override {
-        timed([&] { m_inner.begin_frame(h); });
-    }
-    void begin_pass(const TilePass& p) override {
-        timed([&] { m_inner.begin_pass(p); });
-    }
+    void begin_frame(const TraceHeader& h) override { timed([&] { m_inner.begin_frame(h); }); }
+    void begin_pass(const TilePass& p) override { timed([&] { m_inner.begin_pass(p); }); }
     void op(const StreamOp& o) override { m_inner.op(o); }
-    void end_pass(const TilePass& p) override {
-        timed([&] { m_inner.end_pass(p); });
-    }
-    void end_frame() override {
-        timed([&] { m_inner.end_frame(); });
-    }
+    void end_pass(const TilePass& p) override { timed([&] { m_inner.end_pass(p); }); }
+    void end_frame() override { timed([&] { m_inner.end_frame(); }); }
     double seconds() const { return m_seconds; }
 
-  private:
+private:
     template <class F>
     void timed(F&& f) {
         const auto start = std::chrono::steady_clock::now();
@@ -76,6 +58,8 @@ class TimedSink : public TraceSink {
     TraceSink& m_inner;
     double m_seconds = 0.0;
 };
+
+
 
 // Ideal utilization at configuration i's width from the counted trace.
 void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
@@ -92,18 +76,15 @@ void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t wi
 
 // Sums the lanes of a pass: the pilot's cost estimate of a tile.
 class LaneCounter : public TraceSink {
-  public:
+public:
     void op(const StreamOp& op) override { lanes += op.length; }
     uint64_t lanes = 0;
 };
 
 // Holds the passes of one traced unit: warm-up passes first, the sampled pass last.
 class UnitPasses : public TraceSink {
-  public:
-    void begin_pass(const TilePass& p) override {
-        passes.emplace_back();
-        passes.back().begin_pass(p);
-    }
+public:
+    void begin_pass(const TilePass& p) override { passes.emplace_back(); passes.back().begin_pass(p); }
     void op(const StreamOp& o) override { passes.back().op(o); }
     void end_pass(const TilePass& p) override { passes.back().end_pass(p); }
     std::vector<PassBuffer> passes;
@@ -115,20 +96,18 @@ void replay(const PassBuffer& b, TraceSink& sink) {
     sink.end_pass(b.pass());
 }
 
+
 // Calibrates the analytic model against the cycle-level one on the same frame: every k-th
 // tile pass (a systematic sample across the image, k = 1 / fraction) is also timed at cycle
 // level, after its predecessor has warmed the caches, and priced by the analytic model alone.
 // The ratio of the two over the sample scales each configuration's analytic frame, and the
 // ratio's interval is the calibrated prediction's error estimate.
 class AnalyticCalibration : public TraceSink {
-  public:
+public:
     AnalyticCalibration(const std::vector<HwConfig>& configs, const WorkloadShape& shape,
                         uint32_t stride)
-        : m_configs(configs),
-          m_shape(shape),
-          m_stride(std::max(1u, stride)),
-          m_timing(configs, shape),
-          m_cycle(configs.size()) {}
+        : m_configs(configs), m_shape(shape), m_stride(std::max(1u, stride)),
+          m_timing(configs, shape), m_cycle(configs.size()) {}
 
     void begin_pass(const TilePass& p) override {
         m_current.begin_pass(p);
@@ -165,23 +144,20 @@ class AnalyticCalibration : public TraceSink {
             x.push_back(double(analytic_timing(m_configs[c], m_shape, one, &frame).cycles));
         const size_t n = y.size();
         double sy = 0, sx = 0;
-        for (size_t i = 0; i < n; ++i) {
-            sy += y[i];
-            sx += x[i];
-        }
+        for (size_t i = 0; i < n; ++i) { sy += y[i]; sx += x[i]; }
         if (n < 2 || sx <= 0.0) return {1.0, -1.0};
         const double r = sy / sx, mean_x = sx / double(n);
         double s2 = 0.0;
         for (size_t i = 0; i < n; ++i) s2 += (y[i] - r * x[i]) * (y[i] - r * x[i]);
         s2 /= double(n - 1);
         const double f = double(n) / double(std::max<uint64_t>(n, m_unit));
-        const double half =
-            normal_quantile_two_sided(confidence) * std::sqrt((1.0 - f) * s2 / double(n)) / mean_x;
+        const double half = normal_quantile_two_sided(confidence) *
+                            std::sqrt((1.0 - f) * s2 / double(n)) / mean_x;
         return {r, half / r};
     }
     uint64_t sampled() const { return m_cycle.empty() ? 0 : m_cycle[0].size(); }
 
-  private:
+private:
     const std::vector<HwConfig>& m_configs;
     WorkloadShape m_shape;
     uint32_t m_stride;
@@ -249,11 +225,10 @@ PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSet
     for (const HwConfig& c : configs) widths.push_back(c.simd.width);
     CountingSink counts(widths);
     SystemcTiming timing(configs, shape);
-    std::vector<uint32_t> sampled;  // units, in the order timed
+    std::vector<uint32_t> sampled;                       // units, in the order timed
     std::vector<std::vector<FrameTiming>> per_unit(configs.size());
     std::vector<Estimate> estimates(configs.size());
-    uint64_t target =
-        std::max<uint64_t>(2ull * strata.strata, uint64_t(std::ceil(opt.fraction * units)));
+    uint64_t target = std::max<uint64_t>(2ull * strata.strata, uint64_t(std::ceil(opt.fraction * units)));
     const uint32_t chunk = 4 * threads;
     for (;;) {
         const std::vector<uint32_t> batch = sampler.grow_to(target);
@@ -339,8 +314,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
 uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs) {
     const uint64_t bytes_per_ray = ray_record_bytes(features);
     uint64_t smallest = UINT64_MAX;
-    for (const HwConfig& c : configs)
-        smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
+    for (const HwConfig& c : configs) smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
     return uint32_t(std::sqrt(double(smallest / bytes_per_ray)));
 }
 
@@ -357,7 +331,8 @@ void check_tile_fits(uint32_t tile, const FeatureSet& features,
                                  std::to_string(largest_fitting_tile(features, {c})) + ")");
 }
 
-PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
+PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
+                                 const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
                                  const SamplingOptions& sampling) {
     if (fidelity == Fidelity::sampled) return run_sampled(scene, bvh, settings, configs, sampling);

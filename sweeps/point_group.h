@@ -38,7 +38,8 @@ struct PointGroupResult {
 // Analytic: the closed form over the whole frame's trace. Full: every tile pass at cycle
 // level. Sampled: a stratified sample of tile passes at cycle level (see sweeps/sampling.h),
 // extrapolated with a confidence interval on frame cycles.
-PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
+PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh,
+                                 const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
                                  const SamplingOptions& sampling = {});
 
