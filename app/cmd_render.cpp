@@ -70,6 +70,7 @@ void add_render_command(CLI::App& app) {
             j["rays.shadow"] = result.stats.shadow_rays;
             j["nonfinite_paths"] = result.stats.nonfinite_paths;
             j["host_seconds"] = result.stats.host_seconds;
+            j["isa"] = isa_name(settings.isa);
             j["mean_radiance"] = {mean.x, mean.y, mean.z};
             j["png"] = options->output;
             j["pfm"] = pfm;
@@ -82,6 +83,7 @@ void add_render_command(CLI::App& app) {
             std::cout << "scene            " << scene.name << "\n"
                       << "image            " << settings.width << "x" << settings.height << " x "
                       << settings.spp << " spp, depth " << settings.max_depth << "\n"
+                      << "stream back end  " << describe_isa(settings.isa) << "\n"
                       << "rays             " << result.stats.rays() << " (camera "
                       << result.stats.camera_rays << ", extension " << result.stats.extension_rays
                       << ", shadow " << result.stats.shadow_rays << ")\n"

@@ -82,6 +82,7 @@ void add_scene_info_command(CLI::App& app) {
             j["bvh.bytes"] = st.bytes;
             j["bvh.build_seconds"] = build_seconds;
             j["load_seconds"] = load_seconds;
+            j["isa"] = isa_name(best_isa());
             j["memory.geometry_bytes"] = geometry;
             j["memory.bvh_bytes"] = st.bytes;
             j["memory.total_bytes"] = geometry + st.bytes;
@@ -121,6 +122,9 @@ void add_scene_info_command(CLI::App& app) {
         std::printf("memory             geometry %s, bvh %s, total %s\n", mib(geometry).c_str(),
                     mib(st.bytes).c_str(), mib(geometry + st.bytes).c_str());
         std::printf("load seconds       %.3f\n", load_seconds);
+        std::printf("stream back end    %s (widest this CPU runs; --isa on the rendering "
+                    "commands)\n",
+                    describe_isa(Isa::automatic).c_str());
     });
 }
 

@@ -130,9 +130,14 @@ void add_simulate_command(CLI::App& app) {
         }
         std::cout << "scene " << scene.name << ", " << settings.width << "x" << settings.height
                   << " x " << settings.spp << " spp, depth " << settings.max_depth << ", tile "
-                  << settings.tile << ", " << r.render.rays() << " rays\n\n";
+                  << settings.tile << ", " << r.render.rays() << " rays, stream back end "
+                  << describe_isa(settings.isa) << "\n\n";
         print_predictions(r.predictions, std::cout);
-        std::cout << "\nhost seconds for the group: " << r.host_seconds << "\n";
+        std::cout << "\nhost seconds for the group: " << r.host_seconds;
+        if (r.timing_seconds > 0.0)
+            std::cout << " (timing model " << r.timing_seconds << ", render and the rest "
+                      << r.host_seconds - r.timing_seconds << ")";
+        std::cout << "\n";
     });
 }
 

@@ -228,6 +228,7 @@ bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
         j["tile"] = settings.tile;
         j["max_depth"] = settings.max_depth;
         j["seed"] = settings.seed;
+        j["isa"] = isa_name(settings.isa);
         j["pixels"] = uint64_t(settings.width) * settings.height;
         j["differing_pixels"] = differing;
         j["rays.reference"] = ref.stats.rays();
@@ -250,6 +251,7 @@ bool validate_against_reference(const ValidateOptions& o, const Scene& scene,
     std::printf("scene            %s: %ux%u x %u spp, depth %u, tile %u, seed %llu\n",
                 scene.name.c_str(), settings.width, settings.height, settings.spp,
                 settings.max_depth, settings.tile, (unsigned long long)settings.seed);
+    std::printf("stream back end  %s\n", describe_isa(settings.isa).c_str());
     std::printf("image            %llu of %llu pixels differ in any bit\n",
                 (unsigned long long)differing,
                 (unsigned long long)(uint64_t(settings.width) * settings.height));

@@ -21,6 +21,7 @@ struct WorkloadFlags {
     std::string tile = "32";
     uint64_t seed = 0;
     uint32_t threads = 0;
+    std::string isa = "auto";
 
     void add_to(CLI::App* command);
     // The workload the flags give for `scene`; throws InputError (key = the flag) on a bad value.

@@ -14,6 +14,10 @@ void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
     c->add_option("--threads", threads, "worker threads (0: all cores)")->capture_default_str();
+    c->add_option("--isa", isa,
+                  "host SIMD back end of the stream filters: auto|avx512|avx2|scalar (never "
+                  "changes the image or the trace)")
+        ->capture_default_str();
 }
 
 WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
@@ -30,8 +34,11 @@ WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
 
 RenderSettings WorkloadFlags::resolve(const Scene& scene,
                                       const std::vector<HwConfig>& configs) const {
-    return resolve_workload(config(scene.name), scene.features(), configs, "--tile")
-        .config.render_settings(threads);
+    RenderSettings s =
+        resolve_workload(config(scene.name), scene.features(), configs, "--tile")
+            .config.render_settings(threads);
+    s.isa = resolve_isa(parse_isa(isa, "--isa"), "--isa");
+    return s;
 }
 
 namespace {

@@ -4,14 +4,17 @@
 //   counting sink, and Embree 3 rtcIntersect1 (robust scene, via EmbreeScene),
 // for primary rays and diffuse-bounce rays, with ratios; then whole-frame path tracing,
 // reference against stream (trace off / counting). Not a test: speeds vary by machine.
-// Times are thread CPU seconds, best of N, so other processes on the machine matter less.
+// Times are thread CPU seconds, median of N (default 5), so other processes on the machine matter
+// less.
 //
-// Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N]    (default: conference 512x512)
+// Usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa X]    (default: conference
+// 512x512)
 
+#include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <string>
 
@@ -26,7 +29,6 @@ using namespace sfx;
 
 namespace {
 
-
 // CPU seconds of this thread: on a shared machine, wall time measures the neighbours too.
 double thread_seconds() {
     timespec ts;
@@ -34,15 +36,16 @@ double thread_seconds() {
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-// Best of `repeat` runs, in thread CPU seconds (every run here stays on the calling thread).
-double best_seconds(int repeat, const std::function<void()>& run) {
-    double best = 1e30;
+// Median of `repeat` runs, in thread CPU seconds (every run here stays on the calling thread).
+double median_seconds(int repeat, const std::function<void()>& run) {
+    std::vector<double> times;
     for (int i = 0; i < repeat; ++i) {
         const double t0 = thread_seconds();
         run();
-        best = std::min(best, thread_seconds() - t0);
+        times.push_back(thread_seconds() - t0);
     }
-    return best;
+    std::sort(times.begin(), times.end());
+    return times[times.size() / 2];
 }
 
 // Camera rays in tile order (64 x 64 tiles, one sample), so a 4096-ray stream is one tile.
@@ -110,15 +113,20 @@ void report(const char* name, size_t rays, double seconds, double embree_rate) {
 int main(int argc, char** argv) {
     std::string scene_name = "conference";
     uint32_t w = 512, h = 512;
-    int repeat = 3;
+    int repeat = 5;
+    Isa only = Isa::automatic;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--res" && i + 1 < argc) {
             if (std::sscanf(argv[++i], "%ux%u", &w, &h) != 2) return 2;
+        } else if (a == "--isa" && i + 1 < argc) {
+            only = parse_isa(argv[++i]);
         } else if (a == "--repeat" && i + 1 < argc) {
             repeat = std::max(1, std::atoi(argv[++i]));
         } else if (a == "-h" || a == "--help") {
-            std::printf("usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N]\n");
+            std::printf(
+                "usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa "
+                "auto|avx512|avx2|scalar]\n");
             return 0;
         } else {
             scene_name = a;
@@ -127,8 +135,15 @@ int main(int argc, char** argv) {
     const Scene scene = load_scene(scene_name);
     const Bvh bvh(scene);
     const EmbreeScene embree(scene);
-    std::printf("scene %s: %u primitives; %ux%u rays per set; best of %d; one thread\n",
+    std::printf("scene %s: %u primitives; %ux%u rays per set; median of %d; one thread\n",
                 scene.name.c_str(), scene.primitive_count(), w, h, repeat);
+
+    // Every back end the CPU has, widest last (`--isa X` measures one only).
+    std::vector<Isa> isas = supported_isas();
+    if (only != Isa::automatic) isas = {resolve_isa(only)};
+    std::printf("stream back ends:");
+    for (const Isa isa : isas) std::printf(" %s (%u lanes)", isa_name(isa), isa_width(isa));
+    std::printf("; auto would pick %s\n", isa_name(best_isa()));
 
     const std::vector<Ray> primary = primary_rays(scene, w, h);
     const std::vector<Ray> diffuse = diffuse_rays(scene, bvh, primary);
@@ -137,40 +152,55 @@ int main(int argc, char** argv) {
           {"diffuse-bounce rays", &diffuse}}) {
         std::printf("\n%s (%zu)\n", label, rays->size());
         std::vector<Hit> ref(rays->size()), st, em(rays->size());
-        const double t_embree = best_seconds(repeat, [&] {
+        const double t_embree = median_seconds(repeat, [&] {
             for (size_t i = 0; i < rays->size(); ++i) em[i] = embree.intersect((*rays)[i]);
         });
-        const double t_ref = best_seconds(repeat, [&] {
+        const double t_ref = median_seconds(repeat, [&] {
             for (size_t i = 0; i < rays->size(); ++i) ref[i] = bvh.intersect((*rays)[i]);
         });
-        const double t_stream = best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st); });
+        // The stream traversal with each back end the CPU has, side by side on the same rays.
+        std::vector<std::pair<Isa, double>> t_stream, t_counting;
+        size_t differ = 0;
         CountingSink counts({8, 16});
-        const double t_counting =
-            best_seconds(repeat, [&] { stream_intersect(bvh, *rays, st, &counts); });
-        size_t differ = 0, embree_differ = 0;
-        for (size_t i = 0; i < rays->size(); ++i) {
-            differ += std::memcmp(&ref[i], &st[i], sizeof(Hit)) != 0;
-            embree_differ += ref[i].prim != em[i].prim;
+        for (const Isa isa : isas) {
+            t_stream.push_back({isa, median_seconds(repeat, [&] {
+                                    stream_intersect(bvh, *rays, st, nullptr, isa);
+                                })});
+            for (size_t i = 0; i < rays->size(); ++i)
+                differ += std::memcmp(&ref[i], &st[i], sizeof(Hit)) != 0;
+            CountingSink c({8, 16});
+            t_counting.push_back(
+                {isa, median_seconds(repeat, [&] { stream_intersect(bvh, *rays, st, &c, isa); })});
+            if (isa == isas.back()) counts = c;
         }
+        size_t embree_differ = 0;
+        for (size_t i = 0; i < rays->size(); ++i) embree_differ += ref[i].prim != em[i].prim;
         const double embree_rate = double(rays->size()) / t_embree;
         report("Embree rtcIntersect1", rays->size(), t_embree, embree_rate);
         report("reference (Bvh::intersect)", rays->size(), t_ref, embree_rate);
-        report("stream, trace off", rays->size(), t_stream, embree_rate);
-        report("stream, counting sink", rays->size(), t_counting, embree_rate);
-        std::printf("  stream / reference %.2fx; stream hits differing from reference: %zu; "
-                    "primitive differs from Embree's: %zu\n",
-                    t_ref / t_stream, differ, embree_differ);
+        for (size_t k = 0; k < isas.size(); ++k) {
+            const std::string name = std::string("stream ") + isa_name(isas[k]);
+            report((name + ", trace off").c_str(), rays->size(), t_stream[k].second, embree_rate);
+            report((name + ", counting sink").c_str(), rays->size(), t_counting[k].second,
+                   embree_rate);
+        }
+        std::printf(
+            "  stream hits differing from reference (all back ends): %zu; "
+            "primitive differs from Embree's: %zu\n",
+            differ, embree_differ);
         uint64_t boxes = 0, prims = 0;
         for (const Ray& r : *rays) count_reference_tests(bvh, r, boxes, prims);
         const double n = double(rays->size()), runs = double(repeat);
-        std::printf("  tests per ray: reference %.1f box, %.1f primitive; stream %.1f box, %.1f "
-                    "primitive in ops of %.1f and %.1f rays on average\n",
-                    double(boxes) / n, double(prims) / n,
-                    double(counts.kind_lanes(OpKind::box_test)) / runs / n,
-                    double(counts.kind_lanes(OpKind::triangle_test) +
-                           counts.kind_lanes(OpKind::sphere_test)) / runs / n,
-                    counts.stage(false, OpStage::traversal).average_length(),
-                    counts.stage(false, OpStage::intersection).average_length());
+        std::printf(
+            "  tests per ray: reference %.1f box, %.1f primitive; stream %.1f box, %.1f "
+            "primitive in ops of %.1f and %.1f rays on average\n",
+            double(boxes) / n, double(prims) / n,
+            double(counts.kind_lanes(OpKind::box_test)) / runs / n,
+            double(counts.kind_lanes(OpKind::triangle_test) +
+                   counts.kind_lanes(OpKind::sphere_test)) /
+                runs / n,
+            counts.stage(false, OpStage::traversal).average_length(),
+            counts.stage(false, OpStage::intersection).average_length());
     }
 
     // Whole frames: path tracing with all generations, shading included.
@@ -183,20 +213,26 @@ int main(int argc, char** argv) {
     settings.threads = 1;
     RenderResult ref_frame, st_frame;
     const double f_ref =
-        best_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
-    const double f_st =
-        best_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
-    CountingSink counts({8, 16});
-    const double f_count = best_seconds(1, [&] { render_stream(scene, bvh, settings, &counts); });
-    const bool same = std::memcmp(ref_frame.image.pixels.data(), st_frame.image.pixels.data(),
-                                  ref_frame.image.pixels.size() * sizeof(Vec3)) == 0;
+        median_seconds(repeat, [&] { ref_frame = render_reference(scene, bvh, settings); });
     const size_t n = ref_frame.stats.rays();
-    std::printf("\npath tracing %ux%u x %u spp, tile 64 (%zu rays, images %s)\n", settings.width,
-                settings.height, settings.spp, n, same ? "bit-identical" : "DIFFER");
+    std::printf("\npath tracing %ux%u x %u spp, tile 64 (%zu rays)\n", settings.width,
+                settings.height, settings.spp, n);
     report("reference tracer", n, f_ref, 0);
-    report("stream tracer, trace off", n, f_st, 0);
-    report("stream tracer, counting sink", n, f_count, 0);
-    std::printf("  stream / reference %.2fx (trace off), %.2fx (counting)\n", f_ref / f_st,
-                f_ref / f_count);
+    for (const Isa isa : isas) {
+        settings.isa = isa;
+        const double f_st =
+            median_seconds(repeat, [&] { st_frame = render_stream(scene, bvh, settings); });
+        CountingSink counts({8, 16});
+        const double f_count =
+            median_seconds(repeat, [&] { render_stream(scene, bvh, settings, &counts); });
+        const bool same = std::memcmp(ref_frame.image.pixels.data(), st_frame.image.pixels.data(),
+                                      ref_frame.image.pixels.size() * sizeof(Vec3)) == 0;
+        const std::string name = std::string("stream ") + isa_name(isa);
+        report((name + ", trace off").c_str(), n, f_st, 0);
+        report((name + ", counting sink").c_str(), n, f_count, 0);
+        std::printf("  %s: stream / reference %.2fx (trace off), %.2fx (counting); image %s\n",
+                    isa_name(isa), f_ref / f_st, f_ref / f_count,
+                    same ? "bit-identical to the reference" : "DIFFERS from the reference");
+    }
     return 0;
 }

@@ -13,6 +13,7 @@
 #include <limits>
 
 #include "kernels/ray.h"
+#include "kernels/simd/lanes.h"
 #include "workloads/scene.h"
 
 namespace sfx {
@@ -53,23 +54,98 @@ constexpr float k_slab_far_scale = 1.f + 2.f * gamma_bound(3);
 // face, equal-t ties). Culling such a box would make the closest hit depend on traversal order.
 constexpr float k_slab_t_max_scale = 1.f + 1.f / 65536.f;
 
-// Slab test over [0, t_max]. Returns the entry distance, or INFINITY on a miss.
+// Slab test over [0, t_max] for Width rays against one box, written once for the reference
+// tracer (Width 1) and the stream filters (kernels/stream/stream_kernels_impl.h). A lane
+// passes iff its ray enters the box; t0 is the entry distance of passing lanes.
 // The near and far planes are chosen by the sign of the direction (-0 counts as negative), so
 // no swap is needed. The only NaN source, 0 * inf, means the origin lies on a slab plane and the
 // ray runs inside that plane: the plane then bounds nothing (the box is closed, so it is kept).
-inline float intersect_box(const RayPrecomp& r, const Bounds3& b, float t_max) {
-    float t0 = 0.f, t1 = t_max * k_slab_t_max_scale;
+// No early exit per axis: t0 only grows and t1 only shrinks (NaN distances are replaced before
+// they are compared), so "t0 > t1 after some axis" equals "t0 > t1 after the last axis".
+template <int Width>
+SFX_LANES_INLINE vbool<Width> slab_test(const vfloat<Width> org[3], const vfloat<Width> inv_dir[3],
+                                        vfloat<Width> t_max, const Bounds3& b, vfloat<Width>& t0) {
+    const vfloat<Width> inf = broadcast<Width>(INFINITY);
+    t0 = broadcast<Width>(0.f);
+    vfloat<Width> t1 = t_max * k_slab_t_max_scale;
     for (int a = 0; a < 3; ++a) {
-        const bool negative = std::signbit(r.inv_dir[a]);
-        float t_near = ((negative ? b.hi[a] : b.lo[a]) - r.org[a]) * r.inv_dir[a];
-        float t_far = ((negative ? b.lo[a] : b.hi[a]) - r.org[a]) * r.inv_dir[a];
-        t_near = std::isnan(t_near) ? -INFINITY : t_near;
-        t_far = std::isnan(t_far) ? INFINITY : t_far * k_slab_far_scale;
-        t0 = t_near > t0 ? t_near : t0;
-        t1 = t_far < t1 ? t_far : t1;
-        if (t0 > t1) return INFINITY;
+        const vbool<Width> negative = sign_bit<Width>(inv_dir[a]);
+        const vfloat<Width> lo = broadcast<Width>(b.lo[a]), hi = broadcast<Width>(b.hi[a]);
+        vfloat<Width> t_near = (select(negative, hi, lo) - org[a]) * inv_dir[a];
+        vfloat<Width> t_far = (select(negative, lo, hi) - org[a]) * inv_dir[a];
+        t_near = select(is_nan<Width>(t_near), -inf, t_near);
+        t_far = select(is_nan<Width>(t_far), inf, t_far * k_slab_far_scale);
+        t0 = select(t_near > t0, t_near, t0);
+        t1 = select(t_far < t1, t_far, t1);
     }
-    return t0;
+    return mask_and<vbool<Width>>(t0 <= t1, t0 != inf);
+}
+
+// The slab test for one ray. Returns the entry distance, or INFINITY on a miss.
+inline float intersect_box(const RayPrecomp& r, const Bounds3& b, float t_max) {
+    const float org[3] = {r.org.x, r.org.y, r.org.z};
+    const float inv_dir[3] = {r.inv_dir.x, r.inv_dir.y, r.inv_dir.z};
+    float t0;
+    return slab_test<1>(org, inv_dir, t_max, b, t0) ? t0 : INFINITY;
+}
+
+// The first stage of the watertight triangle test (Woop et al.) for Width rays against one
+// triangle, shared by intersect_triangle (Width 1) and the stream's triangle filter: the
+// vertices relative to the origin, sheared so the ray runs along +z, and the scaled
+// barycentrics u, v, w (edge functions) in float.
+template <int Width>
+struct ShearedTriangle {
+    vfloat<Width> ax, ay, bx, by, cx, cy;  // sheared x, y of the vertices
+    vfloat<Width> akz, bkz, ckz;           // unsheared distance along the major axis
+    vfloat<Width> u, v, w;
+};
+
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> pick_axis(vint<Width> k, vfloat<Width> x, vfloat<Width> y,
+                                         vfloat<Width> z) {
+    return select(k == 0, x, select(k == 1, y, z));
+}
+
+// One vertex relative to the origin, sheared: x, y and the distance along the major axis.
+template <int Width>
+SFX_LANES_INLINE void shear_vertex(const vfloat<Width> org[3], vint<Width> kx, vint<Width> ky,
+                                   vint<Width> kz, vfloat<Width> sx, vfloat<Width> sy,
+                                   const Vec3& p, vfloat<Width>& x, vfloat<Width>& y,
+                                   vfloat<Width>& along_kz) {
+    const vfloat<Width> dx = broadcast<Width>(p.x) - org[0];
+    const vfloat<Width> dy = broadcast<Width>(p.y) - org[1];
+    const vfloat<Width> dz = broadcast<Width>(p.z) - org[2];
+    along_kz = pick_axis<Width>(kz, dx, dy, dz);
+    x = pick_axis<Width>(kx, dx, dy, dz) - sx * along_kz;
+    y = pick_axis<Width>(ky, dx, dy, dz) - sy * along_kz;
+}
+
+template <int Width>
+SFX_LANES_INLINE ShearedTriangle<Width> shear_triangle(const vfloat<Width> org[3], vint<Width> kx,
+                                                       vint<Width> ky, vint<Width> kz,
+                                                       vfloat<Width> sx, vfloat<Width> sy,
+                                                       const Vec3& p0, const Vec3& p1,
+                                                       const Vec3& p2) {
+    ShearedTriangle<Width> s;
+    shear_vertex<Width>(org, kx, ky, kz, sx, sy, p0, s.ax, s.ay, s.akz);
+    shear_vertex<Width>(org, kx, ky, kz, sx, sy, p1, s.bx, s.by, s.bkz);
+    shear_vertex<Width>(org, kx, ky, kz, sx, sy, p2, s.cx, s.cy, s.ckz);
+    s.u = s.cx * s.by - s.cy * s.bx;
+    s.v = s.ax * s.cy - s.ay * s.cx;
+    s.w = s.bx * s.ay - s.by * s.ax;
+    return s;
+}
+
+// True only where the watertight test rejects on the float edge functions alone (strictly
+// mixed signs, none zero: a zero is decided in double by intersect_triangle).
+template <int Width>
+SFX_LANES_INLINE vbool<Width> edges_reject(const ShearedTriangle<Width>& s) {
+    using M = vbool<Width>;
+    const vfloat<Width> zero = broadcast<Width>(0.f);
+    const M nonzero = mask_and<M>(mask_and<M>(s.u != zero, s.v != zero), s.w != zero);
+    const M some_negative = mask_or<M>(mask_or<M>(s.u < zero, s.v < zero), s.w < zero);
+    const M some_positive = mask_or<M>(mask_or<M>(s.u > zero, s.v > zero), s.w > zero);
+    return mask_and<M>(nonzero, mask_and<M>(some_negative, some_positive));
 }
 
 // The decisions a hit candidate gets in double precision, from the input floats directly.
@@ -86,8 +162,7 @@ inline TrianglePlaneCheck check_triangle_plane(const Vec3& org, const Vec3& dir,
                  e1z = double(p1.z) - double(p0.z);
     const double e2x = double(p2.x) - double(p0.x), e2y = double(p2.y) - double(p0.y),
                  e2z = double(p2.z) - double(p0.z);
-    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z,
-                 nz = e1x * e2y - e1y * e2x;
+    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
     TrianglePlaneCheck c;
     c.degenerate = nx == 0.0 && ny == 0.0 && nz == 0.0;
     const double num = nx * (double(p0.x) - double(org.x)) + ny * (double(p0.y) - double(org.y)) +
@@ -112,16 +187,12 @@ inline bool triangle_is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p
 // - Degenerate (zero-area) triangles never hit. In sheared ray space collinear vertices are no
 //   longer exactly collinear, so the determinant alone does not catch them.
 // Both double-precision checks run only for candidates that passed every float test.
-inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1,
-                               const Vec3& p2, float t_max, float& t_out, float& u_out,
-                               float& v_out) {
-    const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
-    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
-    float u = cx * by - cy * bx;
-    float v = ax * cy - ay * cx;
-    float w = bx * ay - by * ax;
+inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                               float t_max, float& t_out, float& u_out, float& v_out) {
+    const float org[3] = {r.org.x, r.org.y, r.org.z};
+    const ShearedTriangle<1> s = shear_triangle<1>(org, r.kx, r.ky, r.kz, r.sx, r.sy, p0, p1, p2);
+    const float ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
+    float u = s.u, v = s.v, w = s.w;
     if (u == 0.f || v == 0.f || w == 0.f) {  // on an edge: decide in double, as the paper does
         u = float(double(cx) * double(by) - double(cy) * double(bx));
         v = float(double(ax) * double(cy) - double(ay) * double(cx));
@@ -130,7 +201,7 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     if ((u < 0.f || v < 0.f || w < 0.f) && (u > 0.f || v > 0.f || w > 0.f)) return false;
     const float det = u + v + w;
     if (det == 0.f || !std::isfinite(det)) return false;
-    const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    const float az = r.sz * s.akz, bz = r.sz * s.bkz, cz = r.sz * s.ckz;
     const float t_scaled = u * az + v * bz + w * cz;
     if (det < 0.f ? t_scaled >= 0.f : t_scaled <= 0.f) return false;  // t <= 0
     // The watertight test decides inside/outside and the sign of t; t itself comes from the
@@ -187,13 +258,27 @@ inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, 
     const float t_near_origin = c / q, t_other = q / a;
     float t0 = on_surface ? INFINITY : t_near_origin, t1 = t_other;
     if (t0 > t1) std::swap(t0, t1);
-    if (t0 > 0.f && t0 <= t_max) { t_out = t0; return true; }
-    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) { t_out = t1; return true; }
+    if (t0 > 0.f && t0 <= t_max) {
+        t_out = t0;
+        return true;
+    }
+    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) {
+        t_out = t1;
+        return true;
+    }
     return false;
 }
 
-inline uint32_t float_bits(float f) { uint32_t i; std::memcpy(&i, &f, 4); return i; }
-inline float bits_float(uint32_t i) { float f; std::memcpy(&f, &i, 4); return f; }
+inline uint32_t float_bits(float f) {
+    uint32_t i;
+    std::memcpy(&i, &f, 4);
+    return i;
+}
+inline float bits_float(uint32_t i) {
+    float f;
+    std::memcpy(&f, &i, 4);
+    return f;
+}
 
 // Waechter & Binder: move p off the surface along n (the side the new ray leaves from),
 // by a fixed number of ulps far from the origin and by a fixed distance near it.
@@ -219,8 +304,10 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n)
     const Vec3 offset = n * d;
     Vec3 out = p + offset;
     for (int a = 0; a < 3; ++a) {
-        if (offset[a] > 0.f) out[a] = std::nextafter(out[a], INFINITY);
-        else if (offset[a] < 0.f) out[a] = std::nextafter(out[a], -INFINITY);
+        if (offset[a] > 0.f)
+            out[a] = std::nextafter(out[a], INFINITY);
+        else if (offset[a] < 0.f)
+            out[a] = std::nextafter(out[a], -INFINITY);
     }
     return out;
 }
@@ -228,8 +315,8 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n)
 // Error bounds of surface points, for offset_ray_origin(p, p_error, n).
 // A point p0 w + p1 u + p2 v: any weights summing to 1 give a point of the plane, and
 // w = 1 - u - v makes the sum 1 to a rounding, so the error is the weighted sum's (pbrt-v4).
-inline Vec3 triangle_point_error(const Vec3& p0, const Vec3& p1, const Vec3& p2, float w,
-                                 float u, float v) {
+inline Vec3 triangle_point_error(const Vec3& p0, const Vec3& p1, const Vec3& p2, float w, float u,
+                                 float v) {
     return (abs(p0 * w) + abs(p1 * u) + abs(p2 * v)) * gamma_bound(7);
 }
 // A point center + n * radius with n normalized in float.
@@ -240,8 +327,8 @@ inline Vec3 sphere_point_error(const Vec3& center, const Vec3& n, float radius) 
 // Surface data at a hit, computed the same way by every tracer.
 struct SurfaceHit {
     Vec3 position;
-    Vec3 position_error;  // |position - true surface point| <= position_error, per component
-    Vec3 normal;  // geometric, unit length, facing against the incoming ray
+    Vec3 position_error;     // |position - true surface point| <= position_error, per component
+    Vec3 normal;             // geometric, unit length, facing against the incoming ray
     bool front_face = true;  // the ray arrived from the side the stored normal points to
     uint32_t material = 0;
 };

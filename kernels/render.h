@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/simd/isa.h"
 #include "kernels/vec.h"
 
 namespace sfx {
@@ -18,6 +19,7 @@ struct RenderSettings {
     uint32_t tile = 32;      // tile edge in pixels; the stream tracer's stream is tile^2 rays
     uint32_t threads = 0;    // 0: all hardware threads
     uint64_t seed = 0;
+    Isa isa = Isa::automatic;  // the stream filters' host back end; never changes a bit
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample

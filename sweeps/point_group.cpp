@@ -31,6 +31,32 @@ private:
     std::vector<TraceSink*> m_sinks;
 };
 
+// Forwards to a timing model and adds up the seconds spent in its pass and frame calls (where
+// it simulates), so the host time splits into render and timing. Ops are not timed (a clock
+// read per op would cost more than the op's copy): their recording counts as render time.
+class TimedSink : public TraceSink {
+public:
+    explicit TimedSink(TraceSink& inner) : m_inner(inner) {}
+    void begin_frame(const TraceHeader& h) override { timed([&] { m_inner.begin_frame(h); }); }
+    void begin_pass(const TilePass& p) override { timed([&] { m_inner.begin_pass(p); }); }
+    void op(const StreamOp& o) override { m_inner.op(o); }
+    void end_pass(const TilePass& p) override { timed([&] { m_inner.end_pass(p); }); }
+    void end_frame() override { timed([&] { m_inner.end_frame(); }); }
+    double seconds() const { return m_seconds; }
+
+private:
+    template <class F>
+    void timed(F&& f) {
+        const auto start = HostClock::now();
+        f();
+        m_seconds += seconds_since(start);
+    }
+    TraceSink& m_inner;
+    double m_seconds = 0.0;
+};
+
+
+
 // Ideal utilization at configuration i's width from the counted trace.
 void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t width) {
     for (int sec = 0; sec < 2; ++sec)
@@ -313,6 +339,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     fan.add(&counts);
     TraceProfile profile(shape);
     std::unique_ptr<SystemcTiming> systemc;
+    std::unique_ptr<TimedSink> timed_systemc;
     std::unique_ptr<AnalyticCalibration> calibration;
     if (fidelity == Fidelity::analytic) {
         fan.add(&profile);
@@ -323,7 +350,8 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
         }
     } else {
         systemc = std::make_unique<SystemcTiming>(configs, shape);
-        fan.add(systemc.get());
+        timed_systemc = std::make_unique<TimedSink>(*systemc);
+        fan.add(timed_systemc.get());
     }
     std::unique_ptr<ProgressSink> progress_sink;  // last: counts a pass once it is timed
     if (progress) {
@@ -336,6 +364,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     PointGroupResult result;
     result.render = render_stream(scene, bvh, settings, &fan).stats;
     const double shared_seconds = seconds_since(start);
+    result.timing_seconds = timed_systemc ? timed_systemc->seconds() : 0.0;
 
     for (size_t i = 0; i < configs.size(); ++i) {
         const auto model_start = HostClock::now();

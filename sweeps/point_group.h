@@ -25,6 +25,8 @@ struct PointGroupResult {
     std::vector<Prediction> predictions;  // one per configuration, in order
     RenderStats render;                   // the functional render's rays and time
     double host_seconds = 0.0;            // the whole group
+    double timing_seconds = 0.0;          // full fidelity: of it, in the cycle-level model's
+                                          // pass simulations (the rest: render and counting)
 };
 
 // Told (tile passes done, tile passes to do) as the work advances, from one thread at a

@@ -8,20 +8,12 @@
 
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
-#include "kernels/stream/stream_box.h"
 #include "kernels/stream/stream_filter.h"
+#include "kernels/stream/stream_kernels.h"
 
 namespace sfx {
 
 namespace {
-
-// What a box test gathers per lane, in one cache line: the test's constants and its t_max
-// (the closest hit so far, or the ray's t_max; -1 for an occluded shadow ray, which every
-// later box and primitive test then misses).
-struct alignas(64) TraversalRay {
-    RayPrecomp pre;
-    float t;
-};
 
 // The ray buffers of one stream, one array per field group (structure of arrays). A slot is a
 // path: a path carries one ray at a time, so its next ray goes to the same slot of the
@@ -29,12 +21,13 @@ struct alignas(64) TraversalRay {
 struct RayBuffers {
     uint32_t capacity = 0;
     std::vector<PathState> path;
-    std::vector<Ray> ray[2];          // current and next generation
+    std::vector<Ray> ray[2];  // current and next generation
     std::vector<TraversalRay> trav;
     std::vector<Hit> hit;
-    std::vector<uint8_t> any_hit;     // shadow ray: any hit in (0, t_max) occludes it
+    std::vector<uint8_t> any_hit;  // shadow ray: any hit in (0, t_max) occludes it
     std::vector<SurfaceHit> surf;
-    std::vector<uint32_t> ids, next_ids, trav_ids, scratch;
+    // Id lists and masks have k_stream_padding elements of room: compress writes whole vectors.
+    std::vector<uint32_t> ids, next_ids, trav_ids, scratch, scratch2, positions;
     std::vector<uint8_t> mask;
     std::vector<std::pair<uint32_t, uint32_t>> stack;  // (node, stream length)
 
@@ -50,69 +43,37 @@ struct RayBuffers {
         hit.resize(n);
         any_hit.resize(n);
         surf.resize(n);
-        ids.resize(n);
-        next_ids.resize(n);
-        trav_ids.resize(n);
-        scratch.resize(n);
-        mask.resize(n);
+        const uint32_t padded = n + k_stream_padding;
+        ids.resize(padded);
+        next_ids.resize(padded);
+        trav_ids.resize(padded);
+        scratch.resize(padded);
+        scratch2.resize(padded);
+        positions.resize(padded);
+        mask.resize(padded);
     }
 };
 
-// The first stage of intersect_triangle, the same float operations: true only where that
-// test rejects (strictly mixed edge signs, none zero), so most misses skip the full call.
-inline bool triangle_edge_reject(const RayPrecomp& r, const Vec3& p0, const Vec3& p1,
-                                 const Vec3& p2) {
-    const Vec3 a = p0 - r.org, b = p1 - r.org, c = p2 - r.org;
-    const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-    const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-    const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
-    const float u = cx * by - cy * bx;
-    const float v = ax * cy - ay * cx;
-    const float w = bx * ay - by * ax;
-    if (u == 0.f || v == 0.f || w == 0.f) return false;  // the full test decides in double
-    return (u < 0.f || v < 0.f || w < 0.f) && (u > 0.f || v > 0.f || w > 0.f);
-}
-
-// The box filter of Fig. 5: gather 4 lanes (a partial last group repeats its last ray),
-// test them together, partition. `negative` counts passing rays whose direction is negative
-// on the node's split axis (for the front-child vote).
+// The box filter of Fig. 5 by the back end's kernel: passing ids first, failing ids after
+// them (the prefix [0, len) keeps its set of ids, so the streams on the stack stay valid).
 template <class Trace>
-uint32_t box_filter(Trace& trace, const BvhNode& node, uint32_t node_index, uint16_t generation,
-                    const TraversalRay* rays, uint32_t* ids, uint32_t len, uint8_t* mask,
-                    uint32_t* scratch, uint32_t& negative) {
-    constexpr uint32_t W = 4;
-    const int axis = node.axis;
-    uint32_t front = 0, back = 0, passed = 0;
-    for (uint32_t g = 0; g < len; g += W) {
-        const uint32_t count = std::min<uint32_t>(W, len - g);
-        const RayPrecomp* lane[W];
-        float t_max[W];
-        for (uint32_t l = 0; l < W; ++l) {
-            const TraversalRay& r = rays[ids[g + std::min(l, count - 1)]];
-            lane[l] = &r.pre;
-            t_max[l] = r.t;
-        }
-        const uint32_t bits = box_test_gather4(lane, t_max, node.bounds);
-        for (uint32_t l = 0; l < count; ++l) {
-            const uint32_t id = ids[g + l];
-            const bool in = (bits >> l) & 1u;
-            if constexpr (Trace::k_enabled) {
-                mask[g + l] = uint8_t(in);
-            } else {  // in-place compaction: front <= g + l, so no unread id is overwritten
-                if (in) ids[front++] = id;
-                else scratch[back++] = id;
-            }
-            if (in) {
-                ++passed;
-                negative += rays[id].pre.dir[axis] < 0.f;
-            }
-        }
-    }
-    if constexpr (Trace::k_enabled) {
-        trace.op(OpKind::box_test, generation, node_index, ids, len, mask, passed);
-        partition(ids, len, mask, passed, scratch);
-    } else if (front != 0) {
-        for (uint32_t i = 0; i < back; ++i) ids[front + i] = scratch[i];
+uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& node,
+                    uint32_t node_index, uint16_t generation, const TraversalRay* rays,
+                    uint32_t* ids, uint32_t len, RayBuffers& b, uint32_t& negative) {
+    uint32_t* scratch = b.scratch.data();
+    uint32_t passed;
+    if constexpr (Trace::k_enabled) {  // the op lists the slots in input order
+        uint32_t* failing = b.scratch2.data();
+        passed = kernels.box_filter(rays, node.bounds, node.axis, ids, len, scratch, failing,
+                                    b.mask.data(), negative);
+        trace.op(OpKind::box_test, generation, node_index, ids, len, b.mask.data(), passed);
+        std::copy(scratch, scratch + passed, ids);
+        std::copy(failing, failing + (len - passed), ids + passed);
+    } else {
+        passed = kernels.box_filter(rays, node.bounds, node.axis, ids, len, ids, scratch, nullptr,
+                                    negative);
+        // Always, even if none passed: the kernel's whole-vector stores wrote over ids.
+        std::copy(scratch, scratch + (len - passed), ids + passed);
     }
     return passed;
 }
@@ -123,14 +84,15 @@ uint32_t box_filter(Trace& trace, const BvhNode& node, uint32_t node_index, uint
 // The front child is chosen by a majority of the passing rays' direction signs on the split
 // axis: independent of the order of the stream, and for one ray the reference's choice.
 template <class Trace>
-void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Trace& trace) {
+void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
+              uint16_t generation, Trace& trace) {
     if (n == 0) return;
     const std::vector<BvhNode>& nodes = bvh.nodes();
     const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
     const Scene& scene = bvh.scene();
     uint32_t* ids = b.trav_ids.data();
     uint8_t* mask = b.mask.data();
-    uint32_t* scratch = b.scratch.data();
+    uint32_t* positions = b.positions.data();
     TraversalRay* rays = b.trav.data();
     Hit* hit = b.hit.data();
     const uint8_t* any_hit = b.any_hit.data();
@@ -148,28 +110,40 @@ void traverse(const Bvh& bvh, RayBuffers& b, uint32_t n, uint16_t generation, Tr
             __builtin_prefetch(&nodes[node.right()]);
         }
         uint32_t negative = 0;
-        const uint32_t k = box_filter(trace, node, node_index, generation, rays, ids, len, mask,
-                                      scratch, negative);
+        const uint32_t k =
+            box_filter(kernels, trace, node, node_index, generation, rays, ids, len, b, negative);
         if (k == 0) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
-                const bool sphere = scene.is_sphere(prim);
-                const Triangle tri = sphere ? Triangle{} : scene.triangles[prim];
-                const Vec3 p0 = sphere ? Vec3() : scene.positions[tri.v0];
-                const Vec3 p1 = sphere ? Vec3() : scene.positions[tri.v1];
-                const Vec3 p2 = sphere ? Vec3() : scene.positions[tri.v2];
-                const uint32_t passed = evaluate<k_host_width>(ids, k, mask, [&](uint32_t id) {
+                // Closest hit: later tests need t or less. Any hit: the ray is done, and with
+                // t = -1 every later box and primitive test misses it.
+                auto test = [&](uint32_t id) {
                     TraversalRay& r = rays[id];
-                    if (!sphere && triangle_edge_reject(r.pre, p0, p1, p2)) return false;
                     if (!bvh.intersect_primitive(r.pre, prim, r.t, hit[id])) return false;
-                    // Closest hit: later tests need t or less. Any hit: the ray is done, and
-                    // with t = -1 every later box and primitive test misses it.
                     r.t = any_hit[id] ? -1.f : hit[id].t;
                     return true;
-                });
-                trace.op(scene.is_sphere(prim) ? OpKind::sphere_test : OpKind::triangle_test,
-                         generation, prim, ids, k, mask, passed);
+                };
+                if (scene.is_sphere(prim)) {
+                    const uint32_t passed = evaluate(ids, k, mask, test);
+                    trace.op(OpKind::sphere_test, generation, prim, ids, k, mask, passed);
+                    continue;
+                }
+                // Triangles: the float stage of the watertight test at the back end's width
+                // rejects most lanes; the full test runs on the candidates it leaves.
+                const Triangle& tri = scene.triangles[prim];
+                const uint32_t candidates = kernels.triangle_candidates(
+                    rays, scene.positions[tri.v0], scene.positions[tri.v1], scene.positions[tri.v2],
+                    ids, k, positions);
+                if constexpr (Trace::k_enabled) std::fill(mask, mask + k, uint8_t(0));
+                uint32_t passed = 0;
+                for (uint32_t j = 0; j < candidates; ++j) {
+                    const uint32_t at = positions[j];
+                    if (!test(ids[at])) continue;
+                    ++passed;
+                    if constexpr (Trace::k_enabled) mask[at] = 1;
+                }
+                trace.op(OpKind::triangle_test, generation, prim, ids, k, mask, passed);
             }
         } else {
             const bool right_first = 2 * negative > k;
@@ -202,13 +176,18 @@ struct StreamTracer::Impl {
     const Scene& scene;
     const Bvh& bvh;
     RenderSettings settings;
+    const StreamKernels& kernels;
     CameraFrame camera;
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
     RayBuffers b;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
-        : scene(s), bvh(h), settings(r), camera(s.camera, r.width, r.height),
+        : scene(s),
+          bvh(h),
+          settings(r),
+          kernels(stream_kernels(resolve_isa(r.isa))),
+          camera(s.camera, r.width, r.height),
           material_rays(s.materials.size(), 0) {}
 
     template <class Trace>
@@ -217,14 +196,17 @@ struct StreamTracer::Impl {
 };
 
 template <class Trace>
-void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t sample,
-                             Vec3* sums, RenderStats& stats, Trace& trace, TraceSink* sink,
+void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
+                             RenderStats& stats, Trace& trace, TraceSink* sink,
                              RayObserver* observer) {
     const uint32_t w = rect.x1 - rect.x0, h = rect.y1 - rect.y0, count = w * h;
     b.ensure(count);
     TilePass info;
     info.tile = tile_index;
-    info.x0 = rect.x0; info.y0 = rect.y0; info.x1 = rect.x1; info.y1 = rect.y1;
+    info.x0 = rect.x0;
+    info.y0 = rect.y0;
+    info.x1 = rect.x1;
+    info.y1 = rect.y1;
     info.sample = sample;
     info.slot_count = count;
     if constexpr (Trace::k_enabled) sink->begin_pass(info);
@@ -258,7 +240,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
         for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
-        traverse(bvh, b, load_rays(b, rays, n), generation, trace);
+        traverse(kernels, bvh, b, load_rays(b, rays, n), generation, trace);
         if (observer)
             for (uint32_t i = 0; i < n; ++i) {
                 const uint32_t id = ids[i];
@@ -270,25 +252,24 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         uint32_t* next_ids = b.next_ids.data();
         auto run_filter = [&](OpKind kind, uint32_t object, uint32_t* s, uint32_t len,
                               auto&& test) {
-            return filter<k_host_width>(trace, kind, generation, object, s, len, mask, scratch,
-                                        test);
+            return filter(kernels, trace, kind, generation, object, s, len, mask, scratch, test);
         };
         uint32_t* s = ids;
         uint32_t len = n;
-        const uint32_t shadows = run_filter(OpKind::shadow_filter, k_no_object, s, len,
-                                            [&](uint32_t id) {
-            if (!any_hit[id]) return false;
-            finish_shadow(path[id], hit[id].valid());
-            return true;
-        });
+        const uint32_t shadows =
+            run_filter(OpKind::shadow_filter, k_no_object, s, len, [&](uint32_t id) {
+                if (!any_hit[id]) return false;
+                finish_shadow(path[id], hit[id].valid());
+                return true;
+            });
         s += shadows;
         len -= shadows;
-        const uint32_t misses = run_filter(OpKind::miss_filter, k_no_object, s, len,
-                                           [&](uint32_t id) {
-            if (hit[id].valid()) return false;
-            shade_miss(path[id], scene);
-            return true;
-        });
+        const uint32_t misses =
+            run_filter(OpKind::miss_filter, k_no_object, s, len, [&](uint32_t id) {
+                if (hit[id].valid()) return false;
+                shade_miss(path[id], scene);
+                return true;
+            });
         s += misses;
         len -= misses;
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
@@ -344,8 +325,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                 if (!ambient)  // with ambient light, the indirect group ends here
                     run_filter(OpKind::lambertian_indirect, k_no_object, s + direct, g - direct,
                                [&](uint32_t id) {
-                                   if (!lambertian_indirect(path[id], scene, material(id),
-                                                            surf[id], next[id]))
+                                   if (!lambertian_indirect(path[id], scene, material(id), surf[id],
+                                                            next[id]))
                                        return false;
                                    push(id, false);
                                    return true;
@@ -407,8 +388,8 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
     RenderResult result;
     result.image = Image(settings.width, settings.height);
     const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
-    uint32_t threads = settings.threads ? settings.threads
-                                        : std::max(1u, std::thread::hardware_concurrency());
+    uint32_t threads =
+        settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
     threads = std::min<uint32_t>(threads, uint32_t(tiles.size()));
     if (sink) {
         TraceHeader header;
@@ -493,8 +474,9 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
 }
 
 void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<Hit>& hits,
-                      TraceSink* sink) {
+                      TraceSink* sink, Isa isa) {
     constexpr uint32_t k_stream = 4096;  // the paper's largest stream (64 x 64)
+    const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
     RayBuffers b;
     b.ensure(k_stream);
     hits.resize(rays.size());
@@ -512,11 +494,11 @@ void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<
         if (sink) {
             SinkTrace trace{sink};
             sink->begin_pass(info);
-            traverse(bvh, b, m, 0, trace);
+            traverse(kernels, bvh, b, m, 0, trace);
             sink->end_pass(info);
         } else {
             NoTrace trace;
-            traverse(bvh, b, m, 0, trace);
+            traverse(kernels, bvh, b, m, 0, trace);
         }
         std::copy(b.hit.begin(), b.hit.begin() + n, hits.begin() + begin);
     }

@@ -3,6 +3,10 @@
 // streams through BVH traversal (Fig. 3), intersection filters and the shading filter stack
 // (Fig. 4), one tile pass (T x T primary rays, one sample per pixel) at a time.
 //
+// The box and triangle filters run at the host's SIMD width through the back end chosen by
+// RenderSettings::isa (kernels/stream/stream_kernels.h); the image and the trace never
+// depend on it.
+//
 // It calls the same per-ray functions as the reference tracer in the same per-path order, so
 // its image is bit-identical to the reference's: camera ray, RayPrecomp, intersect_box,
 // Bvh::intersect_primitive (ties to the lower id), surface_at and the path steps of path.h.
@@ -21,13 +25,13 @@ namespace sfx {
 
 // Sees every traced ray of a pass with its result (tests compare hit records through it).
 class RayObserver {
-public:
+  public:
     virtual ~RayObserver() = default;
     virtual void ray(const PathState& path, const Ray& ray, const Hit& hit, bool occluded) = 0;
 };
 
 class StreamTracer {
-public:
+  public:
     StreamTracer(const Scene& scene, const Bvh& bvh, const RenderSettings& settings);
     ~StreamTracer();
     StreamTracer(const StreamTracer&) = delete;
@@ -39,7 +43,7 @@ public:
     void trace_pass(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
                     RenderStats& stats, TraceSink* sink, RayObserver* observer = nullptr);
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
 };
@@ -54,7 +58,8 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
 
 // Closest hits of an arbitrary ray list traced as one stream (Fig. 3 traversal). Used by the
 // benchmark and the hit-record checks. hits[i] is what Bvh::intersect(rays[i]) returns.
+// `isa`: the back end of the filters (the hits and the trace are the same for every one).
 void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<Hit>& hits,
-                      TraceSink* sink = nullptr);
+                      TraceSink* sink = nullptr, Isa isa = Isa::automatic);
 
 }  // namespace sfx

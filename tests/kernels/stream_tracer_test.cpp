@@ -1,5 +1,7 @@
 // The stream tracer against the reference tracer, bit for bit; its hit records; the trace.
 
+#include "kernels/stream/stream_tracer.h"
+
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <cstring>
@@ -9,7 +11,6 @@
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
-#include "kernels/stream/stream_tracer.h"
 #include "tests/kernels/test_scenes.h"
 
 using namespace sfx;
@@ -54,8 +55,10 @@ struct HitChecker : RayObserver {
     void ray(const PathState& p, const Ray& ray, const Hit& hit, bool occluded) override {
         if (seen++ % every) return;
         ++checked;
-        if (p.kind == RayKind::shadow) mismatches += bvh.occluded(ray) != occluded;
-        else mismatches += !same_hit(bvh.intersect(ray), hit);
+        if (p.kind == RayKind::shadow)
+            mismatches += bvh.occluded(ray) != occluded;
+        else
+            mismatches += !same_hit(bvh.intersect(ray), hit);
     }
 };
 
@@ -64,25 +67,31 @@ void check_identical(const Scene& s, RenderSettings settings) {
     settings.threads = 1;
     const RenderResult ref = render_reference(s, bvh, settings);
     REQUIRE(ref.image.mean().x > 0.f);
-    for (uint32_t tile : {1u, 8u, 32u, 64u})
-        for (uint32_t threads : {1u, 2u}) {
-            settings.tile = tile;
-            settings.threads = threads;
-            const RenderResult st = render_stream(s, bvh, settings);
-            INFO("scene " << s.name << " tile " << tile << " threads " << threads << ": "
-                          << differing_pixels(ref.image, st.image) << " pixels differ");
-            CHECK(same_bits(ref.image, st.image));
-            CHECK(st.stats.camera_rays == ref.stats.camera_rays);
-            CHECK(st.stats.extension_rays == ref.stats.extension_rays);
-            CHECK(st.stats.shadow_rays == ref.stats.shadow_rays);
-            CHECK(st.stats.nonfinite_paths == ref.stats.nonfinite_paths);
-        }
+    // Every back end the machine has, the scalar one always.
+    for (const Isa isa : supported_isas())
+        for (uint32_t tile : {1u, 8u, 32u, 64u})
+            for (uint32_t threads : {1u, 2u}) {
+                settings.tile = tile;
+                settings.threads = threads;
+                settings.isa = isa;
+                const RenderResult st = render_stream(s, bvh, settings);
+                INFO("scene " << s.name << " back end " << isa_name(isa) << " tile " << tile
+                              << " threads " << threads << ": "
+                              << differing_pixels(ref.image, st.image) << " pixels differ");
+                CHECK(same_bits(ref.image, st.image));
+                CHECK(st.stats.camera_rays == ref.stats.camera_rays);
+                CHECK(st.stats.extension_rays == ref.stats.extension_rays);
+                CHECK(st.stats.shadow_rays == ref.stats.shadow_rays);
+                CHECK(st.stats.nonfinite_paths == ref.stats.nonfinite_paths);
+            }
 }
 
 }  // namespace
 
-TEST_CASE("Stream image equals the reference image bit for bit (tiles 1-64, threads 1-2)",
-          "[stream]") {
+TEST_CASE(
+    "Stream image equals the reference image bit for bit (every back end, tiles 1-64, "
+    "threads 1-2)",
+    "[stream]") {
     SECTION("area lights, three materials, thin lens") {
         check_identical(box_scene(Variant::lights), small(box_scene(Variant::lights), 32, 28, 3));
     }

@@ -1,0 +1,334 @@
+#pragma once
+// Width-generic SIMD lanes, written once (after Embree's vfloat<N> / vbool<N>):
+//   vfloat<Width>, vint<Width>, vbool<Width>
+// are `float`, `int32_t`, `bool` for Width 1 and GCC vector types (element-wise IEEE
+// operations; a comparison gives 0 / -1 per lane) for Width 8 and 16, so the reference
+// tracer's one-ray code and the stream kernels share every line of ray math.
+//
+// Masks are values: any, none, popcount, bits, select. Gather and compress-store are
+// operations of the type. Under __AVX512F__ (Width 16) and __AVX2__ (Width 8) they use the
+// instructions (vpgatherdd/vgatherdps, vpcompressd, a permutation table); otherwise a portable
+// loop with the same results.
+//
+// One rule keeps one binary safe on every machine (see kernels/simd/isa.h): each Width is
+// used only in translation units compiled for its instruction set (16: AVX-512, 8: AVX2,
+// 1: the default flags), and every function here is always inlined, so no out-of-line copy
+// built with wider instructions can be picked by the linker for a narrower caller.
+// Bit-identity: only IEEE add/sub/mul/div/compare/select; no FMA (-ffp-contract=off), no
+// approximate reciprocals.
+
+#include <cstdint>
+
+#if defined(__AVX512F__) || defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+#define SFX_LANES_INLINE inline __attribute__((always_inline))
+
+namespace sfx {
+
+template <int Width>
+struct LaneTypes {
+    static_assert(Width == 4 || Width == 8 || Width == 16, "lane widths: 1, 4, 8, 16");
+    typedef float Float __attribute__((vector_size(4 * Width)));
+    typedef int32_t Int __attribute__((vector_size(4 * Width)));
+    typedef Int Bool;  // a comparison's result: -1 (true) or 0 per lane
+};
+template <>
+struct LaneTypes<1> {
+    using Float = float;
+    using Int = int32_t;
+    using Bool = bool;
+};
+
+template <int Width>
+using vfloat = typename LaneTypes<Width>::Float;
+template <int Width>
+using vint = typename LaneTypes<Width>::Int;
+template <int Width>
+using vbool = typename LaneTypes<Width>::Bool;
+
+// One value in every lane.
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> broadcast(float x) {
+    if constexpr (Width == 1) {
+        return x;
+    } else {
+        // An element loop would compile to Width masked inserts; say "broadcast".
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) return vfloat<Width>(_mm512_set1_ps(x));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vfloat<Width>(_mm256_set1_ps(x));
+#endif
+        vfloat<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = x;
+        return v;
+    }
+}
+template <int Width>
+SFX_LANES_INLINE vint<Width> broadcast_int(int32_t x) {
+    if constexpr (Width == 1) {
+        return x;
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) return vint<Width>(_mm512_set1_epi32(x));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vint<Width>(_mm256_set1_epi32(x));
+#endif
+        vint<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = x;
+        return v;
+    }
+}
+
+// Lane indices 0, 1, ..., Width-1.
+template <int Width>
+SFX_LANES_INLINE vint<Width> lane_index() {
+    if constexpr (Width == 1) {
+        return 0;
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vint<Width>(
+                _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vint<Width>(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+#endif
+        vint<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = l;
+        return v;
+    }
+}
+
+// Per lane: m ? a : b.
+template <class Mask, class Value>
+SFX_LANES_INLINE Value select(Mask m, Value a, Value b) {
+    return m ? a : b;
+}
+
+// Per-lane logic on masks (for Width 1 the operators of bool).
+template <class Mask>
+SFX_LANES_INLINE Mask mask_and(Mask a, Mask b) {
+    if constexpr (sizeof(Mask) == 1)
+        return a && b;
+    else
+        return a & b;
+}
+template <class Mask>
+SFX_LANES_INLINE Mask mask_or(Mask a, Mask b) {
+    if constexpr (sizeof(Mask) == 1)
+        return a || b;
+    else
+        return a | b;
+}
+template <class Mask>
+SFX_LANES_INLINE Mask mask_not(Mask a) {
+    if constexpr (sizeof(Mask) == 1)
+        return !a;
+    else
+        return ~a;
+}
+
+// The sign bit of each lane (true for -0 and -inf, as std::signbit).
+template <int Width>
+SFX_LANES_INLINE vbool<Width> sign_bit(vfloat<Width> x) {
+    if constexpr (Width == 1) {
+        return __builtin_signbit(x) != 0;
+    } else {
+        vint<Width> bits;
+        __builtin_memcpy(&bits, &x, sizeof bits);
+        return bits < 0;
+    }
+}
+
+template <int Width>
+SFX_LANES_INLINE vbool<Width> is_nan(vfloat<Width> x) {
+    return x != x;
+}
+
+// Bit l set iff lane l of the mask is true.
+template <int Width>
+SFX_LANES_INLINE uint32_t bits(vbool<Width> m) {
+    if constexpr (Width == 1) {
+        return uint32_t(m);
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return uint32_t(_mm512_cmplt_epi32_mask(__m512i(m), _mm512_setzero_si512()));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return uint32_t(_mm256_movemask_ps(__m256(m)));
+#endif
+        uint32_t r = 0;
+        for (int l = 0; l < Width; ++l) r |= uint32_t(m[l] & 1) << l;
+        return r;
+    }
+}
+
+// The mask of the lanes whose bit is set.
+template <int Width>
+SFX_LANES_INLINE vbool<Width> from_bits(uint32_t b) {
+    if constexpr (Width == 1) {
+        return (b & 1u) != 0;
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vbool<Width>(_mm512_maskz_mov_epi32(__mmask16(b), _mm512_set1_epi32(-1)));
+#endif
+        const vint<Width> one = broadcast_int<Width>(1);
+        return ((broadcast_int<Width>(int32_t(b)) >> lane_index<Width>()) & one) == one;
+    }
+}
+
+template <int Width>
+SFX_LANES_INLINE bool any(vbool<Width> m) {
+    return bits<Width>(m) != 0;
+}
+template <int Width>
+SFX_LANES_INLINE bool none(vbool<Width> m) {
+    return bits<Width>(m) == 0;
+}
+template <int Width>
+SFX_LANES_INLINE uint32_t popcount(vbool<Width> m) {
+    return uint32_t(__builtin_popcount(bits<Width>(m)));
+}
+
+// Unaligned load of Width 32-bit lanes.
+template <int Width>
+SFX_LANES_INLINE vint<Width> load_int(const uint32_t* p) {
+    vint<Width> v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+
+// lane l = base[index[l]] (32-bit elements).
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> gather(const float* base, vint<Width> index) {
+    if constexpr (Width == 1) {
+        return base[index];
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vfloat<Width>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), __mmask16(0xffff),
+                                                          __m512i(index), base, 4));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8)
+            return vfloat<Width>(_mm256_i32gather_ps(base, __m256i(index), 4));
+#endif
+        vfloat<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = base[index[l]];
+        return v;
+    }
+}
+template <int Width>
+SFX_LANES_INLINE vint<Width> gather_int(const int32_t* base, vint<Width> index) {
+    if constexpr (Width == 1) {
+        return base[index];
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vint<Width>(_mm512_mask_i32gather_epi32(
+                _mm512_setzero_si512(), __mmask16(0xffff), __m512i(index), base, 4));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8)
+            return vint<Width>(_mm256_i32gather_epi32(base, __m256i(index), 4));
+#endif
+        vint<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = base[index[l]];
+        return v;
+    }
+}
+
+#if defined(__AVX2__)
+// AVX2 has no compress: for each 8-bit mask, the indices of its set lanes in order, packed
+// 4 bits each (Width-8 compress by permutation).
+struct CompressTable8 {
+    uint32_t packed[256];
+    constexpr CompressTable8() : packed() {
+        for (uint32_t m = 0; m < 256; ++m) {
+            uint32_t p = 0, k = 0;
+            for (uint32_t l = 0; l < 8; ++l)
+                if (m >> l & 1u) p |= l << (4 * k++);
+            packed[m] = p;
+        }
+    }
+};
+inline constexpr CompressTable8 k_compress_table8{};
+#endif
+
+// The paper's partition step: stores the lanes of `values` whose mask bit is set, in lane
+// order, at out[0 .. popcount); returns the popcount. Writes all Width elements of out (the
+// ones past the popcount are don't-care), so out needs Width elements of room.
+template <int Width>
+SFX_LANES_INLINE uint32_t compress_store(uint32_t mask_bits, vint<Width> values, uint32_t* out) {
+    if constexpr (Width == 1) {
+        *out = uint32_t(values);
+        return mask_bits & 1u;
+    } else {
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) {  // vpcompressd into a register, then one plain store
+            _mm512_storeu_si512(out,
+                                _mm512_maskz_compress_epi32(__mmask16(mask_bits), __m512i(values)));
+            return uint32_t(__builtin_popcount(mask_bits));
+        }
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) {
+            const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+            const __m256i perm = _mm256_and_si256(
+                _mm256_srlv_epi32(_mm256_set1_epi32(int(k_compress_table8.packed[mask_bits & 255])),
+                                  shifts),
+                _mm256_set1_epi32(7));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                                _mm256_permutevar8x32_epi32(__m256i(values), perm));
+            return uint32_t(__builtin_popcount(mask_bits & 255));
+        }
+#endif
+        uint32_t k = 0;
+        for (int l = 0; l < Width; ++l)
+            if (mask_bits >> l & 1u) out[k++] = uint32_t(values[l]);
+        return k;
+    }
+}
+
+// mask[l] = bit l of mask_bits, as bytes 0 / 1 (the trace's per-lane pass flags).
+template <int Width>
+SFX_LANES_INLINE void store_mask_bytes(uint32_t mask_bits, uint8_t* mask) {
+#if defined(__AVX512BW__) && defined(__AVX512VL__)
+    if constexpr (Width == 16) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(mask),
+                         _mm_maskz_mov_epi8(__mmask16(mask_bits), _mm_set1_epi8(1)));
+        return;
+    }
+#endif
+    for (int l = 0; l < Width; ++l) mask[l] = uint8_t(mask_bits >> l & 1u);
+}
+
+// Bit l set iff mask[l] != 0 (Width bytes).
+template <int Width>
+SFX_LANES_INLINE uint32_t load_mask_bytes(const uint8_t* mask) {
+#if defined(__AVX512BW__) && defined(__AVX512VL__)
+    if constexpr (Width == 16)
+        return uint32_t(_mm_test_epi8_mask(_mm_loadu_si128(reinterpret_cast<const __m128i*>(mask)),
+                                           _mm_set1_epi8(-1)));
+#endif
+#if defined(__AVX2__)
+    if constexpr (Width == 8) {
+        uint64_t b;
+        __builtin_memcpy(&b, mask, 8);
+        return uint32_t(_mm_movemask_epi8(
+                   _mm_cmpgt_epi8(_mm_cvtsi64_si128(int64_t(b)), _mm_setzero_si128()))) &
+               255u;
+    }
+#endif
+    uint32_t r = 0;
+    for (int l = 0; l < Width; ++l) r |= uint32_t(mask[l] != 0) << l;
+    return r;
+}
+
+}  // namespace sfx

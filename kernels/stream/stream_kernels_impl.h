@@ -1,0 +1,141 @@
+#pragma once
+// The width-generic source of the stream kernels (stream_kernels.h). Included by exactly one
+// translation unit per instruction set, which defines SFX_KERNEL_ISA (the namespace its
+// instantiations live in) and is compiled with that instruction set's flags: stream_kernels.cpp
+// (scalar, Width 1), stream_kernels_avx2.cpp (Width 8), stream_kernels_avx512.cpp (Width 16).
+// Only always-inline lane operations and the shared ray math of intersect.h are used here,
+// so no out-of-line function compiled with wide instructions escapes its namespace.
+
+#include <cstring>
+
+#include "kernels/intersect.h"
+#include "kernels/simd/lanes.h"
+#include "kernels/stream/stream_kernels.h"
+
+#ifndef SFX_KERNEL_ISA
+#error "define SFX_KERNEL_ISA before including stream_kernels_impl.h"
+#endif
+
+namespace sfx {
+namespace SFX_KERNEL_ISA {
+
+// The active lanes of the group that starts `left` ids before the end of the stream.
+template <int Width>
+SFX_LANES_INLINE uint32_t active_bits(uint32_t left) {
+    return left >= uint32_t(Width) ? (1u << Width) - 1u : (1u << left) - 1u;
+}
+
+// ids[g, g + Width) with the inactive lanes of a partial group set to ids[g] (a slot that
+// exists, so their gathers stay inside the ray buffer; their results are masked off).
+template <int Width>
+SFX_LANES_INLINE vint<Width> load_ids(const uint32_t* ids, uint32_t active) {
+    const vint<Width> id = load_int<Width>(ids);
+    return select(from_bits<Width>(active), id, broadcast_int<Width>(int32_t(ids[0])));
+}
+
+// Compress-store at out that never writes past out[count) in a partial group: an in-place
+// partition's ids past the stream belong to the streams around it.
+template <int Width>
+SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values, uint32_t* out,
+                                          bool full_group) {
+    if (full_group) return compress_store<Width>(mask_bits, values, out);
+    uint32_t tmp[Width];
+    const uint32_t count = compress_store<Width>(mask_bits, values, tmp);
+    std::memcpy(out, tmp, count * sizeof(uint32_t));
+    return count;
+}
+
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> gather_field(const float* base, vint<Width> at, int field) {
+    return gather<Width>(base, at + broadcast_int<Width>(field));
+}
+
+template <int Width>
+uint32_t box_filter(const TraversalRay* rays, const Bounds3& box, int axis, const uint32_t* ids,
+                    uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
+                    uint32_t& negative) {
+    namespace f = traversal_field;
+    const float* base = reinterpret_cast<const float*>(rays);
+    uint32_t front = 0, back = 0, negatives = 0;
+    for (uint32_t g = 0; g < n; g += Width) {
+        const uint32_t active = active_bits<Width>(n - g);
+        const vint<Width> id = load_ids<Width>(ids + g, active);
+        const vint<Width> at = id * broadcast_int<Width>(16);
+        vfloat<Width> org[3], inv_dir[3];
+        for (int a = 0; a < 3; ++a) {
+            org[a] = gather_field<Width>(base, at, f::org + a);
+            inv_dir[a] = gather_field<Width>(base, at, f::inv_dir + a);
+        }
+        const vfloat<Width> t_max = gather_field<Width>(base, at, f::t);
+        vfloat<Width> t0;
+        const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
+        // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
+        // flushes denormals, so a negative normal dir has a finite inverse).
+        const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
+        const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
+        negatives += uint32_t(__builtin_popcount(
+            bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
+        if (mask) store_mask_bytes<Width>(pass, mask + g);
+        const bool full = g + Width <= n;
+        front += compress_append<Width>(pass, id, pass_out + front, full);
+        back += compress_append<Width>(~pass & active, id, fail_out + back, full);
+    }
+    negative += negatives;
+    return front;
+}
+
+template <int Width>
+uint32_t triangle_candidates(const TraversalRay* rays, const Vec3& p0, const Vec3& p1,
+                             const Vec3& p2, const uint32_t* ids, uint32_t n, uint32_t* positions) {
+    namespace f = traversal_field;
+    const float* base = reinterpret_cast<const float*>(rays);
+    const int32_t* base_int = reinterpret_cast<const int32_t*>(rays);
+    uint32_t k = 0;
+    for (uint32_t g = 0; g < n; g += Width) {
+        const uint32_t active = active_bits<Width>(n - g);
+        const vint<Width> at = load_ids<Width>(ids + g, active) * broadcast_int<Width>(16);
+        const vfloat<Width> org[3] = {gather_field<Width>(base, at, f::org),
+                                      gather_field<Width>(base, at, f::org + 1),
+                                      gather_field<Width>(base, at, f::org + 2)};
+        const vint<Width> kx = gather_int<Width>(base_int, at + broadcast_int<Width>(f::kx));
+        const vint<Width> ky = gather_int<Width>(base_int, at + broadcast_int<Width>(f::ky));
+        const vint<Width> kz = gather_int<Width>(base_int, at + broadcast_int<Width>(f::kz));
+        const ShearedTriangle<Width> s =
+            shear_triangle<Width>(org, kx, ky, kz, gather_field<Width>(base, at, f::sx),
+                                  gather_field<Width>(base, at, f::sy), p0, p1, p2);
+        const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
+        k += compress_store<Width>(keep, lane_index<Width>() + broadcast_int<Width>(int32_t(g)),
+                                   positions + k);  // positions has room past n
+    }
+    return k;
+}
+
+template <int Width>
+uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch) {
+    uint32_t front = 0, back = 0;
+    for (uint32_t g = 0; g < n; g += Width) {
+        const uint32_t active = active_bits<Width>(n - g);
+        const vint<Width> id = load_int<Width>(ids + g);
+        const uint32_t pass = load_mask_bytes<Width>(mask + g) & active;
+        const bool full = g + Width <= n;  // front <= g: ids[front, g + Width) are read
+        front += compress_append<Width>(pass, id, ids + front, full);
+        back += compress_append<Width>(~pass & active, id, scratch + back, full);
+    }
+    // Always: the whole-vector stores overwrote ids[0, n) past the passing prefix.
+    if (back != 0) std::memcpy(ids + front, scratch, back * sizeof(uint32_t));
+    return front;
+}
+
+template <int Width>
+StreamKernels make_kernels(Isa isa) {
+    StreamKernels k;
+    k.isa = isa;
+    k.width = Width;
+    k.box_filter = &box_filter<Width>;
+    k.triangle_candidates = &triangle_candidates<Width>;
+    k.partition = &partition<Width>;
+    return k;
+}
+
+}  // namespace SFX_KERNEL_ISA
+}  // namespace sfx

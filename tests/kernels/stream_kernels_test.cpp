@@ -1,0 +1,220 @@
+// Every stream-kernel back end the machine has (scalar always) decides exactly as the one-ray
+// code, lane by lane, and partitions exactly as a stable partition: the slab test on the hard
+// cases (origins on slab planes with zero directions (0 * inf), infinite inverse directions,
+// signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
+// stage, and the compress. Streams of odd lengths exercise partial groups.
+
+#include "kernels/stream/stream_kernels.h"
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <numeric>
+#include <vector>
+
+#include "kernels/rng.h"
+#include "kernels/simd/lanes.h"
+
+using namespace sfx;
+
+namespace {
+
+float pick(uint32_t i, uint32_t dim, const std::vector<float>& specials) {
+    const uint32_t bits = random_bits(11, i, 0, 0, dim);
+    if (bits % 3 == 0) return specials[(bits >> 8) % specials.size()];
+    return (float((bits >> 8) & 0xffff) / 65536.f - 0.5f) * 8.f;
+}
+
+// Ids in a shuffled order with a padded tail, as the tracer's buffers have. The tail holds a
+// sentinel: in-place kernels must not write past the stream (other streams live there).
+constexpr uint32_t k_sentinel = 0xdeadbeef;
+bool tail_intact(const std::vector<uint32_t>& ids, uint32_t n) {
+    return std::all_of(ids.begin() + n, ids.end(), [](uint32_t v) { return v == k_sentinel; });
+}
+
+std::vector<uint32_t> shuffled_ids(uint32_t n, uint32_t seed) {
+    std::vector<uint32_t> ids(n + k_stream_padding, k_sentinel);
+    std::iota(ids.begin(), ids.begin() + n, 0u);
+    for (uint32_t i = n; i > 1; --i) std::swap(ids[i - 1], ids[random_bits(seed, i, 0, 0, 1) % i]);
+    return ids;
+}
+
+}  // namespace
+
+TEST_CASE("Box filter of every back end equals intersect_box per lane, hard cases included",
+          "[stream][simd]") {
+    const std::vector<float> coords{0.f, -0.f, 1.f, -1.f, 2.f, 0.5f, 1e-30f, -1e30f};
+    const std::vector<float> dirs{0.f, -0.f, 1.f, -1.f, 1e-40f, -1e-40f, 0.3f, 1e20f};
+    const std::vector<float> t_maxes{INFINITY, 1.f, -1.f, 0.f, 0.5f, 3.f, 1e-7f, 100.f};
+    for (const Isa isa : supported_isas()) {
+        const StreamKernels& kernels = stream_kernels(isa);
+        INFO("back end " << isa_name(isa));
+        CHECK(kernels.isa == isa);
+        CHECK(kernels.width == isa_width(isa));
+        uint64_t lanes = 0, hits = 0, mismatches = 0, order_errors = 0, negative_errors = 0;
+        for (uint32_t i = 0; i < 2000; ++i) {
+            Bounds3 box;
+            for (int a = 0; a < 3; ++a) {
+                const float p = pick(i, 10 + a, coords), q = pick(i, 20 + a, coords);
+                box.lo[a] = std::min(p, q);
+                box.hi[a] = i % 11 == 0 ? box.lo[a] : std::max(p, q);  // flat boxes too
+            }
+            if (i % 97 == 0) box = Bounds3{};  // empty: lo = inf, hi = -inf
+            const uint32_t n = 1 + i % 41;
+            std::vector<TraversalRay> rays;
+            Ray unit;
+            unit.dir = {0.f, 0.f, 1.f};
+            for (uint32_t l = 0; l < n; ++l) {
+                const uint32_t k = i * 64 + l;
+                Ray ray;
+                for (int a = 0; a < 3; ++a) {
+                    ray.org[a] = pick(k, 30 + a, coords);
+                    ray.dir[a] = pick(k, 40 + a, dirs);
+                }
+                if (k % 2 == 0 && !box.empty()) ray.dir = box.center() - ray.org;  // aim at it
+                if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
+                rays.push_back(
+                    {RayPrecomp(ray), t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]});
+            }
+            const int axis = int(i % 3);
+            const std::vector<uint32_t> ids = shuffled_ids(n, i);
+            std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
+            std::vector<uint8_t> mask(n + k_stream_padding, 7);
+            uint32_t negative = 0;
+            const uint32_t passed =
+                kernels.box_filter(rays.data(), box, axis, ids.data(), n, pass.data(), fail.data(),
+                                   mask.data(), negative);
+            std::vector<uint32_t> want_pass, want_fail;
+            uint32_t want_negative = 0;
+            for (uint32_t l = 0; l < n; ++l) {
+                const TraversalRay& r = rays[ids[l]];
+                const bool expected = intersect_box(r.pre, box, r.t) != INFINITY;
+                ++lanes;
+                hits += expected;
+                mismatches += mask[l] != uint8_t(expected);
+                (expected ? want_pass : want_fail).push_back(ids[l]);
+                want_negative += expected && r.pre.dir[axis] < 0.f;
+            }
+            order_errors += passed != want_pass.size() ||
+                            !std::equal(want_pass.begin(), want_pass.end(), pass.begin()) ||
+                            !std::equal(want_fail.begin(), want_fail.end(), fail.begin());
+            negative_errors += negative != want_negative;
+            // In place, without a mask: the passing prefix is the same.
+            std::vector<uint32_t> in_place = ids;
+            uint32_t negative2 = 0;
+            const uint32_t passed2 =
+                kernels.box_filter(rays.data(), box, axis, in_place.data(), n, in_place.data(),
+                                   fail.data(), nullptr, negative2);
+            order_errors += !tail_intact(in_place, n);
+            order_errors += passed2 != passed ||
+                            !std::equal(want_pass.begin(), want_pass.end(), in_place.begin()) ||
+                            !std::equal(want_fail.begin(), want_fail.end(), fail.begin());
+        }
+        CHECK(hits > lanes / 10);
+        CHECK(hits < lanes - lanes / 10);
+        CHECK(mismatches == 0);
+        CHECK(order_errors == 0);
+        CHECK(negative_errors == 0);
+    }
+}
+
+TEST_CASE("Triangle filter of every back end keeps every hit and equals the scalar one",
+          "[stream][simd]") {
+    const std::vector<float> coords{0.f, -0.f, 1.f, -1.f, 2.f, 0.5f};
+    const StreamKernels& scalar = stream_kernels(Isa::scalar);
+    uint64_t total_hits = 0, total_candidates = 0, lanes = 0;
+    for (const Isa isa : supported_isas()) {
+        const StreamKernels& kernels = stream_kernels(isa);
+        INFO("back end " << isa_name(isa));
+        uint64_t lost_hits = 0, differ = 0;
+        for (uint32_t i = 0; i < 1500; ++i) {
+            Vec3 p[3];
+            for (int v = 0; v < 3; ++v)
+                for (int a = 0; a < 3; ++a) p[v][a] = pick(i, 10 + 3 * v + a, coords);
+            const uint32_t n = 1 + i % 37;
+            std::vector<TraversalRay> rays;
+            for (uint32_t l = 0; l < n; ++l) {
+                const uint32_t k = i * 64 + l;
+                Ray ray;
+                for (int a = 0; a < 3; ++a) ray.org[a] = pick(k, 30 + a, coords) * 3.f;
+                // Aim at a point near the triangle (edges and vertices included).
+                const float u = float(random_bits(13, k, 0, 0, 1) % 5) / 4.f;
+                const float v = float(random_bits(13, k, 0, 0, 2) % 5) / 4.f * (1.f - u);
+                ray.dir = p[0] * (1.f - u - v) + p[1] * u + p[2] * v - ray.org;
+                if (k % 3 == 0) ray.dir = ray.dir + Vec3(0.f, 0.7f, 0.f);
+                if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
+                rays.push_back({RayPrecomp(ray), INFINITY});
+            }
+            const std::vector<uint32_t> ids = shuffled_ids(n, i);
+            std::vector<uint32_t> got(n + k_stream_padding), want(n + k_stream_padding);
+            const uint32_t c = kernels.triangle_candidates(rays.data(), p[0], p[1], p[2],
+                                                           ids.data(), n, got.data());
+            const uint32_t c_scalar = scalar.triangle_candidates(rays.data(), p[0], p[1], p[2],
+                                                                 ids.data(), n, want.data());
+            differ += c != c_scalar || !std::equal(got.begin(), got.begin() + c, want.begin());
+            for (uint32_t l = 0; l < n; ++l) {
+                float t, u, v;
+                const bool hit =
+                    intersect_triangle(rays[ids[l]].pre, p[0], p[1], p[2], INFINITY, t, u, v);
+                const bool kept = std::find(got.begin(), got.begin() + c, l) != got.begin() + c;
+                lost_hits += hit && !kept;
+                total_hits += hit;
+            }
+            total_candidates += c;
+            lanes += n;
+        }
+        CHECK(lost_hits == 0);
+        CHECK(differ == 0);
+    }
+    CHECK(total_hits > 0);
+    CHECK(total_candidates < lanes);  // the filter rejects something
+}
+
+TEST_CASE("Compress partition of every back end is the stable partition", "[stream][simd]") {
+    for (const Isa isa : supported_isas()) {
+        const StreamKernels& kernels = stream_kernels(isa);
+        INFO("back end " << isa_name(isa));
+        for (uint32_t n = 1; n < 70; ++n) {
+            std::vector<uint32_t> ids = shuffled_ids(n, n), scratch(n + k_stream_padding);
+            std::vector<uint8_t> mask(n + k_stream_padding, 1);  // past n: "passing" junk
+            for (uint32_t i = 0; i < n; ++i) mask[i] = random_bits(17, n, i, 0, 0) % 3 == 0;
+            std::vector<uint32_t> want(ids.begin(), ids.begin() + n);
+            std::vector<uint8_t> want_mask(mask.begin(), mask.begin() + n);
+            std::vector<uint32_t> order(n);
+            std::iota(order.begin(), order.end(), 0u);
+            std::stable_partition(order.begin(), order.end(),
+                                  [&](uint32_t i) { return want_mask[i] != 0; });
+            for (uint32_t i = 0; i < n; ++i) order[i] = want[order[i]];
+            const uint32_t passed = kernels.partition(ids.data(), n, mask.data(), scratch.data());
+            CHECK(passed == uint32_t(std::count(want_mask.begin(), want_mask.end(), 1)));
+            CHECK(std::equal(order.begin(), order.end(), ids.begin()));
+            CHECK(tail_intact(ids, n));
+        }
+    }
+}
+
+TEST_CASE("Lane type: masks as values, gather and compress at width 1 and 4", "[simd]") {
+    const vfloat<4> a = {1.f, -2.f, 3.f, -0.f};
+    const vbool<4> negative = sign_bit<4>(a);
+    CHECK(bits<4>(negative) == 0b1010u);
+    CHECK(popcount<4>(negative) == 2u);
+    CHECK(any<4>(negative));
+    CHECK_FALSE(none<4>(negative));
+    CHECK(none<4>(a != a));
+    const vfloat<4> picked = select(negative, broadcast<4>(9.f), a);
+    CHECK((picked[0] == 1.f && picked[1] == 9.f && picked[2] == 3.f && picked[3] == 9.f));
+    CHECK(bits<4>(from_bits<4>(0b0110u)) == 0b0110u);
+    const float table[5] = {10.f, 11.f, 12.f, 13.f, 14.f};
+    const vfloat<4> g = gather<4>(table, vint<4>{4, 0, 2, 2});
+    CHECK((g[0] == 14.f && g[1] == 10.f && g[2] == 12.f && g[3] == 12.f));
+    uint32_t out[4] = {};
+    CHECK(compress_store<4>(0b1101u, vint<4>{5, 6, 7, 8}, out) == 3u);
+    CHECK((out[0] == 5u && out[1] == 7u && out[2] == 8u));
+    // Width 1 is plain float and bool.
+    static_assert(std::is_same_v<vfloat<1>, float> && std::is_same_v<vbool<1>, bool>);
+    CHECK(sign_bit<1>(-0.f));
+    CHECK(select(true, 1.f, 2.f) == 1.f);
+    CHECK(popcount<1>(true) == 1u);
+    uint32_t one = 0;
+    CHECK(compress_store<1>(1u, 42, &one) == 1u);
+    CHECK(one == 42u);
+}
