@@ -73,6 +73,7 @@ FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
     }
     dram_reads += o.dram_reads;
     passes += o.passes;
+    actions += o.actions;
     return *this;
 }
 
@@ -112,6 +113,7 @@ void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
     }
     f(t.dram_reads, o.dram_reads);
     f(t.passes, o.passes);
+    ActionCounts::for_each(t.actions, o.actions, f);
 }
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hw_model/action_counts.h"
 #include "hw_model/hw_config.h"
 #include "kernels/trace.h"
 
@@ -66,6 +67,7 @@ struct FrameTiming {
     std::vector<uint64_t> cache_hits, cache_misses;  // per scene-cache level
     uint64_t dram_reads = 0;
     uint64_t passes = 0;
+    ActionCounts actions;  // what each unit did, for area_energy's costing
 
     FrameTiming& operator+=(const FrameTiming& o);
     // Adds o * weight (each counter rounded): the expansion of a sampled pass to its stratum.
