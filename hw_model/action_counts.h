@@ -16,7 +16,7 @@ namespace sfx {
 enum class HwUnit : uint8_t { ray_buffer, agu, simd, partition, scratchpad, interconnect, count };
 constexpr uint32_t k_hw_unit_count = uint32_t(HwUnit::count);
 inline const char* to_string(HwUnit u) {
-    static const char* names[] = {"ray_buffer", "agu",       "simd",
+    static const char* names[] = {"ray_buffer", "agu",        "simd",
                                   "partition",  "scratchpad", "interconnect"};
     return names[size_t(u)];
 }
@@ -33,9 +33,9 @@ struct ActionCounts {
     // carry a ray (the lanes doing useful work).
     std::array<uint64_t, k_op_kind_count> simd_instructions{};
     std::array<uint64_t, k_op_kind_count> simd_lane_ops{};
-    uint64_t partition_compares = 0;   // mask lanes compared
-    uint64_t partition_moves = 0;      // ids moved (their bank read and write are counted above)
-    uint64_t scratchpad_accesses = 0;  // words read or written
+    uint64_t partition_compares = 0;      // mask lanes compared
+    uint64_t partition_moves = 0;         // ids moved (their bank read and write are counted above)
+    uint64_t scratchpad_accesses = 0;     // words read or written
     uint64_t interconnect_word_hops = 0;  // words moved x multiplexer levels crossed
     // Scene-data caches, nearest first: lookups, and lines filled on a miss.
     std::array<uint64_t, k_max_cache_levels> cache_accesses{};
@@ -44,7 +44,8 @@ struct ActionCounts {
     std::array<uint64_t, k_hw_unit_count> busy_cycles{};  // by HwUnit
 
     // Applies f(counter of a, counter of b) to every counter of a pair.
-    template <class F> static void for_each(ActionCounts& a, const ActionCounts& b, F f) {
+    template <class F>
+    static void for_each(ActionCounts& a, const ActionCounts& b, F f) {
         f(a.bank_reads, b.bank_reads);
         f(a.bank_writes, b.bank_writes);
         f(a.agu_addresses, b.agu_addresses);
@@ -74,8 +75,9 @@ struct ActionCounts {
     }
     // Adds o * weight, each counter rounded: a sampled pass expanded to its stratum.
     void add_scaled(const ActionCounts& o, double weight) {
-        for_each(*this, o,
-                 [weight](uint64_t& x, uint64_t y) { x += uint64_t(std::llround(double(y) * weight)); });
+        for_each(*this, o, [weight](uint64_t& x, uint64_t y) {
+            x += uint64_t(std::llround(double(y) * weight));
+        });
     }
     bool operator==(const ActionCounts& o) const {
         bool equal = true;

@@ -4,11 +4,13 @@
 // percentages, rates) are derived when the stats are dumped, never accumulated.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "hw_model/action_counts.h"
 #include "hw_model/hw_config.h"
+#include "hw_model/tech_table.h"
 #include "kernels/trace.h"
 
 namespace sfx {
@@ -98,6 +100,8 @@ struct Prediction {
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)
     uint64_t total_passes = 0;
+    // The technology table pricing area and energy in stats(); null: default_tech_table().
+    std::shared_ptr<const TechTable> tech;
 
     // The frame's cycles: passes' core-cycles over the cores (tiles keep every core busy).
     double frame_cycles() const;
