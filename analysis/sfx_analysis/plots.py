@@ -312,10 +312,20 @@ def _varying_label(rows: pd.DataFrame, columns: Sequence[str]) -> Callable[[pd.S
     varying = [c for c in dict.fromkeys(columns)
                if c in rows.columns and rows[c].nunique(dropna=False) > 1]
 
+    last = [c.rsplit(".", 1)[-1] for c in varying]
+
+    def short(c: str) -> str:
+        if c == WIDTH:
+            return "N"
+        if c == TILE:
+            return "tile"
+        name = c.rsplit(".", 1)[-1]  # the parameter, or unit.parameter when that is ambiguous
+        return name if last.count(name) == 1 and name != "count" else ".".join(c.split(".")[-2:])
+
     def label(r: pd.Series) -> str:
         parts = []
         for c in varying:
-            name = "N" if c == WIDTH else ("tile" if c == TILE else c.rsplit(".", 1)[-1])
+            name = short(c)
             v = r[c]
             parts.append(f"{name}={_n(v) if isinstance(v, (int, float, np.number)) else v}")
         return " ".join(parts) or "the one design"
@@ -348,9 +358,12 @@ def _cost_front(store: Store, directory: str, plot: Plot, cost: str, cost_label:
         ax.scatter(d[x], d[y], color="0.6", s=18, label="sweep points")
         ax.plot(f[x], f[y], color="C3", linewidth=1.2)
         ax.scatter(f[x], f[y], color="C3", s=30, zorder=3, label="Pareto front")
-        for _, r in f.iterrows():
-            ax.annotate(label(r), (r[x], r[y]), textcoords="offset points", xytext=(4, 4),
-                        fontsize="x-small")
+        # At most eight labels on the plot (spread along the front); the caption names all.
+        step = max(1, math.ceil(len(f) / 8))
+        for k, (_, r) in enumerate(f.iterrows()):
+            if k % step == 0 or k == len(f) - 1:
+                ax.annotate(label(r), (r[x], r[y]), textcoords="offset points", xytext=(4, 4),
+                            fontsize="x-small")
         named.append(f"{scene}: " + "; ".join(label(r) for _, r in f.iterrows()))
         ax.set_title(scene)
         ax.set_xlabel("predicted fps [frames/s]" if fps_on_x else cost_label)
