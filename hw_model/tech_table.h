@@ -33,7 +33,8 @@ struct SramTech {
     void visit(V& v) {
         v.param("ref_kib", ref_kib, "KiB", "size the reference values are for", 0.001, 1e6);
         v.param("area_mm2", area_mm2, "mm2", "macro area at ref_kib", 0.0, 1e4);
-        v.param("area_exponent", area_exponent, "", "area ~ kib^x", 0.0, 2.0);
+        // At most 1: splitting a buffer into more banks never shrinks it (periphery per bank).
+        v.param("area_exponent", area_exponent, "", "area ~ kib^x", 0.0, 1.0);
         v.param("read_pj", read_pj, "pJ", "energy of one 32-bit read at ref_kib", 0.0, 1e6);
         v.param("read_exponent", read_exponent, "", "read energy ~ kib^x", 0.0, 2.0);
         v.param("write_pj", write_pj, "pJ", "energy of one 32-bit write at ref_kib", 0.0, 1e6);
