@@ -241,7 +241,7 @@ std::vector<Stat> Prediction::stats() const {
 
     // Area and energy: the action counts priced with the technology table (area_energy.h).
     const TechTable& t = tech ? *tech : default_tech_table();
-    const AreaEnergy ae = evaluate_area_energy(config, timing.actions, timing.cycles, t);
+    const AreaEnergy ae = evaluate_area_energy(config, timing.actions, uint64_t(std::llround(frame_cycles())), t);
     add("tech.node_nm", t.node_nm, "nm", "process node of the technology table");
     for (const UnitCost& u : ae.units)
         if (u.unit != "dram")

@@ -223,7 +223,9 @@ TEST_CASE("More lanes or units never mean less area", "[hw_model][energy]") {
               {1, 2, 4, 8, 16, 32, 64, 128});
         grows([](HwConfig& c, uint32_t v) { c.ray_buffer.buffers = v; }, {2, 3, 4});
         grows([](HwConfig& c, uint32_t v) { c.ray_buffer.kib = v; }, {128, 256, 512, 1024});
-        grows([](HwConfig& c, uint32_t v) { c.partition.lanes_per_cycle = v; }, {1, 4, 16, 64});
+        grows([](HwConfig& c, uint32_t v) { c.partition.comparators_per_lane = v; }, {1, 2, 4});
+        grows([](HwConfig& c, uint32_t v) { c.simd.units = v; }, {1, 2, 4, 8});
+        grows([](HwConfig& c, uint32_t v) { c.cores.count = v; }, {1, 2, 4});
         grows([](HwConfig& c, uint32_t v) { c.scratchpad.ports = v; }, {1, 2, 3, 4});
         grows([](HwConfig& c, uint32_t v) { c.scratchpad.kib = v; }, {16, 32, 64, 128});
         grows([](HwConfig& c, uint32_t v) { c.interconnect.width_words = v; }, {4, 8, 16, 32});
@@ -243,12 +245,18 @@ TEST_CASE("A small machine's area and energy equal a hand computation", "[hw_mod
     c.agu.count = 2;
     c.agu.addresses_per_cycle = 1;
     c.simd.width = 4;
-    c.partition.lanes_per_cycle = 4;
-    c.scratchpad.kib = 64;  // 4x the reference, two ports
+    c.simd.units = 1;
+    c.cores.count = 1;
+    c.partition.comparators_per_lane = 1;  // 4 comparators
+    c.scratchpad.kib = 64;                 // 4x the reference, two ports
     c.scratchpad.ports = 2;
     c.interconnect.width_words = 4;
     c.interconnect.mux_levels = 2;
-    c.scene_memory.caches = {{"l1", 128, 64, 8, 4}};  // 4x the reference
+    c.scene_memory.caches.resize(1);
+    c.scene_memory.caches[0].name = "l1";
+    c.scene_memory.caches[0].kib = 128;  // 4x the reference
+    c.scene_memory.caches[0].line_bytes = 64;
+    c.scene_memory.caches[0].ways = 8;
 
     ActionCounts n;
     n.bank_reads = 1000;
@@ -296,4 +304,17 @@ TEST_CASE("A small machine's area and energy equal a hand computation", "[hw_mod
     CHECK(unit(r, "dram").leakage_mj == 0);
     CHECK(r.leakage_mj() == Approx(5.34094e-5));
     CHECK(r.total_energy_mj() == Approx(2.2925e-5 + 5.34094e-5));
+
+    // Two cores: every unit twice but a shared cache level; the same work over twice the
+    // capacity leaks more idle cycles.
+    HwConfig two = c;
+    two.cores.count = 2;
+    two.scene_memory.caches[0].shared = true;
+    const AreaEnergy r2 = evaluate_area_energy(two, n, 1000, t);
+    CHECK(unit(r2, "ray_buffer").area_mm2 == Approx(2 * 4 * 0.25));
+    CHECK(unit(r2, "simd").area_mm2 == Approx(2 * 0.012));
+    CHECK(unit(r2, "cache_l1").area_mm2 == Approx(4.0));
+    CHECK(unit(r2, "ray_buffer").dynamic_mj == Approx(unit(r, "ray_buffer").dynamic_mj));
+    // 4 macros of 2 mW per core, over the cores' 600 busy and 1400 idle core-cycles.
+    CHECK(unit(r2, "ray_buffer").leakage_mj == Approx(4 * 2 * (600 + 0.5 * 1400) * 2e-9));
 }

@@ -375,8 +375,11 @@ TEST_CASE("The core model counts each unit's actions", "[hw_model][systemc][ener
     CHECK(a.bank_reads == 32 + 7 * 32 + 32);
     CHECK(a.bank_writes == 32);
     CHECK(a.agu_addresses == 7 * 32);
-    CHECK(a.simd_instructions[size_t(OpKind::box_test)] == 2 * 19);  // 2 groups x 19
-    CHECK(a.simd_lane_ops[size_t(OpKind::box_test)] == 32 * 19);
+    const uint32_t instructions =
+        OpCostTable(RayRecordLayout(triangle_shape(64).features), config.datapath)[OpKind::box_test]
+            .compute_instructions;
+    CHECK(a.simd_instructions[size_t(OpKind::box_test)] == 2 * instructions);  // 2 groups
+    CHECK(a.simd_lane_ops[size_t(OpKind::box_test)] == 32 * instructions);
     CHECK(a.partition_compares == 32);
     CHECK(a.partition_moves == 32);
     CHECK(a.scratchpad_accesses == 2);  // one mask word per group
@@ -387,7 +390,7 @@ TEST_CASE("The core model counts each unit's actions", "[hw_model][systemc][ener
         CHECK(a.cache_fills[level] == 1);
     }
     CHECK(a.dram_bytes == 64);
-    CHECK(a.busy_cycles[size_t(HwUnit::simd)] == 2 * 19);
+    CHECK(a.busy_cycles[size_t(HwUnit::simd)] == 2 * instructions);
     // Triangle tests scatter 5 words for each of the 16 passing lanes.
     const ActionCounts t =
         time_one(config, OpKind::triangle_test, consecutive(32), alternate, 5).actions;
