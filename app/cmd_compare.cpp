@@ -78,6 +78,12 @@ std::vector<Row> comparison_rows(const std::map<std::string, double>& a,
         add(std::string("op_mix.") + m + "_percent", std::string("op mix ") + m + " %", 0.01);
     add("op_mix.instructions", "instructions", 0);
     add("ray_buffer.bank_conflict_rate", "bank conflict rate", 1);
+    // Area and energy (technology table): shown with ratios, not ranked against frame time.
+    add("area.total_mm2", "area mm2", 0);
+    add("energy.total_per_frame_mj", "energy per frame mJ", 0);
+    add("power.w", "power W", 0);
+    add("fps_per_mm2", "fps per mm2", 0);
+    add("frames_per_joule", "frames per joule", 0);
     return rows;
 }
 
@@ -148,7 +154,7 @@ void compare_stored(const std::string& db, const std::string& sel_a, const std::
 
 void add_compare_command(CLI::App& app) {
     struct Options {
-        std::string a, b, scene, fidelity = "full", store, sel_a, sel_b;
+        std::string a, b, scene, fidelity = "full", store, sel_a, sel_b, tech = "90nm";
         bool json = false;
         WorkloadFlags workload;
     };
@@ -165,6 +171,7 @@ void add_compare_command(CLI::App& app) {
     c->add_option("--a", o->sel_a, "selection A: COLUMN=VALUE[,...], e.g. hw.simd.width=8");
     c->add_option("--b", o->sel_b, "selection B, e.g. hw.simd.width=16");
     c->add_flag("--json", o->json, "print one JSON document");
+    add_tech_option(c, o->tech);
     o->workload.add_to(c);
     c->callback([o] {
         if (!o->store.empty()) {
@@ -175,11 +182,13 @@ void add_compare_command(CLI::App& app) {
         if (o->a.empty() || o->b.empty())
             throw InputError("command line", 0, "compare", "expected two hardware files A B (or --store DB --a ... --b ...)");
         if (o->scene.empty()) throw InputError("command line", 0, "--scene", "required with two hardware files");
+        const auto tech = std::make_shared<const TechTable>(resolve_tech_table(o->tech));
         const std::vector<HwConfig> configs = {load_hw_config(o->a), load_hw_config(o->b)};
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
-        const PointGroupResult r = run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
+        PointGroupResult r = run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
+        for (Prediction& p : r.predictions) p.tech = tech;
         const Prediction& pa = r.predictions[0];
         const Prediction& pb = r.predictions[1];
         const std::vector<Row> rows = comparison_rows(stat_map(pa), stat_map(pb));

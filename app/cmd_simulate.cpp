@@ -73,6 +73,21 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
             return fixed(100 * stat(p, "scene_cache." + name + ".hit_rate"), 1) + "%";
         });
     }
+    // Area and energy per unit (the technology table's node), then the totals.
+    for (const Stat& s : predictions.front().stats()) {
+        const bool area = s.name.rfind("area.", 0) == 0, energy = s.name.rfind("energy.", 0) == 0;
+        if (!area && !energy) continue;
+        const std::string what = s.name.substr(s.name.find('.') + 1);
+        const std::string label = area ? "area " + what.substr(0, what.size() - 4) + " mm2"
+                                       : "energy " + what.substr(0, what.size() - 13) + " mJ/frame";
+        row(label, [&](const Prediction& p) { return fixed(stat(p, s.name), 3); });
+    }
+    row("power W (leakage W)", [&](const Prediction& p) {
+        return fixed(stat(p, "power.w"), 3) + " (" + fixed(stat(p, "power.leakage_w"), 3) + ")";
+    });
+    row("fps per mm2", [&](const Prediction& p) { return fixed(stat(p, "fps_per_mm2"), 4); });
+    row("frames per joule", [&](const Prediction& p) { return fixed(stat(p, "frames_per_joule"), 2); });
+    row("technology node nm", [&](const Prediction& p) { return fixed(stat(p, "tech.node_nm"), 0); });
     row("host seconds", [&](const Prediction& p) { return fixed(p.host_seconds, 3); });
     row("error estimate (interval)", [&](const Prediction& p) {
         return p.error_relative < 0 ? std::string("unknown") : "+-" + fixed(100 * p.error_relative, 2) + "%";
@@ -87,6 +102,7 @@ void add_simulate_command(CLI::App& app) {
         std::vector<std::string> hw;
         std::string scene;
         std::string fidelity = "full";
+        std::string tech = "90nm";
         bool json = false;
         WorkloadFlags workload;
         SamplingFlags sampling;
@@ -100,9 +116,11 @@ void add_simulate_command(CLI::App& app) {
         ->check(CLI::IsMember({"analytic", "sampled", "full"}))
         ->capture_default_str();
     c->add_flag("--json", o->json, "print one JSON document (a list for several configurations)");
+    add_tech_option(c, o->tech);
     o->workload.add_to(c);
     o->sampling.add_to(c);
     c->callback([o] {
+        const auto tech = std::make_shared<const TechTable>(resolve_tech_table(o->tech));
         std::vector<HwConfig> configs;
         for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
         const Scene scene = load_scene(o->scene);
@@ -111,13 +129,14 @@ void add_simulate_command(CLI::App& app) {
         Progress progress("simulate", 0, "tile passes");
         progress.set_label(o->fidelity + " fidelity, " + std::to_string(configs.size()) +
                            (configs.size() == 1 ? " configuration" : " configurations"));
-        const PointGroupResult r =
+        PointGroupResult r =
             run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity),
                             o->sampling.resolve(settings.seed), [&](uint64_t done, uint64_t total) {
                                 progress.set_total(total);
                                 progress.set_done(done);
                             });
         progress.finish();
+        for (Prediction& p : r.predictions) p.tech = tech;
         if (o->json) {
             if (r.predictions.size() == 1) {
                 std::cout << prediction_json(r.predictions[0]).dump(2) << "\n";

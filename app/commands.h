@@ -45,6 +45,10 @@ struct SamplingFlags {
     SamplingOptions resolve(uint64_t seed) const;
 };
 
+// --tech NAME|FILE: the technology table pricing area and energy (a built-in name or a
+// *.tech.yaml file; default 90nm, the paper's node).
+void add_tech_option(CLI::App* command, std::string& tech);
+
 void add_render_command(CLI::App& app);
 void add_trace_stats_command(CLI::App& app);
 void add_validate_command(CLI::App& app);

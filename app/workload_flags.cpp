@@ -2,6 +2,7 @@
 #include <cstdlib>
 
 #include "app/commands.h"
+#include "hw_model/tech_table.h"
 #include "workloads/input_error.h"
 #include "workloads/strict_number.h"
 
@@ -86,6 +87,16 @@ SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
     o.strata = strata;
     o.seed = seed + 1;
     return o;
+}
+
+void add_tech_option(CLI::App* command, std::string& tech) {
+    std::string names;
+    for (const std::string& n : builtin_tech_names()) names += (names.empty() ? "" : ", ") + n;
+    command
+        ->add_option("--tech", tech,
+                     "technology table for area and energy: a built-in (" + names +
+                         ") or a *.tech.yaml file")
+        ->capture_default_str();
 }
 
 }  // namespace sfx

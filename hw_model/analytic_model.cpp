@@ -132,7 +132,8 @@ namespace {
 // not); a first touch in the pass hits if the line survived from earlier passes, in
 // proportion to how much of the frame's working set fits; the frame's first touches miss.
 double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
-                             const TraceProfile& profile) {
+                             const TraceProfile& profile,
+                             std::vector<double>* global_misses = nullptr) {
     const TraceProfile::Footprint& f = profile.footprint();
     const double fetches = double(f.fetches);
     const double line = TraceProfile::k_line_bytes;
@@ -154,6 +155,7 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
         cycles +=
             (previous_miss - global_miss) * double(ns_to_cycles(level.hit_latency_ns, core_mhz));
         previous_miss = global_miss;
+        if (global_misses) global_misses->push_back(global_miss);
     }
     const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
     const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
@@ -170,8 +172,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
-    const double fetch_cycles =
-        expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, footprint ? *footprint : profile);
+    std::vector<double> global_misses;  // per cache level, for the action counts
+    const double fetch_cycles = expected_fetch_cycles(
+        c.scene_memory, c.clock.core_mhz, footprint ? *footprint : profile, &global_misses);
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank =
@@ -198,6 +201,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     // Fractional sums in unit-cycles, rounded once at the end: conflict, alignment, address,
     // partition, scene memory, interconnect, pipeline fill, unit idle.
     double stall_values[8] = {};
+    // Expected action counts, summed fractionally and rounded once at the end (as the stalls).
+    double bank_reads = 0, bank_writes = 0, addresses = 0, compares = 0, moved = 0,
+           scratch_words = 0, word_hops = 0, fetches = 0, busy_units[k_hw_unit_count] = {};
+    double simd_instructions[k_op_kind_count] = {}, simd_lane_ops[k_op_kind_count] = {};
     const double units = double(std::max(1u, c.simd.units));
     const double agu_rate = double(c.agu.count) * c.agu.addresses_per_cycle;
     const double occupancy = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
@@ -221,7 +228,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double rounds = std::ceil(double(groups) / sharing);
         double align = 0.0, conflict = 0.0, accesses = 0.0, round_sum = 0.0, addr_sum = 0.0,
                ic_sum = 0.0;
-        double first_fetch = 0.0, scatter_addresses = 0.0;
+        double first_fetch = 0.0, scatter_addresses = 0.0, access_sum = 0.0, word_sum = 0.0;
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const RayBufferModel::Contiguous ids = buffer.access_contiguous(g * n, lanes);
@@ -237,6 +244,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             const double addresses = sharing * words / agu_rate;
             const double wires = sharing * words / words_per_core_cycle;
             round_sum += std::max({busy, access, addresses, wires});
+            access_sum += access;
+            word_sum += words;
             addr_sum += std::max(0.0, addresses - std::max(busy, access));
             ic_sum += std::max(0.0, wires - std::max({busy, access, addresses}));
             align += double(ids.alignment_cycles);
@@ -254,10 +263,11 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double per_round = round_sum / double(groups);
         const double exec = rounds * per_round;
         const double tail = std::max(0.0, double(p.latency_cycles) - busy) + 1.0;
-        double compare = 0.0, moves = 0.0;
+        double compare = 0.0, moves = 0.0, moved_ids = 0.0;
         if (p.partitions) {
             compare = std::ceil(double(length) / (double(n) * c.partition.comparators_per_lane));
-            moves = std::ceil(expected_moved_ids(length, pass_rate) / n);
+            moved_ids = expected_moved_ids(length, pass_rate);
+            moves = std::ceil(moved_ids / n);
         }
         const double bubble = p.partitions ? first_fetch + tail + compare + moves : 0.0;
         // Scene data is requested at dispatch (or prefetch_depth ops earlier): what the first
@@ -271,6 +281,25 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double op_cycles = exec + bubble + memory_stall;
 
         total_cycles += ops * op_cycles;
+        // Action counts, as the cycle-level core model counts them.
+        const double passed = double(bucket.passed);
+        bank_reads += ops * (double(length) * (1.0 + gathers) + moved_ids);
+        bank_writes += passed * double(p.scatter_words.size()) + ops * moved_ids +
+                       (p.pushes_rays ? passed : 0.0);
+        addresses += ops * word_sum;
+        simd_instructions[size_t(kind)] += ops * double(groups) * p.compute_instructions;
+        simd_lane_ops[size_t(kind)] += ops * double(length) * p.compute_instructions;
+        compares += p.partitions ? ops * double(length) : 0.0;
+        moved += ops * moved_ids;
+        scratch_words += ops * double(groups);
+        word_hops += ops * word_sum * c.interconnect.mux_levels;
+        fetches += p.scene_bytes ? double(bucket.fetches) : 0.0;
+        busy_units[size_t(HwUnit::ray_buffer)] += ops * access_sum;
+        busy_units[size_t(HwUnit::agu)] += ops * word_sum / agu_rate;
+        busy_units[size_t(HwUnit::simd)] += ops * double(groups) * busy;
+        busy_units[size_t(HwUnit::partition)] += ops * (compare + moves);
+        busy_units[size_t(HwUnit::scratchpad)] += ops * double(groups) / c.scratchpad.ports;
+        busy_units[size_t(HwUnit::interconnect)] += ops * word_sum / words_per_core_cycle;
         // Unit-cycles: busy ones issue instructions; the rest are charged to their causes.
         const double busy_units = double(groups) * busy;
         const double fetch_excess = ops * sharing * std::max(0.0, exec - rounds * busy);
@@ -307,6 +336,30 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     stalls_sum.pipeline_fill = uint64_t(std::llround(stall_values[6]));
     stalls_sum.unit_idle = uint64_t(std::llround(stall_values[7]));
     t.stalls = stalls_sum;
+    auto count = [](double v) { return uint64_t(std::llround(v)); };
+    ActionCounts& a = t.actions;
+    a.bank_reads = count(bank_reads);
+    a.bank_writes = count(bank_writes);
+    a.agu_addresses = count(addresses);
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        a.simd_instructions[k] = count(simd_instructions[k]);
+        a.simd_lane_ops[k] = count(simd_lane_ops[k]);
+    }
+    a.partition_compares = count(compares);
+    a.partition_moves = count(moved);
+    a.scratchpad_accesses = count(scratch_words);
+    a.interconnect_word_hops = count(word_hops);
+    // One line per fetch: level i is looked up by the fetches every nearer level missed.
+    double reaching = fetches;
+    for (size_t i = 0; i < global_misses.size() && i < ActionCounts::k_max_cache_levels; ++i) {
+        a.cache_accesses[i] = count(reaching);
+        a.cache_fills[i] = count(fetches * global_misses[i]);
+        reaching = fetches * global_misses[i];
+    }
+    const uint32_t dram_line =
+        c.scene_memory.caches.empty() ? 64 : c.scene_memory.caches.back().line_bytes;
+    a.dram_bytes = count(reaching * dram_line);
+    for (uint32_t u = 0; u < k_hw_unit_count; ++u) a.busy_cycles[u] = count(busy_units[u]);
     t.cycles = uint64_t(std::llround(total_cycles));
     return t;
 }

@@ -72,13 +72,19 @@ void CoreModel::dispatch_op(uint32_t index) {
     mix.load += groups * (1 + p.gather_words.size()) + (fetches ? 1 : 0);
     mix.compute += groups * p.compute_instructions;
     mix.scatter_gather += groups * p.gather_words.size();
+    ActionCounts& act = m_timing.actions;  // ACTIONS: counted beside the timing (area_energy)
     if (p.partitions) {
         const PartitionCost part =
             partition_cost(m_config.partition, n, op.length, m_pass->moved_ids(index));
         mix.partition += part.compare_cycles;
         mix.store += part.move_cycles;
+        act.partition_compares += op.length;  // ACTIONS: the moved ids are read and written
+        act.partition_moves += part.moved_ids;
+        act.bank_reads += part.moved_ids;
+        act.bank_writes += part.moved_ids;
     }
     if (p.pushes_rays) mix.store += (uint64_t(op.pass_count) + n - 1) / n;
+    if (p.pushes_rays) act.bank_writes += op.pass_count;  // ACTIONS: next generation's ids
 }
 
 void CoreModel::request_scene(uint32_t index, uint64_t now) {
@@ -154,6 +160,16 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     t.alignment = ids.alignment_cycles;
     const uint64_t ids_done = now + ids.cycles;
     const size_t gathers = p.gather_words.size();
+    // ACTIONS: ids and gathered words out of the banks, their addresses and interconnect hops.
+    ActionCounts& act = m_timing.actions;
+    const uint64_t gathered = uint64_t(t.lanes) * gathers;
+    act.bank_reads += t.lanes + gathered;
+    act.agu_addresses += gathered;
+    act.interconnect_word_hops += gathered * m_config.interconnect.mux_levels;
+    act.busy_cycles[size_t(HwUnit::ray_buffer)] += ids.cycles + gathers;
+    act.busy_cycles[size_t(HwUnit::agu)] += ceil_cycle(double(gathered) / m_agu.per_cycle());
+    act.busy_cycles[size_t(HwUnit::interconnect)] +=
+        ceil_cycle(double(gathered) / m_interconnect.per_cycle());
     if (gathers == 0) {
         t.data_ready = ids_done;
         return ids_done;
@@ -200,6 +216,13 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
         e.start + (programmable ? std::max<uint64_t>(busy, p.latency_cycles) : p.latency_cycles);
     stage.busy_cycles += busy;
     m_unit_free[unit] = e.issue_end;
+    // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
+    ActionCounts& act = m_timing.actions;
+    act.simd_instructions[size_t(op.kind)] += p.compute_instructions;
+    act.simd_lane_ops[size_t(op.kind)] += uint64_t(t.lanes) * p.compute_instructions;
+    act.busy_cycles[size_t(HwUnit::simd)] += busy;
+    act.scratchpad_accesses += 1;
+    act.busy_cycles[size_t(HwUnit::scratchpad)] += 1;
     m_unit_stage[unit] = uint8_t((op.generation > 0) * k_op_stage_count + uint32_t(op.stage));
 
     // The mask goes through the scratchpad to the partition unit.
@@ -223,6 +246,11 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
             m_timing.field_accesses += words;
             m_timing.mix.scatter_gather += words;
             m_timing.mix.store += words;  // each scattered word's address vector
+            const uint64_t scattered = uint64_t(lanes) * words;  // ACTIONS
+            act.bank_writes += scattered;
+            act.agu_addresses += scattered;
+            act.interconnect_word_hops += scattered * m_config.interconnect.mux_levels;
+            act.busy_cycles[size_t(HwUnit::ray_buffer)] += words;
         }
     }
     m_op_completion[t.op] = std::max(m_op_completion[t.op], e.completion);
@@ -280,6 +308,7 @@ uint64_t CoreModel::partition(uint32_t index, uint64_t ready) {
         partition_cost(m_config.partition, width(), op.length, m_pass->moved_ids(index));
     const uint64_t start = std::max(ready, m_partition_free);
     m_partition_free = start + part.cycles();
+    m_timing.actions.busy_cycles[size_t(HwUnit::partition)] += part.cycles();  // ACTIONS
     return m_partition_free;
 }
 

@@ -1,5 +1,7 @@
 #include "hw_model/hw_config.h"
 
+#include "hw_model/strict_yaml.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
@@ -16,127 +18,7 @@
 namespace sfx {
 namespace {
 
-// Scalar text <-> typed values, strictly: "16x", "-1" for unsigned, "1e999" are errors.
-bool parse_scalar(const std::string& s, uint32_t& out) {
-    uint64_t v = 0;
-    if (!parse_unsigned(s, v) || v > 0xffffffffull) return false;
-    out = uint32_t(v);
-    return true;
-}
-bool parse_scalar(const std::string& s, double& out) { return parse_finite(s, out); }
-bool parse_scalar(const std::string& s, bool& out) {
-    if (s == "true") { out = true; return true; }
-    if (s == "false") { out = false; return true; }
-    return false;
-}
-bool parse_scalar(const std::string& s, std::string& out) {
-    out = s;
-    return true;
-}
-const char* type_name(uint32_t) { return "a non-negative integer"; }
-const char* type_name(double) { return "a finite number"; }
-const char* type_name(bool) { return "true or false"; }
-const char* type_name(const std::string&) { return "a string"; }
-
-std::string to_text(uint32_t v) { return std::to_string(v); }
-std::string to_text(bool v) { return v ? "true" : "false"; }
-std::string to_text(const std::string& v) { return v; }
-std::string to_text(double v) { return shortest_text(v); }
-
-template <class T> bool in_range(const T& v, const T& lo, const T& hi) { return v >= lo && v <= hi; }
-
-int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
-
-std::string join(const std::string& prefix, const std::string& name) {
-    return prefix.empty() ? name : prefix + "." + name;
-}
-
-// Reads a YAML map into a config: every key must be visited, every value must parse and lie
-// in range. Absent keys keep their defaults.
-class YamlReader {
-public:
-    YamlReader(const YAML::Node& node, std::string file, std::string prefix, HwLineMap& lines)
-        : m_node(node), m_file(std::move(file)), m_prefix(std::move(prefix)), m_lines(lines) {
-        if (!m_node.IsMap())
-            throw InputError(m_file, line_of(m_node), m_prefix.empty() ? "(top level)" : m_prefix,
-                             "expected a mapping of keys to values");
-    }
-
-    template <class T, class B> void param(const char* name, T& value, const char*, const char*,
-                                           B lo, B hi) {
-        if (read(name, value) && !in_range(value, T(lo), T(hi)))
-            throw InputError(m_file, line_of(m_node[name]), join(m_prefix, name),
-                             "value " + to_text(value) + " is outside [" + to_text(T(lo)) + ", " +
-                                 to_text(T(hi)) + "]");
-    }
-    template <class T> void param(const char* name, T& value, const char*, const char*) {
-        read(name, value);
-    }
-    void choice(const char* name, std::string& value, std::initializer_list<const char*> allowed,
-                const char*) {
-        if (!read(name, value)) return;
-        std::string list;
-        for (const char* a : allowed) {
-            if (value == a) return;
-            list += list.empty() ? a : std::string(", ") + a;
-        }
-        throw InputError(m_file, line_of(m_node[name]), join(m_prefix, name),
-                         "'" + value + "' is not one of: " + list);
-    }
-    template <class G> void group(const char* name, G& g) {
-        m_seen.insert(name);
-        const YAML::Node child = m_node[name];
-        if (!child) return;
-        m_lines[join(m_prefix, name)] = line_of(child);
-        YamlReader r(child, m_file, join(m_prefix, name), m_lines);
-        g.visit(r);
-        r.finish();
-    }
-    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
-        m_seen.insert(name);
-        const YAML::Node child = m_node[name];
-        if (!child) return;
-        if (!child.IsSequence())
-            throw InputError(m_file, line_of(child), join(m_prefix, name), "expected a list");
-        m_lines[join(m_prefix, name)] = line_of(child);
-        items.assign(child.size(), G{});
-        for (size_t i = 0; i < child.size(); ++i) {
-            const std::string item = join(m_prefix, name) + "[" + std::to_string(i) + "]";
-            m_lines[item] = line_of(child[i]);
-            YamlReader r(child[i], m_file, item, m_lines);
-            items[i].visit(r);
-            r.finish();
-        }
-    }
-    void finish() const {
-        std::set<std::string> keys;
-        for (const auto& kv : m_node) {
-            const std::string key = kv.first.as<std::string>();
-            if (!m_seen.count(key))
-                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "unknown key");
-            if (!keys.insert(key).second)
-                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "duplicate key");
-        }
-    }
-
-private:
-    template <class T> bool read(const char* name, T& value) {
-        m_seen.insert(name);
-        const YAML::Node child = m_node[name];
-        if (!child) return false;
-        if (!child.IsScalar() || !parse_scalar(child.Scalar(), value))
-            throw InputError(m_file, line_of(child), join(m_prefix, name),
-                             std::string("expected ") + type_name(value));
-        m_lines[join(m_prefix, name)] = line_of(child);
-        return true;
-    }
-
-    // A copy (a handle): group() and list() pass temporaries.
-    const YAML::Node m_node;
-    std::string m_file, m_prefix;
-    HwLineMap& m_lines;
-    std::set<std::string> m_seen;
-};
+using namespace strict_yaml;
 
 class YamlWriter {
 public:

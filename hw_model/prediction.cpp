@@ -1,5 +1,7 @@
 #include "hw_model/prediction.h"
 
+#include "hw_model/area_energy.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -73,6 +75,7 @@ FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
     }
     dram_reads += o.dram_reads;
     passes += o.passes;
+    actions += o.actions;
     return *this;
 }
 
@@ -112,6 +115,7 @@ void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
     }
     f(t.dram_reads, o.dram_reads);
     f(t.passes, o.passes);
+    ActionCounts::for_each(t.actions, o.actions, f);
 }
 }  // namespace
 
@@ -234,6 +238,26 @@ std::vector<Stat> Prediction::stats() const {
     }
     add("scene_memory.dram_reads", double(timing.dram_reads), "lines",
         "scene-data lines read from DRAM");
+
+    // Area and energy: the action counts priced with the technology table (area_energy.h).
+    const TechTable& t = tech ? *tech : default_tech_table();
+    const AreaEnergy ae = evaluate_area_energy(config, timing.actions, uint64_t(std::llround(frame_cycles())), t);
+    add("tech.node_nm", t.node_nm, "nm", "process node of the technology table");
+    for (const UnitCost& u : ae.units)
+        if (u.unit != "dram")
+            add("area." + u.unit + "_mm2", u.area_mm2, "mm2", "area of " + u.unit);
+    const double area = ae.total_area_mm2(), energy_mj = ae.total_energy_mj();
+    add("area.total_mm2", area, "mm2", "on-chip area");
+    for (const UnitCost& u : ae.units)
+        add("energy." + u.unit + "_per_frame_mj", u.energy_mj(), "mJ",
+            "energy of " + u.unit + " per frame, dynamic and leakage");
+    add("energy.total_per_frame_mj", energy_mj, "mJ", "energy per frame");
+    const double seconds = frame_seconds();
+    add("power.w", seconds > 0 ? energy_mj * 1e-3 / seconds : 0.0, "W", "average power while rendering");
+    add("power.leakage_w", seconds > 0 ? ae.leakage_mj() * 1e-3 / seconds : 0.0, "W",
+        "leakage share of the average power");
+    add("fps_per_mm2", ratio(fps(), area), "frames/s/mm2", "frame rate per on-chip area");
+    add("frames_per_joule", ratio(1.0, energy_mj * 1e-3), "frames/J", "frames per joule");
     return s;
 }
 

@@ -4,10 +4,13 @@
 // percentages, rates) are derived when the stats are dumped, never accumulated.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "hw_model/action_counts.h"
 #include "hw_model/hw_config.h"
+#include "hw_model/tech_table.h"
 #include "kernels/trace.h"
 
 namespace sfx {
@@ -66,6 +69,7 @@ struct FrameTiming {
     std::vector<uint64_t> cache_hits, cache_misses;  // per scene-cache level
     uint64_t dram_reads = 0;
     uint64_t passes = 0;
+    ActionCounts actions;  // what each unit did, for area_energy's costing
 
     FrameTiming& operator+=(const FrameTiming& o);
     // Adds o * weight (each counter rounded): the expansion of a sampled pass to its stratum.
@@ -96,6 +100,8 @@ struct Prediction {
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)
     uint64_t total_passes = 0;
+    // The technology table pricing area and energy in stats(); null: default_tech_table().
+    std::shared_ptr<const TechTable> tech;
 
     // The frame's cycles: passes' core-cycles over the cores (tiles keep every core busy).
     double frame_cycles() const;

@@ -335,6 +335,99 @@ def plot_pareto(store: Store, directory: str) -> Plot:
     return plot
 
 
+AREA = "area.total_mm2"
+ENERGY = "energy.total_per_frame_mj"
+
+
+def _varying_label(rows: pd.DataFrame, columns: Sequence[str]) -> Callable[[pd.Series], str]:
+    """Names a point by the configuration columns that vary among `rows` (N for the SIMD width,
+    else the parameter's last name): what tells the designs on a front apart."""
+    varying = [c for c in dict.fromkeys(columns)
+               if c in rows.columns and rows[c].nunique(dropna=False) > 1]
+
+    last = [c.rsplit(".", 1)[-1] for c in varying]
+
+    def short(c: str) -> str:
+        if c == WIDTH:
+            return "N"
+        if c == TILE:
+            return "tile"
+        name = c.rsplit(".", 1)[-1]  # the parameter, or unit.parameter when that is ambiguous
+        return name if last.count(name) == 1 and name != "count" else ".".join(c.split(".")[-2:])
+
+    def label(r: pd.Series) -> str:
+        parts = []
+        for c in varying:
+            name = short(c)
+            v = r[c]
+            parts.append(f"{name}={_n(v) if isinstance(v, (int, float, np.number)) else v}")
+        return " ".join(parts) or "the one design"
+    return label
+
+
+def _cost_front(store: Store, directory: str, plot: Plot, cost: str, cost_label: str,
+                fps_on_x: bool) -> Plot:
+    """Pareto front of fps against a cost column (less cost and more fps are better), one
+    panel per scene, the designs on the front named on the plot and in the caption."""
+    data = _with(store.points, ["fps", cost])
+    if data.empty:
+        plot.skipped = f"the store has no {cost} values (results of an sfx without area and " \
+                       "energy)"
+        return plot
+    hw = [c for c in data.columns if c.startswith("hw.") and c != "hw.name"]
+    context, data = dominant_context(data, [SCENE, TILE] + hw)
+    if data.groupby(SCENE)[cost].nunique().max() < 2:
+        plot.skipped = f"needs points of two different {cost} for one scene"
+        return plot
+    scenes = sorted(data[SCENE].unique())
+    fig, axes = _subplots(len(scenes), ncols=2, size=(5.6, 4.0))
+    named = []
+    for ax, scene in zip(axes, scenes):
+        d = data[data[SCENE] == scene].reset_index(drop=True)
+        label = _varying_label(d, [WIDTH, TILE] + hw)
+        front = pareto_front(list(d[cost]), list(d["fps"]))
+        f = d.iloc[front]
+        x, y = ("fps", cost) if fps_on_x else (cost, "fps")
+        ax.scatter(d[x], d[y], color="0.6", s=18, label="sweep points")
+        ax.plot(f[x], f[y], color="C3", linewidth=1.2)
+        ax.scatter(f[x], f[y], color="C3", s=30, zorder=3, label="Pareto front")
+        # At most eight labels on the plot (spread along the front); the caption names all.
+        step = max(1, math.ceil(len(f) / 8))
+        for k, (_, r) in enumerate(f.iterrows()):
+            if k % step == 0 or k == len(f) - 1:
+                ax.annotate(label(r), (r[x], r[y]), textcoords="offset points", xytext=(4, 4),
+                            fontsize="x-small")
+        named.append(f"{scene}: " + "; ".join(label(r) for _, r in f.iterrows()))
+        ax.set_title(scene)
+        ax.set_xlabel("predicted fps [frames/s]" if fps_on_x else cost_label)
+        ax.set_ylabel(cost_label if fps_on_x else "predicted fps [frames/s]")
+        ax.margins(0.15)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="x-small", loc="best")
+    fig.suptitle(plot.title)
+    plot.file = _save(fig, directory, plot.name)
+    tech = ""
+    if "tech.node_nm" in data.columns and data["tech.node_nm"].nunique() == 1:
+        tech = f" Priced at {_n(data['tech.node_nm'].iloc[0])} nm."
+    plot.caption = ("Red: the designs no other design beats with less or equal " +
+                    cost_label.split(" [")[0] + " and more or equal fps. On the front: " +
+                    " | ".join(named) + "." + tech + _context_caption(context))
+    return plot
+
+
+def plot_pareto_area(store: Store, directory: str) -> Plot:
+    return _cost_front(store, directory,
+                       Plot("pareto_fps_vs_area", "Pareto front: frame rate against chip area"),
+                       AREA, "on-chip area [mm²]", fps_on_x=False)
+
+
+def plot_pareto_energy(store: Store, directory: str) -> Plot:
+    return _cost_front(store, directory,
+                       Plot("pareto_energy_vs_fps", "Pareto front: energy per frame against "
+                                                    "frame rate"),
+                       ENERGY, "energy per frame [mJ]", fps_on_x=True)
+
+
 def accuracy_rows(points: pd.DataFrame) -> pd.DataFrame:
     """Points whose configuration was run at two or more fidelities (a sweep with `fidelity`
     as an axis), with
@@ -406,6 +499,8 @@ PLOTTERS: List[Callable[[Store, str], Plot]] = [
     plot_stalls,
     plot_fps_vs_buffer,
     plot_pareto,
+    plot_pareto_area,
+    plot_pareto_energy,
     plot_error_vs_host_time,
 ]
 

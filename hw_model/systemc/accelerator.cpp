@@ -54,6 +54,16 @@ FrameTiming Accelerator::timing() const {
         t.cache_misses.push_back(m_scene_memory->misses(level));
     }
     t.dram_reads = m_scene_memory->dram_reads();
+    // ACTIONS: cache lookups and fills per level (summed over a private level's instances),
+    // DRAM bytes in lines of the last level.
+    for (uint32_t level = 0; level < m_scene_memory->level_count() &&
+                             level < ActionCounts::k_max_cache_levels;
+         ++level) {
+        t.actions.cache_accesses[level] = m_scene_memory->hits(level) + m_scene_memory->misses(level);
+        t.actions.cache_fills[level] = m_scene_memory->misses(level);
+    }
+    const auto& caches = m_config.scene_memory.caches;
+    t.actions.dram_bytes = m_scene_memory->dram_reads() * (caches.empty() ? 64 : caches.back().line_bytes);
     return t;
 }
 

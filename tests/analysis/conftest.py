@@ -78,6 +78,10 @@ def point(scene, tile, width, kib=512.0, fps=None, **extra):
     for name, v in [("load", 24.1), ("store", 14.9), ("compute", 35.4), ("scatter_gather", 19.6),
                     ("partition", 5.0)]:
         p[f"op_mix.{name}_percent"] = v + (width - 4) / 100.0
+    # Area grows with the lanes and the buffers; energy per frame falls with width.
+    p["area.total_mm2"] = 20.0 + 0.5 * width + kib / 64.0
+    p["energy.total_per_frame_mj"] = 30.0 - width / 2.0 + tile / 16.0
+    p["tech.node_nm"] = 90.0
     p.update(extra)
     return p
 

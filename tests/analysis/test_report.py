@@ -45,7 +45,7 @@ def test_index_references_only_existing_files(tmp_path):
     report = write_report(accuracy_store(tmp_path), str(tmp_path / "r"))
     html = open(report.index, encoding="utf-8").read()
     refs = re.findall(r'(?:src|href)="([^"]+)"', html)
-    assert len([r for r in refs if r.endswith(".png")]) == 6
+    assert len([r for r in refs if r.endswith(".png")]) == 8
     for ref in refs:
         assert not re.match(r"^[a-z]+:", ref) and not ref.startswith("/"), ref
         assert os.path.isfile(os.path.join(report.directory, ref)), ref
@@ -101,3 +101,25 @@ def test_sfx_report_command(grid_store, tmp_path):
     done = subprocess.run([sfx, "report", str(tmp_path / "none.db")], capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 2
+
+
+def test_area_and_energy_fronts_name_their_designs(buffer_store, tmp_path):
+    report = write_report(buffer_store, str(tmp_path / "r"))
+    plots = {p.name: p for p in report.plots}
+    for name in ["pareto_fps_vs_area", "pareto_energy_vs_fps"]:
+        assert not plots[name].skipped, plots[name].skipped
+        assert os.path.isfile(os.path.join(report.directory, plots[name].file))
+    # conftest: fps rises with width and tile, area with width and kib: at 128 KiB both widths
+    # and the larger tile are on the fps/area front of each scene.
+    caption = plots["pareto_fps_vs_area"].caption
+    assert "N=4 tile=32 kib=128" in caption and "N=16 tile=32 kib=128" in caption
+    assert "90 nm" in caption
+
+
+def test_fronts_skip_stores_without_area(tmp_path):
+    points = [{k: v for k, v in p.items() if not k.startswith(("area.", "energy."))}
+              for p in grid_points()]
+    report = write_report(write_store(str(tmp_path / "old.db"), points), str(tmp_path / "r"))
+    skipped = {p.name: p.skipped for p in report.plots if p.skipped}
+    assert "area.total_mm2" in skipped["pareto_fps_vs_area"]
+    assert "energy.total_per_frame_mj" in skipped["pareto_energy_vs_fps"]

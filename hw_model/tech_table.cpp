@@ -1,0 +1,101 @@
+#include "hw_model/tech_table.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "hw_model/strict_yaml.h"
+#include "hw_model/tech/builtin_tech.h"  // generated: k_builtin_tech[] = {name, yaml text}
+
+namespace sfx {
+namespace {
+
+// Every dotted key a table must contain (a table has no defaults: no number goes unsourced).
+class KeyLister {
+  public:
+    explicit KeyLister(std::vector<std::string>& out, std::string prefix = "")
+        : m_out(out), m_prefix(std::move(prefix)) {}
+    template <class T, class B>
+    void param(const char* name, T&, const char*, const char*, B, B) {
+        m_out.push_back(strict_yaml::join(m_prefix, name));
+    }
+    template <class T>
+    void param(const char* name, T&, const char*, const char*) {
+        m_out.push_back(strict_yaml::join(m_prefix, name));
+    }
+    template <class G>
+    void group(const char* name, G& g) {
+        KeyLister l(m_out, strict_yaml::join(m_prefix, name));
+        g.visit(l);
+    }
+
+  private:
+    std::vector<std::string>& m_out;
+    std::string m_prefix;
+};
+
+}  // namespace
+
+TechTable parse_tech_table(const std::string& text, const std::string& file) {
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", e.msg);
+    }
+    TechTable table;
+    std::map<std::string, int> lines;
+    strict_yaml::YamlReader reader(root, file, "", lines);
+    table.visit(reader);
+    reader.finish();
+    std::vector<std::string> keys;
+    KeyLister lister(keys);
+    table.visit(lister);
+    for (const std::string& key : keys)
+        if (!lines.count(key)) {
+            // The line of the enclosing group, when it was written.
+            const auto dot = key.find('.');
+            const auto group =
+                dot == std::string::npos ? lines.end() : lines.find(key.substr(0, dot));
+            throw InputError(file, group == lines.end() ? 0 : group->second, key,
+                             "missing (every number of a technology table is required)");
+        }
+    if (table.name.empty()) throw InputError(file, lines["name"], "name", "must not be empty");
+    return table;
+}
+
+TechTable load_tech_table(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "", "cannot read technology table");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parse_tech_table(text.str(), path);
+}
+
+std::vector<std::string> builtin_tech_names() {
+    std::vector<std::string> names;
+    for (const BuiltinTech& t : k_builtin_tech) names.push_back(t.name);
+    return names;
+}
+
+TechTable resolve_tech_table(const std::string& name_or_path, const std::string& flag) {
+    for (const BuiltinTech& t : k_builtin_tech)
+        if (name_or_path == t.name)
+            return parse_tech_table(t.yaml, std::string(t.name) + ".tech.yaml");
+    std::ifstream probe(name_or_path);
+    if (!probe) {
+        std::string names;
+        for (const BuiltinTech& t : k_builtin_tech)
+            names += names.empty() ? t.name : std::string(", ") + t.name;
+        throw InputError("command line", 0, flag,
+                         "'" + name_or_path + "' is neither a built-in technology (" + names +
+                             ") nor a readable *.tech.yaml file");
+    }
+    return load_tech_table(name_or_path);
+}
+
+const TechTable& default_tech_table() {
+    static const TechTable table = resolve_tech_table("90nm");
+    return table;
+}
+
+}  // namespace sfx
