@@ -99,16 +99,12 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
 }
 
 uint64_t CoreModel::book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
-                              uint64_t issue, uint64_t& conflict_cycles) {
+                              uint64_t issue) {
     const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
     SlotServer* banks = &m_banks[size_t(buffer) * m_layout.banks()];
     uint64_t last = issue;
     for (uint32_t i = 0; i < lanes; ++i)
         last = std::max(last, banks[m_layout.bank_of(word, slots[i])].book(issue, occupancy));
-    // Without conflicts the busiest bank serves ceil(lanes / banks) requests back to back.
-    const uint64_t ideal =
-        issue + (uint64_t(lanes + m_layout.banks() - 1) / m_layout.banks() - 1) * occupancy;
-    if (last > ideal) conflict_cycles += last - ideal;
     return last;
 }
 
@@ -126,11 +122,9 @@ uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& wor
                 at = addresses;
             }
         }
-        uint64_t conflicts = 0;
-        last_grant = std::max(last_grant, book_word(buffer, words[w], slots, lanes, at, conflicts));
         // A conflict delays this word; later words queue behind it in the same banks, so only
-        // the growth of the last grant is charged, once.
-        (void)conflicts;
+        // the growth of the last grant is charged, once, below.
+        last_grant = std::max(last_grant, book_word(buffer, words[w], slots, lanes, at));
     }
     const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
     const uint64_t ideal =
@@ -206,7 +200,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     Executed e;
     e.start = std::max(now, t.data_ready);
     if (p.scene_bytes && op.object != k_no_object) e.start = std::max(e.start, m_scene_ready[t.op]);
-    charge_idle(unit, m_unit_free[unit], e.start, t, stage);
+    charge_idle(m_unit_free[unit], e.start, t, stage);
 
     const bool programmable = m_config.datapath.issue == "programmable";
     const uint64_t busy =
@@ -261,13 +255,12 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     return e;
 }
 
-void CoreModel::charge_idle(uint32_t unit, uint64_t from, uint64_t start, const GroupToken& t,
+void CoreModel::charge_idle(uint64_t from, uint64_t start, const GroupToken& t,
                             StageTiming& stage) {
     if (start <= from) return;
     const uint64_t idle = start - from;
     StallCycles& s = m_timing.stalls;
     stage.stall_cycles += idle;
-    (void)unit;
     // 1. The dispatcher held this op for the previous op's partition.
     const uint64_t part = overlap(from, start, t.partition_start, t.partition_end);
     s.partition += part;

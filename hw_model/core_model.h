@@ -25,7 +25,6 @@ struct GroupToken {
     uint32_t op = 0;     // index in the pass
     uint32_t first = 0;  // first position in the op's stream
     uint32_t lanes = 0;
-    bool last = false;  // the op's last group
     // The partition the dispatcher waited on before releasing this op (first group only).
     uint64_t partition_start = 0, partition_end = 0;
     uint64_t dispatched = 0;  // cycle the dispatcher released the group
@@ -77,13 +76,12 @@ class CoreModel {
     uint32_t width() const { return m_config.simd.width; }
     const OpProfile& profile(uint32_t op) const;
     const PassBuffer& pass() const { return *m_pass; }
-    uint64_t scene_ready(uint32_t op) const { return m_scene_ready[op]; }
 
   private:
     // Books one field word for each of `lanes` slots of `buffer` (0: current generation, 1:
-    // next), the requests issued at `issue`; returns the last grant and adds waiting cycles.
+    // next), the requests issued at `issue`; returns the last grant.
     uint64_t book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
-                       uint64_t issue, uint64_t& conflict_cycles);
+                       uint64_t issue);
     // Books `words` for the lanes, one word per cycle at the earliest; returns the cycle the
     // last word's data is out of its bank.
     // `ready_at[w]`, when given, is the first cycle word w's addresses can be used.
@@ -93,7 +91,7 @@ class CoreModel {
     // Books the interconnect for `words` words ready at `ready`; returns the cycle the last
     // has crossed, and adds the cycles spent waiting for it beyond an idle interconnect.
     uint64_t cross(uint64_t ready, uint64_t words, uint64_t& wait_cycles);
-    void charge_idle(uint32_t unit, uint64_t idle_from, uint64_t start, const GroupToken& token,
+    void charge_idle(uint64_t idle_from, uint64_t start, const GroupToken& token,
                      StageTiming& stage);
 
     HwConfig m_config;
@@ -103,7 +101,6 @@ class CoreModel {
     RayBufferModel m_layout;
     std::vector<SlotServer> m_banks;  // buffers * banks
     CapacityServer m_agu, m_interconnect, m_scratchpad;
-    double m_interconnect_cycles_per_core_cycle;
     uint64_t m_crossing_cycles;
     std::shared_ptr<SceneMemoryModel> m_scene_memory;
 

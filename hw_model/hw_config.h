@@ -137,7 +137,7 @@ struct InterconnectConfig {
     // G&R 3.3: the interconnect "sustains the bandwidth requirements of the address fetch and
     // execution units": one word from each of the 32 banks per cycle.
     uint32_t width_words = 32;
-    bool contention = true;
+    bool contention = true;  // G&R 3.3: "contention on the interconnects ... is modeled"
 
     template <class V>
     void visit(V& v) {
@@ -155,8 +155,8 @@ struct CacheLevelConfig {
     uint32_t kib = 32;
     uint32_t line_bytes = 64;
     uint32_t ways = 8;
-    double hit_latency_ns = 1.4;
-    bool shared = false;  // one instance for all cores (else one per core)
+    double hit_latency_ns = 1.4;  // Bikker's L1 (SceneMemoryConfig below says how)
+    bool shared = false;          // one instance for all cores (else one per core)
 
     template <class V>
     void visit(V& v) {
@@ -202,9 +202,9 @@ struct SceneMemoryConfig {
 // cycles. Instruction counts and chain depths come from the op table (hw_model/op_costs.cpp).
 struct DatapathConfig {
     std::string issue = "programmable";
-    uint32_t fp_latency_cycles = 2;  // assumed: a 90 nm single-precision adder or multiplier at
-                                     // 500 MHz (2 ns per cycle) in two pipeline stages
-    uint32_t initiation_interval = 1;
+    uint32_t fp_latency_cycles = 2;    // assumed: a 90 nm single-precision adder or multiplier at
+                                       // 500 MHz (2 ns per cycle) in two pipeline stages
+    uint32_t initiation_interval = 1;  // assumed (issue: pipelined only): a group per cycle
 
     template <class V>
     void visit(V& v) {

@@ -42,7 +42,6 @@ uint64_t SlotServer::book_slow(uint64_t ready, uint32_t occupancy) {
         cycle += free_run + 1;
     }
     for (uint32_t i = 0; i < occupancy; ++i) mark(cycle + i);
-    ++m_bookings;
     return cycle;
 }
 

@@ -27,13 +27,11 @@ class SlotServer {
             const uint64_t bit = uint64_t(1) << (offset % 64);
             if (!(word & bit)) {
                 word |= bit;
-                ++m_bookings;
                 return ready;
             }
         }
         return book_slow(ready, occupancy);
     }
-    uint64_t bookings() const { return m_bookings; }
 
   private:
     uint64_t book_slow(uint64_t ready, uint32_t occupancy);
@@ -45,7 +43,6 @@ class SlotServer {
     uint64_t m_base = 0;  // first cycle of the window, a multiple of 64
     uint32_t m_head = 0;  // ring index of the word holding m_base
     std::array<uint64_t, k_words> m_bits{};
-    uint64_t m_bookings = 0;
 };
 
 // A pool with a capacity per cycle (the address-generation units: addresses per cycle; the

@@ -25,7 +25,6 @@ class Accelerator : public sc_core::sc_module, public PassSource {
     FrameTiming timing() const;
     const HwConfig& config() const { return m_config; }
     uint32_t core_count() const { return uint32_t(m_cores.size()); }
-    const Core& core(uint32_t i) const { return *m_cores[i]; }
 
     std::shared_ptr<const PassBuffer> next_pass() override;
     void pass_done(const FrameTiming& timing) override;

@@ -115,7 +115,6 @@ void Core::dispatch() {
                 t.op = i;
                 t.first = first;
                 t.lanes = std::min(width, op.length - first);
-                t.last = first + width >= op.length;
                 if (waited && first == 0) {
                     t.partition_start = m_partition_start;
                     t.partition_end = m_partition_end;

@@ -72,6 +72,17 @@ std::vector<uint32_t> consecutive(uint32_t n, uint32_t stride = 1, uint32_t firs
     return v;
 }
 
+// A 32x32 x 2 spp frame in 16x16 tiles on two threads: small enough for every invariant test.
+RenderSettings small_frame(const Scene& scene) {
+    RenderSettings settings;
+    settings.width = settings.height = 32;
+    settings.spp = 2;
+    settings.tile = 16;
+    settings.max_depth = scene.max_depth;
+    settings.threads = 2;
+    return settings;
+}
+
 HwConfig with_width(uint32_t width, uint32_t units = 1) {
     HwConfig c;
     c.simd.width = width;
@@ -232,12 +243,7 @@ TEST_CASE("More units, more cores, deeper queues are never slower on the same tr
           "[hw_model][systemc]") {
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
-    RenderSettings settings;
-    settings.width = settings.height = 32;
-    settings.spp = 2;
-    settings.tile = 16;
-    settings.max_depth = scene.max_depth;
-    settings.threads = 2;
+    const RenderSettings settings = small_frame(scene);
     std::vector<HwConfig> configs;
     auto add = [&](uint32_t units, uint32_t cores, uint32_t depth) {
         HwConfig c;
@@ -266,12 +272,7 @@ TEST_CASE(
     "[hw_model][systemc]") {
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
-    RenderSettings settings;
-    settings.width = settings.height = 32;
-    settings.spp = 2;
-    settings.tile = 16;
-    settings.max_depth = scene.max_depth;
-    settings.threads = 2;
+    const RenderSettings settings = small_frame(scene);
     std::vector<HwConfig> configs;
     for (uint32_t banks : {4u, 8u, 16u, 32u, 64u}) {
         HwConfig c;
