@@ -60,7 +60,7 @@ void add_accuracy_command(CLI::App& app) {
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand(
         "accuracy", "one point at analytic, sampled (1, 2, 5, 10 %, adaptive to 2 %) and full fidelity");
-    c->add_option("hw", o->hw, "hardware configuration file (*.hw.yaml)")->required();
+    c->add_option("hw", o->hw, "hardware configuration file (*.hw.yaml) or preset name (gr08, ...)")->required();
     c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();
     c->add_flag("--json", o->json, "print a JSON list of rows");
     c->add_option("--plot", o->plot, "also draw error against host time into this PNG");

@@ -161,8 +161,8 @@ void add_compare_command(CLI::App& app) {
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand(
         "compare", "two hardware configurations side by side on one render, or two selections from a store");
-    c->add_option("a", o->a, "configuration A (*.hw.yaml)");
-    c->add_option("b", o->b, "configuration B (*.hw.yaml)");
+    c->add_option("a", o->a, "configuration A (*.hw.yaml or preset name)");
+    c->add_option("b", o->b, "configuration B (*.hw.yaml or preset name)");
     c->add_option("--scene", o->scene, "scene file or built-in scene name");
     c->add_option("--fidelity", o->fidelity, "analytic | sampled | full")
         ->check(CLI::IsMember({"analytic", "sampled", "full"}))

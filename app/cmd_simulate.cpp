@@ -109,7 +109,7 @@ void add_simulate_command(CLI::App& app) {
     };
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand("simulate", "predict frame rate and utilization of hardware configurations");
-    c->add_option("hw", o->hw, "hardware configuration files (*.hw.yaml); several share one render")
+    c->add_option("hw", o->hw, "hardware configuration files (*.hw.yaml) or preset names (gr08, ...); several share one render")
         ->required();
     c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();
     c->add_option("--fidelity", o->fidelity, "analytic | sampled | full")

@@ -5,7 +5,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -14,6 +16,10 @@
 #include "workloads/input_error.h"
 #include "workloads/user_files.h"
 #include "workloads/strict_number.h"
+
+#ifndef SFX_PRESET_DIR
+#define SFX_PRESET_DIR "hw_model/presets"
+#endif
 
 namespace sfx {
 namespace {
@@ -199,7 +205,41 @@ HwConfig parse_hw_config(const std::string& text, const std::string& file) {
     return config;
 }
 
+static std::filesystem::path preset_dir() {
+    if (const char* env = std::getenv("SFX_PRESET_DIR"); env && *env) return env;
+    return SFX_PRESET_DIR;
+}
+
+std::vector<std::string> builtin_preset_names() {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(preset_dir(), ec)) {
+        const std::string file = entry.path().filename().string();
+        const std::string suffix = ".hw.yaml";
+        if (file.size() > suffix.size() && file.compare(file.size() - suffix.size(), suffix.size(), suffix) == 0)
+            names.push_back(file.substr(0, file.size() - suffix.size()));
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 HwConfig load_hw_config(const std::string& path) {
+    // A plain name that is not a file is a shipped preset (hw_model/presets/NAME.hw.yaml), as
+    // scene names are shipped scenes.
+    std::error_code ec;
+    const bool plain_name = !path.empty() && path.find('/') == std::string::npos &&
+                            path.find(".yaml") == std::string::npos;
+    if (plain_name && !std::filesystem::exists(path, ec)) {
+        const std::filesystem::path preset = preset_dir() / (path + ".hw.yaml");
+        if (!std::filesystem::is_regular_file(preset, ec)) {
+            std::string list;
+            for (const std::string& n : builtin_preset_names()) list += (list.empty() ? "" : ", ") + n;
+            throw InputError(path, 0, "", "no such hardware configuration file or preset (presets: " +
+                                              list + ")");
+        }
+        return parse_hw_config(read_input_file(preset.string(), "hardware configuration"),
+                               preset.string());
+    }
     return parse_hw_config(read_input_file(path, "hardware configuration"), path);
 }
 

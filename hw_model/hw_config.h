@@ -252,7 +252,10 @@ struct HwConfig {
 // Strict parsing: unknown keys, wrong types and out-of-range values throw InputError naming
 // file, line and dotted key. Cross-parameter rules are checked too (banks divide the buffer,
 // cache sizes divide into sets, ...).
+// Reads a *.hw.yaml file, or a shipped preset by name ("gr08": hw_model/presets/gr08.hw.yaml;
+// SFX_PRESET_DIR overrides where presets are found).
 HwConfig load_hw_config(const std::string& path);
+std::vector<std::string> builtin_preset_names();
 HwConfig parse_hw_config(const std::string& yaml_text, const std::string& file_name);
 // Cross-parameter checks only (after programmatic changes, e.g. a sweep axis). `lines` maps
 // dotted keys to the lines they were read from, for the message.

@@ -33,6 +33,22 @@ uint64_t SlotServer::book_slow(uint64_t ready, uint32_t occupancy) {
     if (occupancy == 0) occupancy = 1;
     // Cycles before the window were forgotten when a later booking moved it: never book them.
     uint64_t cycle = ready > m_base ? ready : m_base;
+    if (occupancy == 1) {
+        // A pipelined bank: the first free cycle, found a 64-cycle word at a time (a conflict
+        // queues behind every booking in flight, so runs of booked cycles are common).
+        for (;;) {
+            slide_to(cycle);
+            const uint64_t offset = cycle - m_base;
+            uint64_t& word = m_bits[(m_head + offset / 64) % k_words];
+            const uint64_t free = ~word >> (offset % 64);
+            if (free) {
+                const uint32_t skip = uint32_t(__builtin_ctzll(free));
+                word |= uint64_t(1) << (offset % 64 + skip);
+                return cycle + skip;
+            }
+            cycle += 64 - offset % 64;
+        }
+    }
     for (;;) {
         slide_to(cycle + occupancy - 1);
         if (cycle < m_base) cycle = m_base;

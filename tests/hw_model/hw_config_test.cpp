@@ -1,8 +1,10 @@
 // The hardware configuration: strict parsing with file, line and key; one source of truth.
 
+#include "hw_model/hw_config.h"
+
+#include <algorithm>
 #include <catch2/catch.hpp>
 
-#include "hw_model/hw_config.h"
 #include "workloads/input_error.h"
 
 using namespace sfx;
@@ -28,6 +30,20 @@ TEST_CASE("The gr08 preset parses and is the in-class default", "[hw_config]") {
     CHECK(preset.simd.width == 16);
     CHECK(preset.scene_memory.caches.size() == 3);
     CHECK(preset.scene_memory.caches[2].ways == 16);
+}
+
+TEST_CASE("a preset is found by its name; an unknown name lists the presets", "[hw_config]") {
+    CHECK(dump_hw_config(load_hw_config("gr08-w8")) ==
+          dump_hw_config(load_hw_config(SFX_SOURCE_DIR "/hw_model/presets/gr08-w8.hw.yaml")));
+    CHECK(load_hw_config("gr08-w8").simd.width == 8);
+    const std::vector<std::string> names = builtin_preset_names();
+    CHECK(std::find(names.begin(), names.end(), "gr08-256k") != names.end());
+    try {
+        load_hw_config("gr09");
+        FAIL("no error for an unknown preset");
+    } catch (const InputError& e) {
+        CHECK_THAT(e.what(), Catch::Contains("gr09") && Catch::Contains("gr08-w12"));
+    }
 }
 
 TEST_CASE("dump then parse gives the same configuration", "[hw_config]") {
