@@ -244,6 +244,55 @@ SFX_LANES_INLINE vint<Width> gather_int(const int32_t* base, vint<Width> index) 
     }
 }
 
+// A gather whose indices all lie in one window [lo, lo + 2 * Width): lane l = base[lo +
+// offset[l]], read by two plain loads at base + lo and a permute across them instead of
+// Width separate loads. The stream's ids come in runs (stable partitions keep the order of
+// the passing ids), so the ray fields of a group are usually a few cache lines apart. Reads
+// base[lo, lo + 2 * Width): the caller pads the array. Same bits as gather().
+template <int Width>
+SFX_LANES_INLINE bool in_window(vint<Width> index, int32_t lo) {
+    if constexpr (Width == 1) {
+        return true;
+    } else {
+        const vint<Width> offset = index - broadcast_int<Width>(lo);
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return _mm512_cmpge_epu32_mask(__m512i(offset), _mm512_set1_epi32(2 * Width)) == 0;
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8)  // offset < 16 unsigned: no bit above the low four
+            return _mm256_testz_si256(__m256i(offset), _mm256_set1_epi32(~15)) != 0;
+#endif
+        for (int l = 0; l < Width; ++l)
+            if (uint32_t(offset[l]) >= 2u * Width) return false;
+        return true;
+    }
+}
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> gather_window(const float* base, int32_t lo, vint<Width> offset) {
+    if constexpr (Width == 1) {
+        return base[lo + offset];
+    } else {
+        const float* p = base + lo;
+#if defined(__AVX512F__)
+        if constexpr (Width == 16)
+            return vfloat<Width>(_mm512_permutex2var_ps(_mm512_loadu_ps(p), __m512i(offset),
+                                                        _mm512_loadu_ps(p + 16)));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) {  // each half permuted, bit 3 of the offset picks the half
+            const __m256 a = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), __m256i(offset));
+            const __m256 b = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p + 8), __m256i(offset));
+            return vfloat<Width>(_mm256_blendv_ps(
+                a, b, _mm256_castsi256_ps(_mm256_slli_epi32(__m256i(offset), 28))));
+        }
+#endif
+        vfloat<Width> v;
+        for (int l = 0; l < Width; ++l) v[l] = p[offset[l]];
+        return v;
+    }
+}
+
 #if defined(__AVX2__)
 // AVX2 has no compress: for each 8-bit mask, the indices of its set lanes in order, packed
 // 4 bits each (Width-8 compress by permutation).

@@ -7,31 +7,63 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <vector>
 
 #include "kernels/intersect.h"
 #include "kernels/simd/isa.h"
 
 namespace sfx {
 
-// What a box or triangle test gathers per lane, in one cache line: the test's constants and
-// its t_max (the closest hit so far, or the ray's t_max; -1 for an occluded shadow ray, which
-// every later box and primitive test then misses). Kernels gather its fields as 32-bit
-// elements at 16 * slot + field.
-struct alignas(64) TraversalRay {
-    RayPrecomp pre;
-    float t;
-};
-static_assert(sizeof(TraversalRay) == 64, "one cache line per ray");
-namespace traversal_field {  // 32-bit element offsets inside TraversalRay
-constexpr int org = int(offsetof(RayPrecomp, org) / 4);
-constexpr int inv_dir = int(offsetof(RayPrecomp, inv_dir) / 4);
-constexpr int kx = int(offsetof(RayPrecomp, kx) / 4);
-constexpr int ky = int(offsetof(RayPrecomp, ky) / 4);
-constexpr int kz = int(offsetof(RayPrecomp, kz) / 4);
-constexpr int sx = int(offsetof(RayPrecomp, sx) / 4);
-constexpr int sy = int(offsetof(RayPrecomp, sy) / 4);
-constexpr int t = int(offsetof(TraversalRay, t) / 4);
+// The ray fields the box and triangle filters read, one array per field (structure of
+// arrays): the test's constants and t (the closest hit so far, or the ray's t_max; -1 for an
+// occluded shadow ray, which every later box and primitive test then misses). A group of
+// Width slots reads each field by two plain loads and a permute when its ids lie in one
+// window of 2 * Width slots (stable partitions keep ids in runs), by a gather otherwise.
+namespace traversal_field {  // the field arrays, in order
+constexpr int org = 0, inv_dir = 3, t = 6, kx = 7, ky = 8, kz = 9, sx = 10, sy = 11, count = 12;
 }  // namespace traversal_field
+
+// Room past the last slot of each field array: a window read loads 2 * Width elements.
+constexpr uint32_t k_window_padding = 32;
+
+// What the kernels read: field f of slot i at data[f * stride + i]. A plain view, so the wide
+// translation units instantiate no out-of-line member of a library type.
+struct TraversalView {
+    const float* data;
+    uint32_t stride;
+};
+
+class TraversalRays {
+  public:
+    // Room for `slots` rays; every field zero.
+    void resize(uint32_t slots) {
+        m_stride = slots + k_window_padding;
+        m_data.assign(size_t(traversal_field::count) * m_stride, 0.f);
+    }
+    // Slot `slot` gets the test constants of `pre` and t.
+    void set(uint32_t slot, const RayPrecomp& pre, float t) {
+        namespace f = traversal_field;
+        for (int a = 0; a < 3; ++a) {
+            at(f::org + a, slot) = pre.org[a];
+            at(f::inv_dir + a, slot) = pre.inv_dir[a];
+        }
+        at(f::t, slot) = t;
+        const int32_t k[3] = {pre.kx, pre.ky, pre.kz};
+        for (int a = 0; a < 3; ++a) std::memcpy(&at(f::kx + a, slot), &k[a], sizeof(float));
+        at(f::sx, slot) = pre.sx;
+        at(f::sy, slot) = pre.sy;
+    }
+    float& t(uint32_t slot) { return at(traversal_field::t, slot); }
+    float t(uint32_t slot) const { return field(traversal_field::t)[slot]; }
+    const float* field(int f) const { return m_data.data() + size_t(f) * m_stride; }
+    TraversalView view() const { return {m_data.data(), m_stride}; }
+
+  private:
+    float& at(int f, uint32_t slot) { return m_data[size_t(f) * m_stride + slot]; }
+    std::vector<float> m_data;
+    uint32_t m_stride = 0;
+};
 
 // Room every id, position and scratch buffer needs past its length: a group's compress
 // writes whole vectors.
@@ -46,13 +78,13 @@ struct StreamKernels {
     // nothing past ids[n) is written).
     // Writes mask[i] (0/1, input order) when mask is not null. Adds to `negative` the passing
     // rays whose direction is negative on `axis` (the front-child vote). Returns the passing count.
-    uint32_t (*box_filter)(const TraversalRay* rays, const Bounds3& box, int axis,
-                           const uint32_t* ids, uint32_t n, uint32_t* pass_out, uint32_t* fail_out,
-                           uint8_t* mask, uint32_t& negative);
+    uint32_t (*box_filter)(TraversalView rays, const Bounds3& box, int axis, const uint32_t* ids,
+                           uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
+                           uint32_t& negative);
 
     // The float stage of the watertight test of ids[0, n) against one triangle: writes the
     // positions i (in order) that it does not reject to `positions`; returns their count.
-    uint32_t (*triangle_candidates)(const TraversalRay* rays, const Vec3& p0, const Vec3& p1,
+    uint32_t (*triangle_candidates)(TraversalView rays, const Vec3& p0, const Vec3& p1,
                                     const Vec3& p2, const uint32_t* ids, uint32_t n,
                                     uint32_t* positions);
 

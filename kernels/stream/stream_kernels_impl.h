@@ -45,28 +45,49 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
     return count;
 }
 
+// The ids of one group and how its fields are read: by window (two loads and a permute)
+// when every id lies in [ids[g], ids[g] + 2 * Width), else by gather. Same bits either way.
 template <int Width>
-SFX_LANES_INLINE vfloat<Width> gather_field(const float* base, vint<Width> at, int field) {
-    return gather<Width>(base, at + broadcast_int<Width>(field));
-}
+struct GroupReader {
+    const float* data;
+    uint32_t stride;
+    vint<Width> id;
+    int32_t lo;
+    vint<Width> offset;
+    bool window;
+
+    SFX_LANES_INLINE GroupReader(TraversalView rays, vint<Width> ids, int32_t first)
+        : data(rays.data), stride(rays.stride), id(ids), lo(first) {
+        window = in_window<Width>(id, lo);
+        offset = id - broadcast_int<Width>(lo);
+    }
+    SFX_LANES_INLINE vfloat<Width> read(int field) const {
+        const float* base = data + size_t(field) * stride;
+        return window ? gather_window<Width>(base, lo, offset) : gather<Width>(base, id);
+    }
+    SFX_LANES_INLINE vint<Width> read_int(int field) const {
+        const vfloat<Width> v = read(field);
+        vint<Width> r;
+        __builtin_memcpy(&r, &v, sizeof r);
+        return r;
+    }
+};
 
 template <int Width>
-uint32_t box_filter(const TraversalRay* rays, const Bounds3& box, int axis, const uint32_t* ids,
+uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint32_t* ids,
                     uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
                     uint32_t& negative) {
     namespace f = traversal_field;
-    const float* base = reinterpret_cast<const float*>(rays);
     uint32_t front = 0, back = 0, negatives = 0;
     for (uint32_t g = 0; g < n; g += Width) {
         const uint32_t active = active_bits<Width>(n - g);
-        const vint<Width> id = load_ids<Width>(ids + g, active);
-        const vint<Width> at = id * broadcast_int<Width>(16);
+        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
         vfloat<Width> org[3], inv_dir[3];
         for (int a = 0; a < 3; ++a) {
-            org[a] = gather_field<Width>(base, at, f::org + a);
-            inv_dir[a] = gather_field<Width>(base, at, f::inv_dir + a);
+            org[a] = r.read(f::org + a);
+            inv_dir[a] = r.read(f::inv_dir + a);
         }
-        const vfloat<Width> t_max = gather_field<Width>(base, at, f::t);
+        const vfloat<Width> t_max = r.read(f::t);
         vfloat<Width> t0;
         const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
         // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
@@ -77,32 +98,25 @@ uint32_t box_filter(const TraversalRay* rays, const Bounds3& box, int axis, cons
             bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
         if (mask) store_mask_bytes<Width>(pass, mask + g);
         const bool full = g + Width <= n;
-        front += compress_append<Width>(pass, id, pass_out + front, full);
-        back += compress_append<Width>(~pass & active, id, fail_out + back, full);
+        front += compress_append<Width>(pass, r.id, pass_out + front, full);
+        back += compress_append<Width>(~pass & active, r.id, fail_out + back, full);
     }
     negative += negatives;
     return front;
 }
 
 template <int Width>
-uint32_t triangle_candidates(const TraversalRay* rays, const Vec3& p0, const Vec3& p1,
-                             const Vec3& p2, const uint32_t* ids, uint32_t n, uint32_t* positions) {
+uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                             const uint32_t* ids, uint32_t n, uint32_t* positions) {
     namespace f = traversal_field;
-    const float* base = reinterpret_cast<const float*>(rays);
-    const int32_t* base_int = reinterpret_cast<const int32_t*>(rays);
     uint32_t k = 0;
     for (uint32_t g = 0; g < n; g += Width) {
         const uint32_t active = active_bits<Width>(n - g);
-        const vint<Width> at = load_ids<Width>(ids + g, active) * broadcast_int<Width>(16);
-        const vfloat<Width> org[3] = {gather_field<Width>(base, at, f::org),
-                                      gather_field<Width>(base, at, f::org + 1),
-                                      gather_field<Width>(base, at, f::org + 2)};
-        const vint<Width> kx = gather_int<Width>(base_int, at + broadcast_int<Width>(f::kx));
-        const vint<Width> ky = gather_int<Width>(base_int, at + broadcast_int<Width>(f::ky));
-        const vint<Width> kz = gather_int<Width>(base_int, at + broadcast_int<Width>(f::kz));
+        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
+        const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
         const ShearedTriangle<Width> s =
-            shear_triangle<Width>(org, kx, ky, kz, gather_field<Width>(base, at, f::sx),
-                                  gather_field<Width>(base, at, f::sy), p0, p1, p2);
+            shear_triangle<Width>(org, r.read_int(f::kx), r.read_int(f::ky), r.read_int(f::kz),
+                                  r.read(f::sx), r.read(f::sy), p0, p1, p2);
         const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
         k += compress_store<Width>(keep, lane_index<Width>() + broadcast_int<Width>(int32_t(g)),
                                    positions + k);  // positions has room past n

@@ -21,8 +21,9 @@ namespace {
 struct RayBuffers {
     uint32_t capacity = 0;
     std::vector<PathState> path;
-    std::vector<Ray> ray[2];  // current and next generation
-    std::vector<TraversalRay> trav;
+    std::vector<Ray> ray[2];      // current and next generation
+    TraversalRays trav;           // the filters' fields, t included
+    std::vector<RayPrecomp> pre;  // the full primitive tests' constants
     std::vector<Hit> hit;
     std::vector<uint8_t> any_hit;  // shadow ray: any hit in (0, t_max) occludes it
     std::vector<SurfaceHit> surf;
@@ -39,7 +40,8 @@ struct RayBuffers {
         ray[1].resize(n);
         Ray unit;
         unit.dir = {0.f, 0.f, 1.f};
-        trav.resize(n, TraversalRay{RayPrecomp(unit), 0.f});
+        trav.resize(n);
+        pre.resize(n, RayPrecomp(unit));
         hit.resize(n);
         any_hit.resize(n);
         surf.resize(n);
@@ -58,8 +60,8 @@ struct RayBuffers {
 // them (the prefix [0, len) keeps its set of ids, so the streams on the stack stay valid).
 template <class Trace>
 uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& node,
-                    uint32_t node_index, uint16_t generation, const TraversalRay* rays,
-                    uint32_t* ids, uint32_t len, RayBuffers& b, uint32_t& negative) {
+                    uint32_t node_index, uint16_t generation, TraversalView rays, uint32_t* ids,
+                    uint32_t len, RayBuffers& b, uint32_t& negative) {
     uint32_t* scratch = b.scratch.data();
     uint32_t passed;
     if constexpr (Trace::k_enabled) {  // the op lists the slots in input order
@@ -93,7 +95,8 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     uint32_t* ids = b.trav_ids.data();
     uint8_t* mask = b.mask.data();
     uint32_t* positions = b.positions.data();
-    TraversalRay* rays = b.trav.data();
+    TraversalRays& rays = b.trav;
+    const RayPrecomp* pre = b.pre.data();
     Hit* hit = b.hit.data();
     const uint8_t* any_hit = b.any_hit.data();
     auto& stack = b.stack;
@@ -110,8 +113,8 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
             __builtin_prefetch(&nodes[node.right()]);
         }
         uint32_t negative = 0;
-        const uint32_t k =
-            box_filter(kernels, trace, node, node_index, generation, rays, ids, len, b, negative);
+        const uint32_t k = box_filter(kernels, trace, node, node_index, generation, rays.view(),
+                                      ids, len, b, negative);
         if (k == 0) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
@@ -119,9 +122,9 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 // Closest hit: later tests need t or less. Any hit: the ray is done, and with
                 // t = -1 every later box and primitive test misses it.
                 auto test = [&](uint32_t id) {
-                    TraversalRay& r = rays[id];
-                    if (!bvh.intersect_primitive(r.pre, prim, r.t, hit[id])) return false;
-                    r.t = any_hit[id] ? -1.f : hit[id].t;
+                    float& t = rays.t(id);
+                    if (!bvh.intersect_primitive(pre[id], prim, t, hit[id])) return false;
+                    t = any_hit[id] ? -1.f : hit[id].t;
                     return true;
                 };
                 if (scene.is_sphere(prim)) {
@@ -133,8 +136,8 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 // rejects most lanes; the full test runs on the candidates it leaves.
                 const Triangle& tri = scene.triangles[prim];
                 const uint32_t candidates = kernels.triangle_candidates(
-                    rays, scene.positions[tri.v0], scene.positions[tri.v1], scene.positions[tri.v2],
-                    ids, k, positions);
+                    rays.view(), scene.positions[tri.v0], scene.positions[tri.v1],
+                    scene.positions[tri.v2], ids, k, positions);
                 if constexpr (Trace::k_enabled) std::fill(mask, mask + k, uint8_t(0));
                 uint32_t passed = 0;
                 for (uint32_t j = 0; j < candidates; ++j) {
@@ -163,8 +166,8 @@ uint32_t load_rays(RayBuffers& b, const Ray* rays, uint32_t n) {
         const Ray& r = rays[id];
         b.hit[id] = Hit{};
         if (!ray_is_valid(r)) continue;
-        b.trav[id].pre = RayPrecomp(r);
-        b.trav[id].t = r.t_max;
+        b.pre[id] = RayPrecomp(r);
+        b.trav.set(id, b.pre[id], r.t_max);
         b.trav_ids[m++] = id;
     }
     return m;

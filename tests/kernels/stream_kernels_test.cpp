@@ -2,7 +2,8 @@
 // code, lane by lane, and partitions exactly as a stable partition: the slab test on the hard
 // cases (origins on slab planes with zero directions (0 * inf), infinite inverse directions,
 // signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
-// stage, and the compress. Streams of odd lengths exercise partial groups.
+// stage, and the compress. Streams of odd lengths exercise partial groups; shuffled and
+// increasing ids exercise both ways of reading a group's fields (gather and window).
 
 #include "kernels/stream/stream_kernels.h"
 
@@ -38,6 +39,22 @@ std::vector<uint32_t> shuffled_ids(uint32_t n, uint32_t seed) {
     return ids;
 }
 
+// n distinct ids out of 2n slots, as the tracer's streams hold them: shuffled (the kernels
+// gather), in increasing runs with gaps (most groups lie in one window: loads and a
+// permute), or runs with a few neighbours swapped (a group's first id is not its least).
+std::vector<uint32_t> stream_ids(uint32_t n, uint32_t seed) {
+    std::vector<uint32_t> ids(n + k_stream_padding, k_sentinel);
+    std::vector<uint32_t> slots(2 * n);
+    std::iota(slots.begin(), slots.end(), 0u);
+    for (uint32_t i = 2 * n; i > 1; --i)
+        std::swap(slots[i - 1], slots[random_bits(seed, i, 0, 0, 2) % i]);
+    std::copy(slots.begin(), slots.begin() + n, ids.begin());
+    if (seed % 3 != 0) std::sort(ids.begin(), ids.begin() + n);
+    if (seed % 3 == 2)
+        for (uint32_t i = 1; i < n; i += 5) std::swap(ids[i - 1], ids[i]);
+    return ids;
+}
+
 }  // namespace
 
 TEST_CASE("Box filter of every back end equals intersect_box per lane, hard cases included",
@@ -60,11 +77,12 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             }
             if (i % 97 == 0) box = Bounds3{};  // empty: lo = inf, hi = -inf
             const uint32_t n = 1 + i % 41;
-            std::vector<TraversalRay> rays;
+            std::vector<RayPrecomp> pre;
+            std::vector<float> t_max;
             Ray unit;
             unit.dir = {0.f, 0.f, 1.f};
-            for (uint32_t l = 0; l < n; ++l) {
-                const uint32_t k = i * 64 + l;
+            for (uint32_t l = 0; l < 2 * n; ++l) {
+                const uint32_t k = i * 128 + l;
                 Ray ray;
                 for (int a = 0; a < 3; ++a) {
                     ray.org[a] = pick(k, 30 + a, coords);
@@ -72,27 +90,30 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
                 }
                 if (k % 2 == 0 && !box.empty()) ray.dir = box.center() - ray.org;  // aim at it
                 if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
-                rays.push_back(
-                    {RayPrecomp(ray), t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]});
+                pre.push_back(RayPrecomp(ray));
+                t_max.push_back(t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]);
             }
-            const int axis = int(i % 3);
-            const std::vector<uint32_t> ids = shuffled_ids(n, i);
+            TraversalRays rays;
+            rays.resize(2 * n);
+            for (uint32_t l = 0; l < 2 * n; ++l) rays.set(l, pre[l], t_max[l]);
+            const int axis = int(i % 5 % 3);
+            const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
             std::vector<uint8_t> mask(n + k_stream_padding, 7);
             uint32_t negative = 0;
             const uint32_t passed =
-                kernels.box_filter(rays.data(), box, axis, ids.data(), n, pass.data(), fail.data(),
+                kernels.box_filter(rays.view(), box, axis, ids.data(), n, pass.data(), fail.data(),
                                    mask.data(), negative);
             std::vector<uint32_t> want_pass, want_fail;
             uint32_t want_negative = 0;
             for (uint32_t l = 0; l < n; ++l) {
-                const TraversalRay& r = rays[ids[l]];
-                const bool expected = intersect_box(r.pre, box, r.t) != INFINITY;
+                const RayPrecomp& r = pre[ids[l]];
+                const bool expected = intersect_box(r, box, t_max[ids[l]]) != INFINITY;
                 ++lanes;
                 hits += expected;
                 mismatches += mask[l] != uint8_t(expected);
                 (expected ? want_pass : want_fail).push_back(ids[l]);
-                want_negative += expected && r.pre.dir[axis] < 0.f;
+                want_negative += expected && r.dir[axis] < 0.f;
             }
             order_errors += passed != want_pass.size() ||
                             !std::equal(want_pass.begin(), want_pass.end(), pass.begin()) ||
@@ -102,7 +123,7 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             std::vector<uint32_t> in_place = ids;
             uint32_t negative2 = 0;
             const uint32_t passed2 =
-                kernels.box_filter(rays.data(), box, axis, in_place.data(), n, in_place.data(),
+                kernels.box_filter(rays.view(), box, axis, in_place.data(), n, in_place.data(),
                                    fail.data(), nullptr, negative2);
             order_errors += !tail_intact(in_place, n);
             order_errors += passed2 != passed ||
@@ -131,9 +152,9 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
             for (int v = 0; v < 3; ++v)
                 for (int a = 0; a < 3; ++a) p[v][a] = pick(i, 10 + 3 * v + a, coords);
             const uint32_t n = 1 + i % 37;
-            std::vector<TraversalRay> rays;
-            for (uint32_t l = 0; l < n; ++l) {
-                const uint32_t k = i * 64 + l;
+            std::vector<RayPrecomp> pre;
+            for (uint32_t l = 0; l < 2 * n; ++l) {
+                const uint32_t k = i * 128 + l;
                 Ray ray;
                 for (int a = 0; a < 3; ++a) ray.org[a] = pick(k, 30 + a, coords) * 3.f;
                 // Aim at a point near the triangle (edges and vertices included).
@@ -142,19 +163,22 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
                 ray.dir = p[0] * (1.f - u - v) + p[1] * u + p[2] * v - ray.org;
                 if (k % 3 == 0) ray.dir = ray.dir + Vec3(0.f, 0.7f, 0.f);
                 if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
-                rays.push_back({RayPrecomp(ray), INFINITY});
+                pre.push_back(RayPrecomp(ray));
             }
-            const std::vector<uint32_t> ids = shuffled_ids(n, i);
+            TraversalRays rays;
+            rays.resize(2 * n);
+            for (uint32_t l = 0; l < 2 * n; ++l) rays.set(l, pre[l], INFINITY);
+            const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> got(n + k_stream_padding), want(n + k_stream_padding);
-            const uint32_t c = kernels.triangle_candidates(rays.data(), p[0], p[1], p[2],
+            const uint32_t c = kernels.triangle_candidates(rays.view(), p[0], p[1], p[2],
                                                            ids.data(), n, got.data());
-            const uint32_t c_scalar = scalar.triangle_candidates(rays.data(), p[0], p[1], p[2],
+            const uint32_t c_scalar = scalar.triangle_candidates(rays.view(), p[0], p[1], p[2],
                                                                  ids.data(), n, want.data());
             differ += c != c_scalar || !std::equal(got.begin(), got.begin() + c, want.begin());
             for (uint32_t l = 0; l < n; ++l) {
                 float t, u, v;
                 const bool hit =
-                    intersect_triangle(rays[ids[l]].pre, p[0], p[1], p[2], INFINITY, t, u, v);
+                    intersect_triangle(pre[ids[l]], p[0], p[1], p[2], INFINITY, t, u, v);
                 const bool kept = std::find(got.begin(), got.begin() + c, l) != got.begin() + c;
                 lost_hits += hit && !kept;
                 total_hits += hit;
