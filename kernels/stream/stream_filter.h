@@ -25,17 +25,23 @@ inline uint32_t evaluate(const uint32_t* ids, uint32_t n, uint8_t* mask, Test&& 
     return passed;
 }
 
-// Trace policies: NoTrace compiles every report away; SinkTrace forwards to a TraceSink.
+// Trace policies: NoTrace compiles every report away; SinkTrace forwards to a TraceSink
+// every op with its slots and pass flags; CountTrace forwards ops without them, for a sink
+// whose reads_lanes() is false (the counting sink), so the filters need no mask.
 struct NoTrace {
     static constexpr bool k_enabled = false;
+    static constexpr bool k_lanes = false;
     void op(OpKind, uint16_t, uint32_t, const uint32_t*, uint32_t, const uint8_t*, uint32_t) {}
 };
 
-struct SinkTrace {
+template <bool Lanes>
+struct SinkTraceOf {
     static constexpr bool k_enabled = true;
+    static constexpr bool k_lanes = Lanes;
     TraceSink* sink;
     void op(OpKind kind, uint16_t generation, uint32_t object, const uint32_t* ids, uint32_t n,
             const uint8_t* mask, uint32_t passed) {
+        if constexpr (!Lanes) ids = nullptr, mask = nullptr;
         StreamOp o;
         o.kind = kind;
         o.stage = stage_of(kind);
@@ -48,16 +54,19 @@ struct SinkTrace {
         sink->op(o);
     }
 };
+using SinkTrace = SinkTraceOf<true>;
+using CountTrace = SinkTraceOf<false>;
 
 // The filter of Fig. 5: evaluate, report the op (slots in input order), partition by the
-// back end's compress. Without a trace nothing needs the mask, so the test and the partition
-// run in one pass. ids, mask and scratch have k_stream_padding elements of room past n.
+// back end's compress. When the trace takes no lanes nothing needs the mask, so the test and
+// the partition run in one pass. ids, mask and scratch have k_stream_padding elements of room
+// past n.
 template <class Trace, class Test>
 inline uint32_t filter(const StreamKernels& kernels, Trace& trace, OpKind kind, uint16_t generation,
                        uint32_t object, uint32_t* ids, uint32_t n, uint8_t* mask, uint32_t* scratch,
                        Test&& test) {
     if (n == 0) return 0;
-    if constexpr (!Trace::k_enabled) {
+    if constexpr (!Trace::k_lanes) {
         uint32_t front = 0, back = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint32_t id = ids[i];
@@ -68,6 +77,7 @@ inline uint32_t filter(const StreamKernels& kernels, Trace& trace, OpKind kind, 
         }
         if (front != 0)
             for (uint32_t i = 0; i < back; ++i) ids[front + i] = scratch[i];
+        trace.op(kind, generation, object, ids, n, nullptr, front);
         return front;
     }
     const uint32_t passed = evaluate(ids, n, mask, test);

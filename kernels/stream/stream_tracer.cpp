@@ -64,7 +64,7 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
                     uint32_t len, RayBuffers& b, uint32_t& negative) {
     uint32_t* scratch = b.scratch.data();
     uint32_t passed;
-    if constexpr (Trace::k_enabled) {  // the op lists the slots in input order
+    if constexpr (Trace::k_lanes) {  // the op lists the slots in input order
         uint32_t* failing = b.scratch2.data();
         passed = kernels.box_filter(rays, node.bounds, node.axis, ids, len, scratch, failing,
                                     b.mask.data(), negative);
@@ -76,6 +76,7 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
                                     negative);
         // Always, even if none passed: the kernel's whole-vector stores wrote over ids.
         std::copy(scratch, scratch + (len - passed), ids + passed);
+        trace.op(OpKind::box_test, generation, node_index, ids, len, nullptr, passed);
     }
     return passed;
 }
@@ -138,13 +139,13 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 const uint32_t candidates = kernels.triangle_candidates(
                     rays.view(), scene.positions[tri.v0], scene.positions[tri.v1],
                     scene.positions[tri.v2], ids, k, positions);
-                if constexpr (Trace::k_enabled) std::fill(mask, mask + k, uint8_t(0));
+                if constexpr (Trace::k_lanes) std::fill(mask, mask + k, uint8_t(0));
                 uint32_t passed = 0;
                 for (uint32_t j = 0; j < candidates; ++j) {
                     const uint32_t at = positions[j];
                     if (!test(ids[at])) continue;
                     ++passed;
-                    if constexpr (Trace::k_enabled) mask[at] = 1;
+                    if constexpr (Trace::k_lanes) mask[at] = 1;
                 }
                 trace.op(OpKind::triangle_test, generation, prim, ids, k, mask, passed);
             }
@@ -376,8 +377,11 @@ StreamTracer::~StreamTracer() = default;
 void StreamTracer::trace_pass(const TileRect& rect, uint32_t tile_index, uint32_t sample,
                               Vec3* sums, RenderStats& stats, TraceSink* sink,
                               RayObserver* observer) {
-    if (sink) {
+    if (sink && sink->reads_lanes()) {
         SinkTrace trace{sink};
+        m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
+    } else if (sink) {
+        CountTrace trace{sink};
         m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
     } else {
         NoTrace trace;
@@ -494,8 +498,13 @@ void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<
         info.tile = uint32_t(begin / k_stream);
         info.slot_count = n;
         info.generations = 1;
-        if (sink) {
+        if (sink && sink->reads_lanes()) {
             SinkTrace trace{sink};
+            sink->begin_pass(info);
+            traverse(kernels, bvh, b, m, 0, trace);
+            sink->end_pass(info);
+        } else if (sink) {
+            CountTrace trace{sink};
             sink->begin_pass(info);
             traverse(kernels, bvh, b, m, 0, trace);
             sink->end_pass(info);

@@ -1,9 +1,9 @@
 // The workload trace: the counting sink's arithmetic, the Table 7 generalizations (tile 1 and
 // width 1 is recursive tracing; width = stream size is packet tracing), the trace file.
 
-#include <catch2/catch.hpp>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -39,8 +39,8 @@ Scene cluster_scene(bool light) {
         s.triangles.push_back({b, b + 1, b + 2, uint32_t(i % 2)});
     }
     const uint32_t b = uint32_t(s.positions.size());
-    s.positions.insert(s.positions.end(), {{-4, -1.5f, -4}, {4, -1.5f, -4}, {4, -1.5f, 4},
-                                           {-4, -1.5f, 4}});
+    s.positions.insert(s.positions.end(),
+                       {{-4, -1.5f, -4}, {4, -1.5f, -4}, {4, -1.5f, 4}, {-4, -1.5f, 4}});
     s.triangles.push_back({b, b + 1, b + 2, 0});
     s.triangles.push_back({b, b + 2, b + 3, 0});
     for (int i = 0; i < 10; ++i)
@@ -151,8 +151,7 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per stage",
-          "[stream]") {
+TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per stage", "[stream]") {
     CountingSink sink({1, 4, 16});
     std::vector<uint32_t> slots(40);
     std::vector<uint8_t> passed(40, 1);
@@ -180,8 +179,8 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     CHECK(t.ops == 3);
     CHECK(t.lanes == 38);
     CHECK(t.passed == 21);
-    CHECK(t.groups[1] == 2 + 4 + 5);   // width 4
-    CHECK(t.groups[2] == 1 + 1 + 2);   // width 16
+    CHECK(t.groups[1] == 2 + 4 + 5);  // width 4
+    CHECK(t.groups[2] == 1 + 1 + 2);  // width 16
     CHECK(t.utilization(0, 1) == 1.0);
     CHECK(t.utilization(1, 4) == Approx(38.0 / 44.0));
     CHECK(t.utilization(2, 16) == Approx(38.0 / 64.0));
@@ -222,8 +221,7 @@ TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[st
         }
 }
 
-TEST_CASE("Table 7: width equal to the stream size gives packet tracing's op counts",
-          "[stream]") {
+TEST_CASE("Table 7: width equal to the stream size gives packet tracing's op counts", "[stream]") {
     const Scene s = cluster_scene(false);
     const Bvh bvh(s);
     for (uint32_t tile : {4u, 16u}) {
@@ -268,7 +266,8 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
 
     // In the temporary directory, named by process, so parallel test runs never share a file.
     const std::string base = (std::filesystem::temp_directory_path() /
-                              ("sfx_stream_trace_" + std::to_string(::getpid()))).string();
+                              ("sfx_stream_trace_" + std::to_string(::getpid())))
+                                 .string();
     const std::string p1 = base + "_1.trc", p2 = base + "_2.trc";
     {
         TraceFileWriter w(p1);
@@ -298,7 +297,16 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
             CHECK(x.lanes == y.lanes);
             CHECK(x.passed == y.passed);
             CHECK(x.groups == y.groups);
+            CHECK(x.histogram == y.histogram);
         }
+    // The direct counts took the tracer's lane-free path (CountingSink::reads_lanes is false);
+    // the file was written with every slot and pass flag: the same ops either way.
+    CHECK_FALSE(direct.reads_lanes());
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        CHECK(replayed.kind_ops(OpKind(k)) == direct.kind_ops(OpKind(k)));
+        CHECK(replayed.kind_lanes(OpKind(k)) == direct.kind_lanes(OpKind(k)));
+    }
+    CHECK(replayed.rays() == direct.rays());
     std::remove(p1.c_str());
     std::remove(p2.c_str());
     // A truncated file is an error, not a silent partial trace.
