@@ -138,9 +138,10 @@ class TraceSink {
     virtual void op(const StreamOp&) = 0;
     virtual void end_pass(const TilePass&) {}
     virtual void end_frame() {}
-    // False if op() never reads an op's slots or pass flags: the stream tracer then leaves
-    // them null and runs its filters as without a trace (one pass, no mask).
-    virtual bool reads_lanes() const { return true; }
+    // True if the sink reads counts only: never an op's slots or pass flags, nor the frame
+    // header's scene hash. The stream tracer then leaves those null or zero, runs its filters
+    // as without a trace (one pass, no mask) and hashes no scene.
+    virtual bool counts_only() const { return false; }
 };
 
 // Counts lanes and ops: op counts, stream-length histograms and the ideal SIMD utilization
@@ -164,7 +165,7 @@ class CountingSink : public TraceSink {
     void begin_pass(const TilePass&) override;
     void op(const StreamOp& op) override;
     void end_pass(const TilePass&) override;
-    bool reads_lanes() const override { return false; }
+    bool counts_only() const override { return true; }
 
     const std::vector<uint32_t>& widths() const { return m_widths; }
     // [secondary][stage]: secondary = generation > 0.

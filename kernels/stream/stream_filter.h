@@ -27,7 +27,7 @@ inline uint32_t evaluate(const uint32_t* ids, uint32_t n, uint8_t* mask, Test&& 
 
 // Trace policies: NoTrace compiles every report away; SinkTrace forwards to a TraceSink
 // every op with its slots and pass flags; CountTrace forwards ops without them, for a sink
-// whose reads_lanes() is false (the counting sink), so the filters need no mask.
+// that reads counts only (TraceSink::counts_only, the counting sink), so the filters need no mask.
 struct NoTrace {
     static constexpr bool k_enabled = false;
     static constexpr bool k_lanes = false;

@@ -377,7 +377,7 @@ StreamTracer::~StreamTracer() = default;
 void StreamTracer::trace_pass(const TileRect& rect, uint32_t tile_index, uint32_t sample,
                               Vec3* sums, RenderStats& stats, TraceSink* sink,
                               RayObserver* observer) {
-    if (sink && sink->reads_lanes()) {
+    if (sink && !sink->counts_only()) {
         SinkTrace trace{sink};
         m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
     } else if (sink) {
@@ -400,7 +400,7 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
     threads = std::min<uint32_t>(threads, uint32_t(tiles.size()));
     if (sink) {
         TraceHeader header;
-        header.scene_hash = scene_hash(scene);
+        if (!sink->counts_only()) header.scene_hash = scene_hash(scene);
         header.width = settings.width;
         header.height = settings.height;
         header.spp = settings.spp;
@@ -498,7 +498,7 @@ void stream_intersect(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<
         info.tile = uint32_t(begin / k_stream);
         info.slot_count = n;
         info.generations = 1;
-        if (sink && sink->reads_lanes()) {
+        if (sink && !sink->counts_only()) {
             SinkTrace trace{sink};
             sink->begin_pass(info);
             traverse(kernels, bvh, b, m, 0, trace);
