@@ -244,11 +244,16 @@ SFX_LANES_INLINE vint<Width> gather_int(const int32_t* base, vint<Width> index) 
     }
 }
 
-// A gather whose indices all lie in one window [lo, lo + 2 * Width): lane l = base[lo +
-// offset[l]], read by two plain loads at base + lo and a permute across them instead of
+// A gather whose indices all lie in one window [lo, lo + window_slots<Width>()): lane l =
+// base[lo + offset[l]], read by plain loads at base + lo and permutes across them instead of
 // Width separate loads. The stream's ids come in runs (stable partitions keep the order of
 // the passing ids), so the ray fields of a group are usually a few cache lines apart. Reads
-// base[lo, lo + 2 * Width): the caller pads the array. Same bits as gather().
+// base[lo, lo + window_slots): the caller pads the array. Same bits as gather().
+// The window: four vectors at 16 lanes (two two-register permutes and a blend), two at 8.
+template <int Width>
+constexpr int32_t window_slots() {
+    return Width == 16 ? 4 * Width : 2 * Width;
+}
 template <int Width>
 SFX_LANES_INLINE bool in_window(vint<Width> index, int32_t lo) {
     if constexpr (Width == 1) {
@@ -257,14 +262,15 @@ SFX_LANES_INLINE bool in_window(vint<Width> index, int32_t lo) {
         const vint<Width> offset = index - broadcast_int<Width>(lo);
 #if defined(__AVX512F__)
         if constexpr (Width == 16)
-            return _mm512_cmpge_epu32_mask(__m512i(offset), _mm512_set1_epi32(2 * Width)) == 0;
+            return _mm512_cmpge_epu32_mask(__m512i(offset),
+                                           _mm512_set1_epi32(window_slots<Width>())) == 0;
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8)  // offset < 16 unsigned: no bit above the low four
             return _mm256_testz_si256(__m256i(offset), _mm256_set1_epi32(~15)) != 0;
 #endif
         for (int l = 0; l < Width; ++l)
-            if (uint32_t(offset[l]) >= 2u * Width) return false;
+            if (uint32_t(offset[l]) >= uint32_t(window_slots<Width>())) return false;
         return true;
     }
 }
@@ -275,9 +281,14 @@ SFX_LANES_INLINE vfloat<Width> gather_window(const float* base, int32_t lo, vint
     } else {
         const float* p = base + lo;
 #if defined(__AVX512F__)
-        if constexpr (Width == 16)
-            return vfloat<Width>(_mm512_permutex2var_ps(_mm512_loadu_ps(p), __m512i(offset),
-                                                        _mm512_loadu_ps(p + 16)));
+        if constexpr (Width == 16) {  // bits 0-4 pick within a pair of vectors, bit 5 the pair
+            const __m512i o = __m512i(offset);
+            const __m512 a = _mm512_permutex2var_ps(_mm512_loadu_ps(p), o, _mm512_loadu_ps(p + 16));
+            const __m512 b =
+                _mm512_permutex2var_ps(_mm512_loadu_ps(p + 32), o, _mm512_loadu_ps(p + 48));
+            return vfloat<Width>(
+                _mm512_mask_blend_ps(_mm512_test_epi32_mask(o, _mm512_set1_epi32(32)), a, b));
+        }
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) {  // each half permuted, bit 3 of the offset picks the half

@@ -18,14 +18,15 @@ namespace sfx {
 // The ray fields the box and triangle filters read, one array per field (structure of
 // arrays): the test's constants and t (the closest hit so far, or the ray's t_max; -1 for an
 // occluded shadow ray, which every later box and primitive test then misses). A group of
-// Width slots reads each field by two plain loads and a permute when its ids lie in one
-// window of 2 * Width slots (stable partitions keep ids in runs), by a gather otherwise.
+// Width slots reads each field by plain loads and permutes when its ids lie in one window of
+// slots (kernels/simd/lanes.h, window_slots: 64 at 16 lanes, 16 at 8; stable partitions keep
+// ids in runs), by a gather otherwise.
 namespace traversal_field {  // the field arrays, in order
 constexpr int org = 0, inv_dir = 3, t = 6, kx = 7, ky = 8, kz = 9, sx = 10, sy = 11, count = 12;
 }  // namespace traversal_field
 
-// Room past the last slot of each field array: a window read loads 2 * Width elements.
-constexpr uint32_t k_window_padding = 32;
+// Room past the last slot of each field array: a window read loads up to 64 elements.
+constexpr uint32_t k_window_padding = 64;
 
 // What the kernels read: field f of slot i at data[f * stride + i]. A plain view, so the wide
 // translation units instantiate no out-of-line member of a library type.

@@ -45,10 +45,11 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
     return count;
 }
 
-// The ids of one group and how its fields are read: by window (two loads and a permute)
-// when every id lies in [ids[g], ids[g] + 2 * Width), else by gather. Same bits either way.
+// The ids of one group and how its fields are read: by window (plain loads and permutes)
+// when every id lies in [ids[g], ids[g] + window_slots), else by gather. Same bits either way.
 template <int Width>
 struct GroupReader {
+    static_assert(window_slots<Width>() <= int32_t(k_window_padding), "field arrays' padding");
     const float* data;
     uint32_t stride;
     vint<Width> id;

@@ -39,14 +39,15 @@ std::vector<uint32_t> shuffled_ids(uint32_t n, uint32_t seed) {
     return ids;
 }
 
-// n distinct ids out of 2n slots, as the tracer's streams hold them: shuffled (the kernels
-// gather), in increasing runs with gaps (most groups lie in one window: loads and a
-// permute), or runs with a few neighbours swapped (a group's first id is not its least).
+// n distinct ids out of the first n, 2n, 3n or 4n slots (the test makes 4n rays), as the
+// tracer's streams hold them: shuffled (the kernels gather), increasing with gaps (a group
+// lies in one window or not: loads and permutes, or a gather), or increasing with a few
+// neighbours swapped (a group's first id is not its least).
 std::vector<uint32_t> stream_ids(uint32_t n, uint32_t seed) {
     std::vector<uint32_t> ids(n + k_stream_padding, k_sentinel);
-    std::vector<uint32_t> slots(2 * n);
+    std::vector<uint32_t> slots((1 + seed / 3 % 4) * n);
     std::iota(slots.begin(), slots.end(), 0u);
-    for (uint32_t i = 2 * n; i > 1; --i)
+    for (uint32_t i = uint32_t(slots.size()); i > 1; --i)
         std::swap(slots[i - 1], slots[random_bits(seed, i, 0, 0, 2) % i]);
     std::copy(slots.begin(), slots.begin() + n, ids.begin());
     if (seed % 3 != 0) std::sort(ids.begin(), ids.begin() + n);
@@ -81,8 +82,8 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             std::vector<float> t_max;
             Ray unit;
             unit.dir = {0.f, 0.f, 1.f};
-            for (uint32_t l = 0; l < 2 * n; ++l) {
-                const uint32_t k = i * 128 + l;
+            for (uint32_t l = 0; l < 4 * n; ++l) {
+                const uint32_t k = i * 256 + l;
                 Ray ray;
                 for (int a = 0; a < 3; ++a) {
                     ray.org[a] = pick(k, 30 + a, coords);
@@ -94,8 +95,8 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
                 t_max.push_back(t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]);
             }
             TraversalRays rays;
-            rays.resize(2 * n);
-            for (uint32_t l = 0; l < 2 * n; ++l) rays.set(l, pre[l], t_max[l]);
+            rays.resize(4 * n);
+            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], t_max[l]);
             const int axis = int(i % 5 % 3);
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
@@ -153,8 +154,8 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
                 for (int a = 0; a < 3; ++a) p[v][a] = pick(i, 10 + 3 * v + a, coords);
             const uint32_t n = 1 + i % 37;
             std::vector<RayPrecomp> pre;
-            for (uint32_t l = 0; l < 2 * n; ++l) {
-                const uint32_t k = i * 128 + l;
+            for (uint32_t l = 0; l < 4 * n; ++l) {
+                const uint32_t k = i * 256 + l;
                 Ray ray;
                 for (int a = 0; a < 3; ++a) ray.org[a] = pick(k, 30 + a, coords) * 3.f;
                 // Aim at a point near the triangle (edges and vertices included).
@@ -166,8 +167,8 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
                 pre.push_back(RayPrecomp(ray));
             }
             TraversalRays rays;
-            rays.resize(2 * n);
-            for (uint32_t l = 0; l < 2 * n; ++l) rays.set(l, pre[l], INFINITY);
+            rays.resize(4 * n);
+            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], INFINITY);
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> got(n + k_stream_padding), want(n + k_stream_padding);
             const uint32_t c = kernels.triangle_candidates(rays.view(), p[0], p[1], p[2],
