@@ -171,9 +171,9 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples) {
     std::vector<double> e;
     for (const OpCostSample& s : samples)
-        e.push_back(std::abs(host_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) /
-                                 std::max(s.cycles, k_resolution) -
-                             1.0));
+        e.push_back(
+            std::abs(host_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) - s.cycles) /
+            std::max(s.cycles, k_resolution));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};

@@ -73,7 +73,8 @@ struct OpCostSample {
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
                          const std::vector<OpCostSample>& samples);
 
-// The fit's relative error on its own samples: (median, worst) of |predicted / measured - 1|.
+// The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
+// measured, a measurement under 100 cycles counting as 100 (the clock's steps).
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples);
 

@@ -1,6 +1,7 @@
 #include "sweeps/host_calibration.h"
 
 #include <sched.h>
+#include <time.h>
 
 #include <algorithm>
 #include <map>
@@ -81,23 +82,47 @@ SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, Rende
         m.predicted_frame = r.frame_cycles();
     }
     // The measurement: unclocked and stage-clocked renders alternate, so drift in the machine's
-    // load touches both alike.
+    // load touches both alike. The TSC counts while the thread is descheduled too, so a render
+    // whose TSC ticks exceed its process CPU time (at the TSC rate) by more than 3 % was
+    // interrupted by a neighbour: it is dropped and run again (at most 4 x repeats renders).
     std::array<std::vector<double>, 3> stages;
     std::vector<double> clocked_totals;
-    render_stream(scene, bvh, settings);  // warm: caches, page faults, the tracer's buffers
-    for (uint32_t i = 0; i < repeats; ++i) {
-        settings.stage_clock = false;
+    const double mhz = host.clock.core_mhz;
+    auto timed = [&](bool clock, RenderResult& result) {
+        settings.stage_clock = clock;
+        timespec c0, c1;
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
         const uint64_t start = read_tsc();
-        render_stream(scene, bvh, settings);
-        m.frame_samples.push_back(double(read_tsc() - start));
-        settings.stage_clock = true;
-        const RenderResult r = render_stream(scene, bvh, settings);
-        double total = 0.0;
-        for (int s = 0; s < 3; ++s) {
-            stages[size_t(s)].push_back(double(r.stats.stage_tsc[s]));
-            total += double(r.stats.stage_tsc[s]);
+        result = render_stream(scene, bvh, settings);
+        const double ticks = double(read_tsc() - start);
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+        const double cpu_us = (c1.tv_sec - c0.tv_sec) * 1e6 + (c1.tv_nsec - c0.tv_nsec) * 1e-3;
+        const bool clean = ticks <= 1.03 * cpu_us * mhz + 2000.0;
+        return std::make_pair(ticks, clean);
+    };
+    RenderResult r;
+    timed(false, r);  // warm: caches, page faults, the tracer's buffers
+    for (uint32_t attempt = 0; attempt < 4 * repeats; ++attempt) {
+        const bool need_frame = m.frame_samples.size() < repeats;
+        const bool need_stages = clocked_totals.size() < repeats;
+        if (!need_frame && !need_stages) break;
+        const bool last_chance = attempt + 2 >= 4 * repeats;
+        if (need_frame) {
+            const auto [ticks, clean] = timed(false, r);
+            if (clean || last_chance) m.frame_samples.push_back(ticks);
+            m.dropped += !clean;
         }
-        clocked_totals.push_back(total);
+        if (need_stages) {
+            const auto [ticks, clean] = timed(true, r);
+            m.dropped += !clean;
+            if (!clean && !last_chance) continue;
+            double total = 0.0;
+            for (int s = 0; s < 3; ++s) {
+                stages[size_t(s)].push_back(double(r.stats.stage_tsc[s]));
+                total += double(r.stats.stage_tsc[s]);
+            }
+            clocked_totals.push_back(total);
+        }
     }
     m.measured_frame = median(m.frame_samples);
     for (int s = 0; s < 3; ++s) m.measured_stage[size_t(s)] = median(stages[size_t(s)]);

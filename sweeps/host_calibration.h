@@ -45,11 +45,13 @@ struct SiliconMeasurement {
     double measured_frame = 0.0;             // median of the unclocked renders
     std::vector<double> frame_samples;       // every unclocked render (TSC ticks)
     double stage_clock_overhead = 0.0;       // clocked total / unclocked median - 1
+    uint32_t dropped = 0;  // renders run again: descheduled (TSC ticks beyond the CPU time)
 };
 
 // One workload: `settings` are forced to one thread and `isa`. The host config must carry
 // op_costs for every kind the scene uses. Renders once with the trace on (the prediction),
-// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock.
+// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock,
+// each undisturbed (see `dropped`).
 SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
                                        const HwConfig& host, uint32_t repeats);
 
