@@ -212,7 +212,8 @@ void add_calibrate_command(CLI::App& app) {
                     row["measured.frame_cycles"] = m.measured_frame;
                     row["measured.frame_samples"] = m.frame_samples;
                     row["stage_clock_overhead"] = m.stage_clock_overhead;
-                    row["measured.dropped_renders"] = m.dropped;
+                    row["measured.interrupted_renders"] = m.interrupted;
+                    row["measured.frame_tsc"] = m.measured_frame_tsc;
                     for (int st = 0; st < 3; ++st) {
                         row[std::string("predicted.") + k_stage_names[st] + "_cycles"] =
                             m.predicted_stage[size_t(st)];

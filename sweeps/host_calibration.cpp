@@ -82,11 +82,16 @@ SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, Rende
         m.predicted_frame = r.frame_cycles();
     }
     // The measurement: unclocked and stage-clocked renders alternate, so drift in the machine's
-    // load touches both alike. The TSC counts while the thread is descheduled too, so a render
-    // whose TSC ticks exceed its process CPU time (at the TSC rate) by more than 3 % was
-    // interrupted by a neighbour: it is dropped and run again (at most 4 x repeats renders).
-    std::array<std::vector<double>, 3> stages;
-    std::vector<double> clocked_totals;
+    // load touches both alike. The TSC counts while the thread is descheduled too, and on a
+    // shared machine that is often most of a render's wall time; so a render's cycles are its
+    // process CPU time at the TSC rate (what the TSC would count were the core ours alone), and
+    // a render whose TSC ticks exceed that by more than 3 % is counted as interrupted.
+    // Stages: the TSC split of the least interrupted stage-clocked render (ticks closest to its
+    // CPU time: a neighbour's time lands in whichever stage it interrupts), as fractions of the
+    // frame's cycles.
+    std::array<double, 3> fractions{};
+    double least_interrupted = 1e300;
+    std::vector<double> clocked_totals, tsc_samples;
     const double mhz = host.clock.core_mhz;
     auto timed = [&](bool clock, RenderResult& result) {
         settings.stage_clock = clock;
@@ -97,35 +102,28 @@ SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, Rende
         const double ticks = double(read_tsc() - start);
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
         const double cpu_us = (c1.tv_sec - c0.tv_sec) * 1e6 + (c1.tv_nsec - c0.tv_nsec) * 1e-3;
-        const bool clean = ticks <= 1.03 * cpu_us * mhz + 2000.0;
-        return std::make_pair(ticks, clean);
+        if (ticks > 1.03 * cpu_us * mhz + 2000.0) ++m.interrupted;
+        return std::make_pair(cpu_us * mhz, ticks);
     };
     RenderResult r;
     timed(false, r);  // warm: caches, page faults, the tracer's buffers
-    for (uint32_t attempt = 0; attempt < 4 * repeats; ++attempt) {
-        const bool need_frame = m.frame_samples.size() < repeats;
-        const bool need_stages = clocked_totals.size() < repeats;
-        if (!need_frame && !need_stages) break;
-        const bool last_chance = attempt + 2 >= 4 * repeats;
-        if (need_frame) {
-            const auto [ticks, clean] = timed(false, r);
-            if (clean || last_chance) m.frame_samples.push_back(ticks);
-            m.dropped += !clean;
+    for (uint32_t i = 0; i < repeats; ++i) {
+        const auto [cycles, ticks] = timed(false, r);
+        m.frame_samples.push_back(cycles);
+        tsc_samples.push_back(ticks);
+        const auto [clocked, clocked_ticks] = timed(true, r);
+        double total = 0.0;
+        for (int s = 0; s < 3; ++s) total += double(r.stats.stage_tsc[s]);
+        if (total > 0 && clocked_ticks / clocked < least_interrupted) {
+            least_interrupted = clocked_ticks / clocked;
+            for (int s = 0; s < 3; ++s) fractions[size_t(s)] = double(r.stats.stage_tsc[s]) / total;
         }
-        if (need_stages) {
-            const auto [ticks, clean] = timed(true, r);
-            m.dropped += !clean;
-            if (!clean && !last_chance) continue;
-            double total = 0.0;
-            for (int s = 0; s < 3; ++s) {
-                stages[size_t(s)].push_back(double(r.stats.stage_tsc[s]));
-                total += double(r.stats.stage_tsc[s]);
-            }
-            clocked_totals.push_back(total);
-        }
+        clocked_totals.push_back(clocked);
     }
     m.measured_frame = median(m.frame_samples);
-    for (int s = 0; s < 3; ++s) m.measured_stage[size_t(s)] = median(stages[size_t(s)]);
+    m.measured_frame_tsc = median(tsc_samples);
+    for (int s = 0; s < 3; ++s)
+        m.measured_stage[size_t(s)] = fractions[size_t(s)] * m.measured_frame;
     m.stage_clock_overhead = median(clocked_totals) / m.measured_frame - 1.0;
     return m;
 }

@@ -41,17 +41,19 @@ struct SiliconMeasurement {
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses
     double predicted_frame = 0.0;
-    std::array<double, 3> measured_stage{};  // medians of the stage-clocked renders
-    double measured_frame = 0.0;             // median of the unclocked renders
-    std::vector<double> frame_samples;       // every unclocked render (TSC ticks)
-    double stage_clock_overhead = 0.0;       // clocked total / unclocked median - 1
-    uint32_t dropped = 0;  // renders run again: descheduled (TSC ticks beyond the CPU time)
+    // Cycles: process CPU time at the TSC rate (the TSC alone counts the neighbours' time on
+    // a shared machine); the median of the unclocked renders.
+    double measured_frame = 0.0;
+    double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
+    std::vector<double> frame_samples;       // every unclocked render's cycles
+    std::array<double, 3> measured_stage{};  // least interrupted split x measured_frame
+    double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
+    uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
 };
 
 // One workload: `settings` are forced to one thread and `isa`. The host config must carry
 // op_costs for every kind the scene uses. Renders once with the trace on (the prediction),
-// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock,
-// each undisturbed (see `dropped`).
+// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock.
 SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
                                        const HwConfig& host, uint32_t repeats);
 
