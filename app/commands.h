@@ -58,6 +58,7 @@ void add_accuracy_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);  // also the hidden run-group
 void add_compare_command(CLI::App& app);
 void add_report_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);  // --describe-host, --check
 
 // After every command is added: each number flag must be plain decimal text in its type's
 // range (no sign wrapping, clamping, octal, hex, NaN or infinity).

@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
     sfx::add_sweep_command(app);
     sfx::add_compare_command(app);
     sfx::add_report_command(app);
+    sfx::add_calibrate_command(app);
     sfx::strict_number_flags(app);
     if (argc > 1 && unknown_command(app, argv[1])) return 2;
     try {

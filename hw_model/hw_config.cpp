@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "kernels/trace.h"
 #include "workloads/input_error.h"
 #include "workloads/user_files.h"
 #include "workloads/strict_number.h"
@@ -191,6 +192,15 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
                                     std::to_string(l.ways) + " lines");
         if (l.name.empty() || !names.insert(l.name).second)
             fail(key + ".name", "cache level names must be unique and non-empty");
+    }
+    std::set<std::string> ops;
+    for (size_t i = 0; i < c.op_costs.size(); ++i) {
+        const std::string& op = c.op_costs[i].op;
+        const std::string key = "op_costs[" + std::to_string(i) + "].op";
+        bool known = false;
+        for (const OpKindInfo& info : k_op_kinds) known |= op == info.name;
+        if (!known) fail(key, "'" + op + "' is not an op kind (kernels/trace.h)");
+        if (!ops.insert(op).second) fail(key, "'" + op + "' has two cost entries");
     }
 }
 

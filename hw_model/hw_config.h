@@ -67,6 +67,9 @@ struct RayBufferConfig {
     uint32_t access_latency_cycles = 2;  // G&R 3.3: "Data access requires two cycles,
     bool pipelined = true;               //  but the operations are pipelined"
     std::string layout = "soa";          // G&R Fig. 5: one array per field (org_x, org_y, ...)
+    // G&R 3.3: dedicated banked SRAM. "l1d": a CPU core's ray buffers live in its L1 data
+    // cache (no banks); only the host timing (hw_model/host_timing.h) reads such a machine.
+    std::string storage = "banks";
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
@@ -83,6 +86,9 @@ struct RayBufferConfig {
         v.choice("layout", layout, {"soa", "aos"},
                  "ray records: soa puts a field of consecutive slots in consecutive banks; aos "
                  "puts slot * record words + field word in bank (that word mod banks)");
+        v.choice("storage", storage, {"banks", "l1d"},
+                 "banks: dedicated banked buffers (the machine model); l1d: the buffers live in a "
+                 "CPU core's L1 data cache (kib = its size; timed by the host timing only)");
     }
 };
 
@@ -120,13 +126,16 @@ struct ScratchpadConfig {
 };
 
 struct PartitionConfig {
-    std::string kind = "in_place_compare";  // G&R 3.3: "SIMD comparator units", in place
+    // G&R 3.3: "SIMD comparator units", in place. "compress": a CPU's compress instruction
+    // (vpcompressd) writes the passing ids, then the failing ones (kernels/stream).
+    std::string kind = "in_place_compare";
     uint32_t comparators_per_lane = 1;      // G&R 3.3: SIMD comparators, i.e. one per lane
 
     template <class V>
     void visit(V& v) {
-        v.choice("kind", kind, {"in_place_compare"},
-                 "partition algorithm (SIMD comparators, in place)");
+        v.choice("kind", kind, {"in_place_compare", "compress"},
+                 "partition algorithm (in_place_compare: SIMD comparators, in place; compress: a "
+                 "CPU's compress instruction, timed by the host timing only)");
         v.param("comparators_per_lane", comparators_per_lane, "comparators/lane",
                 "mask lanes compared per cycle, per SIMD lane", 1u, 64u);
     }
@@ -218,6 +227,38 @@ struct DatapathConfig {
     }
 };
 
+// A CPU core's measured cost of one kind of stream operation (hw_model/host_timing.h), fitted
+// by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
+// streams, never on frames. An op of n lanes in g = ceil(n / simd.width) groups, p passing,
+// whose ray buffer is a fraction f beyond the L1D costs
+//   per_op + per_group * g + per_lane * n + per_pass * p + beyond_l1_per_lane * f * n cycles.
+// Empty (every preset): the machine model prices ops from instruction counts instead.
+struct OpCostConfig {
+    std::string op = "box_test";  // an op kind name (kernels/trace.h)
+    double per_op_cycles = 0.0;
+    double per_group_cycles = 0.0;
+    double per_lane_cycles = 0.0;
+    double per_pass_cycles = 0.0;
+    double beyond_l1_per_lane_cycles = 0.0;
+
+    template <class V>
+    void visit(V& v) {
+        v.param("op", op, "", "op kind (kernels/trace.h k_op_kinds)");
+        v.param("per_op_cycles", per_op_cycles, "cycles", "fixed cost of one op (call, setup)",
+                0.0, 1e9);
+        v.param("per_group_cycles", per_group_cycles, "cycles",
+                "cost per group of simd.width lanes (vector gathers, test, compress)", 0.0, 1e9);
+        v.param("per_lane_cycles", per_lane_cycles, "cycles",
+                "cost per lane (per-ray scalar work)", 0.0, 1e9);
+        v.param("per_pass_cycles", per_pass_cycles, "cycles",
+                "cost per passing lane (work only passing rays do)", 0.0, 1e9);
+        v.param("beyond_l1_per_lane_cycles", beyond_l1_per_lane_cycles, "cycles",
+                "extra cost per lane when the ray buffer is wholly beyond the L1D (scaled by "
+                "the fraction beyond)",
+                0.0, 1e9);
+    }
+};
+
 struct HwConfig {
     uint32_t version = 1;
     std::string name = "gr08";
@@ -231,6 +272,7 @@ struct HwConfig {
     InterconnectConfig interconnect;
     SceneMemoryConfig scene_memory;
     DatapathConfig datapath;
+    std::vector<OpCostConfig> op_costs;  // measured per-op costs of a CPU core (host only)
 
     template <class V>
     void visit(V& v) {
@@ -246,6 +288,9 @@ struct HwConfig {
         v.group("interconnect", interconnect);
         v.group("scene_memory", scene_memory);
         v.group("datapath", datapath);
+        v.list("op_costs", op_costs,
+               "measured per-op costs of a CPU core (sfx calibrate --describe-host); empty: "
+               "priced from instruction counts");
     }
 };
 

@@ -27,6 +27,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     extension_rays += o.extension_rays;
     shadow_rays += o.shadow_rays;
     nonfinite_paths += o.nonfinite_paths;
+    for (int i = 0; i < 3; ++i) stage_tsc[i] += o.stage_tsc[i];
     return *this;
 }
 

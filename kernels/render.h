@@ -20,6 +20,9 @@ struct RenderSettings {
     uint32_t threads = 0;    // 0: all hardware threads
     uint64_t seed = 0;
     Isa isa = Isa::automatic;  // the stream filters' host back end; never changes a bit
+    // The stream tracer reads the time-stamp counter at stage boundaries (RenderStats::
+    // stage_tsc); off by default (it costs a few cycles per leaf visited); never changes a bit.
+    bool stage_clock = false;
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
@@ -45,6 +48,10 @@ struct RenderStats {
     uint64_t shadow_rays = 0;
     uint64_t nonfinite_paths = 0;  // paths whose radiance was NaN/Inf: zeroed, counted
     double host_seconds = 0.0;
+    // With RenderSettings::stage_clock (stream tracer): TSC ticks per stage, [traversal,
+    // intersection, shading] as kernels/trace.h's OpStage; shading is the rest of each pass
+    // (camera, ray set-up, the shading filter stack).
+    uint64_t stage_tsc[3] = {0, 0, 0};
 
     uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
     RenderStats& operator+=(const RenderStats& o);

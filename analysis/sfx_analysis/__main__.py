@@ -74,6 +74,28 @@ def _paper(args) -> int:
     return 0
 
 
+def _silicon(args) -> int:
+    from . import silicon
+    try:
+        df = silicon.load_rows(args.rows)
+    except (OSError, ValueError, KeyError) as e:
+        raise StoreError(f"{args.rows}: cannot read the silicon-check rows ({e})") from None
+    with open(args.header) as f:
+        header = f.read()
+    plot = os.path.join(os.path.dirname(os.path.abspath(args.output)), args.plot)
+    silicon.scatter_plot(df, plot)
+    s = silicon.write_page(df, args.output, args.plot, header)
+    print(silicon.table_text(df))
+    print()
+    print(silicon.stage_table_text(df))
+    print()
+    print(silicon.ranking_text(df))
+    print()
+    print(silicon.summary_text(s))
+    print(f"silicon check: {os.path.abspath(args.output)}, {plot}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="sfx_analysis",
                                      description="tables, plots and a report from a results store")
@@ -91,6 +113,12 @@ def main(argv=None) -> int:
     pp.add_argument("--command", default="", help="the command named on the page as its source")
     pp.add_argument("--quiet", action="store_true", help="print only where the page is")
     pp.set_defaults(run=_paper)
+    si = sub.add_parser("silicon", help="the silicon check page (docs/silicon-check.md)")
+    si.add_argument("rows", help="`sfx calibrate --check --json` output")
+    si.add_argument("-o", "--output", required=True, help="page to write (Markdown)")
+    si.add_argument("--plot", default="silicon-check.png", help="plot file name, beside the page")
+    si.add_argument("--header", required=True, help="Markdown put under the page's title")
+    si.set_defaults(run=_silicon)
     t = sub.add_parser("tables", help="the paper's Tables 2-6 in Markdown on stdout")
     t.add_argument("db")
     t.set_defaults(run=_tables)

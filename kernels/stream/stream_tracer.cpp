@@ -6,6 +6,8 @@
 #include <mutex>
 #include <thread>
 
+#include <x86intrin.h>
+
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/stream_filter.h"
@@ -88,7 +90,7 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
 // axis: independent of the order of the stream, and for one ray the reference's choice.
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
-              uint16_t generation, Trace& trace) {
+              uint16_t generation, Trace& trace, uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
     const std::vector<BvhNode>& nodes = bvh.nodes();
     const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
@@ -118,6 +120,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                                       ids, len, b, negative);
         if (k == 0) continue;
         if (node.is_leaf()) {
+            const uint64_t leaf_start = leaf_tsc ? __rdtsc() : 0;
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const uint32_t prim = prim_ids[i];
                 // Closest hit: later tests need t or less. Any hit: the ray is done, and with
@@ -149,6 +152,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 }
                 trace.op(OpKind::triangle_test, generation, prim, ids, k, mask, passed);
             }
+            if (leaf_tsc) *leaf_tsc += __rdtsc() - leaf_start;
         } else {
             const bool right_first = 2 * negative > k;
             const uint32_t left = BvhNode::left(node_index), right = node.right();
@@ -223,6 +227,9 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     const Hit* hit = b.hit.data();
     const uint8_t* any_hit = b.any_hit.data();
     const uint32_t max_depth = settings.max_depth;
+    const bool clock = settings.stage_clock;
+    const uint64_t pass_start = clock ? __rdtsc() : 0;
+    uint64_t traverse_tsc = 0;
 
     // Camera: the input buffer gets one primary ray per pixel of the tile.
     int cur = 0;
@@ -244,7 +251,18 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
         for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
-        traverse(kernels, bvh, b, load_rays(b, rays, n), generation, trace);
+        const uint32_t traversal_rays = load_rays(b, rays, n);
+        if (clock) {
+            uint64_t leaf = 0;
+            const uint64_t start = __rdtsc();
+            traverse(kernels, bvh, b, traversal_rays, generation, trace, &leaf);
+            const uint64_t spent = __rdtsc() - start;
+            stats.stage_tsc[0] += spent - leaf;
+            stats.stage_tsc[1] += leaf;
+            traverse_tsc += spent;
+        } else {
+            traverse(kernels, bvh, b, traversal_rays, generation, trace);
+        }
         if (observer)
             for (uint32_t i = 0; i < n; ++i) {
                 const uint32_t id = ids[i];
@@ -365,6 +383,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     // its samples in the reference tracer's order.
     for (uint32_t slot = 0; slot < count; ++slot)
         sums[slot] += sanitize_radiance(path[slot].radiance, stats);
+    if (clock) stats.stage_tsc[2] += __rdtsc() - pass_start - traverse_tsc;
     info.generations = generation;
     if constexpr (Trace::k_enabled) sink->end_pass(info);
 }

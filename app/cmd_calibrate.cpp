@@ -1,0 +1,241 @@
+// sfx calibrate: the host CPU as a hardware configuration, validated on silicon.
+//   --describe-host: describe the host (cpuid, caches, TSC, load latencies), microbenchmark the
+//     native filters on synthetic streams, fit the per-op costs, write host.hw.yaml.
+//   --check HOST.hw.yaml: for held-out workloads, the host timing's prediction from the trace
+//     against the native tracer's measured cycles (TSC, one pinned thread, trace off).
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/progress.h"
+#include "kernels/bvh.h"
+#include "sweeps/host_calibration.h"
+#include "workloads/input_error.h"
+#include "workloads/scene_loader.h"
+#include "workloads/strict_number.h"
+#include "workloads/user_files.h"
+
+namespace sfx {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    while (start <= s.size()) {
+        const size_t comma = s.find(',', start);
+        out.push_back(
+            s.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return out;
+}
+
+uint32_t parse_count(const std::string& text, const std::string& flag, uint64_t lo, uint64_t hi) {
+    uint64_t v = 0;
+    if (!parse_unsigned(text, v) || v < lo || v > hi)
+        throw InputError("command line", 0, flag,
+                         "expected an integer in [" + std::to_string(lo) + ", " +
+                             std::to_string(hi) + "], got '" + text + "'");
+    return uint32_t(v);
+}
+
+std::pair<uint32_t, uint32_t> parse_res(const std::string& text) {
+    const size_t x = text.find('x');
+    if (x == std::string::npos)
+        throw InputError("command line", 0, "--res", "expected WxH, got '" + text + "'");
+    return {parse_count(text.substr(0, x), "--res", 1, 16384),
+            parse_count(text.substr(x + 1), "--res", 1, 16384)};
+}
+
+const char* k_stage_names[3] = {"traversal", "intersection", "shading"};
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app) {
+    struct Options {
+        bool describe = false;
+        std::string output = "host.hw.yaml";
+        std::string check;
+        std::string isa = "auto";
+        uint32_t repeats = 9;
+        std::string scenes = "cornell,furnace,atrium,conference,temple";
+        std::string tiles = "16,32,64";
+        std::string res = "64x64,128x128";
+        uint32_t spp = 1;
+        uint32_t repeat = 5;
+        bool json = false;
+    };
+    auto o = std::make_shared<Options>();
+    CLI::App* c = app.add_subcommand(
+        "calibrate", "the host CPU as a hardware configuration: describe and fit it, or check it");
+    c->add_flag("--describe-host", o->describe,
+                "describe the host, fit its per-op costs on microbenchmarks, write -o");
+    c->add_option("-o,--output", o->output, "the host configuration written by --describe-host")
+        ->capture_default_str();
+    c->add_option("--check", o->check,
+                  "HOST.hw.yaml: predict and measure the native tracer's cycles per workload");
+    c->add_option("--isa", o->isa, "auto, avx512, avx2 or scalar: the back end measured")
+        ->capture_default_str();
+    c->add_option("--microbench-repeats", o->repeats, "repetitions per microbenchmark point")
+        ->capture_default_str();
+    c->add_option("--scenes", o->scenes, "--check: comma-separated scenes")->capture_default_str();
+    c->add_option("--tiles", o->tiles, "--check: comma-separated tile sizes")
+        ->capture_default_str();
+    c->add_option("--res", o->res, "--check: comma-separated resolutions WxH")
+        ->capture_default_str();
+    c->add_option("--spp", o->spp, "--check: samples per pixel")->capture_default_str();
+    c->add_option("--repeat", o->repeat, "--check: measured renders per workload (median)")
+        ->capture_default_str();
+    c->add_flag("--json", o->json, "print one JSON document");
+    c->callback([o] {
+        if (o->describe == !o->check.empty())
+            throw InputError("command line", 0, "--describe-host",
+                             "give exactly one of --describe-host and --check");
+        const Isa isa = resolve_isa(parse_isa(o->isa));
+        if (o->repeats < 1 || o->repeats > 1000)
+            throw InputError("command line", 0, "--microbench-repeats", "expected 1 to 1000");
+        if (o->repeat < 1 || o->repeat > 1000)
+            throw InputError("command line", 0, "--repeat", "expected 1 to 1000");
+        if (o->spp < 1 || o->spp > 4096)
+            throw InputError("command line", 0, "--spp", "expected 1 to 4096");
+        const bool pinned = pin_to_current_cpu();
+        if (o->describe) {
+            OutputFiles outputs;
+            const std::string temp = outputs.add(o->output, "--output");
+            Progress progress("calibrate", 15, "op kinds");
+            const HostCalibration cal =
+                calibrate_host(isa, o->repeats, [&](uint32_t done, uint32_t total) {
+                    progress.set_total(total);
+                    progress.set_done(done);
+                });
+            progress.finish();
+            std::ofstream(temp) << cal.yaml;
+            parse_hw_config(cal.yaml, o->output);  // what was written reads back
+            outputs.commit();
+            if (o->json) {
+                nlohmann::json j;
+                j["output"] = o->output;
+                j["tsc_mhz"] = cal.host.tsc_mhz;
+                j["simd_width"] = cal.host.simd_width;
+                j["pinned"] = pinned;
+                for (size_t i = 0; i < cal.op_costs.size(); ++i) {
+                    const OpCostConfig& k = cal.op_costs[i];
+                    j["op_costs"][k.op] = {{"per_op", k.per_op_cycles},
+                                           {"per_group", k.per_group_cycles},
+                                           {"per_lane", k.per_lane_cycles},
+                                           {"per_pass", k.per_pass_cycles},
+                                           {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
+                                           {"fit_median_error", cal.fit_errors[i].first},
+                                           {"fit_worst_error", cal.fit_errors[i].second}};
+                }
+                for (const MicrobenchSample& m : cal.samples)
+                    j["samples"].push_back({{"op", to_string(m.kind)},
+                                            {"slots", m.slots},
+                                            {"lanes", m.lanes},
+                                            {"passed", m.passed},
+                                            {"cycles", m.cycles}});
+                for (const KernelRate& r : cal.rates)
+                    j["rates"].push_back({{"what", r.what},
+                                          {"slots", r.slots},
+                                          {"lanes", r.lanes},
+                                          {"scattered", r.scattered},
+                                          {"cycles_per_lane", r.cycles_per_lane}});
+                std::cout << j.dump(2) << "\n";
+                return;
+            }
+            std::printf("host: %s, TSC %.1f MHz, %zu cache levels%s\n", cal.host.isa.c_str(),
+                        cal.host.tsc_mhz, cal.host.caches.size(),
+                        pinned ? ", pinned" : ", NOT pinned");
+            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s\n", "op kind", "per_op", "per_group",
+                        "per_lane", "per_pass", "beyondL1", "fit med", "fit max");
+            for (size_t i = 0; i < cal.op_costs.size(); ++i) {
+                const OpCostConfig& k = cal.op_costs[i];
+                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%%\n", k.op.c_str(),
+                            k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
+                            k.per_pass_cycles, k.beyond_l1_per_lane_cycles,
+                            100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second);
+            }
+            std::printf("\n%-30s %6s %6s %9s %12s\n", "kernel", "slots", "lanes", "slots are",
+                        "cycles/lane");
+            for (const KernelRate& r : cal.rates)
+                std::printf("%-30s %6u %6u %9s %12.2f\n", r.what, r.slots, r.lanes,
+                            r.scattered ? "random" : "in order", r.cycles_per_lane);
+            std::printf("\nwrote %s\n", o->output.c_str());
+            return;
+        }
+
+        const HwConfig host = load_hw_config(o->check);
+        if (host.op_costs.empty())
+            throw InputError(
+                o->check, 0, "op_costs",
+                "no fitted per-op costs (write it with sfx calibrate --describe-host)");
+        std::vector<uint32_t> tiles;
+        for (const std::string& t : split(o->tiles))
+            tiles.push_back(parse_count(t, "--tiles", 1, 4096));
+        std::vector<std::pair<uint32_t, uint32_t>> resolutions;
+        for (const std::string& r : split(o->res)) resolutions.push_back(parse_res(r));
+        const std::vector<std::string> scenes = split(o->scenes);
+        Progress progress("calibrate --check", scenes.size() * tiles.size() * resolutions.size(),
+                          "workloads");
+        nlohmann::json rows = nlohmann::json::array();
+        for (const std::string& name : scenes) {
+            progress.set_label(name + ": loading");
+            const Scene scene = load_scene(name);
+            const Bvh bvh(scene);
+            for (const auto& [w, h] : resolutions)
+                for (uint32_t tile : tiles) {
+                    progress.set_label(name + " " + std::to_string(w) + "x" + std::to_string(h) +
+                                       " tile " + std::to_string(tile));
+                    RenderSettings s;
+                    s.width = w;
+                    s.height = h;
+                    s.spp = o->spp;
+                    s.tile = tile;
+                    s.max_depth = scene.max_depth;
+                    s.isa = isa;
+                    const SiliconMeasurement m =
+                        predict_and_measure(scene, bvh, s, host, o->repeat);
+                    nlohmann::json row;
+                    row["scene"] = name;
+                    row["width"] = w;
+                    row["height"] = h;
+                    row["tile"] = tile;
+                    row["spp"] = o->spp;
+                    row["isa"] = isa_name(isa);
+                    row["pinned"] = pinned;
+                    row["predicted.frame_cycles"] = m.predicted_frame;
+                    row["measured.frame_cycles"] = m.measured_frame;
+                    row["measured.frame_samples"] = m.frame_samples;
+                    row["stage_clock_overhead"] = m.stage_clock_overhead;
+                    row["measured.interrupted_renders"] = m.interrupted;
+                    row["measured.frame_tsc"] = m.measured_frame_tsc;
+                    for (int st = 0; st < 3; ++st) {
+                        row[std::string("predicted.") + k_stage_names[st] + "_cycles"] =
+                            m.predicted_stage[size_t(st)];
+                        row[std::string("predicted.") + k_stage_names[st] + "_memory_cycles"] =
+                            m.predicted_memory[size_t(st)];
+                        row[std::string("measured.") + k_stage_names[st] + "_cycles"] =
+                            m.measured_stage[size_t(st)];
+                    }
+                    rows.push_back(row);
+                    progress.advance();
+                    if (!o->json) {
+                        progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) +
+                                     " tile " + std::to_string(tile) + ": predicted " +
+                                     std::to_string(m.predicted_frame / 1e6) +
+                                     " Mcycles, measured " +
+                                     std::to_string(m.measured_frame / 1e6));
+                    }
+                }
+        }
+        progress.finish();
+        std::cout << rows.dump(o->json ? 2 : -1) << "\n";
+    });
+}
+
+}  // namespace sfx

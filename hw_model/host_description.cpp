@@ -1,0 +1,285 @@
+#include "hw_model/host_description.h"
+
+#include <cpuid.h>
+#include <x86intrin.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "workloads/strict_number.h"
+
+namespace sfx {
+
+namespace {
+
+bool read_text(const std::string& path, std::string& out) {
+    std::ifstream in(path);
+    if (!in) return false;
+    std::getline(in, out);
+    return true;
+}
+
+// "48K", "1024K", "32M" -> KiB.
+uint32_t parse_kib(const std::string& s) {
+    uint64_t v = 0;
+    size_t i = 0;
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') v = v * 10 + uint64_t(s[i++] - '0');
+    if (i < s.size() && s[i] == 'M') v *= 1024;
+    return uint32_t(v);
+}
+
+std::vector<HostCacheLevel> caches_from_sysfs() {
+    std::vector<HostCacheLevel> out;
+    const std::string root = "/sys/devices/system/cpu/cpu0/cache/index";
+    for (int i = 0; i < 16; ++i) {
+        const std::string dir = root + std::to_string(i) + "/";
+        std::string level, type, size, line, ways, shared;
+        if (!read_text(dir + "level", level) || !read_text(dir + "type", type)) break;
+        if (type == "Instruction") continue;
+        read_text(dir + "size", size);
+        read_text(dir + "coherency_line_size", line);
+        read_text(dir + "ways_of_associativity", ways);
+        read_text(dir + "shared_cpu_list", shared);
+        HostCacheLevel c;
+        c.level = uint32_t(std::stoul(level));
+        c.type = type == "Data" ? "data" : "unified";
+        c.kib = parse_kib(size);
+        c.line_bytes = uint32_t(std::stoul(line.empty() ? "64" : line));
+        c.ways = uint32_t(std::stoul(ways.empty() ? "1" : ways));
+        c.shared = shared.find_first_of(",-") != std::string::npos;
+        c.source = "sysfs " + dir;
+        out.push_back(c);
+    }
+    return out;
+}
+
+// cpuid deterministic cache parameters: leaf 4 (Intel) or 0x8000001D (AMD), same layout.
+std::vector<HostCacheLevel> caches_from_cpuid() {
+    std::vector<HostCacheLevel> out;
+    unsigned a, b, c, d;
+    __cpuid(0, a, b, c, d);
+    const bool amd = b == 0x68747541;  // "Auth"enticAMD
+    const unsigned leaf = amd ? 0x8000001D : 4;
+    if (amd) {
+        __cpuid(0x80000000, a, b, c, d);
+        if (a < leaf) return out;
+    } else if (a < leaf) {
+        return out;
+    }
+    for (unsigned sub = 0; sub < 16; ++sub) {
+        __cpuid_count(leaf, sub, a, b, c, d);
+        const unsigned type = a & 0x1f;
+        if (type == 0) break;
+        if (type == 2) continue;  // instruction cache
+        HostCacheLevel l;
+        l.level = (a >> 5) & 7;
+        l.type = type == 1 ? "data" : "unified";
+        l.line_bytes = (b & 0xfff) + 1;
+        const uint32_t partitions = ((b >> 12) & 0x3ff) + 1;
+        l.ways = (b >> 22) + 1;
+        const uint64_t sets = uint64_t(c) + 1;
+        l.kib = uint32_t(uint64_t(l.ways) * partitions * l.line_bytes * sets / 1024);
+        l.shared = ((a >> 14) & 0xfff) > 0;
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "cpuid leaf 0x%X subleaf %u", leaf, sub);
+        l.source = buf;
+        out.push_back(l);
+    }
+    return out;
+}
+
+// AMD's legacy cache leaves (0x80000005 L1D, 0x80000006 L2 and L3), for when 0x8000001D is
+// masked (some hypervisors). The L2/L3 associativity is a code (AMD APM vol. 3, CPUID
+// Fn8000_0006); code 9 means "see 0x8000001D", which then is masked: 16 ways assumed.
+std::vector<HostCacheLevel> caches_from_amd_legacy() {
+    std::vector<HostCacheLevel> out;
+    unsigned a, b, c, d;
+    __cpuid(0x80000000, a, b, c, d);
+    if (a < 0x80000006) return out;
+    auto ways_of = [](unsigned code, std::string& source) -> uint32_t {
+        static const uint32_t k_ways[16] = {0, 1, 2, 3, 4, 6, 8, 0, 16, 0, 32, 48, 64, 96, 128, 0};
+        if (k_ways[code & 15]) return k_ways[code & 15];
+        source += " (ways not given: 16 assumed)";
+        return 16;
+    };
+    __cpuid(0x80000005, a, b, c, d);
+    HostCacheLevel l1{
+        1, "data", c >> 24, c & 0xff, (c >> 16) & 0xff, false, "cpuid leaf 0x80000005 ECX"};
+    if (l1.kib) out.push_back(l1);
+    __cpuid(0x80000006, a, b, c, d);
+    HostCacheLevel l2{2, "unified", c >> 16, c & 0xff, 0, false, "cpuid leaf 0x80000006 ECX"};
+    l2.ways = ways_of((c >> 12) & 15, l2.source);
+    if (l2.kib) out.push_back(l2);
+    HostCacheLevel l3{
+        3, "unified", (d >> 18) * 512, d & 0xff, 0, true, "cpuid leaf 0x80000006 EDX"};
+    l3.ways = ways_of((d >> 12) & 15, l3.source);
+    if (l3.kib) out.push_back(l3);
+    return out;
+}
+
+std::string fmt(double v, int digits = 1) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return buf;
+}
+
+}  // namespace
+
+std::vector<HostCacheLevel> read_host_caches() {
+    std::vector<HostCacheLevel> c = caches_from_sysfs();
+    if (c.empty()) c = caches_from_cpuid();
+    unsigned a, b, cx, d;
+    __cpuid(0, a, b, cx, d);
+    if (c.empty() && b == 0x68747541) c = caches_from_amd_legacy();
+    std::stable_sort(c.begin(), c.end(), [](const HostCacheLevel& x, const HostCacheLevel& y) {
+        return x.level < y.level;
+    });
+    return c;
+}
+
+uint64_t read_tsc() {
+    return __rdtsc();
+}
+
+double measure_tsc_mhz(double seconds) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const uint64_t c0 = __rdtsc();
+    auto t1 = t0;
+    while (std::chrono::duration<double>((t1 = Clock::now()) - t0).count() < seconds) {
+    }
+    const uint64_t c1 = __rdtsc();
+    return double(c1 - c0) / std::chrono::duration<double, std::micro>(t1 - t0).count();
+}
+
+double measure_load_latency_ns(uint64_t bytes, double tsc_mhz) {
+    constexpr uint32_t k_line = 64;
+    const size_t lines = std::max<uint64_t>(bytes / k_line, 8);
+    const size_t stride = k_line / sizeof(size_t);
+    std::vector<size_t> order(lines);
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(12345));
+    std::vector<size_t> chase(lines * stride);
+    for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
+    size_t at = 0;
+    for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i) at = chase[at];  // warm
+    const size_t loads = 1u << 19;  // a fraction of a second even from DRAM
+    double best = 1e30;
+    for (int rep = 0; rep < 3; ++rep) {  // the fastest of three: the least disturbed
+        const uint64_t c0 = __rdtsc();
+        for (size_t i = 0; i < loads; ++i) at = chase[at];
+        const uint64_t c1 = __rdtsc();
+        best = std::min(best, double(c1 - c0) / double(loads));
+    }
+    if (at == size_t(-1)) std::printf(" ");  // keeps the chase
+    return best / tsc_mhz * 1000.0;
+}
+
+// DRAM: a chase over 256 MiB (beyond the L3 a core sees on any current CPU; no larger, the
+// machine may be shared). Its 4 KiB pages miss the TLB too, as scene data does.
+constexpr uint64_t k_largest_chase = 256ull << 20;
+
+HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
+    HostDescription h;
+    h.simd_width = simd_width;
+    h.isa = isa;
+    h.tsc_mhz = measure_tsc_mhz();
+    h.caches = read_host_caches();
+    for (const HostCacheLevel& c : h.caches) {
+        // Half the level: it fits there, and not in the level before (which is smaller). At
+        // most 8 MiB: a virtual machine may report a whole socket's L3 for one core.
+        h.latency_ns.push_back(measure_load_latency_ns(
+            std::min<uint64_t>(uint64_t(c.kib) * 1024 / 2, k_largest_chase / 32), h.tsc_mhz));
+    }
+    h.latency_ns.push_back(measure_load_latency_ns(k_largest_chase, h.tsc_mhz));
+    return h;
+}
+
+HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig>& op_costs) {
+    HwConfig c;
+    c.name = "host";
+    c.clock.core_mhz = h.tsc_mhz;
+    c.clock.interconnect_mhz = h.tsc_mhz;
+    c.simd.width = h.simd_width;
+    c.simd.units = 1;
+    c.cores.count = 1;
+    const uint32_t l1d = h.caches.empty() ? 32 : h.caches.front().kib;
+    c.ray_buffer.kib = l1d;
+    c.ray_buffer.banks = 1;
+    c.ray_buffer.storage = "l1d";
+    c.ray_buffer.line_words = (h.caches.empty() ? 64 : h.caches.front().line_bytes) / 4;
+    c.partition.kind = "compress";
+    c.scene_memory.caches.clear();
+    for (size_t i = 0; i < h.caches.size(); ++i) {
+        const HostCacheLevel& l = h.caches[i];
+        CacheLevelConfig cl;
+        cl.name = "l" + std::to_string(l.level);
+        cl.kib = l.kib;
+        cl.line_bytes = l.line_bytes;
+        cl.ways = l.ways;
+        cl.hit_latency_ns = i < h.latency_ns.size() ? h.latency_ns[i] : 1.0;
+        cl.shared = l.shared;
+        c.scene_memory.caches.push_back(cl);
+    }
+    if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
+    c.op_costs = op_costs;
+    return c;
+}
+
+std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfig>& op_costs,
+                         const std::string& fit_note) {
+    const HwConfig c = host_hw_config(h, op_costs);
+    std::ostringstream y;
+    y << "# The host CPU as a hardware configuration, written by `sfx calibrate --describe-host`.\n"
+      << "# One core running the native stream tracer (kernels/stream) single-threaded; timed by\n"
+      << "# the host timing (hw_model/host_timing.h), not by the machine model of the paper.\n"
+      << "version: 1\nname: host\nclock:\n"
+      << "  core_mhz: " << fmt(h.tsc_mhz, 3)
+      << "  # measured: TSC ticks over 0.2 s of the steady clock\n"
+      << "  interconnect_mhz: " << fmt(h.tsc_mhz, 3)
+      << "  # one clock (unused by the host timing)\n"
+      << "simd:\n  width: " << h.simd_width << "  # cpuid: " << h.isa << "\n"
+      << "  units: 1  # the native tracer runs its filters on one core's vector unit\n"
+      << "cores:\n  count: 1  # measured single-threaded, one pinned thread\n"
+      << "ray_buffer:\n"
+      << "  kib: " << c.ray_buffer.kib << "  # the L1D holds the ray buffers: "
+      << (h.caches.empty() ? "assumed" : h.caches.front().source) << "\n"
+      << "  banks: 1  # no banks: the L1D serves the gathers (storage: l1d)\n"
+      << "  line_words: " << c.ray_buffer.line_words << "  # the L1D line\n"
+      << "  storage: l1d\n"
+      << "partition:\n  kind: compress  # vpcompressd (AVX-512) or a permutation table (AVX2)\n"
+      << "scene_memory:\n  caches:\n";
+    for (size_t i = 0; i < c.scene_memory.caches.size(); ++i) {
+        const CacheLevelConfig& l = c.scene_memory.caches[i];
+        y << "    - {name: " << l.name << ", kib: " << l.kib << ", line_bytes: " << l.line_bytes
+          << ", ways: " << l.ways << ", hit_latency_ns: " << fmt(l.hit_latency_ns, 2)
+          << ", shared: " << (l.shared ? "true" : "false") << "}  # " << h.caches[i].source
+          << "; latency measured (pointer chase over "
+          << std::min<uint64_t>(h.caches[i].kib / 2, 8192) << " KiB)\n";
+    }
+    y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2)
+      << "  # measured: pointer chase over 256 MiB\n"
+      << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
+      << "  # assumed (unused by the host timing)\n";
+    y << "# Fitted: " << fit_note << "\n";
+    if (op_costs.empty()) {
+        y << "op_costs: []\n";
+    } else {
+        y << "op_costs:\n";
+        for (const OpCostConfig& o : op_costs)
+            y << "  - {op: " << o.op << ", per_op_cycles: " << fmt(o.per_op_cycles, 2)
+              << ", per_group_cycles: " << fmt(o.per_group_cycles, 2)
+              << ", per_lane_cycles: " << fmt(o.per_lane_cycles, 2)
+              << ", per_pass_cycles: " << fmt(o.per_pass_cycles, 2)
+              << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2) << "}\n";
+    }
+    return y.str();
+}
+
+}  // namespace sfx

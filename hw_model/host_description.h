@@ -1,0 +1,59 @@
+#pragma once
+// The host CPU described as a hardware configuration: one core of the machine that runs the
+// native stream tracer (kernels/stream), with the ISA's SIMD width, the cache hierarchy the CPU
+// reports, its time-stamp-counter clock and measured load latencies. `sfx calibrate
+// --describe-host` writes it as host.hw.yaml, every value with where it came from; the fitted
+// per-op costs (HwConfig::op_costs) are added by the calibration (sweeps/host_calibration.h).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hw_model/hw_config.h"
+
+namespace sfx {
+
+struct HostCacheLevel {
+    uint32_t level = 1;
+    std::string type;  // "data" or "unified" (instruction caches are left out)
+    uint32_t kib = 0, line_bytes = 64, ways = 1;
+    bool shared = false;  // shared by more than one core
+    std::string source;   // "sysfs ..." or "cpuid leaf ..."
+};
+
+// Data and unified caches of cpu0, nearest first: /sys/devices/system/cpu/cpu0/cache/ when the
+// kernel exposes it, else cpuid's deterministic cache parameters (leaf 0x8000001D on AMD, 4 on
+// Intel). Empty if neither says anything.
+std::vector<HostCacheLevel> read_host_caches();
+
+// The time-stamp counter's rate in MHz, measured against the steady clock over `seconds`.
+double measure_tsc_mhz(double seconds = 0.2);
+
+// Average load-to-use latency in ns of a dependent pointer chase over a random cycle of lines
+// spanning `bytes` (so it hits the level that holds that many bytes).
+double measure_load_latency_ns(uint64_t bytes, double tsc_mhz);
+
+// Reads the TSC (rdtsc): the clock the native tracer's cycles are counted in.
+uint64_t read_tsc();
+
+struct HostDescription {
+    uint32_t simd_width = 1;
+    std::string isa;  // e.g. "avx512 (16 lanes)"
+    double tsc_mhz = 0.0;
+    std::vector<HostCacheLevel> caches;
+    std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
+};
+
+// Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).
+HostDescription describe_host(uint32_t simd_width, const std::string& isa);
+
+// The configuration: one core, one SIMD unit of the ISA's width at the TSC clock; the ray
+// buffers in the L1D (storage l1d, no banks), partition by compress; the caches as scene
+// memory with measured latencies. `op_costs` as given (the fitted ones, or empty).
+HwConfig host_hw_config(const HostDescription& host, const std::vector<OpCostConfig>& op_costs);
+
+// host.hw.yaml text: host_hw_config with a comment on every value naming its source.
+std::string host_hw_yaml(const HostDescription& host, const std::vector<OpCostConfig>& op_costs,
+                         const std::string& fit_note);
+
+}  // namespace sfx

@@ -1,0 +1,182 @@
+#include "hw_model/host_timing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sfx {
+
+double host_op_cycles(const OpCostConfig& c, uint32_t width, uint32_t lanes, uint32_t passed,
+                      double beyond_l1) {
+    const double groups = double((lanes + width - 1) / width);
+    return c.per_op_cycles + c.per_group_cycles * groups + c.per_lane_cycles * lanes +
+           c.per_pass_cycles * passed + c.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
+}
+
+double beyond_l1_fraction(uint32_t slots, uint32_t record_bytes, uint32_t l1d_kib) {
+    const double bytes = double(slots) * record_bytes;
+    return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(l1d_kib) * 1024.0 / bytes);
+}
+
+HostTiming::HostTiming(const HwConfig& config, const SceneDataMap& scene,
+                       const OpCostTable& profiles, uint32_t record_bytes)
+    : m_config(config), m_scene(scene), m_profiles(profiles), m_record_bytes(record_bytes) {
+    for (const OpCostConfig& c : m_config.op_costs)
+        for (uint32_t k = 0; k < k_op_kind_count; ++k)
+            if (c.op == k_op_kinds[k].name) m_costs[k] = &c;
+    const std::vector<CacheLevelConfig>& levels = m_config.scene_memory.caches;
+    const double l1_ns = levels.empty() ? 0.0 : levels.front().hit_latency_ns;
+    const double mhz = m_config.clock.core_mhz;
+    for (const CacheLevelConfig& l : levels) {
+        m_caches.emplace_back(l);
+        m_extra_cycles.push_back((l.hit_latency_ns - l1_ns) * mhz / 1000.0);
+    }
+    m_extra_cycles.push_back((m_config.scene_memory.dram_latency_ns - l1_ns) * mhz / 1000.0);
+}
+
+void HostTiming::begin_pass(const TilePass& pass) {
+    m_beyond_l1 = beyond_l1_fraction(pass.slot_count, m_record_bytes, m_config.ray_buffer.kib);
+    ++m_result.passes;
+}
+
+void HostTiming::op(const StreamOp& op) {
+    const OpCostConfig* cost = m_costs[size_t(op.kind)];
+    if (!cost)
+        throw std::invalid_argument(std::string("the host configuration has no op_costs entry "
+                                                "for ") +
+                                    to_string(op.kind) + " (run sfx calibrate --describe-host)");
+    double cycles =
+        host_op_cycles(*cost, m_config.simd.width, op.length, op.pass_count, m_beyond_l1);
+    const uint32_t bytes = m_profiles[op.kind].scene_bytes;
+    double memory = 0.0;
+    if (bytes && op.object != k_no_object && !m_caches.empty()) {
+        const uint64_t address = m_scene.address(op.kind, op.object);
+        const uint32_t line = m_caches.front().config().line_bytes;
+        double worst = 0.0;  // the op waits for its slowest line
+        for (uint64_t a = address / line * line; a < address + bytes; a += line) {
+            size_t level = 0;
+            while (level < m_caches.size() && !m_caches[level].access(a)) ++level;
+            worst = std::max(worst, m_extra_cycles[level]);
+        }
+        memory = worst;
+    }
+    const size_t stage = size_t(op.stage);
+    m_result.stage_cycles[stage] += cycles + memory;
+    m_result.scene_memory_cycles[stage] += memory;
+    m_result.kind_cycles[size_t(op.kind)] += cycles + memory;
+    ++m_result.ops;
+}
+
+namespace {
+
+// Cycles under which a microbenchmark sample is mostly the time-stamp counter's granularity
+// (it steps by tens of ticks on some machines) and counts as this many in relative errors.
+constexpr double k_resolution = 100.0;
+
+// Columns of the cost formula for one sample (per op, group, lane, passing lane, beyond L1).
+constexpr int k_terms = 5;
+std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
+    return {1.0, double((s.lanes + width - 1) / width), double(s.lanes), double(s.passed),
+            s.beyond_l1 * s.lanes};
+}
+
+OpCostConfig from_coefficients(const std::string& op, const std::array<double, k_terms>& x) {
+    OpCostConfig c;
+    c.op = op;
+    c.per_op_cycles = x[0];
+    c.per_group_cycles = x[1];
+    c.per_lane_cycles = x[2];
+    c.per_pass_cycles = x[3];
+    c.beyond_l1_per_lane_cycles = x[4];
+    return c;
+}
+
+// Solves A x = b (A symmetric positive semi-definite, small) by Gaussian elimination with
+// partial pivoting; a column with no pivot gets 0.
+std::vector<double> solve(std::vector<std::vector<double>> a, std::vector<double> b) {
+    const size_t n = b.size();
+    std::vector<double> x(n, 0.0);
+    std::vector<int> pivot_col(n, -1);
+    size_t row = 0;
+    for (size_t col = 0; col < n && row < n; ++col) {
+        size_t best = row;
+        for (size_t r = row; r < n; ++r)
+            if (std::abs(a[r][col]) > std::abs(a[best][col])) best = r;
+        if (std::abs(a[best][col]) < 1e-12) continue;
+        std::swap(a[row], a[best]);
+        std::swap(b[row], b[best]);
+        for (size_t r = 0; r < n; ++r) {
+            if (r == row) continue;
+            const double f = a[r][col] / a[row][col];
+            for (size_t c = col; c < n; ++c) a[r][c] -= f * a[row][c];
+            b[r] -= f * b[row];
+        }
+        pivot_col[row] = int(col);
+        ++row;
+    }
+    for (size_t r = 0; r < row; ++r) x[size_t(pivot_col[r])] = b[r] / a[r][size_t(pivot_col[r])];
+    return x;
+}
+
+}  // namespace
+
+OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
+                         const std::vector<OpCostSample>& samples) {
+    if (samples.empty()) throw std::invalid_argument("no microbenchmark samples for " + op);
+    std::array<bool, k_terms> active;
+    active.fill(true);
+    // A column that never varies apart from the constant carries no information.
+    bool any_beyond = false, any_passed = false;
+    for (const OpCostSample& s : samples) {
+        any_beyond |= s.beyond_l1 > 0;
+        any_passed |= s.passed > 0;
+    }
+    active[4] = any_beyond;
+    active[3] = any_passed;
+    std::array<double, k_terms> x{};
+    for (int round = 0; round < k_terms; ++round) {
+        std::vector<int> cols;
+        for (int t = 0; t < k_terms; ++t)
+            if (active[t]) cols.push_back(t);
+        const size_t m = cols.size();
+        std::vector<std::vector<double>> ata(m, std::vector<double>(m, 0.0));
+        std::vector<double> atb(m, 0.0);
+        for (const OpCostSample& s : samples) {
+            const auto row = terms(s, width);
+            // Relative error; below k_resolution cycles the clock's steps dominate a sample.
+            const double w = 1.0 / std::max(s.cycles, k_resolution);
+            for (size_t i = 0; i < m; ++i) {
+                atb[i] += row[size_t(cols[i])] * w * s.cycles * w;
+                for (size_t j = 0; j < m; ++j)
+                    ata[i][j] += row[size_t(cols[i])] * w * row[size_t(cols[j])] * w;
+            }
+        }
+        const std::vector<double> sol = solve(ata, atb);
+        x.fill(0.0);
+        int most_negative = -1;
+        for (size_t i = 0; i < m; ++i) {
+            x[size_t(cols[i])] = sol[i];
+            if (sol[i] < 0 && (most_negative < 0 || sol[i] < x[size_t(most_negative)]))
+                most_negative = cols[i];
+        }
+        if (most_negative < 0) break;
+        active[size_t(most_negative)] = false;
+        x[size_t(most_negative)] = 0.0;
+    }
+    for (double& v : x) v = std::max(v, 0.0);
+    return from_coefficients(op, x);
+}
+
+std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
+                                    const std::vector<OpCostSample>& samples) {
+    std::vector<double> e;
+    for (const OpCostSample& s : samples)
+        e.push_back(
+            std::abs(host_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) - s.cycles) /
+            std::max(s.cycles, k_resolution));
+    if (e.empty()) return {0.0, 0.0};
+    std::sort(e.begin(), e.end());
+    return {e[e.size() / 2], e.back()};
+}
+
+}  // namespace sfx

@@ -1,0 +1,386 @@
+#include "kernels/stream/stream_microbench.h"
+
+#include <x86intrin.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "kernels/bvh.h"
+#include "kernels/camera.h"
+#include "kernels/path.h"
+#include "kernels/stream/stream_filter.h"
+#include "kernels/stream/stream_kernels.h"
+#include "workloads/generators.h"
+
+namespace sfx {
+
+uint32_t stream_slot_bytes() {
+    // The per-slot arrays of the stream tracer's RayBuffers (stream_tracer.cpp): path state,
+    // two ray generations, traversal ray, hit, any-hit flag, surface, six id lists and a mask.
+    return uint32_t(sizeof(PathState) + 2 * sizeof(Ray) + sizeof(TraversalRay) + sizeof(Hit) + 1 +
+                    sizeof(SurfaceHit) + 6 * sizeof(uint32_t) + 1);
+}
+
+namespace {
+
+// A floor (Lambertian), a glossy panel, a glass sphere and a light over them.
+Scene synthetic_scene() {
+    Scene s;
+    s.name = "microbench";
+    Material floor, panel, glass, light;
+    floor.kind = MaterialKind::lambertian;
+    panel.kind = MaterialKind::glossy;
+    glass.kind = MaterialKind::dielectric;
+    light.kind = MaterialKind::lambertian;
+    light.emission = Vec3(5.f);
+    s.materials = {floor, panel, glass, light};
+    SceneBuilder b(s);
+    b.begin_object();
+    shapes::quad(b, Vec3(-4, 0, -4), Vec3(8, 0, 0), Vec3(0, 0, 8), 0);
+    b.begin_object();
+    shapes::quad(b, Vec3(-3, 0, -3), Vec3(3, 0, 0), Vec3(0, 3, 0), 1);
+    b.begin_object();
+    shapes::quad(b, Vec3(-1, 4, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), 3);
+    b.begin_object();
+    b.add_sphere(Vec3(1.5f, 1.f, 0.5f), 1.f, 2);
+    s.camera.eye = Vec3(0, 2, 8);
+    s.camera.look_at = Vec3(0, 1, 0);
+    s.finalize(b.light_groups());
+    return s;
+}
+
+struct Buffers {
+    std::vector<PathState> path, saved_path;
+    std::vector<Ray> ray, next;
+    std::vector<TraversalRay> trav, saved_trav;
+    std::vector<Hit> hit, saved_hit;
+    std::vector<uint8_t> any_hit, mask;
+    std::vector<SurfaceHit> surf;
+    std::vector<uint32_t> ids, scratch, scratch2, positions;
+};
+
+// Random rays from above the scene toward random points of it: a mix of hits on every
+// material, misses and (every fourth) shadow rays.
+Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    Buffers b;
+    b.path.resize(slots);
+    b.ray.resize(slots);
+    b.next.resize(slots);
+    Ray unit;
+    unit.dir = {0.f, 0.f, 1.f};
+    b.trav.resize(slots, TraversalRay{RayPrecomp(unit), 0.f});
+    b.hit.resize(slots);
+    b.any_hit.resize(slots);
+    b.surf.resize(slots);
+    const uint32_t padded = slots + k_stream_padding;
+    b.ids.resize(padded);
+    b.scratch.resize(padded);
+    b.scratch2.resize(padded);
+    b.positions.resize(padded);
+    b.mask.resize(padded);
+    for (uint32_t i = 0; i < slots; ++i) {
+        Ray r;
+        r.org = Vec3(3 * u(rng), 5.f + u(rng), 6.f + u(rng));
+        const Vec3 target(4.5f * u(rng), 0.5f + u(rng), 4.5f * u(rng));
+        r.dir = normalize(target - r.org);
+        b.ray[i] = r;
+        b.trav[i] = TraversalRay{RayPrecomp(r), r.t_max};
+        b.hit[i] = bvh.intersect(r);
+        PathState& p = b.path[i];
+        p.key = {7, i, 0};
+        p.bounce = i % 3;
+        p.kind = i % 4 == 3 ? RayKind::shadow : RayKind::extension;
+        b.any_hit[i] = p.kind == RayKind::shadow;
+        if (b.hit[i].valid()) b.surf[i] = surface_at(scene, r, b.hit[i]);
+    }
+    b.saved_path = b.path;
+    b.saved_trav = b.trav;
+    b.saved_hit = b.hit;
+    return b;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+// TSC ticks of an empty timed region (subtracted from every measurement).
+double tsc_overhead() {
+    std::vector<double> t;
+    for (int i = 0; i < 101; ++i) {
+        const uint64_t a = __rdtsc();
+        const uint64_t c = __rdtsc();
+        t.push_back(double(c - a));
+    }
+    return median(t);
+}
+
+}  // namespace
+
+std::vector<MicrobenchSample> run_stream_microbenchmarks(
+    const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress) {
+    const Scene scene = synthetic_scene();
+    const Bvh bvh(scene);
+    const StreamKernels& kernels = stream_kernels(resolve_isa(options.isa));
+    CameraFrame camera(scene.camera, 64, 64);
+    const double overhead = tsc_overhead();
+    std::mt19937 rng(uint32_t(options.seed));
+
+    // The kinds, in the order they are reported.
+    const std::vector<OpKind> kinds = {OpKind::camera,
+                                       OpKind::box_test,
+                                       OpKind::triangle_test,
+                                       OpKind::sphere_test,
+                                       OpKind::shadow_filter,
+                                       OpKind::miss_filter,
+                                       OpKind::emission_filter,
+                                       OpKind::depth_filter,
+                                       OpKind::material_filter,
+                                       OpKind::ambient,
+                                       OpKind::lambertian_choice,
+                                       OpKind::lambertian_direct,
+                                       OpKind::lambertian_indirect,
+                                       OpKind::dielectric,
+                                       OpKind::glossy};
+    std::vector<MicrobenchSample> out;
+    uint32_t done = 0;
+    Scene ambient_scene = scene;  // the ambient filter reads scene.ambient
+    ambient_scene.ambient = Vec3(0.2f);
+
+    std::vector<Buffers> buffers;
+    for (uint32_t slots : options.buffer_slots)
+        buffers.push_back(make_buffers(scene, bvh, slots, rng));
+
+    for (OpKind kind : kinds) {
+        for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
+            const uint32_t slots = options.buffer_slots[bi];
+            Buffers& b = buffers[bi];
+            std::vector<uint32_t> order(slots);
+            std::iota(order.begin(), order.end(), 0u);
+            for (uint32_t n : options.lengths) {
+                if (n > slots) continue;
+                std::vector<double> times;
+                uint32_t passed = 0;
+                for (uint32_t rep = 0; rep < options.repeats; ++rep) {
+                    // A fresh random stream; the whole buffer touched in random order first, so
+                    // the L1D holds what a pass over this buffer leaves in it.
+                    std::shuffle(order.begin(), order.end(), rng);
+                    std::copy(order.begin(), order.begin() + n, b.ids.begin());
+                    std::copy(b.saved_path.begin(), b.saved_path.end(), b.path.begin());
+                    std::copy(b.saved_trav.begin(), b.saved_trav.end(), b.trav.begin());
+                    // Intersection tests start from no hit, as after the tracer's load_rays;
+                    // shading filters read the hits the setup found.
+                    if (stage_of(kind) == OpStage::shading)
+                        std::copy(b.saved_hit.begin(), b.saved_hit.end(), b.hit.begin());
+                    else
+                        std::fill(b.hit.begin(), b.hit.end(), Hit{});
+                    float touch = 0.f;
+                    for (uint32_t id : order)
+                        touch += b.ray[id].org.x + b.next[id].org.x + b.trav[id].t +
+                                 b.surf[id].position.x + b.path[id].radiance.x + b.hit[id].t;
+                    if (touch == 12345.f) b.mask[0] = 1;
+
+                    uint32_t* ids = b.ids.data();
+                    uint8_t* mask = b.mask.data();
+                    uint32_t* scratch = b.scratch.data();
+                    NoTrace trace;
+                    const uint32_t mat = 0;
+                    auto run_filter = [&](auto&& test) {
+                        return filter(kernels, trace, kind, 1, mat, ids, n, mask, scratch, test);
+                    };
+                    // Short streams run several times in the timed region: the TSC ticks in
+                    // steps of tens of cycles here. Repeats test the same ids again, as
+                    // traversal tests one stream against node after node.
+                    const uint32_t inner = std::max(1u, 256u / n);
+                    const uint64_t start = __rdtsc();
+                    for (uint32_t again = 0; again < inner; ++again) switch (kind) {
+                            case OpKind::camera:
+                                for (uint32_t i = 0; i < n; ++i) {
+                                    const uint32_t slot = ids[i];
+                                    PathState& p = b.path[slot];
+                                    p = PathState{};
+                                    p.key = {1, slot, 0};
+                                    b.next[slot] = camera.generate(p.key);
+                                    mask[i] = 1;
+                                }
+                                passed = n;
+                                break;
+                            case OpKind::box_test: {
+                                // The tracer's box_filter with the trace off: the kernel, then
+                                // the failing ids copied back behind the passing ones.
+                                uint32_t negative = 0;
+                                const BvhNode& node = bvh.nodes()[0];
+                                passed =
+                                    kernels.box_filter(b.trav.data(), node.bounds, node.axis, ids,
+                                                       n, ids, scratch, nullptr, negative);
+                                std::copy(scratch, scratch + (n - passed), ids + passed);
+                                break;
+                            }
+                            case OpKind::triangle_test: {
+                                const uint32_t prim = 0;  // a floor triangle: about half the rays
+                                const Triangle& tri = scene.triangles[prim];
+                                uint32_t* positions = b.positions.data();
+                                const uint32_t candidates = kernels.triangle_candidates(
+                                    b.trav.data(), scene.positions[tri.v0], scene.positions[tri.v1],
+                                    scene.positions[tri.v2], ids, n, positions);
+                                passed = 0;
+                                for (uint32_t j = 0; j < candidates; ++j) {
+                                    const uint32_t id = ids[positions[j]];
+                                    TraversalRay& r = b.trav[id];
+                                    if (!bvh.intersect_primitive(r.pre, prim, r.t, b.hit[id]))
+                                        continue;
+                                    r.t = b.any_hit[id] ? -1.f : b.hit[id].t;
+                                    ++passed;
+                                }
+                                break;
+                            }
+                            case OpKind::sphere_test: {
+                                const uint32_t prim = scene.triangle_count();
+                                passed = evaluate(ids, n, mask, [&](uint32_t id) {
+                                    TraversalRay& r = b.trav[id];
+                                    if (!bvh.intersect_primitive(r.pre, prim, r.t, b.hit[id]))
+                                        return false;
+                                    r.t = b.any_hit[id] ? -1.f : b.hit[id].t;
+                                    return true;
+                                });
+                                break;
+                            }
+                            case OpKind::shadow_filter:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.any_hit[id]) return false;
+                                    finish_shadow(b.path[id], b.hit[id].valid());
+                                    return true;
+                                });
+                                break;
+                            case OpKind::miss_filter:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (b.hit[id].valid()) return false;
+                                    shade_miss(b.path[id], scene);
+                                    return true;
+                                });
+                                break;
+                            case OpKind::emission_filter:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.hit[id].valid()) return false;  // misses left earlier
+                                    b.surf[id] = surface_at(scene, b.ray[id], b.hit[id]);
+                                    const Material& m = scene.materials[b.surf[id].material];
+                                    if (!m.emissive()) return false;
+                                    shade_emission(b.path[id], m);
+                                    return true;
+                                });
+                                break;
+                            case OpKind::depth_filter: {
+                                uint32_t material_rays[4] = {0, 0, 0, 0};
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!may_scatter(b.path[id], 3)) return false;
+                                    ++material_rays[b.surf[id].material & 3];
+                                    return true;
+                                });
+                                break;
+                            }
+                            case OpKind::material_filter:
+                                passed = run_filter(
+                                    [&](uint32_t id) { return b.surf[id].material == mat; });
+                                break;
+                            case OpKind::ambient:
+                                passed = run_filter([&](uint32_t id) {
+                                    add_ambient(b.path[id], scene.materials[b.surf[id].material],
+                                                ambient_scene);
+                                    return true;
+                                });
+                                break;
+                            case OpKind::lambertian_choice:
+                                passed = run_filter([&](uint32_t id) {
+                                    return lambertian_takes_direct(b.path[id], scene);
+                                });
+                                break;
+                            case OpKind::lambertian_direct:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.hit[id].valid()) return false;
+                                    return lambertian_direct(b.path[id], scene, scene.materials[0],
+                                                             b.surf[id], b.next[id]);
+                                });
+                                break;
+                            case OpKind::lambertian_indirect:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.hit[id].valid()) return false;
+                                    return lambertian_indirect(b.path[id], scene,
+                                                               scene.materials[0], b.surf[id],
+                                                               b.next[id]);
+                                });
+                                break;
+                            case OpKind::dielectric:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.hit[id].valid()) return false;
+                                    return dielectric_scatter(b.path[id], scene.materials[2],
+                                                              b.surf[id], b.ray[id], b.next[id]);
+                                });
+                                break;
+                            case OpKind::glossy:
+                                passed = run_filter([&](uint32_t id) {
+                                    if (!b.hit[id].valid()) return false;
+                                    return glossy_scatter(b.path[id], scene.materials[1],
+                                                          b.surf[id], b.ray[id], b.next[id]);
+                                });
+                                break;
+                            default:
+                                break;
+                        }
+                    const uint64_t end = __rdtsc();
+                    times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
+                }
+                out.push_back({kind, slots, n, passed, median(times)});
+            }
+        }
+        if (progress) progress(++done, uint32_t(kinds.size()));
+    }
+    return out;
+}
+
+std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t repeats) {
+    const Scene scene = synthetic_scene();
+    const Bvh bvh(scene);
+    const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
+    std::mt19937 rng(3);
+    const double overhead = tsc_overhead();
+    std::vector<KernelRate> out;
+    for (uint32_t slots : {256u, 4096u, 65536u}) {
+        Buffers b = make_buffers(scene, bvh, slots, rng);
+        std::vector<uint32_t> order(slots);
+        std::iota(order.begin(), order.end(), 0u);
+        for (bool scattered : {false, true}) {
+            for (uint32_t n : {16u, 256u, slots}) {
+                if (n > slots) continue;
+                std::vector<double> gather_t, compress_t;
+                for (uint32_t rep = 0; rep < repeats; ++rep) {
+                    if (scattered) std::shuffle(order.begin(), order.end(), rng);
+                    std::copy(order.begin(), order.begin() + n, b.ids.begin());
+                    // The box kernel against a box every ray passes: 7 gathers and a compress
+                    // per group, no failing ids.
+                    Bounds3 all;
+                    all.lo = Vec3(-1e30f);
+                    all.hi = Vec3(1e30f);
+                    uint32_t negative = 0;
+                    uint64_t s = __rdtsc();
+                    kernels.box_filter(b.trav.data(), all, 0, b.ids.data(), n, b.scratch.data(),
+                                       b.scratch2.data(), nullptr, negative);
+                    uint64_t e = __rdtsc();
+                    gather_t.push_back((double(e - s) - overhead) / n);
+                    for (uint32_t i = 0; i < n; ++i) b.mask[i] = uint8_t(rng() & 1);
+                    s = __rdtsc();
+                    kernels.partition(b.ids.data(), n, b.mask.data(), b.scratch.data());
+                    e = __rdtsc();
+                    compress_t.push_back((double(e - s) - overhead) / n);
+                }
+                out.push_back(
+                    {"gather (box kernel, 7 fields)", slots, n, scattered, median(gather_t)});
+                out.push_back({"compress partition", slots, n, scattered, median(compress_t)});
+            }
+        }
+    }
+    return out;
+}
+
+}  // namespace sfx

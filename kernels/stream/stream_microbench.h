@@ -1,0 +1,55 @@
+#pragma once
+// Microbenchmarks of the stream tracer's native filters on synthetic streams: each op kind's
+// filter (the box kernel, the triangle test's SIMD float stage and its exact stage, the sphere
+// test, the camera and every shading filter of Fig. 4 with the same per-ray steps of path.h)
+// run with the trace off on streams of a chosen length whose ids are scattered at random over a
+// ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
+// glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
+// the median of several repetitions. `sfx calibrate --describe-host` fits the host's per-op
+// costs to these samples (hw_model/host_timing.h), never to frames.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "kernels/simd/isa.h"
+#include "kernels/trace.h"
+
+namespace sfx {
+
+// Bytes of the stream tracer's ray buffers per slot (every per-slot array of a pass): what a
+// pass of n slots asks the L1D to hold.
+uint32_t stream_slot_bytes();
+
+struct MicrobenchSample {
+    OpKind kind = OpKind::box_test;
+    uint32_t slots = 0;   // the ray buffer the stream's ids are scattered over
+    uint32_t lanes = 0;   // stream length
+    uint32_t passed = 0;  // lanes that passed (the filter's result)
+    double cycles = 0.0;  // TSC ticks per call, median over repetitions
+};
+
+struct MicrobenchOptions {
+    Isa isa = Isa::automatic;
+    std::vector<uint32_t> buffer_slots = {256, 1024, 4096};  // 16^2, 32^2, 64^2 ray buffers
+    std::vector<uint32_t> lengths = {1, 8, 16, 24, 48, 96, 200, 512, 1024, 4096};
+    uint32_t repeats = 9;
+    uint64_t seed = 1;
+};
+
+// Every op kind the native tracer has, at every (buffer, length <= buffer). `progress(done,
+// total)` is called after each kind.
+std::vector<MicrobenchSample> run_stream_microbenchmarks(
+    const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
+
+// The gather and compress rates by themselves: TSC ticks per lane of a 16-field gather of
+// `lanes` ids over `slots` records (contiguous or random slots), and of the compress partition.
+struct KernelRate {
+    const char* what;
+    uint32_t slots, lanes;
+    bool scattered;
+    double cycles_per_lane;
+};
+std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t repeats = 9);
+
+}  // namespace sfx

@@ -1,0 +1,131 @@
+#include "sweeps/host_calibration.h"
+
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+
+#include "hw_model/op_costs.h"
+#include "kernels/stream/stream_tracer.h"
+
+namespace sfx {
+
+namespace {
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+HostCalibration calibrate_host(Isa isa, uint32_t repeats,
+                               const std::function<void(uint32_t, uint32_t)>& progress) {
+    HostCalibration c;
+    const Isa resolved = resolve_isa(isa);
+    c.host = describe_host(isa_width(resolved), describe_isa(resolved));
+    MicrobenchOptions options;
+    options.isa = resolved;
+    options.repeats = repeats;
+    c.samples = run_stream_microbenchmarks(options, progress);
+    c.rates = run_gather_compress_microbenchmarks(resolved, repeats);
+    const uint32_t l1d = c.host.caches.empty() ? 32 : c.host.caches.front().kib;
+    const uint32_t slot_bytes = stream_slot_bytes();
+    std::map<OpKind, std::vector<OpCostSample>> by_kind;
+    for (const MicrobenchSample& s : c.samples)
+        by_kind[s.kind].push_back(
+            {s.lanes, s.passed, beyond_l1_fraction(s.slots, slot_bytes, l1d), s.cycles});
+    size_t points = 0;
+    for (const auto& [kind, samples] : by_kind) {
+        c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
+        c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
+        points += samples.size();
+    }
+    std::ostringstream note;
+    note << points << " microbenchmark points of the native filters on synthetic streams ("
+         << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
+         << "256/1024/4096 slots of " << slot_bytes << " bytes, median of " << repeats
+         << "; kernels/stream/stream_microbench.h), least squares on relative error; no frame";
+    c.yaml = host_hw_yaml(c.host, c.op_costs, note.str());
+    return c;
+}
+
+bool pin_to_current_cpu() {
+    const int cpu = sched_getcpu();
+    if (cpu < 0) return false;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    return sched_setaffinity(0, sizeof set, &set) == 0;
+}
+
+SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
+                                       const HwConfig& host, uint32_t repeats) {
+    settings.threads = 1;
+    SiliconMeasurement m;
+    {  // The prediction, from the trace of the same render.
+        settings.stage_clock = false;
+        SceneDataMap map;
+        map.nodes = bvh.nodes().size();
+        map.triangles = scene.triangles.size();
+        map.spheres = scene.spheres.size();
+        const OpCostTable profiles(RayRecordLayout(scene.features()), host.datapath);
+        HostTiming timing(host, map, profiles, stream_slot_bytes());
+        render_stream(scene, bvh, settings, &timing);
+        const HostTimingResult& r = timing.result();
+        for (int s = 0; s < 3; ++s) {
+            m.predicted_stage[size_t(s)] = r.stage_cycles[size_t(s)];
+            m.predicted_memory[size_t(s)] = r.scene_memory_cycles[size_t(s)];
+        }
+        m.predicted_frame = r.frame_cycles();
+    }
+    // The measurement: unclocked and stage-clocked renders alternate, so drift in the machine's
+    // load touches both alike. The TSC counts while the thread is descheduled too, and on a
+    // shared machine that is often most of a render's wall time; so a render's cycles are its
+    // process CPU time at the TSC rate (what the TSC would count were the core ours alone), and
+    // a render whose TSC ticks exceed that by more than 3 % is counted as interrupted.
+    // Stages: the TSC split of the least interrupted stage-clocked render (ticks closest to its
+    // CPU time: a neighbour's time lands in whichever stage it interrupts), as fractions of the
+    // frame's cycles.
+    std::array<double, 3> fractions{};
+    double least_interrupted = 1e300;
+    std::vector<double> clocked_totals, tsc_samples;
+    const double mhz = host.clock.core_mhz;
+    auto timed = [&](bool clock, RenderResult& result) {
+        settings.stage_clock = clock;
+        timespec c0, c1;
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+        const uint64_t start = read_tsc();
+        result = render_stream(scene, bvh, settings);
+        const double ticks = double(read_tsc() - start);
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+        const double cpu_us = (c1.tv_sec - c0.tv_sec) * 1e6 + (c1.tv_nsec - c0.tv_nsec) * 1e-3;
+        if (ticks > 1.03 * cpu_us * mhz + 2000.0) ++m.interrupted;
+        return std::make_pair(cpu_us * mhz, ticks);
+    };
+    RenderResult r;
+    timed(false, r);  // warm: caches, page faults, the tracer's buffers
+    for (uint32_t i = 0; i < repeats; ++i) {
+        const auto [cycles, ticks] = timed(false, r);
+        m.frame_samples.push_back(cycles);
+        tsc_samples.push_back(ticks);
+        const auto [clocked, clocked_ticks] = timed(true, r);
+        double total = 0.0;
+        for (int s = 0; s < 3; ++s) total += double(r.stats.stage_tsc[s]);
+        if (total > 0 && clocked_ticks / clocked < least_interrupted) {
+            least_interrupted = clocked_ticks / clocked;
+            for (int s = 0; s < 3; ++s) fractions[size_t(s)] = double(r.stats.stage_tsc[s]) / total;
+        }
+        clocked_totals.push_back(clocked);
+    }
+    m.measured_frame = median(m.frame_samples);
+    m.measured_frame_tsc = median(tsc_samples);
+    for (int s = 0; s < 3; ++s)
+        m.measured_stage[size_t(s)] = fractions[size_t(s)] * m.measured_frame;
+    m.stage_clock_overhead = median(clocked_totals) / m.measured_frame - 1.0;
+    return m;
+}
+
+}  // namespace sfx

@@ -1,0 +1,60 @@
+#pragma once
+// The host CPU as a hardware configuration, validated on silicon: describe the host and fit its
+// per-op costs on microbenchmarks of the native filters (never on frames), then, for a held-out
+// workload, predict the native stream tracer's single-thread cycles from the trace of the same
+// render (hw_model/host_timing.h) and measure them (TSC, trace off, one pinned thread).
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "hw_model/host_description.h"
+#include "hw_model/host_timing.h"
+#include "kernels/bvh.h"
+#include "kernels/render.h"
+#include "kernels/stream/stream_microbench.h"
+#include "workloads/scene.h"
+
+namespace sfx {
+
+struct HostCalibration {
+    HostDescription host;
+    std::vector<OpCostConfig> op_costs;
+    std::vector<MicrobenchSample> samples;
+    std::vector<KernelRate> rates;  // gather and compress by themselves (reported, not fitted)
+    // Per fitted kind: the fit's (median, worst) relative error on its own samples.
+    std::vector<std::pair<double, double>> fit_errors;
+    std::string yaml;  // host.hw.yaml
+};
+
+// Describes the host, runs the microbenchmarks (`repeats` per point) and fits. `isa`: the
+// back end measured (auto: the widest). `progress(done, total)` per op kind.
+HostCalibration calibrate_host(Isa isa, uint32_t repeats,
+                               const std::function<void(uint32_t, uint32_t)>& progress = {});
+
+// Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
+bool pin_to_current_cpu();
+
+struct SiliconMeasurement {
+    std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
+    std::array<double, 3> predicted_memory{};  // of which scene-data misses
+    double predicted_frame = 0.0;
+    // Cycles: process CPU time at the TSC rate (the TSC alone counts the neighbours' time on
+    // a shared machine); the median of the unclocked renders.
+    double measured_frame = 0.0;
+    double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
+    std::vector<double> frame_samples;       // every unclocked render's cycles
+    std::array<double, 3> measured_stage{};  // least interrupted split x measured_frame
+    double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
+    uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
+};
+
+// One workload: `settings` are forced to one thread and `isa`. The host config must carry
+// op_costs for every kind the scene uses. Renders once with the trace on (the prediction),
+// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock.
+SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
+                                       const HwConfig& host, uint32_t repeats);
+
+}  // namespace sfx

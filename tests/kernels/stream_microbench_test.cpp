@@ -1,0 +1,62 @@
+// The stage clock and the microbenchmarks of the native filters: the flow on tiny inputs (no
+// timing is asserted beyond "it counted something").
+
+#include "kernels/stream/stream_microbench.h"
+
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <set>
+
+#include "kernels/bvh.h"
+#include "kernels/stream/stream_tracer.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+
+TEST_CASE("The stage clock never changes a bit and counts every stage", "[stream][host]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.spp = 1;
+    s.tile = 8;
+    s.threads = 2;
+    const RenderResult plain = render_stream(scene, bvh, s);
+    s.stage_clock = true;
+    const RenderResult clocked = render_stream(scene, bvh, s);
+    REQUIRE(plain.image.pixels.size() == clocked.image.pixels.size());
+    CHECK(std::memcmp(plain.image.pixels.data(), clocked.image.pixels.data(),
+                      plain.image.pixels.size() * sizeof(Vec3)) == 0);
+    for (int i = 0; i < 3; ++i) {
+        CHECK(plain.stats.stage_tsc[i] == 0);
+        CHECK(clocked.stats.stage_tsc[i] > 0);
+    }
+}
+
+TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][host]") {
+    MicrobenchOptions o;
+    o.buffer_slots = {64};
+    o.lengths = {1, 16, 64, 128};  // 128 > 64 slots: skipped
+    o.repeats = 1;
+    const std::vector<MicrobenchSample> samples = run_stream_microbenchmarks(o);
+    std::set<OpKind> kinds;
+    for (const MicrobenchSample& m : samples) {
+        kinds.insert(m.kind);
+        CHECK(m.slots == 64);
+        CHECK(m.lanes <= 64);
+        CHECK(m.passed <= m.lanes);
+        CHECK(m.cycles >= 0.0);
+    }
+    CHECK(kinds.size() == k_op_kind_count);
+    CHECK(samples.size() == 3 * k_op_kind_count);
+    // Some pass and some fail: the synthetic streams exercise both sides of the filters.
+    uint64_t lanes = 0, passed = 0;
+    for (const MicrobenchSample& m : samples)
+        if (m.kind == OpKind::miss_filter || m.kind == OpKind::box_test) {
+            lanes += m.lanes;
+            passed += m.passed;
+        }
+    CHECK(passed > 0);
+    CHECK(passed < lanes);
+    CHECK(stream_slot_bytes() > 64);
+}

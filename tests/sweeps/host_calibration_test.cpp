@@ -1,0 +1,52 @@
+// Predict, then measure, on a tiny workload: the flow, with loose tolerances (the machine is
+// shared; accuracy is the business of scripts/silicon-check, not of a unit test).
+
+#include "sweeps/host_calibration.h"
+
+#include <catch2/catch.hpp>
+#include <map>
+
+#include "kernels/bvh.h"
+#include "workloads/scene_loader.h"
+
+using namespace sfx;
+
+TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame", "[host]") {
+    // A quick fit: few points, one repetition (scripts/silicon-check fits properly).
+    const Isa isa = resolve_isa(Isa::automatic);
+    const HostDescription host = describe_host(isa_width(isa), describe_isa(isa));
+    MicrobenchOptions o;
+    o.isa = isa;
+    o.buffer_slots = {64, 256};
+    o.lengths = {1, 16, 64, 256};
+    o.repeats = 3;
+    std::map<OpKind, std::vector<OpCostSample>> by_kind;
+    for (const MicrobenchSample& s : run_stream_microbenchmarks(o))
+        by_kind[s.kind].push_back(
+            {s.lanes, s.passed,
+             beyond_l1_fraction(s.slots, stream_slot_bytes(), host.caches.front().kib), s.cycles});
+    std::vector<OpCostConfig> costs;
+    for (const auto& [kind, samples] : by_kind)
+        costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
+    const HwConfig config = parse_hw_config(host_hw_yaml(host, costs, "test"), "host.hw.yaml");
+
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings s;
+    s.width = s.height = 16;
+    s.spp = 1;
+    s.tile = 8;
+    s.max_depth = scene.max_depth;
+    s.isa = isa;
+    const SiliconMeasurement m = predict_and_measure(scene, bvh, s, config, 1);
+    CHECK(m.frame_samples.size() == 1);
+    CHECK(m.measured_frame > 0);
+    CHECK(m.predicted_frame > 0);
+    for (int i = 0; i < 3; ++i) {
+        CHECK(m.predicted_stage[size_t(i)] > 0);
+        CHECK(m.measured_stage[size_t(i)] > 0);
+    }
+    // Within a factor of 20 either way: only a broken flow (units, a lost stage) misses that.
+    CHECK(m.predicted_frame / m.measured_frame > 0.05);
+    CHECK(m.predicted_frame / m.measured_frame < 20);
+}
