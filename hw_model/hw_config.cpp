@@ -253,6 +253,18 @@ HwConfig load_hw_config(const std::string& path) {
     return parse_hw_config(read_input_file(path, "hardware configuration"), path);
 }
 
+void check_machine_model_config(const HwConfig& config) {
+    const auto refuse = [&](const std::string& key, const std::string& value) {
+        throw InputError(config.name, 0, key,
+                         value + " describes a CPU core, which only `sfx calibrate --check` times; "
+                                 "the machine model (simulate, compare, accuracy, sweeps) needs "
+                                 "a configuration of the stream-filtering machine");
+    };
+    if (config.ray_buffer.storage != "banks") refuse("ray_buffer.storage", config.ray_buffer.storage);
+    if (config.partition.kind != "in_place_compare") refuse("partition.kind", config.partition.kind);
+    if (!config.op_costs.empty()) refuse("op_costs", "a list of measured op costs");
+}
+
 std::string dump_hw_config(const HwConfig& config) {
     YAML::Emitter out;
     out << YAML::BeginMap;

@@ -307,6 +307,10 @@ HwConfig parse_hw_config(const std::string& yaml_text, const std::string& file_n
 using HwLineMap = std::map<std::string, int>;
 void check_hw_config(const HwConfig& config, const std::string& file_name,
                      const HwLineMap& lines = {});
+// The machine model times dedicated banked buffers and the comparator partition unit; a host
+// description (ray_buffer.storage: l1d, partition.kind: compress, op_costs) is timed only by
+// the host timing (sfx calibrate --check). Throws an InputError naming the configuration.
+void check_machine_model_config(const HwConfig& config);
 
 // The fully resolved configuration as YAML: load(dump(c)) == c.
 std::string dump_hw_config(const HwConfig& config);

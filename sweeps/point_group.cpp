@@ -326,6 +326,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
 PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                                  const std::vector<HwConfig>& configs, Fidelity fidelity,
                                  const SamplingOptions& sampling, const PassProgress& progress) {
+    for (const HwConfig& c : configs) check_machine_model_config(c);
     if (fidelity == Fidelity::sampled)
         return run_sampled(scene, bvh, settings, configs, sampling, progress);
     const auto start = HostClock::now();

@@ -150,6 +150,7 @@ ResolvedWorkload resolve_workload(const WorkloadConfig& w, const FeatureSet& sce
                                   const std::vector<HwConfig>& configs,
                                   const std::string& tile_key) {
     ResolvedWorkload r{w, scene_features};
+    for (const HwConfig& c : configs) check_machine_model_config(c);  // before its buffer size
     if (w.depth < 0) r.config.depth = scene_features.max_depth;
     // The ray record does not depend on the depth today, but the hardware model sees the
     // resolved depth (workload_shape), so the fit is checked against the same features.
