@@ -3,29 +3,52 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 namespace sfx {
 
 const char* to_string(MaterialKind kind) {
     switch (kind) {
-        case MaterialKind::lambertian: return "lambertian";
-        case MaterialKind::dielectric: return "dielectric";
-        case MaterialKind::glossy: return "glossy";
+        case MaterialKind::lambertian:
+            return "lambertian";
+        case MaterialKind::dielectric:
+            return "dielectric";
+        case MaterialKind::glossy:
+            return "glossy";
     }
     return "?";
+}
+
+bool FeatureSet::*FeatureSet::material_flag(MaterialKind kind) {
+    switch (kind) {
+        case MaterialKind::lambertian:
+            return &FeatureSet::lambertian;
+        case MaterialKind::dielectric:
+            return &FeatureSet::dielectric;
+        case MaterialKind::glossy:
+            return &FeatureSet::glossy;
+    }
+    throw std::logic_error("FeatureSet::material_flag: not a material kind");
+}
+
+uint32_t FeatureSet::material_kinds() const {
+    uint32_t n = 0;
+    for (MaterialKind k : k_material_kinds) n += uses(k);
+    return n;
 }
 
 std::string FeatureSet::describe() const {
     std::ostringstream s;
     const char* sep = "";
     auto item = [&](bool on, const char* name) {
-        if (on) { s << sep << name; sep = ", "; }
+        if (on) {
+            s << sep << name;
+            sep = ", ";
+        }
     };
     item(triangles, "triangles");
     item(spheres, "spheres");
-    item(lambertian, "lambertian");
-    item(dielectric, "dielectric");
-    item(glossy, "glossy");
+    for (MaterialKind k : k_material_kinds) item(uses(k), to_string(k));
     item(thin_lens, "thin-lens");
     item(ambient, "ambient");
     item(environment, "environment");
@@ -39,7 +62,8 @@ float Scene::primitive_area(uint32_t prim) const {
         return 4.f * float(M_PI) * r * r;
     }
     const Triangle& t = triangles[prim];
-    return 0.5f * length(cross(positions[t.v1] - positions[t.v0], positions[t.v2] - positions[t.v0]));
+    return 0.5f *
+           length(cross(positions[t.v1] - positions[t.v0], positions[t.v2] - positions[t.v0]));
 }
 
 Bounds3 Scene::primitive_bounds(uint32_t prim) const {
@@ -71,10 +95,7 @@ FeatureSet Scene::features() const {
     for (const Triangle& t : triangles) used[t.material] = true;
     for (const Sphere& s : spheres) used[s.material] = true;
     for (size_t m = 0; m < materials.size(); ++m) {
-        if (!used[m]) continue;
-        f.lambertian |= materials[m].kind == MaterialKind::lambertian;
-        f.dielectric |= materials[m].kind == MaterialKind::dielectric;
-        f.glossy |= materials[m].kind == MaterialKind::glossy;
+        if (used[m]) f.*FeatureSet::material_flag(materials[m].kind) = true;
     }
     f.thin_lens = camera.aperture_radius > 0.f;
     f.ambient = !is_black(ambient);
