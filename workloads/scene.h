@@ -81,6 +81,11 @@ struct FeatureSet {
     std::string describe() const;
 };
 
+struct Scene;
+// Hash of everything in a scene that changes a trace (geometry, materials, camera, lights):
+// a trace file's header names the scene it is of by this.
+uint64_t scene_hash(const Scene& scene);
+
 struct Scene {
     std::string name;
     std::vector<Vec3> positions;
