@@ -19,6 +19,16 @@ namespace {
 Vec3 place(const Transform* xf, const Vec3& p) {
     return xf ? xf->apply(p) : p;
 }
+// Two triangles per cell of an (nu + 1) x (nv + 1) vertex grid appended from `first`, row by row.
+void grid_triangles(SceneBuilder& b, uint32_t first, uint32_t nu, uint32_t nv, uint32_t material) {
+    const uint32_t row = nu + 1;
+    for (uint32_t j = 0; j < nv; ++j)
+        for (uint32_t i = 0; i < nu; ++i) {
+            const uint32_t a = first + j * row + i;
+            b.add_triangle(a, a + 1, a + row + 1, material);
+            b.add_triangle(a, a + row + 1, a + row, material);
+        }
+}
 }  // namespace
 
 void quad(SceneBuilder& b, const Vec3& o, const Vec3& u, const Vec3& v, uint32_t material,
@@ -58,13 +68,7 @@ void grid(SceneBuilder& b, const Vec3& o, const Vec3& u, const Vec3& v, uint32_t
             b.add_vertex(place(xf, p));
         }
     }
-    const uint32_t row = nu + 1;
-    for (uint32_t j = 0; j < nv; ++j)
-        for (uint32_t i = 0; i < nu; ++i) {
-            const uint32_t a = first + j * row + i;
-            b.add_triangle(a, a + 1, a + row + 1, material);
-            b.add_triangle(a, a + row + 1, a + row, material);
-        }
+    grid_triangles(b, first, nu, nv, material);
 }
 
 void lathe(SceneBuilder& b, const Vec3& base, float h, uint32_t segments, uint32_t rings,
@@ -154,13 +158,7 @@ void surface(SceneBuilder& b, uint32_t nu, uint32_t nv, uint32_t material,
     for (uint32_t j = 0; j <= nv; ++j)
         for (uint32_t i = 0; i <= nu; ++i)
             b.add_vertex(point(float(i) / float(nu), float(j) / float(nv)));
-    const uint32_t row = nu + 1;
-    for (uint32_t j = 0; j < nv; ++j)
-        for (uint32_t i = 0; i < nu; ++i) {
-            const uint32_t a = first + j * row + i;
-            b.add_triangle(a, a + 1, a + row + 1, material);
-            b.add_triangle(a, a + row + 1, a + row, material);
-        }
+    grid_triangles(b, first, nu, nv, material);
 }
 
 const IcoMesh& icosphere(uint32_t levels) {
