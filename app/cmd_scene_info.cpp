@@ -35,7 +35,7 @@ void add_scene_info_command(CLI::App& app) {
         const FeatureSet features = scene.features();
         const auto fields = ray_record_fields(features);
         const uint32_t ray_bytes = ray_record_bytes(features);
-        uint32_t kinds[3] = {0, 0, 0};
+        uint32_t kinds[k_material_kind_count] = {};
         for (const Material& m : scene.materials) ++kinds[int(m.kind)];
         uint32_t emissive = 0;
         for (const Material& m : scene.materials) emissive += m.emissive();
@@ -53,16 +53,14 @@ void add_scene_info_command(CLI::App& app) {
             j["lights"] = scene.lights.size();
             j["light_primitives"] = light_primitives;
             j["materials"] = scene.materials.size();
-            j["materials.lambertian"] = kinds[int(MaterialKind::lambertian)];
-            j["materials.dielectric"] = kinds[int(MaterialKind::dielectric)];
-            j["materials.glossy"] = kinds[int(MaterialKind::glossy)];
+            for (MaterialKind k : k_material_kinds)
+                j[std::string("materials.") + to_string(k)] = kinds[int(k)];
             j["materials.emissive"] = emissive;
             j["features"] = features.describe();
             j["features.triangles"] = features.triangles;
             j["features.spheres"] = features.spheres;
-            j["features.lambertian"] = features.lambertian;
-            j["features.dielectric"] = features.dielectric;
-            j["features.glossy"] = features.glossy;
+            for (MaterialKind k : k_material_kinds)
+                j[std::string("features.") + to_string(k)] = features.uses(k);
             j["features.thin_lens"] = features.thin_lens;
             j["features.ambient"] = features.ambient;
             j["features.environment"] = features.environment;
@@ -103,8 +101,12 @@ void add_scene_info_command(CLI::App& app) {
                     scene.positions.size());
         std::printf("lights             %zu (%llu emissive primitives)\n", scene.lights.size(),
                     (unsigned long long)light_primitives);
-        std::printf("materials          %zu (lambertian %u, dielectric %u, glossy %u; emissive %u)\n",
-                    scene.materials.size(), kinds[0], kinds[1], kinds[2], emissive);
+        std::string per_kind;
+        for (MaterialKind k : k_material_kinds)
+            per_kind += (per_kind.empty() ? "" : ", ") + std::string(to_string(k)) + " " +
+                        std::to_string(kinds[int(k)]);
+        std::printf("materials          %zu (%s; emissive %u)\n", scene.materials.size(),
+                    per_kind.c_str(), emissive);
         std::printf("features           %s\n", features.describe().c_str());
         std::printf("ray record         %u bytes (%u KiB for 64x64 rays)\n", ray_bytes,
                     ray_bytes * 4096 / 1024);
@@ -122,9 +124,10 @@ void add_scene_info_command(CLI::App& app) {
         std::printf("memory             geometry %s, bvh %s, total %s\n", mib(geometry).c_str(),
                     mib(st.bytes).c_str(), mib(geometry + st.bytes).c_str());
         std::printf("load seconds       %.3f\n", load_seconds);
-        std::printf("stream back end    %s (widest this CPU runs; --isa on the rendering "
-                    "commands)\n",
-                    describe_isa(Isa::automatic).c_str());
+        std::printf(
+            "stream back end    %s (widest this CPU runs; --isa on the rendering "
+            "commands)\n",
+            describe_isa(Isa::automatic).c_str());
     });
 }
 

@@ -77,30 +77,6 @@ std::vector<Ray> diffuse_rays(const Scene& scene, const Bvh& bvh, const std::vec
     return rays;
 }
 
-// Box and primitive tests of Bvh::intersect for one ray (the reference's work per ray).
-void count_reference_tests(const Bvh& bvh, const Ray& ray, uint64_t& boxes, uint64_t& prims) {
-    if (!ray_is_valid(ray)) return;
-    const RayPrecomp r(ray);
-    Hit hit;
-    float t_max = ray.t_max;
-    std::vector<uint32_t> stack{0};
-    while (!stack.empty()) {
-        const uint32_t index = stack.back();
-        const BvhNode& node = bvh.nodes()[index];
-        stack.pop_back();
-        ++boxes;
-        if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
-        if (node.is_leaf()) {
-            for (uint32_t i = node.first; i < node.first + node.count; ++i, ++prims)
-                if (bvh.intersect_primitive(r, bvh.prim_ids()[i], t_max, hit)) t_max = hit.t;
-        } else {
-            const bool right_first = visit_right_first(node, r.dir);
-            stack.push_back(right_first ? BvhNode::left(index) : node.right());
-            stack.push_back(right_first ? node.right() : BvhNode::left(index));
-        }
-    }
-}
-
 void report(const char* name, size_t rays, double seconds, double embree_rate) {
     const double rate = double(rays) / seconds;
     std::printf("  %-34s %8.2f Mrays/s", name, rate * 1e-6);
@@ -188,13 +164,13 @@ int main(int argc, char** argv) {
             "  stream hits differing from reference (all back ends): %zu; "
             "primitive differs from Embree's: %zu\n",
             differ, embree_differ);
-        uint64_t boxes = 0, prims = 0;
-        for (const Ray& r : *rays) count_reference_tests(bvh, r, boxes, prims);
+        TraversalCounts reference;  // Bvh::intersect's own tests, counted by its policy
+        for (const Ray& r : *rays) bvh.intersect(r, reference);
         const double n = double(rays->size()), runs = double(repeat);
         std::printf(
             "  tests per ray: reference %.1f box, %.1f primitive; stream %.1f box, %.1f "
             "primitive in ops of %.1f and %.1f rays on average\n",
-            double(boxes) / n, double(prims) / n,
+            double(reference.boxes) / n, double(reference.primitives) / n,
             double(counts.kind_lanes(OpKind::box_test)) / runs / n,
             double(counts.kind_lanes(OpKind::triangle_test) +
                    counts.kind_lanes(OpKind::sphere_test)) /

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "hw_model/counter_info.h"
 #include "kernels/trace.h"
 
 namespace sfx {
@@ -43,46 +44,65 @@ struct ActionCounts {
     uint64_t dram_bytes = 0;
     std::array<uint64_t, k_hw_unit_count> busy_cycles{};  // by HwUnit
 
-    // Applies f(counter of a, counter of b) to every counter of a pair.
-    template <class F>
-    static void for_each(ActionCounts& a, const ActionCounts& b, F f) {
-        f(a.bank_reads, b.bank_reads);
-        f(a.bank_writes, b.bank_writes);
-        f(a.agu_addresses, b.agu_addresses);
+    // Every counter of a and b in step, named (counter_info.h).
+    template <class A, class B, class F>
+    static void visit(A& a, B& b, F&& f) {
+        f(CounterInfo("bank_reads", "words", "32-bit words read from ray-buffer banks"),
+          a.bank_reads, b.bank_reads);
+        f(CounterInfo("bank_writes", "words", "32-bit words written to ray-buffer banks"),
+          a.bank_writes, b.bank_writes);
+        f(CounterInfo("agu_addresses", "addresses", "addresses the AGUs computed"), a.agu_addresses,
+          b.agu_addresses);
         for (uint32_t k = 0; k < k_op_kind_count; ++k) {
-            f(a.simd_instructions[k], b.simd_instructions[k]);
-            f(a.simd_lane_ops[k], b.simd_lane_ops[k]);
+            const char* kind = to_string(OpKind(k));
+            f(CounterInfo(kind, "instructions", "SIMD instructions issued (one per lane group)")
+                  .under("simd_instructions"),
+              a.simd_instructions[k], b.simd_instructions[k]);
+            f(CounterInfo(kind, "lane-instructions", "lane-instructions that carry a ray")
+                  .under("simd_lane_ops"),
+              a.simd_lane_ops[k], b.simd_lane_ops[k]);
         }
-        f(a.partition_compares, b.partition_compares);
-        f(a.partition_moves, b.partition_moves);
-        f(a.scratchpad_accesses, b.scratchpad_accesses);
-        f(a.interconnect_word_hops, b.interconnect_word_hops);
+        f(CounterInfo("partition_compares", "lanes", "mask lanes compared"), a.partition_compares,
+          b.partition_compares);
+        f(CounterInfo("partition_moves", "ids", "ids the partition moved"), a.partition_moves,
+          b.partition_moves);
+        f(CounterInfo("scratchpad_accesses", "words", "scratchpad words read or written"),
+          a.scratchpad_accesses, b.scratchpad_accesses);
+        f(CounterInfo("interconnect_word_hops", "word-hops",
+                      "words moved x multiplexer levels crossed"),
+          a.interconnect_word_hops, b.interconnect_word_hops);
         for (uint32_t i = 0; i < k_max_cache_levels; ++i) {
-            f(a.cache_accesses[i], b.cache_accesses[i]);
-            f(a.cache_fills[i], b.cache_fills[i]);
+            f(CounterInfo(index_name(i), "lookups", "scene-cache lookups").under("cache_accesses"),
+              a.cache_accesses[i], b.cache_accesses[i]);
+            f(CounterInfo(index_name(i), "lines", "scene-cache lines filled").under("cache_fills"),
+              a.cache_fills[i], b.cache_fills[i]);
         }
-        f(a.dram_bytes, b.dram_bytes);
-        for (uint32_t u = 0; u < k_hw_unit_count; ++u) f(a.busy_cycles[u], b.busy_cycles[u]);
+        f(CounterInfo("dram_bytes", "bytes", "scene-data bytes read from DRAM"), a.dram_bytes,
+          b.dram_bytes);
+        for (uint32_t u = 0; u < k_hw_unit_count; ++u)
+            f(CounterInfo(to_string(HwUnit(u)), "cycles", "cycles the unit was busy")
+                  .under("busy_cycles"),
+              a.busy_cycles[u], b.busy_cycles[u]);
     }
 
     ActionCounts& operator+=(const ActionCounts& o) {
-        for_each(*this, o, [](uint64_t& x, uint64_t y) { x += y; });
+        visit(*this, o, [](const CounterInfo&, uint64_t& x, uint64_t y) { x += y; });
         return *this;
     }
     ActionCounts& operator-=(const ActionCounts& o) {
-        for_each(*this, o, [](uint64_t& x, uint64_t y) { x -= y; });
+        visit(*this, o, [](const CounterInfo&, uint64_t& x, uint64_t y) { x -= y; });
         return *this;
     }
     // Adds o * weight, each counter rounded: a sampled pass expanded to its stratum.
     void add_scaled(const ActionCounts& o, double weight) {
-        for_each(*this, o, [weight](uint64_t& x, uint64_t y) {
+        visit(*this, o, [weight](const CounterInfo&, uint64_t& x, uint64_t y) {
             x += uint64_t(std::llround(double(y) * weight));
         });
     }
     bool operator==(const ActionCounts& o) const {
         bool equal = true;
-        for_each(const_cast<ActionCounts&>(*this), o,
-                 [&equal](uint64_t& x, uint64_t y) { equal = equal && x == y; });
+        visit(*this, o,
+              [&equal](const CounterInfo&, uint64_t x, uint64_t y) { equal = equal && x == y; });
         return equal;
     }
 };

@@ -197,10 +197,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     FrameTiming t;
     t.passes = profile.passes();
     double total_cycles = 0.0;
-    StallCycles stalls_sum;
-    // Fractional sums in unit-cycles, rounded once at the end: conflict, alignment, address,
-    // partition, scene memory, interconnect, pipeline fill, unit idle.
-    double stall_values[8] = {};
+    // Fractional sums in unit-cycles, rounded once at the end.
+    StallCounts<double> stalls;
     // Expected action counts, summed fractionally and rounded once at the end (as the stalls).
     double bank_reads = 0, bank_writes = 0, addresses = 0, compares = 0, moved = 0,
            scratch_words = 0, word_hops = 0, fetches = 0, busy_units[k_hw_unit_count] = {};
@@ -304,14 +302,14 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double busy_units = double(groups) * busy;
         const double fetch_excess = ops * sharing * std::max(0.0, exec - rounds * busy);
         const double excess_parts = std::max(1e-9, align + conflict + addr_sum + ic_sum);
-        stall_values[0] += fetch_excess * conflict / excess_parts;
-        stall_values[1] += fetch_excess * align / excess_parts;
-        stall_values[2] += fetch_excess * addr_sum / excess_parts;
-        stall_values[5] += fetch_excess * ic_sum / excess_parts;
-        stall_values[3] += ops * units * (compare + moves);
-        stall_values[4] += ops * units * memory_stall;
-        stall_values[6] += ops * units * (p.partitions ? first_fetch + tail : 0.0);
-        stall_values[7] += ops * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
+        stalls.bank_conflict += fetch_excess * conflict / excess_parts;
+        stalls.alignment += fetch_excess * align / excess_parts;
+        stalls.address_fetch += fetch_excess * addr_sum / excess_parts;
+        stalls.interconnect += fetch_excess * ic_sum / excess_parts;
+        stalls.partition += ops * units * (compare + moves);
+        stalls.scene_memory += ops * units * memory_stall;
+        stalls.pipeline_fill += ops * units * (p.partitions ? first_fetch + tail : 0.0);
+        stalls.unit_idle += ops * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
         StageTiming& stage = t.stages[secondary][uint32_t(stage_of(kind))];
         stage.ops += bucket.ops;
         stage.lanes += bucket.ops * length;
@@ -327,15 +325,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         if (p.pushes_rays) t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
         t.field_accesses += uint64_t(std::llround(ops * accesses));
     }
-    stalls_sum.bank_conflict = uint64_t(std::llround(stall_values[0]));
-    stalls_sum.alignment = uint64_t(std::llround(stall_values[1]));
-    stalls_sum.address_fetch = uint64_t(std::llround(stall_values[2]));
-    stalls_sum.partition = uint64_t(std::llround(stall_values[3]));
-    stalls_sum.scene_memory = uint64_t(std::llround(stall_values[4]));
-    stalls_sum.interconnect = uint64_t(std::llround(stall_values[5]));
-    stalls_sum.pipeline_fill = uint64_t(std::llround(stall_values[6]));
-    stalls_sum.unit_idle = uint64_t(std::llround(stall_values[7]));
-    t.stalls = stalls_sum;
+    StallCycles::visit(t.stalls, stalls, [](const CounterInfo&, uint64_t& x, double y) {
+        x = uint64_t(std::llround(y));
+    });
     auto count = [](double v) { return uint64_t(std::llround(v)); };
     ActionCounts& a = t.actions;
     a.bank_reads = count(bank_reads);

@@ -27,107 +27,30 @@ Fidelity parse_fidelity(const std::string& text) {
     throw std::invalid_argument("fidelity must be analytic, sampled or full, not '" + text + "'");
 }
 
-StallCycles& StallCycles::operator+=(const StallCycles& o) {
-    bank_conflict += o.bank_conflict;
-    alignment += o.alignment;
-    address_fetch += o.address_fetch;
-    partition += o.partition;
-    scene_memory += o.scene_memory;
-    interconnect += o.interconnect;
-    pipeline_fill += o.pipeline_fill;
-    unit_idle += o.unit_idle;
-    return *this;
-}
-
 OpMix& OpMix::operator+=(const OpMix& o) {
-    load += o.load;
-    store += o.store;
-    compute += o.compute;
-    scatter_gather += o.scatter_gather;
-    partition += o.partition;
+    visit(*this, o, [](const CounterInfo&, uint64_t& x, uint64_t y) { x += y; });
     return *this;
 }
 
 StageTiming& StageTiming::operator+=(const StageTiming& o) {
-    ops += o.ops;
-    lanes += o.lanes;
-    groups += o.groups;
-    busy_cycles += o.busy_cycles;
-    stall_cycles += o.stall_cycles;
+    visit(*this, o, [](const CounterInfo&, uint64_t& x, uint64_t y) { x += y; });
     return *this;
 }
 
 FrameTiming& FrameTiming::operator+=(const FrameTiming& o) {
-    cycles += o.cycles;
-    stalls += o.stalls;
-    mix += o.mix;
-    for (int s = 0; s < 2; ++s)
-        for (uint32_t k = 0; k < k_op_stage_count; ++k) stages[s][k] += o.stages[s][k];
-    field_accesses += o.field_accesses;
-    conflicted_accesses += o.conflicted_accesses;
-    if (cache_hits.size() < o.cache_hits.size()) {
-        cache_hits.resize(o.cache_hits.size());
-        cache_misses.resize(o.cache_misses.size());
-    }
-    for (size_t i = 0; i < o.cache_hits.size(); ++i) {
-        cache_hits[i] += o.cache_hits[i];
-        cache_misses[i] += o.cache_misses[i];
-    }
-    dram_reads += o.dram_reads;
-    passes += o.passes;
-    actions += o.actions;
+    visit(*this, o, [](const CounterInfo&, uint64_t& x, uint64_t y) { x += y; });
     return *this;
 }
 
-namespace {
-// Applies f(counter of this, counter of o) to every counter of a FrameTiming pair.
-template <class F>
-void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
-    f(t.cycles, o.cycles);
-    f(t.stalls.bank_conflict, o.stalls.bank_conflict);
-    f(t.stalls.alignment, o.stalls.alignment);
-    f(t.stalls.address_fetch, o.stalls.address_fetch);
-    f(t.stalls.partition, o.stalls.partition);
-    f(t.stalls.scene_memory, o.stalls.scene_memory);
-    f(t.stalls.interconnect, o.stalls.interconnect);
-    f(t.stalls.pipeline_fill, o.stalls.pipeline_fill);
-    f(t.stalls.unit_idle, o.stalls.unit_idle);
-    f(t.mix.load, o.mix.load);
-    f(t.mix.store, o.mix.store);
-    f(t.mix.compute, o.mix.compute);
-    f(t.mix.scatter_gather, o.mix.scatter_gather);
-    f(t.mix.partition, o.mix.partition);
-    for (int s = 0; s < 2; ++s)
-        for (uint32_t k = 0; k < k_op_stage_count; ++k) {
-            f(t.stages[s][k].ops, o.stages[s][k].ops);
-            f(t.stages[s][k].lanes, o.stages[s][k].lanes);
-            f(t.stages[s][k].groups, o.stages[s][k].groups);
-            f(t.stages[s][k].busy_cycles, o.stages[s][k].busy_cycles);
-            f(t.stages[s][k].stall_cycles, o.stages[s][k].stall_cycles);
-        }
-    f(t.field_accesses, o.field_accesses);
-    f(t.conflicted_accesses, o.conflicted_accesses);
-    t.cache_hits.resize(std::max(t.cache_hits.size(), o.cache_hits.size()));
-    t.cache_misses.resize(std::max(t.cache_misses.size(), o.cache_misses.size()));
-    for (size_t i = 0; i < o.cache_hits.size(); ++i) {
-        f(t.cache_hits[i], o.cache_hits[i]);
-        f(t.cache_misses[i], o.cache_misses[i]);
-    }
-    f(t.dram_reads, o.dram_reads);
-    f(t.passes, o.passes);
-    ActionCounts::for_each(t.actions, o.actions, f);
-}
-}  // namespace
-
 void FrameTiming::add_scaled(const FrameTiming& o, double weight) {
-    for_each_counter(*this, o, [weight](uint64_t& a, uint64_t b) {
-        a += uint64_t(std::llround(double(b) * weight));
+    visit(*this, o, [weight](const CounterInfo&, uint64_t& x, uint64_t y) {
+        x += uint64_t(std::llround(double(y) * weight));
     });
 }
 
 FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b) {
     FrameTiming d = b;
-    for_each_counter(d, a, [](uint64_t& x, uint64_t y) { x -= y; });
+    FrameTiming::visit(d, a, [](const CounterInfo&, uint64_t& x, uint64_t y) { x -= y; });
     return d;
 }
 
@@ -166,11 +89,10 @@ std::vector<Stat> Prediction::stats() const {
     add("tile", double(tile), "pixels", "tile edge: the initial stream is tile^2 rays");
     add("bytes_per_ray", double(bytes_per_ray), "bytes", "ray record size in the ray buffer");
 
-    static const char* k_stage_names[] = {"traversal", "intersection", "shading"};
     for (uint32_t k = 0; k < k_op_stage_count; ++k) {
         StageTiming all = timing.stages[0][k];
         all += timing.stages[1][k];
-        const std::string st = k_stage_names[k];
+        const std::string st = to_string(OpStage(k));
         // Effective utilization: the ideal (lanes over issued lane slots) times the share of
         // the stage's cycles that issue work; a stall cycle issues nothing.
         auto effective = [](double ideal, const StageTiming& t) {
@@ -201,31 +123,16 @@ std::vector<Stat> Prediction::stats() const {
     const double unit_scale =
         1.0 / double(std::max(1u, config.simd.units) * std::max(1u, config.cores.count));
     const StallCycles& st = timing.stalls;
-    auto stall = [&](const char* name, uint64_t v, const char* what) {
-        add(std::string("stall_cycles.") + name, double(v) * unit_scale, "cycles", what);
-    };
-    stall("bank_conflict", st.bank_conflict, "waiting on a busy ray-buffer bank");
-    stall("alignment", st.alignment, "SIMD groups not aligned to buffer lines");
-    stall("address_fetch", st.address_fetch, "address generation behind the data path");
-    stall("partition", st.partition, "in-place stream partition");
-    stall("scene_memory", st.scene_memory, "waiting for scene data");
-    stall("interconnect", st.interconnect, "interconnect contention");
-    stall("pipeline_fill", st.pipeline_fill, "waiting out bank, interconnect and datapath latency");
-    stall("unit_idle", st.unit_idle, "a SIMD unit with no group released to it");
-    stall("total", st.total(), "all stall cycles");
+    StallCycles::visit(st, st, [&](const CounterInfo& c, uint64_t v, uint64_t) {
+        add("stall_cycles." + c.name(), double(v) * unit_scale, c.unit, c.description);
+    });
+    add("stall_cycles.total", double(st.total()) * unit_scale, "cycles", "all stall cycles");
 
     const double mix_total = double(timing.mix.total());
-    add("op_mix.load_percent", 100.0 * ratio(double(timing.mix.load), mix_total), "%",
-        "loads (Table 5)");
-    add("op_mix.store_percent", 100.0 * ratio(double(timing.mix.store), mix_total), "%",
-        "stores (Table 5)");
-    add("op_mix.compute_percent", 100.0 * ratio(double(timing.mix.compute), mix_total), "%",
-        "compute on ray data (Table 5)");
-    add("op_mix.scatter_gather_percent",
-        100.0 * ratio(double(timing.mix.scatter_gather), mix_total), "%",
-        "scatters and gathers (Table 5)");
-    add("op_mix.partition_percent", 100.0 * ratio(double(timing.mix.partition), mix_total), "%",
-        "partition (Table 5)");
+    OpMix::visit(timing.mix, timing.mix, [&](const CounterInfo& c, uint64_t v, uint64_t) {
+        add("op_mix." + c.name() + "_percent", 100.0 * ratio(double(v), mix_total), "%",
+            c.description);
+    });
     add("op_mix.instructions", mix_total, "instructions", "SIMD instructions per frame");
 
     add("ray_buffer.bank_conflict_rate",

@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "hw_model/action_counts.h"
+#include "hw_model/counter_info.h"
 #include "hw_model/hw_config.h"
 #include "hw_model/tech_table.h"
 #include "kernels/trace.h"
@@ -19,22 +21,50 @@ enum class Fidelity { analytic, sampled, full };
 const char* to_string(Fidelity f);
 Fidelity parse_fidelity(const std::string& text);  // throws std::invalid_argument
 
-struct StallCycles {
-    uint64_t bank_conflict = 0;  // gathers/scatters waiting on a busy bank
-    uint64_t alignment = 0;      // id-stream groups straddling or starting off a buffer line
-    uint64_t address_fetch = 0;  // address generation slower than the data it feeds
-    uint64_t partition = 0;      // in-place partition after a filter
-    uint64_t scene_memory = 0;   // waiting for a node, primitive or material
-    uint64_t interconnect = 0;   // address and data words contending for the interconnect
-    uint64_t pipeline_fill = 0;  // waiting out bank, interconnect and datapath latencies
-    uint64_t unit_idle = 0;      // a SIMD unit with no group released to it (too few groups)
+// Stall cycles by cause. A template so that a model may sum expected (fractional) stalls in
+// the same shape and round once (analytic_model.cpp).
+template <class T>
+struct StallCounts {
+    T bank_conflict{};  // gathers/scatters waiting on a busy bank
+    T alignment{};      // id-stream groups straddling or starting off a buffer line
+    T address_fetch{};  // address generation slower than the data it feeds
+    T partition{};      // in-place partition after a filter
+    T scene_memory{};   // waiting for a node, primitive or material
+    T interconnect{};   // address and data words contending for the interconnect
+    T pipeline_fill{};  // waiting out bank, interconnect and datapath latencies
+    T unit_idle{};      // a SIMD unit with no group released to it (too few groups)
 
-    uint64_t total() const {
-        return bank_conflict + alignment + address_fetch + partition + scene_memory + interconnect +
-               pipeline_fill + unit_idle;
+    template <class A, class B, class F>
+    static void visit(A& a, B& b, F&& f) {
+        f(CounterInfo("bank_conflict", "cycles", "waiting on a busy ray-buffer bank"),
+          a.bank_conflict, b.bank_conflict);
+        f(CounterInfo("alignment", "cycles", "SIMD groups not aligned to buffer lines"),
+          a.alignment, b.alignment);
+        f(CounterInfo("address_fetch", "cycles", "address generation behind the data path"),
+          a.address_fetch, b.address_fetch);
+        f(CounterInfo("partition", "cycles", "in-place stream partition"), a.partition,
+          b.partition);
+        f(CounterInfo("scene_memory", "cycles", "waiting for scene data"), a.scene_memory,
+          b.scene_memory);
+        f(CounterInfo("interconnect", "cycles", "interconnect contention"), a.interconnect,
+          b.interconnect);
+        f(CounterInfo("pipeline_fill", "cycles",
+                      "waiting out bank, interconnect and datapath latency"),
+          a.pipeline_fill, b.pipeline_fill);
+        f(CounterInfo("unit_idle", "cycles", "a SIMD unit with no group released to it"),
+          a.unit_idle, b.unit_idle);
     }
-    StallCycles& operator+=(const StallCycles& o);
+    T total() const {
+        T sum{};
+        visit(*this, *this, [&](const CounterInfo&, const T& v, const T&) { sum += v; });
+        return sum;
+    }
+    StallCounts& operator+=(const StallCounts& o) {
+        visit(*this, o, [](const CounterInfo&, T& x, const T& y) { x += y; });
+        return *this;
+    }
 };
+using StallCycles = StallCounts<uint64_t>;
 
 // SIMD instructions by class, as the paper's Table 5 counts them.
 struct OpMix {
@@ -44,6 +74,17 @@ struct OpMix {
     uint64_t scatter_gather = 0;  // ray-record gathers and conditional scatters
     uint64_t partition = 0;       // comparator passes of the partition unit
 
+    template <class A, class B, class F>
+    static void visit(A& a, B& b, F&& f) {
+        f(CounterInfo("load", "instructions", "loads (Table 5)"), a.load, b.load);
+        f(CounterInfo("store", "instructions", "stores (Table 5)"), a.store, b.store);
+        f(CounterInfo("compute", "instructions", "compute on ray data (Table 5)"), a.compute,
+          b.compute);
+        f(CounterInfo("scatter_gather", "instructions", "scatters and gathers (Table 5)"),
+          a.scatter_gather, b.scatter_gather);
+        f(CounterInfo("partition", "instructions", "partition (Table 5)"), a.partition,
+          b.partition);
+    }
     uint64_t total() const { return load + store + compute + scatter_gather + partition; }
     OpMix& operator+=(const OpMix& o);
 };
@@ -56,6 +97,19 @@ struct StageTiming {
     uint64_t groups = 0;       // lane groups issued: sum of ceil(len / width)
     uint64_t busy_cycles = 0;  // unit-cycles issuing work (no stalls)
     uint64_t stall_cycles = 0;
+
+    template <class A, class B, class F>
+    static void visit(A& a, B& b, F&& f) {
+        f(CounterInfo("ops", "operations", "filter operations issued"), a.ops, b.ops);
+        f(CounterInfo("lanes", "rays", "useful lanes: the operations' stream lengths"), a.lanes,
+          b.lanes);
+        f(CounterInfo("groups", "groups", "lane groups issued: sum of ceil(length / width)"),
+          a.groups, b.groups);
+        f(CounterInfo("busy_cycles", "cycles", "unit-cycles issuing work"), a.busy_cycles,
+          b.busy_cycles);
+        f(CounterInfo("stall_cycles", "cycles", "unit-cycles stalled"), a.stall_cycles,
+          b.stall_cycles);
+    }
     StageTiming& operator+=(const StageTiming& o);
 };
 
@@ -71,6 +125,10 @@ struct FrameTiming {
     uint64_t passes = 0;
     ActionCounts actions;  // what each unit did, for area_energy's costing
 
+    // Every counter of a and b in step (b's cache levels are made a's first if a has fewer).
+    template <class A, class B, class F>
+    static void visit(A& a, B& b, F&& f);
+
     FrameTiming& operator+=(const FrameTiming& o);
     // Adds o * weight (each counter rounded): the expansion of a sampled pass to its stratum.
     void add_scaled(const FrameTiming& o, double weight);
@@ -78,6 +136,44 @@ struct FrameTiming {
 
 // What happened between two snapshots of the same model (b taken after a).
 FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b);
+
+template <class A, class B, class F>
+void FrameTiming::visit(A& a, B& b, F&& f) {
+    static const char* k_secondary[] = {"primary", "secondary"};
+    f(CounterInfo("cycles", "core-cycles", "cycles summed over passes"), a.cycles, b.cycles);
+    StallCycles::visit(a.stalls, b.stalls,
+                       [&](const CounterInfo& c, auto& x, auto& y) { f(c.under("stalls"), x, y); });
+    OpMix::visit(a.mix, b.mix,
+                 [&](const CounterInfo& c, auto& x, auto& y) { f(c.under("mix"), x, y); });
+    for (int s = 0; s < 2; ++s)
+        for (uint32_t k = 0; k < k_op_stage_count; ++k)
+            StageTiming::visit(
+                a.stages[s][k], b.stages[s][k], [&](const CounterInfo& c, auto& x, auto& y) {
+                    f(c.under(to_string(OpStage(k))).under(k_secondary[s]).under("stages"), x, y);
+                });
+    f(CounterInfo("field_accesses", "accesses", "one field word for one lane group"),
+      a.field_accesses, b.field_accesses);
+    f(CounterInfo("conflicted_accesses", "accesses", "field accesses that waited on a bank"),
+      a.conflicted_accesses, b.conflicted_accesses);
+    if constexpr (!std::is_const_v<A>) {
+        if (a.cache_hits.size() < b.cache_hits.size()) {
+            a.cache_hits.resize(b.cache_hits.size());
+            a.cache_misses.resize(b.cache_misses.size());
+        }
+    }
+    for (size_t i = 0; i < b.cache_hits.size() && i < a.cache_hits.size(); ++i) {
+        f(CounterInfo(index_name(i), "lookups", "scene-cache hits").under("cache_hits"),
+          a.cache_hits[i], b.cache_hits[i]);
+        f(CounterInfo(index_name(i), "lookups", "scene-cache misses").under("cache_misses"),
+          a.cache_misses[i], b.cache_misses[i]);
+    }
+    f(CounterInfo("dram_reads", "lines", "scene-data lines read from DRAM"), a.dram_reads,
+      b.dram_reads);
+    f(CounterInfo("passes", "passes", "tile passes"), a.passes, b.passes);
+    ActionCounts::visit(a.actions, b.actions, [&](const CounterInfo& c, auto& x, auto& y) {
+        f(c.under("actions"), x, y);
+    });
+}
 
 struct Stat {
     std::string name;

@@ -149,7 +149,8 @@ bool Bvh::intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, H
     return true;
 }
 
-Hit Bvh::intersect(const Ray& ray) const {
+template <class Counts>
+Hit Bvh::intersect(const Ray& ray, Counts& counts) const {
     Hit hit;
     if (!ray_is_valid(ray)) return hit;
     const RayPrecomp r(ray);
@@ -160,10 +161,13 @@ Hit Bvh::intersect(const Ray& ray) const {
     while (top > 0) {
         const uint32_t index = stack[--top];
         const BvhNode& node = m_nodes[index];
+        counts.box();
         if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
         if (node.is_leaf()) {
-            for (uint32_t i = node.first; i < node.first + node.count; ++i)
+            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+                counts.primitive();
                 if (intersect_primitive(r, m_prim_ids[i], t_max, hit)) t_max = hit.t;
+            }
         } else {
             const bool right_first = visit_right_first(node, r.dir);
             const uint32_t left = BvhNode::left(index), right = node.right();
@@ -173,6 +177,9 @@ Hit Bvh::intersect(const Ray& ray) const {
     }
     return hit;
 }
+
+template Hit Bvh::intersect(const Ray&, NoTraversalCounts&) const;
+template Hit Bvh::intersect(const Ray&, TraversalCounts&) const;
 
 bool Bvh::occluded(const Ray& ray) const {
     if (!ray_is_valid(ray)) return false;

@@ -45,6 +45,17 @@ struct BvhStats {
     uint64_t bytes = 0;
 };
 
+// Counting policies of Bvh::intersect: none (compiles away), or box and primitive tests.
+struct NoTraversalCounts {
+    void box() {}
+    void primitive() {}
+};
+struct TraversalCounts {
+    uint64_t boxes = 0, primitives = 0;
+    void box() { ++boxes; }
+    void primitive() { ++primitives; }
+};
+
 class Bvh {
 public:
     static constexpr uint32_t k_sah_depth_limit = 64;
@@ -59,7 +70,14 @@ public:
     BvhStats stats() const;
 
     // Depth-first, one ray at a time: the reference tracer's traversal.
-    Hit intersect(const Ray& ray) const;
+    Hit intersect(const Ray& ray) const {
+        NoTraversalCounts none;
+        return intersect(ray, none);
+    }
+    // The same traversal, telling `counts` of every box and primitive test (TraversalCounts:
+    // what recursive tracing costs, for benches and tests). Instantiated for the two policies.
+    template <class Counts>
+    Hit intersect(const Ray& ray, Counts& counts) const;
     bool occluded(const Ray& ray) const;
 
     // One primitive test (used by both tracers, so both compute the same bits).

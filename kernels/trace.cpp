@@ -3,8 +3,6 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "workloads/scene.h"
-
 namespace sfx {
 
 const char* to_string(OpStage stage) {
@@ -14,46 +12,6 @@ const char* to_string(OpStage stage) {
         case OpStage::shading: return "shading";
     }
     return "?";
-}
-
-// FNV-1a over the bytes that decide a trace.
-namespace {
-struct Fnv {
-    uint64_t h = 0xcbf29ce484222325ull;
-    void bytes(const void* p, size_t n) {
-        const auto* b = static_cast<const uint8_t*>(p);
-        for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
-    }
-    void f(float v) { bytes(&v, 4); }
-    void u(uint32_t v) { bytes(&v, 4); }
-    void v3(const Vec3& v) { f(v.x); f(v.y); f(v.z); }
-};
-}  // namespace
-
-uint64_t scene_hash(const Scene& s) {
-    Fnv h;
-    h.u(uint32_t(s.positions.size()));
-    for (const Vec3& p : s.positions) h.v3(p);
-    h.u(uint32_t(s.triangles.size()));
-    for (const Triangle& t : s.triangles) { h.u(t.v0); h.u(t.v1); h.u(t.v2); h.u(t.material); }
-    h.u(uint32_t(s.spheres.size()));
-    for (const Sphere& sp : s.spheres) { h.v3(sp.center); h.f(sp.radius); h.u(sp.material); }
-    h.u(uint32_t(s.materials.size()));
-    for (const Material& m : s.materials) {
-        h.u(uint32_t(m.kind));
-        h.v3(m.diffuse); h.v3(m.specular); h.f(m.exponent); h.f(m.ior);
-        h.v3(m.transmission); h.v3(m.emission);
-    }
-    h.u(uint32_t(s.lights.size()));
-    for (const AreaLight& l : s.lights) {
-        h.u(uint32_t(l.primitives.size()));
-        for (uint32_t p : l.primitives) h.u(p);
-    }
-    const ThinLensCamera& c = s.camera;
-    h.v3(c.eye); h.v3(c.look_at); h.v3(c.up);
-    h.f(c.vertical_fov_degrees); h.f(c.aperture_radius); h.f(c.focal_distance);
-    h.v3(s.ambient); h.v3(s.environment); h.u(s.max_depth);
-    return h.h;
 }
 
 // ---- CountingSink -------------------------------------------------------------------------

@@ -17,8 +17,6 @@
 
 namespace sfx {
 
-struct Scene;
-
 enum class OpStage : uint8_t { traversal, intersection, shading };
 constexpr uint32_t k_op_stage_count = 3;
 const char* to_string(OpStage stage);
@@ -121,13 +119,10 @@ struct TilePass {
 struct TraceHeader {
     static constexpr uint32_t k_version = 1;
     uint32_t version = k_version;
-    uint64_t scene_hash = 0;
+    uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
     uint32_t width = 0, height = 0, spp = 0, tile = 0, max_depth = 0;
     uint64_t seed = 0;
 };
-
-// Hash of everything in a scene that changes a trace (geometry, materials, camera, lights).
-uint64_t scene_hash(const Scene& scene);
 
 // Receives a trace. Calls come from one thread at a time, in tile order, sample order.
 class TraceSink {

@@ -56,7 +56,10 @@ std::vector<PointRun> run_group(const nlohmann::json& spec) {
         r.sfx_version = sfx_version();
         r.started_at = started;
         r.finished_at = finished;
-        for (const Stat& s : result.predictions[i].stats()) r.metrics.emplace_back(s.name, s.value);
+        for (const Stat& s : result.predictions[i].stats()) {
+            r.metrics.emplace_back(s.name, s.value);
+            r.units[s.name] = {s.unit, s.description};
+        }
         rows.push_back(std::move(r));
     }
     return rows;
@@ -74,6 +77,9 @@ nlohmann::ordered_json point_run_json(const PointRun& run) {
         else m[name] = nullptr;  // JSON has no NaN or infinity; stored as NULL
     }
     j["metrics"] = m;
+    nlohmann::ordered_json u = nlohmann::ordered_json::object();
+    for (const auto& [name, unit] : run.units) u[name] = {unit.first, unit.second};
+    j["units"] = u;
     return j;
 }
 
@@ -87,6 +93,9 @@ PointRun point_run_from_json(const nlohmann::ordered_json& j) {
     for (const auto& [name, value] : j.at("metrics").items())
         r.metrics.emplace_back(name, value.is_null() ? std::numeric_limits<double>::quiet_NaN()
                                                      : value.get<double>());
+    if (j.contains("units"))
+        for (const auto& [name, unit] : j.at("units").items())
+            r.units[name] = {unit.at(0).get<std::string>(), unit.at(1).get<std::string>()};
     return r;
 }
 

@@ -22,21 +22,31 @@
 namespace sfx {
 namespace {
 
-// Hardware columns with their SQL types, from the same visit() that drives YAML: numbers are
-// REAL, strings and bools TEXT.
+// One hardware column: its name, SQL type (numbers REAL, strings and bools TEXT), unit and
+// description.
+struct HwColumn {
+    std::string name;
+    bool numeric = false;
+    std::string unit, description;
+};
+
+// Hardware columns, from the same visit() that drives YAML.
 class HwColumns {
 public:
-    explicit HwColumns(std::vector<std::pair<std::string, bool>>& out, std::string prefix = "")
-        : m_out(out), m_prefix(std::move(prefix)) {}
-    template <class T, class B> void param(const char* name, T& value, const char* unit,
-                                           const char* description, B, B) {
-        param(name, value, unit, description);
+  explicit HwColumns(std::vector<HwColumn>& out, std::string prefix = "")
+      : m_out(out), m_prefix(std::move(prefix)) {}
+  template <class T, class B>
+  void param(const char* name, T& value, const char* unit, const char* description, B, B) {
+      param(name, value, unit, description);
     }
-    template <class T> void param(const char* name, T&, const char*, const char*) {
-        m_out.emplace_back(join(name), std::is_arithmetic<T>::value && !std::is_same<T, bool>::value);
+    template <class T>
+    void param(const char* name, T&, const char* unit, const char* description) {
+        m_out.push_back({join(name), std::is_arithmetic<T>::value && !std::is_same<T, bool>::value,
+                         unit, description});
     }
-    void choice(const char* name, std::string&, std::initializer_list<const char*>, const char*) {
-        m_out.emplace_back(join(name), false);
+    void choice(const char* name, std::string&, std::initializer_list<const char*>,
+                const char* description) {
+        m_out.push_back({join(name), false, "", description});
     }
     template <class G> void group(const char* name, G& g) {
         HwColumns c(m_out, join(name));
@@ -51,7 +61,7 @@ public:
 
 private:
     std::string join(const char* name) const { return m_prefix.empty() ? name : m_prefix + "." + name; }
-    std::vector<std::pair<std::string, bool>>& m_out;
+    std::vector<HwColumn>& m_out;
     std::string m_prefix;
 };
 
@@ -95,6 +105,9 @@ std::string fixed_columns() {
         sql += ", " + sql_quote_identifier(c.name) + (c.integer ? " INTEGER" : " TEXT");
     return sql + ", fidelity TEXT";
 }
+
+constexpr const char* k_create_units =
+    "CREATE TABLE IF NOT EXISTS units(name TEXT PRIMARY KEY, unit TEXT, description TEXT)";
 
 std::string csv_field(const std::string& s) {
     if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -222,6 +235,7 @@ ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path
             exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
                  std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
             exec(std::string("CREATE TABLE IF NOT EXISTS points(") + fixed_columns() + ")");
+            exec(k_create_units);  // stores written before the table get it here
             exec("COMMIT");
         }
     } catch (const InputError&) {
@@ -276,7 +290,7 @@ void ResultsStore::ensure_column(const std::string& name, const char* type) {
 }
 
 bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep, const PointRun& run) {
-    std::vector<std::pair<std::string, bool>> hw_columns;
+    std::vector<HwColumn> hw_columns;
     HwColumns visitor(hw_columns);
     const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
     const std::vector<HwParamInfo> hw_values = flatten_hw_config(point.hw);
@@ -291,14 +305,27 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
                                           "started_at", "finished_at", "config_yaml"};
         for (const WorkloadColumn& c : workload) names.push_back(c.name);
         names.push_back("fidelity");
-        for (const auto& [name, numeric] : hw_columns) {
-            ensure_column("hw." + name, numeric ? "REAL" : "TEXT");
-            names.push_back("hw." + name);
+        Statement unit(m_db,
+                       "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");
+        auto add_unit = [&](const std::string& name, const std::string& u, const std::string& d) {
+            unit.bind(1, name);
+            unit.bind(2, u);
+            unit.bind(3, d);
+            unit.step();
+            sqlite3_reset(unit.get());
+        };
+        for (const WorkloadColumn& c : workload) add_unit(c.name, c.unit, c.description);
+        for (const HwColumn& c : hw_columns) {
+            ensure_column("hw." + c.name, c.numeric ? "REAL" : "TEXT");
+            names.push_back("hw." + c.name);
+            add_unit("hw." + c.name, c.unit, c.description);
         }
         for (const auto& [name, value] : run.metrics) {
             (void)value;
             ensure_column(name, "REAL");
             names.push_back(name);
+            const auto u = run.units.find(name);
+            if (u != run.units.end()) add_unit(name, u->second.first, u->second.second);
         }
         std::string sql = "INSERT OR IGNORE INTO points(";
         std::string marks;
@@ -324,7 +351,8 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
         }
         insert.bind(i++, std::string(to_string(point.fidelity)));
         for (size_t k = 0; k < hw_columns.size(); ++k) {
-            if (hw_columns[k].second) insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));
+            if (hw_columns[k].numeric)
+                insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));
             else insert.bind(i++, hw_values[k].value);
         }
         for (const auto& [name, value] : run.metrics) {

@@ -2,7 +2,9 @@
 // The results store: one SQLite file, one row per point, written through SQLite's C API.
 // The schema (version 1) is a contract with analysis/ and is described in sweeps/README.md:
 // meta(key, value) and points(key, sfx_version, sweep, point_index, started_at, finished_at,
-// config_yaml, "workload.*", fidelity, "hw.*" per parameter, one REAL column per stat).
+// config_yaml, "workload.*", fidelity, "hw.*" per parameter, one REAL column per stat) and
+// units(name, unit, description): every workload, hw and stat column's unit, from the visit()
+// or stats() that declares it, so analysis reads units rather than re-typing them.
 //
 // Each point is written in its own transaction (new stat columns included), so a process
 // killed at any instant leaves only whole rows; the key makes re-writes no-ops.
@@ -27,6 +29,8 @@ struct PointRun {
     std::string sfx_version;
     std::string started_at, finished_at;  // ISO-8601 UTC
     std::vector<std::pair<std::string, double>> metrics;  // Prediction::stats() names; NaN: NULL
+    // Unit and description of each metric (Prediction::stats()), for the store's units table.
+    std::map<std::string, std::pair<std::string, std::string>> units;
 };
 
 class ResultsStore {

@@ -63,13 +63,14 @@ struct FieldSetter {
 // The store's columns: numbers as INTEGER, the scene as TEXT.
 struct ColumnWriter {
     std::vector<WorkloadColumn> columns;
-    void text(const char* name, std::string& value, const char*) {
-        columns.push_back({std::string("workload.") + name, false, 0, value});
+    void text(const char* name, std::string& value, const char* description) {
+        columns.push_back({std::string("workload.") + name, false, 0, value, "", description});
     }
     template <class T>
-    void param(const char* name, T& value, const char*, const char*, uint64_t, uint64_t,
-               const char* = nullptr) {
-        columns.push_back({std::string("workload.") + name, true, int64_t(value), ""});
+    void param(const char* name, T& value, const char* unit, const char* description, uint64_t,
+               uint64_t, const char* = nullptr) {
+        columns.push_back(
+            {std::string("workload.") + name, true, int64_t(value), "", unit, description});
     }
 };
 

@@ -65,6 +65,7 @@ struct WorkloadColumn {
     bool integer = false;
     int64_t number = 0;
     std::string text;
+    std::string unit, description;  // from visit(), for the store's units table
 };
 std::vector<WorkloadColumn> workload_columns(const WorkloadConfig& w);
 

@@ -3,29 +3,52 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 namespace sfx {
 
 const char* to_string(MaterialKind kind) {
     switch (kind) {
-        case MaterialKind::lambertian: return "lambertian";
-        case MaterialKind::dielectric: return "dielectric";
-        case MaterialKind::glossy: return "glossy";
+        case MaterialKind::lambertian:
+            return "lambertian";
+        case MaterialKind::dielectric:
+            return "dielectric";
+        case MaterialKind::glossy:
+            return "glossy";
     }
     return "?";
+}
+
+bool FeatureSet::*FeatureSet::material_flag(MaterialKind kind) {
+    switch (kind) {
+        case MaterialKind::lambertian:
+            return &FeatureSet::lambertian;
+        case MaterialKind::dielectric:
+            return &FeatureSet::dielectric;
+        case MaterialKind::glossy:
+            return &FeatureSet::glossy;
+    }
+    throw std::logic_error("FeatureSet::material_flag: not a material kind");
+}
+
+uint32_t FeatureSet::material_kinds() const {
+    uint32_t n = 0;
+    for (MaterialKind k : k_material_kinds) n += uses(k);
+    return n;
 }
 
 std::string FeatureSet::describe() const {
     std::ostringstream s;
     const char* sep = "";
     auto item = [&](bool on, const char* name) {
-        if (on) { s << sep << name; sep = ", "; }
+        if (on) {
+            s << sep << name;
+            sep = ", ";
+        }
     };
     item(triangles, "triangles");
     item(spheres, "spheres");
-    item(lambertian, "lambertian");
-    item(dielectric, "dielectric");
-    item(glossy, "glossy");
+    for (MaterialKind k : k_material_kinds) item(uses(k), to_string(k));
     item(thin_lens, "thin-lens");
     item(ambient, "ambient");
     item(environment, "environment");
@@ -39,7 +62,8 @@ float Scene::primitive_area(uint32_t prim) const {
         return 4.f * float(M_PI) * r * r;
     }
     const Triangle& t = triangles[prim];
-    return 0.5f * length(cross(positions[t.v1] - positions[t.v0], positions[t.v2] - positions[t.v0]));
+    return 0.5f *
+           length(cross(positions[t.v1] - positions[t.v0], positions[t.v2] - positions[t.v0]));
 }
 
 Bounds3 Scene::primitive_bounds(uint32_t prim) const {
@@ -71,10 +95,7 @@ FeatureSet Scene::features() const {
     for (const Triangle& t : triangles) used[t.material] = true;
     for (const Sphere& s : spheres) used[s.material] = true;
     for (size_t m = 0; m < materials.size(); ++m) {
-        if (!used[m]) continue;
-        f.lambertian |= materials[m].kind == MaterialKind::lambertian;
-        f.dielectric |= materials[m].kind == MaterialKind::dielectric;
-        f.glossy |= materials[m].kind == MaterialKind::glossy;
+        if (used[m]) f.*FeatureSet::material_flag(materials[m].kind) = true;
     }
     f.thin_lens = camera.aperture_radius > 0.f;
     f.ambient = !is_black(ambient);
@@ -113,5 +134,47 @@ uint64_t Scene::geometry_bytes() const {
     return positions.size() * sizeof(Vec3) + triangles.size() * sizeof(Triangle) +
            spheres.size() * sizeof(Sphere) + materials.size() * sizeof(Material);
 }
+
+// FNV-1a over the bytes that decide a trace; kept one structure a line, as a checklist.
+// clang-format off
+namespace {
+struct Fnv {
+    uint64_t h = 0xcbf29ce484222325ull;
+    void bytes(const void* p, size_t n) {
+        const auto* b = static_cast<const uint8_t*>(p);
+        for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
+    }
+    void f(float v) { bytes(&v, 4); }
+    void u(uint32_t v) { bytes(&v, 4); }
+    void v3(const Vec3& v) { f(v.x); f(v.y); f(v.z); }
+};
+}  // namespace
+
+uint64_t scene_hash(const Scene& s) {
+    Fnv h;
+    h.u(uint32_t(s.positions.size()));
+    for (const Vec3& p : s.positions) h.v3(p);
+    h.u(uint32_t(s.triangles.size()));
+    for (const Triangle& t : s.triangles) { h.u(t.v0); h.u(t.v1); h.u(t.v2); h.u(t.material); }
+    h.u(uint32_t(s.spheres.size()));
+    for (const Sphere& sp : s.spheres) { h.v3(sp.center); h.f(sp.radius); h.u(sp.material); }
+    h.u(uint32_t(s.materials.size()));
+    for (const Material& m : s.materials) {
+        h.u(uint32_t(m.kind));
+        h.v3(m.diffuse); h.v3(m.specular); h.f(m.exponent); h.f(m.ior);
+        h.v3(m.transmission); h.v3(m.emission);
+    }
+    h.u(uint32_t(s.lights.size()));
+    for (const AreaLight& l : s.lights) {
+        h.u(uint32_t(l.primitives.size()));
+        for (uint32_t p : l.primitives) h.u(p);
+    }
+    const ThinLensCamera& c = s.camera;
+    h.v3(c.eye); h.v3(c.look_at); h.v3(c.up);
+    h.f(c.vertical_fov_degrees); h.f(c.aperture_radius); h.f(c.focal_distance);
+    h.v3(s.ambient); h.v3(s.environment); h.u(s.max_depth);
+    return h.h;
+}
+// clang-format on
 
 }  // namespace sfx

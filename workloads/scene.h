@@ -4,6 +4,7 @@
 // Closest-hit ties go to the lower id, so this numbering is part of the image.
 
 #include <cstdint>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,11 @@
 namespace sfx {
 
 enum class MaterialKind : uint8_t { lambertian, dielectric, glossy };
-const char* to_string(MaterialKind kind);
+// Every kind, in enum order: loops over kinds (names, counts, feature flags) read this list.
+inline constexpr MaterialKind k_material_kinds[] = {MaterialKind::lambertian,
+                                                    MaterialKind::dielectric, MaterialKind::glossy};
+inline constexpr uint32_t k_material_kind_count = uint32_t(std::size(k_material_kinds));
+const char* to_string(MaterialKind kind);  // "?" for a value that is no kind
 
 struct Material {
     std::string name;
@@ -69,8 +74,17 @@ struct FeatureSet {
     uint32_t light_count = 0;
     uint32_t max_depth = 0;
 
+    // The flag of one material kind; a switch without default, so a new kind cannot be missed.
+    static bool FeatureSet::*material_flag(MaterialKind kind);
+    bool uses(MaterialKind kind) const { return this->*material_flag(kind); }
+    uint32_t material_kinds() const;  // how many kinds the scene uses
     std::string describe() const;
 };
+
+struct Scene;
+// Hash of everything in a scene that changes a trace (geometry, materials, camera, lights):
+// a trace file's header names the scene it is of by this.
+uint64_t scene_hash(const Scene& scene);
 
 struct Scene {
     std::string name;
@@ -80,8 +94,8 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<AreaLight> lights;  // built by finalize() from emissive primitives
     ThinLensCamera camera;
-    Vec3 ambient{0.f};      // constant ambient term: replaces indirect diffuse bounces when set
-    Vec3 environment{0.f};  // radiance of rays that leave the scene
+    Vec3 ambient{0.f};       // constant ambient term: replaces indirect diffuse bounces when set
+    Vec3 environment{0.f};   // radiance of rays that leave the scene
     uint32_t max_depth = 3;  // bounces after the camera ray
 
     uint32_t triangle_count() const { return uint32_t(triangles.size()); }

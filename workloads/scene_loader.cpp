@@ -136,7 +136,6 @@ private:
     std::string m_file;
 };
 
-const std::set<std::string> k_material_kinds = {"lambertian", "dielectric", "glossy"};
 
 Material parse_material(const Reader& r, const YAML::Node& node, const std::string& path) {
     r.check_map(node, path,
@@ -145,10 +144,13 @@ Material parse_material(const Reader& r, const YAML::Node& node, const std::stri
     Material m;
     m.name = r.string(node["name"], path + ".name");
     const std::string kind = r.string(node["kind"], path + ".kind");
-    if (kind == "lambertian") m.kind = MaterialKind::lambertian;
-    else if (kind == "dielectric") m.kind = MaterialKind::dielectric;
-    else if (kind == "glossy") m.kind = MaterialKind::glossy;
-    else r.fail(node["kind"], path + ".kind", "unknown kind '" + kind + "' (lambertian, dielectric, glossy)");
+    std::string names;
+    bool known = false;
+    for (MaterialKind k : k_material_kinds) {
+        if (kind == to_string(k)) m.kind = k, known = true;
+        names += (names.empty() ? "" : ", ") + std::string(to_string(k));
+    }
+    if (!known) r.fail(node["kind"], path + ".kind", "unknown kind '" + kind + "' (" + names + ")");
     // Keys that the kind does not use are errors: a typo'd kind must not silently drop them.
     auto only_for = [&](const char* key, bool ok, const char* kinds) {
         if (node[key] && !ok) r.fail(node[key], path + "." + key, std::string("applies to ") + kinds + " materials only");

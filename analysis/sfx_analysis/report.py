@@ -171,7 +171,7 @@ def write_report(db: str, directory: str) -> Report:
             tables, f"# {title}\n\n{len(store.points)} points from `{os.path.abspath(db)}`. "
                     f"{tables_module.MISSING} marks a cell the store has no value for."))
     points_csv = os.path.join(directory, "points.csv")
-    for_display(store.points.drop(columns=["config_yaml"], errors="ignore")).to_csv(
+    for_display(store, store.points.drop(columns=["config_yaml"], errors="ignore")).to_csv(
         points_csv, index=False)
     index = os.path.join(directory, "index.html")
     with open(index, "w", encoding="utf-8") as f:

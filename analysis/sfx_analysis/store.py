@@ -2,7 +2,9 @@
 
 One row per point; the configuration columns are already flat in the store (`workload.*`,
 `hw.<dotted path>`, `fidelity`); metric columns keep their raw stat names (`fps`,
-`simd_utilization.primary.traversal`, ...). Units are added only for display (see `units`).
+`simd_utilization.primary.traversal`, ...). Units are added only for display, from the store's
+own `units` table (written from the C++ declarations of each column; a store without one shows
+none).
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import os
 import sqlite3
 import urllib.parse
 from dataclasses import dataclass, field
-from typing import List
+from typing import Dict, List
 
 import pandas as pd
 
@@ -40,6 +42,7 @@ class Store:
     config_columns: List[str]
     metric_columns: List[str]
     warnings: List[str] = field(default_factory=list)
+    units: Dict[str, str] = field(default_factory=dict)  # column -> unit ("" for ratios)
 
     def has(self, column: str) -> bool:
         return column in self.points.columns and self.points[column].notna().any()
@@ -108,6 +111,17 @@ def _check_schema(meta: dict, path: str) -> int:
     return version
 
 
+def _read_units(con: sqlite3.Connection, path: str) -> Dict[str, str]:
+    """The store's units table (column name -> unit); empty for a store written before it."""
+    tables = {r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+    if "units" not in tables:
+        return {}
+    try:
+        return {name: unit or "" for name, unit in con.execute("SELECT name, unit FROM units")}
+    except sqlite3.DatabaseError as e:
+        raise StoreError(f"{path}: unreadable 'units' table ({e})") from None
+
+
 def _numeric_if_possible(column: pd.Series) -> pd.Series:
     """hw.* columns are REAL for numbers and TEXT for strings and bools: convert only when every
     stored value is a number, so 'soa' or 'true' stay text."""
@@ -128,6 +142,7 @@ def load_store(path: str) -> Store:
             points = pd.read_sql_query("SELECT * FROM points", con)
         except (sqlite3.DatabaseError, pd.errors.DatabaseError) as e:
             raise StoreError(f"{path}: unreadable 'points' table ({e})") from None
+        units = _read_units(con, path)
     finally:
         con.close()
 
@@ -156,7 +171,8 @@ def load_store(path: str) -> Store:
                                 kind="mergesort").reset_index(drop=True)
 
     store = Store(path=path, schema_version=version, created_by=meta.get("created_by", ""),
-                  points=points, config_columns=config_columns, metric_columns=metric_columns)
+                  points=points, config_columns=config_columns, metric_columns=metric_columns,
+                  units=units)
     if len(points) == 1:
         store.warnings.append("the store holds one point: tables have one cell each and "
                               "every plot that compares points is skipped")
@@ -172,58 +188,12 @@ def load_store(path: str) -> Store:
     return store
 
 
-# Units of the stats, for display only ("fps [frames/s]"). The store holds raw names; these
-# follow Prediction::stats() in hw_model/prediction.cpp.
-_UNIT_BY_NAME = {
-    "fps": "frames/s",
-    "frame_cycles": "cycles",
-    "frame_seconds": "s",
-    "host_seconds": "s",
-    "passes.total": "passes",
-    "passes.timed": "passes",
-    "tile": "pixels",
-    "bytes_per_ray": "bytes",
-    "op_mix.instructions": "instructions",
-    "scene_memory.dram_reads": "lines",
-    "workload.tile": "pixels",
-    "workload.width": "pixels",
-    "workload.height": "pixels",
-    "hw.simd.width": "lanes",
-}
-_UNIT_BY_PREFIX = [
-    ("stall_cycles.", "cycles"),
-    ("stage_cycles.", "cycles"),
-    ("stream_length.", "rays"),
-]
-_UNIT_BY_SUFFIX = [
-    ("_percent", "%"),
-    ("_cycles", "cycles"),
-    (".kib", "KiB"),
-    ("_mhz", "MHz"),
-    ("_gbps", "GB/s"),
-    ("_bytes", "bytes"),
-    ("_seconds", "s"),
-]
-
-
-def unit(name: str) -> str:
-    if name in _UNIT_BY_NAME:
-        return _UNIT_BY_NAME[name]
-    for prefix, u in _UNIT_BY_PREFIX:
-        if name.startswith(prefix):
-            return u
-    for suffix, u in _UNIT_BY_SUFFIX:
-        if name.endswith(suffix):
-            return u
-    return ""
-
-
-def display_name(name: str) -> str:
+def display_name(name: str, units: Dict[str, str]) -> str:
     """`fps` -> `fps [frames/s]`; names without a unit (ratios) are returned unchanged."""
-    u = unit(name)
+    u = units.get(name, "")
     return f"{name} [{u}]" if u else name
 
 
-def for_display(points: pd.DataFrame) -> pd.DataFrame:
+def for_display(store: Store, points: pd.DataFrame) -> pd.DataFrame:
     """The tidy frame with units in the column names, for CSV and HTML output."""
-    return points.rename(columns={c: display_name(c) for c in points.columns})
+    return points.rename(columns={c: display_name(c, store.units) for c in points.columns})

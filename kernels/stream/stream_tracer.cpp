@@ -328,46 +328,52 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                     ? len
                     : run_filter(OpKind::material_filter, mat, s, len,
                                  [&](uint32_t id) { return surf[id].material == mat; });
-            if (kind == MaterialKind::lambertian) {
-                const bool ambient = !is_black(scene.ambient);
-                if (ambient)
-                    run_filter(OpKind::ambient, k_no_object, s, g, [&](uint32_t id) {
-                        add_ambient(path[id], material(id), scene);
+            switch (kind) {
+                case MaterialKind::lambertian: {
+                    const bool ambient = !is_black(scene.ambient);
+                    if (ambient)
+                        run_filter(OpKind::ambient, k_no_object, s, g, [&](uint32_t id) {
+                            add_ambient(path[id], material(id), scene);
+                            return true;
+                        });
+                    const uint32_t direct = run_filter(
+                        OpKind::lambertian_choice, k_no_object, s, g,
+                        [&](uint32_t id) { return lambertian_takes_direct(path[id], scene); });
+                    run_filter(OpKind::lambertian_direct, k_no_object, s, direct, [&](uint32_t id) {
+                        if (!lambertian_direct(path[id], scene, material(id), surf[id], next[id]))
+                            return false;
+                        push(id, true);
                         return true;
                     });
-                const uint32_t direct = run_filter(
-                    OpKind::lambertian_choice, k_no_object, s, g,
-                    [&](uint32_t id) { return lambertian_takes_direct(path[id], scene); });
-                run_filter(OpKind::lambertian_direct, k_no_object, s, direct, [&](uint32_t id) {
-                    if (!lambertian_direct(path[id], scene, material(id), surf[id], next[id]))
-                        return false;
-                    push(id, true);
-                    return true;
-                });
-                if (!ambient)  // with ambient light, the indirect group ends here
-                    run_filter(OpKind::lambertian_indirect, k_no_object, s + direct, g - direct,
-                               [&](uint32_t id) {
-                                   if (!lambertian_indirect(path[id], scene, material(id), surf[id],
-                                                            next[id]))
-                                       return false;
-                                   push(id, false);
-                                   return true;
-                               });
-            } else if (kind == MaterialKind::dielectric) {
-                run_filter(OpKind::dielectric, k_no_object, s, g, [&](uint32_t id) {
-                    if (!dielectric_scatter(path[id], material(id), surf[id], rays[id], next[id]))
-                        return false;
-                    push(id, false);
-                    return true;
-                });
-            } else {
-                run_filter(OpKind::glossy, k_no_object, s, g, [&](uint32_t id) {
-                    if (!glossy_scatter(path[id], material(id), surf[id], rays[id], next[id]))
-                        return false;
-                    push(id, false);
-                    return true;
-                });
-            }
+                    if (!ambient)  // with ambient light, the indirect group ends here
+                        run_filter(OpKind::lambertian_indirect, k_no_object, s + direct, g - direct,
+                                   [&](uint32_t id) {
+                                       if (!lambertian_indirect(path[id], scene, material(id),
+                                                                surf[id], next[id]))
+                                           return false;
+                                       push(id, false);
+                                       return true;
+                                   });
+                    break;
+                }
+                case MaterialKind::dielectric:
+                    run_filter(OpKind::dielectric, k_no_object, s, g, [&](uint32_t id) {
+                        if (!dielectric_scatter(path[id], material(id), surf[id], rays[id],
+                                                next[id]))
+                            return false;
+                        push(id, false);
+                        return true;
+                    });
+                    break;
+                case MaterialKind::glossy:
+                    run_filter(OpKind::glossy, k_no_object, s, g, [&](uint32_t id) {
+                        if (!glossy_scatter(path[id], material(id), surf[id], rays[id], next[id]))
+                            return false;
+                        push(id, false);
+                        return true;
+                    });
+                    break;
+            }  // no default: -Werror=switch makes a new MaterialKind a compile error here
             s += g;
             len -= g;
         }

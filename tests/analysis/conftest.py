@@ -18,11 +18,14 @@ WORKLOAD = {"workload.scene": "TEXT", "workload.width": "INTEGER", "workload.hei
             "workload.seed": "INTEGER", "fidelity": "TEXT"}
 
 
-def write_store(path, points, schema_version="1", meta=True):
+def write_store(path, points, schema_version="1", meta=True, units=None):
     """Writes a store: meta(schema_version, created_by) and points with the identity and
     workload columns of schema 1, then one column per key the points use (hw.* REAL or TEXT,
-    metrics REAL)."""
+    metrics REAL); with `units` (column -> unit), the units table sfx writes beside them."""
     con = sqlite3.connect(path)
+    if units is not None:
+        con.execute("CREATE TABLE units(name TEXT PRIMARY KEY, unit TEXT, description TEXT)")
+        con.executemany("INSERT INTO units VALUES(?, ?, '')", list(units.items()))
     if meta:
         con.execute("CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT)")
         if schema_version is not None:

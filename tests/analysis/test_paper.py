@@ -275,6 +275,10 @@ def test_paper_check_end_to_end(tmp_path):
     assert "not at the paper's 1024x1024" in text
     assert re.search(r"\| trace side: .* \| not evaluated \|", text)
     assert 'id="paper-check"' in (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
+    # The real store carries its units, from the C++ declarations.
+    units = load_store(str(store)).units
+    assert units["fps"] == "frames/s" and units["hw.ray_buffer.kib"] == "KiB"
+    assert units["stall_cycles.partition"] == "cycles" and units["workload.tile"] == "pixels"
     # An existing store is never replaced unasked; bad arguments: exit 2, nothing written.
     before = page.read_text(encoding="utf-8")
     done = subprocess.run([os.path.join(REPO, "scripts", "paper-check"), "--no-build",

@@ -74,10 +74,14 @@ def test_varying_buffer_size_gives_one_block_per_context(buffer_store):
     assert "hw.ray_buffer.kib = 128" in fps[0].title and "hw.ray_buffer.kib = 512" in fps[1].title
 
 
-def test_units_only_in_display_names(grid_store):
-    store = load_store(grid_store)
-    assert "fps" in store.points.columns
-    assert display_name("fps") == "fps [frames/s]"
-    assert display_name("hw.ray_buffer.kib") == "hw.ray_buffer.kib [KiB]"
-    assert display_name("stall_cycles.partition") == "stall_cycles.partition [cycles]"
-    assert display_name("simd_utilization.traversal") == "simd_utilization.traversal"
+def test_units_only_in_display_names_and_read_from_the_store(tmp_path):
+    # Units the analysis could not have typed itself: they can only come from the store.
+    units = {"fps": "frames per moon", "hw.ray_buffer.kib": "KiB", "simd_utilization.traversal": ""}
+    store = load_store(write_store(str(tmp_path / "u.db"), grid_points(), units=units))
+    assert "fps" in store.points.columns and "fps [frames per moon]" not in store.points.columns
+    assert display_name("fps", store.units) == "fps [frames per moon]"
+    assert display_name("hw.ray_buffer.kib", store.units) == "hw.ray_buffer.kib [KiB]"
+    assert display_name("simd_utilization.traversal", store.units) == "simd_utilization.traversal"
+    assert display_name("stall_cycles.partition", store.units) == "stall_cycles.partition"
+    # A store written before the units table: names without units, no error.
+    assert load_store(write_store(str(tmp_path / "old.db"), grid_points())).units == {}

@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <set>
+#include <string>
 
 #include "hw_model/analytic_model.h"
 #include "hw_model/systemc/accelerator.h"
@@ -423,4 +425,41 @@ TEST_CASE("Analytic action counts agree with the cycle-level ones", "[hw_model][
     CHECK(analytic.bank_writes == Approx(double(full.bank_writes)).epsilon(0.2));
     CHECK(analytic.agu_addresses == Approx(double(full.agu_addresses)).epsilon(0.1));
     CHECK(analytic.cache_accesses[0] > 0);
+}
+
+TEST_CASE("FrameTiming's counters: one visit, unique names with units, sums and differences",
+          "[hw_model]") {
+    FrameTiming a, b;
+    a.cache_hits = a.cache_misses = {1, 2};
+    b.cache_hits = b.cache_misses = {0, 0};
+    uint64_t next = 1;
+    std::set<std::string> names;
+    FrameTiming::visit(a, a, [&](const CounterInfo& c, uint64_t& x, uint64_t&) {
+        CHECK(names.insert(c.name()).second);  // every counter once, under its own name
+        CHECK(std::string(c.unit) != "");
+        CHECK(std::string(c.description) != "");
+        x = next++;
+    });
+    CHECK(names.count("stalls.bank_conflict") == 1);
+    CHECK(names.count("stages.secondary.shading.busy_cycles") == 1);
+    CHECK(names.count("actions.simd_instructions.glossy") == 1);
+    CHECK(names.count("cache_misses.1") == 1);
+    // b = a + a; b - a = a, counter by counter; scaling by 2 doubles each.
+    b += a;
+    b += a;
+    const FrameTiming d = timing_between(a, b);
+    FrameTiming twice;
+    twice.add_scaled(a, 2.0);
+    FrameTiming::visit(d, a, [&](const CounterInfo& c, const uint64_t& x, const uint64_t& y) {
+        INFO(c.name());
+        CHECK(x == y);
+    });
+    FrameTiming::visit(twice, b, [&](const CounterInfo& c, const uint64_t& x, const uint64_t& y) {
+        INFO(c.name());
+        CHECK(x == y);
+    });
+    CHECK(a.stalls.total() == a.stalls.bank_conflict + a.stalls.alignment + a.stalls.address_fetch +
+                                  a.stalls.partition + a.stalls.scene_memory +
+                                  a.stalls.interconnect + a.stalls.pipeline_fill +
+                                  a.stalls.unit_idle);
 }

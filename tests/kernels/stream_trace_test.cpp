@@ -64,33 +64,15 @@ RenderSettings settings_for(const Scene& s, uint32_t size, uint32_t spp, uint32_
     return r;
 }
 
-// Bvh::intersect, counting its box and primitive tests (recursive tracing's op counts).
+// Box and primitive tests of recursive tracing (and of packet tracing, below).
 struct RecursiveCounts {
     uint64_t box = 0, prim = 0;
 };
 void count_recursive(const Bvh& bvh, const Ray& ray, RecursiveCounts& c) {
-    if (!ray_is_valid(ray)) return;
-    const RayPrecomp r(ray);
-    Hit hit;
-    float t_max = ray.t_max;
-    std::vector<uint32_t> stack{0};
-    while (!stack.empty()) {
-        const uint32_t index = stack.back();
-        const BvhNode& node = bvh.nodes()[index];
-        stack.pop_back();
-        ++c.box;
-        if (intersect_box(r, node.bounds, t_max) == INFINITY) continue;
-        if (node.is_leaf()) {
-            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                ++c.prim;
-                if (bvh.intersect_primitive(r, bvh.prim_ids()[i], t_max, hit)) t_max = hit.t;
-            }
-        } else {
-            const bool right_first = visit_right_first(node, r.dir);
-            stack.push_back(right_first ? BvhNode::left(index) : node.right());
-            stack.push_back(right_first ? node.right() : BvhNode::left(index));
-        }
-    }
+    TraversalCounts t;
+    bvh.intersect(ray, t);
+    c.box += t.boxes;
+    c.prim += t.primitives;
 }
 
 // Masked packet traversal of all rays at once (packet tracing): one op per node the packet

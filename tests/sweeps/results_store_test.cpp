@@ -37,6 +37,7 @@ PointRun fake_run(const std::string& key, double fps) {
     r.sfx_version = sfx_version();
     r.started_at = r.finished_at = iso8601_now();
     r.metrics = {{"fps", fps}, {"error.relative", -1}, {"scene_cache.l1.hit_rate", std::nan("")}};
+    r.units = {{"fps", {"frames/s", "predicted frame rate"}}, {"error.relative", {"", "interval"}}};
     return r;
 }
 
@@ -86,6 +87,17 @@ TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps
         const std::string types = query(h, "SELECT name, type FROM pragma_table_info('points') WHERE name IN "
                                            "('hw.simd.width', 'hw.name', 'fps', 'point_index', 'key')");
         CHECK(types == "key|TEXT\npoint_index|INTEGER\nhw.name|TEXT\nhw.simd.width|REAL\nfps|REAL\n");
+        // Units come from the declarations: stats() for metrics, the visit()s for hw and workload.
+        CHECK(
+            query(h,
+                  "SELECT name, unit, description FROM units WHERE name IN ('fps', "
+                  "'error.relative', 'hw.simd.width', 'hw.ray_buffer.kib', 'workload.tile') "
+                  "ORDER BY name") ==
+            "error.relative||interval\nfps|frames/s|predicted frame rate\n"
+            "hw.ray_buffer.kib|KiB|size of one ray buffer\nhw.simd.width|lanes|SIMD lanes per "
+            "unit\n"
+            "workload.tile|pixels|tile edge: the stream holds tile^2 rays (auto: the largest that "
+            "fits the ray buffer)\n");
         // The stored YAML reproduces the point.
         const std::string yaml = query(h, "SELECT config_yaml FROM points WHERE point_index = 1");
         CHECK(point_key(yaml.substr(0, yaml.size() - 1)) == sweep.points[1].key);
@@ -125,6 +137,9 @@ TEST_CASE("A point group runs from its JSON spec: one row per point, keys from t
         REQUIRE(back.metrics.size() == rows[i].metrics.size());
         CHECK(back.metrics.front().first == "fps");
         CHECK(back.metrics.front().second == rows[i].metrics.front().second);
+        CHECK(back.units == rows[i].units);
+        CHECK(back.units.at("fps") ==
+              std::make_pair(std::string("frames/s"), std::string("predicted frame rate")));
     }
     CHECK(rows[0].metrics.front().second > 0);
     CHECK(rows[0].metrics.front().second != rows[1].metrics.front().second);  // widths 4 vs 8

@@ -262,3 +262,17 @@ TEST_CASE("scene loader: SFX_SCENE_DIR overrides where named scenes are found", 
     CHECK(names == std::vector<std::string>{"tiny"});
     CHECK(load_scene("cornell").name == "cornell");  // back to the shipped scenes
 }
+
+TEST_CASE("material kinds: the list names every kind once, in enum order", "[workloads]") {
+    // A kind added to the enum (and so, by -Werror=switch, to to_string) but not to
+    // k_material_kinds would be missed by every loop over kinds: names, counts, feature flags.
+    for (uint32_t i = 0; i < k_material_kind_count; ++i) {
+        CHECK(k_material_kinds[i] == MaterialKind(i));
+        CHECK(std::string(to_string(MaterialKind(i))) != "?");
+        FeatureSet f;
+        f.*FeatureSet::material_flag(MaterialKind(i)) = true;
+        CHECK(f.uses(MaterialKind(i)));
+        CHECK(f.material_kinds() == 1);
+    }
+    CHECK(std::string(to_string(MaterialKind(k_material_kind_count))) == "?");
+}
