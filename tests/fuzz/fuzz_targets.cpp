@@ -32,7 +32,10 @@ const std::filesystem::path& work_dir() {
     static const std::filesystem::path dir = [] {
         std::string templ = (std::filesystem::temp_directory_path() / "sfx-fuzz-XXXXXX").string();
         if (!::mkdtemp(templ.data())) bug("mkdtemp failed");
-        std::atexit([] { std::error_code ec; std::filesystem::remove_all(work_dir(), ec); });
+        std::atexit([] {
+            std::error_code ec;
+            std::filesystem::remove_all(work_dir(), ec);
+        });
         return std::filesystem::path(templ);
     }();
     return dir;
@@ -46,15 +49,17 @@ std::string write_input(const std::string& name, const uint8_t* data, size_t siz
     return path;
 }
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const Vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 // The scene invariants every consumer relies on.
 void check_scene(const Scene& s) {
     for (const Vec3& p : s.positions)
         if (!finite(p)) bug("a loaded scene has a non-finite vertex");
     for (const Triangle& t : s.triangles)
-        if (t.v0 >= s.positions.size() || t.v1 >= s.positions.size() || t.v2 >= s.positions.size() ||
-            t.material >= s.materials.size())
+        if (t.v0 >= s.positions.size() || t.v1 >= s.positions.size() ||
+            t.v2 >= s.positions.size() || t.material >= s.materials.size())
             bug("a loaded scene has a triangle indexing past its arrays");
     for (const Sphere& sp : s.spheres)
         if (!finite(sp.center) || !std::isfinite(sp.radius) || !(sp.radius > 0.f) ||
@@ -78,7 +83,8 @@ class CheckingSink : public TraceSink {
         if (op.length > m_pass.slot_count) bug("trace reader delivered an op longer than its pass");
         uint32_t passed = 0;
         for (uint32_t i = 0; i < op.length; ++i) {
-            if (op.slots[i] >= m_pass.slot_count) bug("trace reader delivered a slot past the pass");
+            if (op.slots[i] >= m_pass.slot_count)
+                bug("trace reader delivered a slot past the pass");
             passed += op.passed[i];
         }
         if (passed != op.pass_count) bug("trace reader delivered a wrong pass count");
@@ -105,9 +111,11 @@ void hw_config(const uint8_t* data, size_t size) {
     try {
         second = dump_hw_config(parse_hw_config(first, "dump.hw.yaml"));
     } catch (const InputError& e) {
-        bug(std::string("the dump of an accepted config does not parse: ") + e.what() + "\n" + first);
+        bug(std::string("the dump of an accepted config does not parse: ") + e.what() + "\n" +
+            first);
     }
-    if (first != second) bug("dump -> parse -> dump changed the text:\n" + first + "---\n" + second);
+    if (first != second)
+        bug("dump -> parse -> dump changed the text:\n" + first + "---\n" + second);
 }
 
 void scene(const uint8_t* data, size_t size) {
@@ -148,8 +156,12 @@ void mesh(const std::string& name, const uint8_t* data, size_t size) {
 }
 }  // namespace
 
-void mesh_obj(const uint8_t* data, size_t size) { mesh("fuzz.obj", data, size); }
-void mesh_ply(const uint8_t* data, size_t size) { mesh("fuzz.ply", data, size); }
+void mesh_obj(const uint8_t* data, size_t size) {
+    mesh("fuzz.obj", data, size);
+}
+void mesh_ply(const uint8_t* data, size_t size) {
+    mesh("fuzz.ply", data, size);
+}
 
 void store(const uint8_t* data, size_t size) {
     const std::string path = write_input("fuzz.db", data, size);
@@ -183,8 +195,8 @@ void trace(const uint8_t* data, size_t size) {
 
 const std::vector<TargetInfo>& targets() {
     static const std::vector<TargetInfo> list = {
-        {"hw_config", hw_config}, {"scene", scene},       {"sweep", sweep}, {"mesh_obj", mesh_obj},
-        {"mesh_ply", mesh_ply},   {"store", store},       {"trace", trace},
+        {"hw_config", hw_config}, {"scene", scene}, {"sweep", sweep}, {"mesh_obj", mesh_obj},
+        {"mesh_ply", mesh_ply},   {"store", store}, {"trace", trace},
     };
     return list;
 }

@@ -3,7 +3,6 @@
 // fixed bug stays fixed in every ordinary build, and under the sanitizers.
 
 #include <catch2/catch.hpp>
-
 #include <filesystem>
 #include <fstream>
 #include <iterator>
