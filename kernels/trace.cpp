@@ -262,6 +262,8 @@ struct Reader {
 };
 }  // namespace
 
+// A file that is not a whole, consistent trace is an InputError naming the file and the byte
+// offset; the sink may have seen ops before it (the reader streams).
 TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
     check_regular_file(path, "trace");
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),

@@ -208,9 +208,7 @@ class TraceFileWriter : public TraceSink {
     std::vector<uint8_t> m_bits;
 };
 
-// Reads a trace file and replays it into a sink; returns its header. A file that is not a
-// whole, consistent trace is an InputError naming the file and the byte offset (the sink may
-// have seen the ops before it: the reader streams).
+// Reads a trace file and replays it into a sink; returns its header. Throws on a bad file.
 TraceHeader read_trace_file(const std::string& path, TraceSink& sink);
 
 // Keeps one tile pass in memory and replays it into a sink (used to order traces of passes
