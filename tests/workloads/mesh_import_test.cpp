@@ -122,7 +122,8 @@ TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever",
         "property list uchar int vertex_indices\n";
     CHECK(import_text("ok.ply", "ply\nformat ascii 1.0\n" + header + "end_header\n" + body)
               .triangle_count() == 1);
-    CHECK_THROWS_WITH(import_text("a.ply", "ply\nformat binary_little_endian 1.0\nply\n" + header),
+    CHECK_THROWS_WITH(import_text("a.ply", "ply\nformat binary_little_endian 1.0\nply\n" + header +
+                                               "end_header\n"),
                       Contains("line 3: not a PLY header"));
     CHECK_THROWS_WITH(import_text("b.ply", "ply\nformat ascii 1.0\n" + header + body),
                       Contains("no end_header"));
