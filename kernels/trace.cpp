@@ -1,15 +1,23 @@
 #include "kernels/trace.h"
 
+#include <cstdio>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
+
+#include "workloads/input_error.h"
+#include "workloads/user_files.h"
 
 namespace sfx {
 
 const char* to_string(OpStage stage) {
     switch (stage) {
-        case OpStage::traversal: return "traversal";
-        case OpStage::intersection: return "intersection";
-        case OpStage::shading: return "shading";
+        case OpStage::traversal:
+            return "traversal";
+        case OpStage::intersection:
+            return "intersection";
+        case OpStage::shading:
+            return "shading";
     }
     return "?";
 }
@@ -31,9 +39,13 @@ CountingSink::CountingSink(std::vector<uint32_t> widths) : m_widths(std::move(wi
         }
 }
 
-void CountingSink::begin_pass(const TilePass&) { ++m_passes; }
+void CountingSink::begin_pass(const TilePass&) {
+    ++m_passes;
+}
 
-void CountingSink::end_pass(const TilePass& p) { m_generations += p.generations; }
+void CountingSink::end_pass(const TilePass& p) {
+    m_generations += p.generations;
+}
 
 void CountingSink::op(const StreamOp& op) {
     if (op.length == 0) return;
@@ -84,8 +96,7 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
 
 static const char k_magic[8] = {'S', 'F', 'X', 'T', 'R', 'A', 'C', 'E'};
 
-TraceFileWriter::TraceFileWriter(const std::string& path)
-    : m_path(path), m_tmp(path + ".partial") {
+TraceFileWriter::TraceFileWriter(const std::string& path) : m_path(path), m_tmp(path + ".partial") {
     m_file = std::fopen(m_tmp.c_str(), "wb");
     if (!m_file) throw std::runtime_error("cannot write " + path);
 }
@@ -102,15 +113,21 @@ void TraceFileWriter::write(const void* data, size_t n) {
     m_bytes += n;
 }
 
-template <class T> static void put(std::vector<uint8_t>& out, T v) {
+template <class T>
+static void put(std::vector<uint8_t>& out, T v) {
     const auto* b = reinterpret_cast<const uint8_t*>(&v);
     out.insert(out.end(), b, b + sizeof(T));
 }
 
 void TraceFileWriter::begin_frame(const TraceHeader& h) {
     std::vector<uint8_t> b(k_magic, k_magic + 8);
-    put(b, h.version); put(b, h.scene_hash);
-    put(b, h.width); put(b, h.height); put(b, h.spp); put(b, h.tile); put(b, h.max_depth);
+    put(b, h.version);
+    put(b, h.scene_hash);
+    put(b, h.width);
+    put(b, h.height);
+    put(b, h.spp);
+    put(b, h.tile);
+    put(b, h.max_depth);
     put(b, h.seed);
     write(b.data(), b.size());
 }
@@ -127,7 +144,9 @@ void TraceFileWriter::op(const StreamOp& op) {
     m_bits.push_back(uint8_t(op.kind));
     m_bits.push_back(uint8_t(op.stage));
     put(m_bits, op.generation);
-    put(m_bits, op.object); put(m_bits, op.length); put(m_bits, op.pass_count);
+    put(m_bits, op.object);
+    put(m_bits, op.length);
+    put(m_bits, op.pass_count);
     write(m_bits.data(), m_bits.size());
     write(op.slots, size_t(op.length) * 4);
     m_bits.assign((op.length + 7) / 8, 0);
@@ -154,73 +173,123 @@ void TraceFileWriter::end_frame() {
 }
 
 namespace {
+// Reads a trace file that may be anything: every count is checked against the bytes left and
+// every slot against its pass before it is used, so a bad file is a clear InputError naming
+// the byte offset, never a huge allocation or a slot past the ray buffer.
 struct Reader {
     std::FILE* f;
     const std::string& path;
-    void read(void* p, size_t n) {
-        if (std::fread(p, 1, n, f) != n) throw std::runtime_error(path + ": truncated trace");
+    uint64_t size = 0, offset = 0;
+    [[noreturn]] void fail(const std::string& what) const {
+        throw InputError(
+            path, 0, "",
+            "not a valid sfx trace: " + what + " (at byte " + std::to_string(offset) + ")");
     }
-    template <class T> T get() { T v; read(&v, sizeof v); return v; }
+    void read(void* p, size_t n) {
+        if (n > size - offset || std::fread(p, 1, n, f) != n) fail("truncated");
+        offset += n;
+    }
+    template <class T>
+    T get() {
+        T v;
+        read(&v, sizeof v);
+        return v;
+    }
 };
 }  // namespace
 
+// A file that is not a whole, consistent trace is an InputError naming the file and the byte
+// offset; the sink may have seen ops before it (the reader streams).
 TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
+    check_regular_file(path, "trace");
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                          &std::fclose);
-    if (!file) throw std::runtime_error("cannot read " + path);
+    if (!file) throw InputError(path, 0, "", "cannot read the trace");
     Reader r{file.get(), path};
+    if (std::fseek(file.get(), 0, SEEK_END) != 0) r.fail("cannot seek");
+    r.size = uint64_t(std::ftell(file.get()));
+    std::rewind(file.get());
     char magic[8];
     r.read(magic, 8);
-    if (std::memcmp(magic, k_magic, 8) != 0) throw std::runtime_error(path + ": not an sfx trace");
+    if (std::memcmp(magic, k_magic, 8) != 0) throw InputError(path, 0, "", "not an sfx trace");
     TraceHeader h;
     h.version = r.get<uint32_t>();
     if (h.version != TraceHeader::k_version)
-        throw std::runtime_error(path + ": trace version " + std::to_string(h.version) +
-                                 ", this sfx reads " + std::to_string(TraceHeader::k_version));
+        throw InputError(path, 0, "",
+                         "trace version " + std::to_string(h.version) + ", this sfx reads " +
+                             std::to_string(TraceHeader::k_version));
     h.scene_hash = r.get<uint64_t>();
-    h.width = r.get<uint32_t>(); h.height = r.get<uint32_t>(); h.spp = r.get<uint32_t>();
-    h.tile = r.get<uint32_t>(); h.max_depth = r.get<uint32_t>();
+    h.width = r.get<uint32_t>();
+    h.height = r.get<uint32_t>();
+    h.spp = r.get<uint32_t>();
+    h.tile = r.get<uint32_t>();
+    h.max_depth = r.get<uint32_t>();
     h.seed = r.get<uint64_t>();
     sink.begin_frame(h);
     TilePass pass;
+    bool in_pass = false;
     std::vector<uint32_t> slots;
     std::vector<uint8_t> bits, passed;
     for (;;) {
         const uint8_t tag = r.get<uint8_t>();
-        if (tag == 'F') break;
+        if (tag == 'F') {
+            if (in_pass) r.fail("the frame ends inside a tile pass");
+            if (r.offset != r.size) r.fail("bytes after the end of the frame");
+            break;
+        }
         if (tag == 'P') {
+            if (in_pass) r.fail("a tile pass starts inside another");
             pass = TilePass{};
             pass.tile = r.get<uint32_t>();
-            pass.x0 = r.get<uint32_t>(); pass.y0 = r.get<uint32_t>();
-            pass.x1 = r.get<uint32_t>(); pass.y1 = r.get<uint32_t>();
+            pass.x0 = r.get<uint32_t>();
+            pass.y0 = r.get<uint32_t>();
+            pass.x1 = r.get<uint32_t>();
+            pass.y1 = r.get<uint32_t>();
             pass.sample = r.get<uint32_t>();
             pass.slot_count = r.get<uint32_t>();
+            if (pass.x0 >= pass.x1 || pass.x1 > h.width || pass.y0 >= pass.y1 || pass.y1 > h.height)
+                r.fail("a tile pass outside the image");
+            if (uint64_t(pass.slot_count) != uint64_t(pass.x1 - pass.x0) * (pass.y1 - pass.y0))
+                r.fail("a tile pass whose slot count is not its pixel count");
+            in_pass = true;
             sink.begin_pass(pass);
         } else if (tag == 'O') {
+            if (!in_pass) r.fail("an operation outside a tile pass");
             StreamOp op;
             op.kind = OpKind(r.get<uint8_t>());
             op.stage = OpStage(r.get<uint8_t>());
             if (uint32_t(op.kind) >= k_op_kind_count || uint32_t(op.stage) >= k_op_stage_count)
-                throw std::runtime_error(path + ": bad op kind or stage");
+                r.fail("bad op kind or stage");
             op.generation = r.get<uint16_t>();
             op.object = r.get<uint32_t>();
             op.length = r.get<uint32_t>();
             op.pass_count = r.get<uint32_t>();
-            if (op.length > pass.slot_count) throw std::runtime_error(path + ": bad op length");
+            if (op.length > pass.slot_count) r.fail("an operation longer than its tile pass");
+            if (uint64_t(op.length) * 4 > r.size - r.offset)
+                r.fail("truncated");  // before allocating
             slots.resize(op.length);
             r.read(slots.data(), size_t(op.length) * 4);
+            for (uint32_t s : slots)
+                if (s >= pass.slot_count) r.fail("a ray slot past its tile pass");
             bits.resize((op.length + 7) / 8);
             r.read(bits.data(), bits.size());
             passed.resize(op.length);
-            for (uint32_t i = 0; i < op.length; ++i) passed[i] = (bits[i >> 3] >> (i & 7)) & 1u;
+            uint32_t count = 0;
+            for (uint32_t i = 0; i < op.length; ++i) {
+                passed[i] = (bits[i >> 3] >> (i & 7)) & 1u;
+                count += passed[i];
+            }
+            if (count != op.pass_count) r.fail("a pass count that disagrees with its pass bits");
             op.slots = slots.data();
             op.passed = passed.data();
             sink.op(op);
         } else if (tag == 'E') {
+            if (!in_pass) r.fail("a tile pass ends that never began");
             pass.generations = r.get<uint32_t>();
+            in_pass = false;
             sink.end_pass(pass);
         } else {
-            throw std::runtime_error(path + ": bad record tag");
+            r.fail("bad record tag");
         }
     }
     sink.end_frame();
@@ -235,13 +304,15 @@ void TraceRecorder::begin_pass(const TilePass& p) {
 }
 
 void TraceRecorder::op(const StreamOp& op) {
-    m_ops.push_back({op.kind, op.stage, op.generation, op.object, op.length, op.pass_count,
-                     m_slots.size()});
+    m_ops.push_back(
+        {op.kind, op.stage, op.generation, op.object, op.length, op.pass_count, m_slots.size()});
     m_slots.insert(m_slots.end(), op.slots, op.slots + op.length);
     m_passed.insert(m_passed.end(), op.passed, op.passed + op.length);
 }
 
-void TraceRecorder::end_pass(const TilePass& p) { m_pass = p; }
+void TraceRecorder::end_pass(const TilePass& p) {
+    m_pass = p;
+}
 
 void TraceRecorder::replay(TraceSink& sink) const {
     sink.begin_pass(m_pass);

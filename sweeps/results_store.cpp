@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "workloads/input_error.h"
-#include "workloads/user_files.h"
 #include "workloads/strict_number.h"
+#include "workloads/user_files.h"
 
 namespace sfx {
 namespace {
@@ -48,11 +48,13 @@ public:
                 const char* description) {
         m_out.push_back({join(name), false, "", description});
     }
-    template <class G> void group(const char* name, G& g) {
+    template <class G>
+    void group(const char* name, G& g) {
         HwColumns c(m_out, join(name));
         g.visit(c);
     }
-    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+    template <class G>
+    void list(const char* name, std::vector<G>& items, const char*) {
         for (size_t i = 0; i < items.size(); ++i) {
             HwColumns c(m_out, join(name) + "[" + std::to_string(i) + "]");
             items[i].visit(c);
@@ -66,10 +68,11 @@ private:
 };
 
 class Statement {
-public:
+  public:
     Statement(sqlite3* db, const std::string& sql) : m_db(db) {
         if (sqlite3_prepare_v2(db, sql.c_str(), -1, &m_stmt, nullptr) != SQLITE_OK)
-            throw std::runtime_error("results store: " + std::string(sqlite3_errmsg(db)) + " in: " + sql);
+            throw std::runtime_error("results store: " + std::string(sqlite3_errmsg(db)) +
+                                     " in: " + sql);
     }
     ~Statement() { sqlite3_finalize(m_stmt); }
     Statement(const Statement&) = delete;
@@ -79,10 +82,18 @@ public:
         sqlite3_bind_text(m_stmt, i, text.c_str(), int(text.size()), SQLITE_TRANSIENT);
     }
     void bind(int i, double v) {
-        if (std::isnan(v)) sqlite3_bind_null(m_stmt, i);
-        else sqlite3_bind_double(m_stmt, i, v);
+        if (std::isnan(v))
+            sqlite3_bind_null(m_stmt, i);
+        else
+            sqlite3_bind_double(m_stmt, i, v);
     }
     void bind_int(int i, int64_t v) { sqlite3_bind_int64(m_stmt, i, v); }
+    // Column `c` of the current row as text; SQL NULL (which a damaged or foreign file may hold
+    // anywhere) is the empty string.
+    std::string text(int c) const {
+        const unsigned char* t = sqlite3_column_text(m_stmt, c);
+        return t ? reinterpret_cast<const char*>(t) : std::string();
+    }
     // SQLITE_ROW: true, SQLITE_DONE: false; anything else throws.
     bool step() {
         const int rc = sqlite3_step(m_stmt);
@@ -91,7 +102,7 @@ public:
         throw std::runtime_error("results store: " + std::string(sqlite3_errmsg(m_db)));
     }
 
-private:
+  private:
     sqlite3* m_db;
     sqlite3_stmt* m_stmt = nullptr;
 };
@@ -127,7 +138,9 @@ std::string sql_quote_identifier(const std::string& name) {
 std::string iso8601_now() {
     const auto now = std::chrono::system_clock::now();
     const std::time_t t = std::chrono::system_clock::to_time_t(now);
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() %
+        1000;
     std::tm tm{};
     gmtime_r(&t, &tm);
     char buf[64];
@@ -179,16 +192,19 @@ bool file_nonempty(const std::string& path) {
 
 ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path) {
     const bool read_only = access == Access::read_only;
-    if (::access(path.c_str(), F_OK) == 0) check_regular_file(path, "results store");
-    else if (read_only) throw InputError(path, 0, "--store", "no such results store");
+    if (::access(path.c_str(), F_OK) == 0)
+        check_regular_file(path, "results store");
+    else if (read_only)
+        throw InputError(path, 0, "--store", "no such results store");
     // A read-only directory: SQLite cannot create the write-ahead log's index (-shm) beside
     // the store. With no log left to replay (a finished sweep leaves none) the file alone is
     // the whole store, and `immutable` reads it without the index.
     const bool immutable = read_only && !directory_writable(path) && !file_nonempty(path + "-wal");
     const std::string uri = "file:" + sqlite_uri_path(path) +
                             (read_only ? (immutable ? "?mode=ro&immutable=1" : "?mode=ro") : "");
-    const int flags = (read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
-                      SQLITE_OPEN_URI;
+    const int flags =
+        (read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
+        SQLITE_OPEN_URI;
     if (sqlite3_open_v2(uri.c_str(), &m_db, flags, nullptr) != SQLITE_OK) {
         const std::string msg = m_db ? sqlite3_errmsg(m_db) : "out of memory";
         sqlite3_close(m_db);
@@ -202,8 +218,9 @@ ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path
         // Nothing is written before the answer is yes: another program's database stays untouched.
         std::vector<std::string> tables;
         {
-            Statement probe(m_db, "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name");
-            while (probe.step()) tables.push_back(reinterpret_cast<const char*>(sqlite3_column_text(probe.get(), 0)));
+            Statement probe(m_db,
+                            "SELECT name FROM sqlite_master WHERE type='table' ORDER BY name");
+            while (probe.step()) tables.push_back(probe.text(0));
         }
         const bool has_meta = std::find(tables.begin(), tables.end(), "meta") != tables.end();
         const bool has_points = std::find(tables.begin(), tables.end(), "points") != tables.end();
@@ -211,20 +228,20 @@ ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path
             std::string list;
             for (const std::string& t : tables) list += (list.empty() ? "" : ", ") + t;
             throw InputError(path, 0, "--store",
-                             "an SQLite database but not an sfx results store (its tables: " + list +
-                                 "; a store has meta and points); left untouched");
+                             "an SQLite database but not an sfx results store (its tables: " +
+                                 list + "; a store has meta and points); left untouched");
         }
         if (has_meta) {
             Statement v(m_db, "SELECT value FROM meta WHERE key='schema_version'");
-            const std::string version =
-                v.step() ? reinterpret_cast<const char*>(sqlite3_column_text(v.get(), 0)) : "";
+            const std::string version = v.step() ? v.text(0) : "";
             if (version != std::to_string(k_schema_version))
                 throw InputError(path, 0, "meta.schema_version",
-                                 "results store has schema version '" + version + "'; this sfx writes " +
-                                     std::to_string(k_schema_version));
+                                 "results store has schema version '" + version +
+                                     "'; this sfx writes " + std::to_string(k_schema_version));
         }
         if (read_only) {
-            if (tables.empty()) throw InputError(path, 0, "--store", "an empty file, not a results store");
+            if (tables.empty())
+                throw InputError(path, 0, "--store", "an empty file, not a results store");
         } else {
             // WAL: a reader never blocks the writer; NORMAL sync still survives a killed
             // process (only a power loss may drop the last transactions, never part of one).
@@ -233,7 +250,8 @@ ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path
             exec("BEGIN IMMEDIATE");
             exec("CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT)");
             exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
-                 std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() + "')");
+                 std::to_string(k_schema_version) + "'), ('created_by', 'sfx " + sfx_version() +
+                 "')");
             exec(std::string("CREATE TABLE IF NOT EXISTS points(") + fixed_columns() + ")");
             exec(k_create_units);  // stores written before the table get it here
             exec("COMMIT");
@@ -245,35 +263,39 @@ ResultsStore::ResultsStore(const std::string& path, Access access) : m_path(path
         sqlite3_close(m_db);
         std::string what = e.what();
         if (read_only && !directory_writable(path) && file_nonempty(path + "-wal"))
-            what += " (the store's write-ahead log holds unfinished writes, and its directory is "
-                    "read-only: run sfx sweep on it once where it is writable, or copy it)";
+            what +=
+                " (the store's write-ahead log holds unfinished writes, and its directory is "
+                "read-only: run sfx sweep on it once where it is writable, or copy it)";
         throw InputError(path, 0, "--store", "not a usable results store: " + what);
     }
     for (const std::string& c : columns()) m_columns.insert(c);
 }
 
-ResultsStore::~ResultsStore() { sqlite3_close(m_db); }
+ResultsStore::~ResultsStore() {
+    sqlite3_close(m_db);
+}
 
 void ResultsStore::exec(const std::string& sql) const {
     char* err = nullptr;
     if (sqlite3_exec(m_db, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
         const std::string msg = err ? err : "unknown error";
         sqlite3_free(err);
-        throw std::runtime_error("results store " + m_path + ": " + msg + " in: " + sql.substr(0, 200));
+        throw std::runtime_error("results store " + m_path + ": " + msg +
+                                 " in: " + sql.substr(0, 200));
     }
 }
 
 std::vector<std::string> ResultsStore::columns() const {
     std::vector<std::string> out;
     Statement s(m_db, "PRAGMA table_info(points)");
-    while (s.step()) out.push_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
+    while (s.step()) out.push_back(s.text(1));
     return out;
 }
 
 std::set<std::string> ResultsStore::keys() const {
     std::set<std::string> out;
     Statement s(m_db, "SELECT key FROM points");
-    while (s.step()) out.insert(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0)));
+    while (s.step()) out.insert(s.text(0));
     return out;
 }
 
@@ -393,10 +415,14 @@ std::vector<ResultsStore::RowValues> ResultsStore::rows() const {
         for (int c = 0; c < sqlite3_column_count(s.get()); ++c) {
             const char* name = sqlite3_column_name(s.get(), c);
             switch (sqlite3_column_type(s.get(), c)) {
-            case SQLITE_NULL: break;
-            case SQLITE_INTEGER:
-            case SQLITE_FLOAT: r.numbers[name] = sqlite3_column_double(s.get(), c); break;
-            default: r.text[name] = reinterpret_cast<const char*>(sqlite3_column_text(s.get(), c));
+                case SQLITE_NULL:
+                    break;
+                case SQLITE_INTEGER:
+                case SQLITE_FLOAT:
+                    r.numbers[name] = sqlite3_column_double(s.get(), c);
+                    break;
+                default:
+                    r.text[name] = s.text(c);
             }
         }
         out.push_back(std::move(r));
@@ -404,7 +430,8 @@ std::vector<ResultsStore::RowValues> ResultsStore::rows() const {
     return out;
 }
 
-void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std::string>& keys) const {
+void ResultsStore::export_csv(const std::string& csv_path,
+                              const std::vector<std::string>& keys) const {
     OutputFiles outputs;  // whole or not at all
     const std::string temp = outputs.add(csv_path, "--csv");
     std::ofstream out(temp);
@@ -415,17 +442,24 @@ void ResultsStore::export_csv(const std::string& csv_path, const std::vector<std
     for (size_t i = 0; i < cols.size(); ++i) out << (i ? "," : "") << csv_field(cols[i]);
     out << "\n";
     std::string select = "SELECT ";
-    for (size_t i = 0; i < cols.size(); ++i) select += (i ? ", " : "") + sql_quote_identifier(cols[i]);
+    for (size_t i = 0; i < cols.size(); ++i)
+        select += (i ? ", " : "") + sql_quote_identifier(cols[i]);
     select += " FROM points";
     auto write_rows = [&](Statement& s) {
         while (s.step()) {
             for (int c = 0; c < int(cols.size()); ++c) {
                 if (c) out << ",";
                 switch (sqlite3_column_type(s.get(), c)) {
-                case SQLITE_NULL: break;
-                case SQLITE_INTEGER: out << sqlite3_column_int64(s.get(), c); break;
-                case SQLITE_FLOAT: out << shortest_text(sqlite3_column_double(s.get(), c)); break;
-                default: out << csv_field(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), c)));
+                    case SQLITE_NULL:
+                        break;
+                    case SQLITE_INTEGER:
+                        out << sqlite3_column_int64(s.get(), c);
+                        break;
+                    case SQLITE_FLOAT:
+                        out << shortest_text(sqlite3_column_double(s.get(), c));
+                        break;
+                    default:
+                        out << csv_field(s.text(c));
                 }
             }
             out << "\n";

@@ -39,10 +39,12 @@ Selection parse_selection(const std::string& text, const std::string& flag) {
     size_t start = 0;
     while (start <= text.size()) {
         const size_t comma = text.find(',', start);
-        const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        const std::string part =
+            text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
         const size_t eq = part.find('=');
         if (eq == std::string::npos || eq == 0)
-            throw InputError("command line", 0, flag, "expected COLUMN=VALUE[,COLUMN=VALUE...], got '" + text + "'");
+            throw InputError("command line", 0, flag,
+                             "expected COLUMN=VALUE[,COLUMN=VALUE...], got '" + text + "'");
         out.emplace_back(part.substr(0, eq), part.substr(eq + 1));
         if (comma == std::string::npos) break;
         start = comma + 1;
@@ -57,9 +59,21 @@ StoreComparison compare_store(const ResultsStore& store, const Selection& a, con
     for (const auto* sel : {&a, &b})
         for (const auto& [column, value] : *sel) {
             (void)value;
-            if (!known.count(column))
-                throw InputError("command line", 0, sel == &a ? "--a" : "--b",
-                                 "the store has no column '" + column + "' (e.g. hw.simd.width, workload.scene)");
+            if (!known.count(column)) {
+                // Name the store's own input columns, never a fixed example (which may be the
+                // very column that is missing, as in a store of another program).
+                std::string inputs;
+                int listed = 0;
+                for (const std::string& c : columns)
+                    if (is_input_column(c) && listed++ < 8)
+                        inputs += (inputs.empty() ? "" : ", ") + c;
+                throw InputError(
+                    "command line", 0, sel == &a ? "--a" : "--b",
+                    "the store has no column '" + column + "'" +
+                        (inputs.empty()
+                             ? std::string(": it has no input columns at all")
+                             : " (its input columns: " + inputs + (listed > 8 ? ", ...)" : ")")));
+            }
             selected.insert(column);
         }
     // The identity of a row: every input column that neither selection names.
@@ -71,7 +85,11 @@ StoreComparison compare_store(const ResultsStore& store, const Selection& a, con
         for (const std::string& c : identity_columns) {
             auto n = r.numbers.find(c);
             auto t = r.text.find(c);
-            id += c + "=" + (n != r.numbers.end() ? std::to_string(n->second) : t != r.text.end() ? t->second : "NULL") + "\n";
+            id += c + "=" +
+                  (n != r.numbers.end() ? std::to_string(n->second)
+                   : t != r.text.end()  ? t->second
+                                        : "NULL") +
+                  "\n";
         }
         return id;
     };
@@ -117,7 +135,8 @@ StoreComparison compare_store(const ResultsStore& store, const Selection& a, con
     }
     if (out.matched == 0)
         throw InputError("command line", 0, "--b",
-                         "no row of --b has the same other inputs (workload, hardware, fidelity) as a row of --a");
+                         "no row of --b has the same other inputs (workload, hardware, fidelity) "
+                         "as a row of --a");
     for (const auto& [name, sum] : sum_a) {
         out.mean_a[name] = sum / double(n_a[name]);
         out.mean_b[name] = sum_b[name] / double(n_b[name]);

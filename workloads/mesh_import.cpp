@@ -9,8 +9,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "workloads/user_files.h"
 
@@ -22,19 +24,73 @@ bool finite_number(const std::string& token) {
     char* end = nullptr;
     errno = 0;
     const float v = std::strtof(token.c_str(), &end);
-    return *end == '\0' && std::isfinite(v) &&  // underflow to 0 is harmless
+    return *end == '\0' && std::isfinite(v) &&                // underflow to 0 is harmless
            token.find_first_of("xXpP") == std::string::npos;  // no hex floats either
+}
+
+// assimp 5.2 loops for ever on some malformed PLY headers (a second `format` line, an
+// unknown keyword, no end_header): the header is checked against the PLY grammar first.
+void check_ply_header(const std::string& text) {
+    static const std::set<std::string> types = {
+        "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+        "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    auto fail = [](int line, const std::string& what) {
+        throw std::runtime_error("line " + std::to_string(line) + ": not a PLY header: " + what);
+    };
+    const size_t header_end = text.find("end_header");
+    if (header_end == std::string::npos) fail(1, "no end_header");
+    std::istringstream in(text.substr(0, header_end));
+    std::string row;
+    int line = 0;
+    bool element = false;
+    while (std::getline(in, row)) {
+        ++line;
+        if (!row.empty() && row.back() == '\r') row.pop_back();
+        std::istringstream tokens(row);
+        std::vector<std::string> t;
+        for (std::string w; tokens >> w;) t.push_back(w);
+        if (line == 1) {
+            if (row != "ply") fail(line, "the first line must be 'ply'");
+        } else if (line == 2) {
+            if (t.size() != 3 || t[0] != "format" || t[2] != "1.0" ||
+                (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
+                fail(line,
+                     "the second line must be 'format ascii|binary_little_endian|binary_big_endian "
+                     "1.0'");
+        } else if (t.empty() || t[0] == "comment" || t[0] == "obj_info") {
+        } else if (t[0] == "element") {
+            if (t.size() != 3 || t[2].find_first_not_of("0123456789") != std::string::npos ||
+                t[2].size() > 10)
+                fail(line, "expected 'element NAME COUNT'");
+            element = true;
+        } else if (t[0] == "property") {
+            const bool list =
+                t.size() == 5 && t[1] == "list" && types.count(t[2]) && types.count(t[3]);
+            if (!element || !(list || (t.size() == 3 && types.count(t[1]))))
+                fail(line,
+                     "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an "
+                     "element");
+        } else {
+            fail(line, "unknown keyword '" + t[0] + "'");
+        }
+    }
+    // end_header must be a line of its own, after a newline.
+    if (header_end == 0 || text[header_end - 1] != '\n')
+        fail(line + 1, "end_header must start a line");
 }
 
 // assimp's number reader takes "1.#INF" (an old C library's infinity) as 1 and "0x1p200" as 0:
 // in the text formats, every coordinate must be a finite decimal number before assimp reads it.
 // OBJ: every number of a `v` line; ASCII PLY: every token after the header.
-void check_text_coordinates(const std::string& path) {
+void check_text_formats(const std::string& path) {
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     const std::string text = read_input_file(path, "mesh");
     const bool obj = ext == ".obj";
-    const bool ascii_ply = text.compare(0, 3, "ply") == 0 && text.find("format ascii") < text.find("end_header");
+    if (ext == ".ply" || text.compare(0, 4, "ply\n") == 0 || text.compare(0, 5, "ply\r\n") == 0)
+        check_ply_header(text);
+    const bool ascii_ply =
+        text.compare(0, 3, "ply") == 0 && text.find("format ascii") < text.find("end_header");
     if (!obj && !ascii_ply) return;
     size_t body = 0;
     int line = 1;
@@ -65,15 +121,35 @@ void check_text_coordinates(const std::string& path) {
 
 TriangleMesh import_mesh(const std::string& path) {
     check_regular_file(path, "mesh");  // assimp would block on a FIFO
-    check_text_coordinates(path);
+    check_text_formats(path);
     Assimp::Importer importer;
     // Points and lines are removed rather than kept as degenerate triangles; vertices are
     // joined so that shared edges stay watertight for the triangle test.
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    const aiScene* scene = importer.ReadFile(
-        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                  aiProcess_PreTransformVertices | aiProcess_SortByPType);
-    if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    // Read first, check, then post-process: Debian's assimp keeps its assertions, and its
+    // post-processing steps abort the process on a face without indices or an index past the
+    // vertices (which a PLY file can hold). Its own validation step does not catch the first.
+    const aiScene* raw = importer.ReadFile(path, 0);
+    if (!raw || (raw->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+        throw std::runtime_error(std::string("cannot import: ") + importer.GetErrorString());
+    for (unsigned m = 0; m < raw->mNumMeshes; ++m) {
+        const aiMesh* am = raw->mMeshes[m];
+        for (unsigned f = 0; f < am->mNumFaces; ++f) {
+            const aiFace& face = am->mFaces[f];
+            if (face.mNumIndices == 0 || !face.mIndices)
+                throw std::runtime_error("face " + std::to_string(f) + " has no vertices");
+            for (unsigned k = 0; k < face.mNumIndices; ++k)
+                if (face.mIndices[k] >= am->mNumVertices)
+                    throw std::runtime_error("face " + std::to_string(f) + " names vertex " +
+                                             std::to_string(face.mIndices[k]) + " of " +
+                                             std::to_string(am->mNumVertices));
+        }
+    }
+    const aiScene* scene =
+        importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                     aiProcess_PreTransformVertices | aiProcess_SortByPType);
+    if (!scene)
         throw std::runtime_error(std::string("cannot import: ") + importer.GetErrorString());
     TriangleMesh mesh;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

@@ -3,11 +3,14 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <yaml-cpp/eventhandler.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <vector>
 
 #include "workloads/input_error.h"
@@ -64,9 +67,9 @@ void check_scalar_keys(const YAML::Node& node, const std::string& file, const st
     }
 }
 
-// The line where the second document starts: its node's, else the second marker's.
-int second_document_line(const YAML::Node& second, const std::string& text) {
-    if (line_of(second) > 0) return line_of(second);
+// The line where the second document starts: its root node's, else the second marker's.
+int second_document_line(int root_line, const std::string& text) {
+    if (root_line > 0) return root_line;
     int line = 1, markers = 0, content_seen = 0;
     for (size_t i = 0; i < text.size(); i = text.find('\n', i) + 1, ++line) {
         const bool marker = text.compare(i, 3, "---") == 0 || text.compare(i, 3, "...") == 0;
@@ -76,6 +79,37 @@ int second_document_line(const YAML::Node& second, const std::string& text) {
     }
     return 0;
 }
+
+// Records where each document's root node starts (the first node event after a document start).
+class DocumentStarts : public YAML::EventHandler {
+  public:
+    std::vector<YAML::Mark> roots;
+    void OnDocumentStart(const YAML::Mark&) override { m_want_root = true; }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark& m, YAML::anchor_t) override { root(m); }
+    void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { root(m); }
+    void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                  const std::string&) override {
+        root(m);
+    }
+    void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                         YAML::EmitterStyle::value) override {
+        root(m);
+    }
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                    YAML::EmitterStyle::value) override {
+        root(m);
+    }
+    void OnMapEnd() override {}
+
+  private:
+    void root(const YAML::Mark& m) {
+        if (m_want_root) roots.push_back(m);
+        m_want_root = false;
+    }
+    bool m_want_root = false;
+};
 
 }  // namespace
 
@@ -111,18 +145,36 @@ std::string read_input_file(const std::string& path, const std::string& what) {
 }
 
 YAML::Node parse_yaml_document(const std::string& text, const std::string& file) {
-    std::vector<YAML::Node> docs;
+    // Not YAML::LoadAll: yaml-cpp 0.7 loops for ever, allocating, on a stray ',' at the top level
+    // (yaml-cpp issue 1040): its parser reports a new empty document at the same place again and
+    // again. The documents are walked here instead, at most three, and a document that starts
+    // where the last one did is that syntax error.
+    YAML::Node root;
+    int documents = 0, second_line = 0;
     try {
-        docs = YAML::LoadAll(text);
+        root = YAML::Load(text);
+        std::istringstream in(text);
+        YAML::Parser parser(in);
+        DocumentStarts starts;
+        for (; documents < 3 && parser.HandleNextDocument(starts); ++documents) {
+            const size_t n = starts.roots.size();
+            if (n >= 2 && starts.roots[n - 1].pos == starts.roots[n - 2].pos) {
+                const size_t at = size_t(std::max(0, starts.roots[n - 1].pos));
+                throw InputError(file, starts.roots[n - 1].line + 1, "",
+                                 "YAML syntax error: unexpected " +
+                                     (at < text.size() ? "'" + text.substr(at, 1) + "'"
+                                                       : std::string("end of file")));
+            }
+            if (documents == 1 && n >= 2) second_line = starts.roots[1].line + 1;
+        }
     } catch (const YAML::Exception& e) {
         throw InputError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "",
                          "YAML syntax error: " + e.msg);
     }
-    if (docs.size() > 1) {
-        throw InputError(file, second_document_line(docs[1], text), "",
+    if (documents > 1) {
+        throw InputError(file, second_document_line(second_line, text), "",
                          "a second YAML document: the file must hold exactly one");
     }
-    const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
     check_scalar_keys(root, file, "", 0);
     return root;
 }

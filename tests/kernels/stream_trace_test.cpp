@@ -12,6 +12,8 @@
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/stream/stream_tracer.h"
+#include "tests/temp_dir.h"
+#include "workloads/input_error.h"
 
 using namespace sfx;
 
@@ -299,4 +301,64 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CountingSink partial(widths);
     CHECK_THROWS(read_trace_file(p1, partial));
     std::remove(p1.c_str());
+}
+
+namespace {
+// A trace file by hand: the header of a 4x4 frame, one pass over all of it (16 slots), one
+// op of `length` lanes with the given slots, pass count and pass bits, then the rest.
+template <class T>
+void put(std::string& b, T v) {
+    b.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_count,
+                          const std::vector<uint32_t>& slots, uint8_t bits, bool finish = true) {
+    std::string b = "SFXTRACE";
+    put(b, TraceHeader::k_version);
+    put(b, uint64_t(7));
+    for (uint32_t v : {4u, 4u, 1u, 4u, 3u}) put(b, v);  // width height spp tile max_depth
+    put(b, uint64_t(0));
+    b += 'P';
+    for (uint32_t v : {0u, 0u, 0u, 4u, 4u, 0u, slot_count}) put(b, v);
+    b += 'O';
+    b += char(OpKind::box_test);
+    b += char(OpStage::traversal);
+    put(b, uint16_t(0));
+    put(b, uint32_t(0));
+    put(b, length);
+    put(b, pass_count);
+    for (uint32_t s : slots) put(b, s);
+    if (length > 0) b += char(bits);
+    if (finish) {
+        b += 'E';
+        put(b, uint32_t(1));
+        b += 'F';
+    }
+    return b;
+}
+}  // namespace
+
+TEST_CASE("Trace file: a damaged file is an InputError naming the byte, never a huge allocation",
+          "[stream]") {
+    const TempDir dir("sfx-trace-reader");
+    const std::string path = (dir.path / "t.trc").string();
+    auto read = [&](const std::string& bytes) {
+        std::ofstream(path, std::ios::binary) << bytes;
+        CountingSink sink({8});
+        read_trace_file(path, sink);
+    };
+    read(crafted_trace(16, 2, 1, {3, 15}, 0b01));  // the well-formed version of each case below
+    using Catch::Matchers::Contains;
+    CHECK_THROWS_WITH(read(crafted_trace(16, 2, 1, {3, 16}, 0b01)),
+                      Contains("a ray slot past its tile pass"));
+    CHECK_THROWS_WITH(read(crafted_trace(16, 2, 2, {3, 15}, 0b01)), Contains("pass count"));
+    CHECK_THROWS_WITH(read(crafted_trace(17, 2, 1, {3, 15}, 0b01)),
+                      Contains("slot count is not its pixel count"));
+    // A length the pass allows but the file cannot hold: refused before allocating 16 GiB.
+    CHECK_THROWS_WITH(read(crafted_trace(0xffffffffu, 0xfffffff0u, 0, {}, 0)),
+                      Contains("slot count"));
+    CHECK_THROWS_WITH(read(crafted_trace(16, 16, 0, {}, 0)), Contains("truncated (at byte"));
+    CHECK_THROWS_WITH(read(crafted_trace(16, 2, 1, {3, 15}, 0b01, false)), Contains("truncated"));
+    CHECK_THROWS_WITH(read(crafted_trace(16, 2, 1, {3, 15}, 0b01) + "x"),
+                      Contains("bytes after the end"));
+    CHECK_THROWS_AS(read("SFXTRACE"), InputError);
 }

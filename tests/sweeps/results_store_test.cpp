@@ -1,21 +1,22 @@
 // The results store (schema version 1): columns and types, one row per key, new stat columns,
 // CSV export; and a point group run from its JSON spec.
 
-#include <catch2/catch.hpp>
-#include <sqlite3.h>
+#include "sweeps/results_store.h"
 
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
-#include <unistd.h>
 
 #include "sweeps/group_runner.h"
-#include "tests/temp_dir.h"
-#include "sweeps/results_store.h"
 #include "sweeps/store_compare.h"
 #include "sweeps/sweep.h"
+#include "tests/temp_dir.h"
 #include "workloads/input_error.h"
 
 using namespace sfx;
@@ -24,11 +25,14 @@ namespace fs = std::filesystem;
 namespace {
 
 Sweep small_sweep(const std::string& fidelity = "analytic") {
-    return parse_sweep("version: 1\nhw: gr08.hw.yaml\n"
-                       "workload: {scene: cornell, res: 16x16, spp: 1, tile: 8}\n"
-                       "fidelity: " + fidelity + "\n"
-                       "axes:\n  hw.simd.width: [4, 8]\n",
-                       "small.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
+    return parse_sweep(
+        "version: 1\nhw: gr08.hw.yaml\n"
+        "workload: {scene: cornell, res: 16x16, spp: 1, tile: 8}\n"
+        "fidelity: " +
+            fidelity +
+            "\n"
+            "axes:\n  hw.simd.width: [4, 8]\n",
+        "small.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
 }
 
 PointRun fake_run(const std::string& key, double fps) {
@@ -66,7 +70,8 @@ TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps
         ResultsStore store(db);
         CHECK(store.keys().empty());
         CHECK(store.write_point(sweep.points[0], sweep.name, fake_run(sweep.points[0].key, 10)));
-        CHECK_FALSE(store.write_point(sweep.points[0], sweep.name, fake_run(sweep.points[0].key, 99)));
+        CHECK_FALSE(
+            store.write_point(sweep.points[0], sweep.name, fake_run(sweep.points[0].key, 99)));
         CHECK(store.contains(sweep.points[0].key));
         CHECK_FALSE(store.contains(sweep.points[1].key));
         // A later sfx adds a stat: it becomes a new column, NULL in older rows.
@@ -75,10 +80,13 @@ TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps
         CHECK(store.write_point(sweep.points[1], sweep.name, later));
         sqlite3* h = store.handle();
         CHECK(query(h, "SELECT value FROM meta WHERE key = 'schema_version'") == "1\n");
-        CHECK(query(h, "SELECT value FROM meta WHERE key = 'created_by'") == std::string("sfx ") + sfx_version() + "\n");
+        CHECK(query(h, "SELECT value FROM meta WHERE key = 'created_by'") ==
+              std::string("sfx ") + sfx_version() + "\n");
         CHECK(query(h, "SELECT count(*) FROM points") == "2\n");
-        CHECK(query(h, "SELECT fps FROM points ORDER BY point_index") == "10.0\n20.0\n");  // not overwritten
-        CHECK(query(h, "SELECT \"new_stat.cycles\" FROM points ORDER BY point_index") == "NULL\n5.0\n");
+        CHECK(query(h, "SELECT fps FROM points ORDER BY point_index") ==
+              "10.0\n20.0\n");  // not overwritten
+        CHECK(query(h, "SELECT \"new_stat.cycles\" FROM points ORDER BY point_index") ==
+              "NULL\n5.0\n");
         CHECK(query(h, "SELECT \"scene_cache.l1.hit_rate\" FROM points LIMIT 1") == "NULL\n");
         CHECK(query(h, "SELECT \"hw.simd.width\", \"hw.name\", \"hw.ray_buffer.pipelined\", "
                        "\"hw.scene_memory.caches[2].kib\", \"workload.scene\", \"workload.tile\", fidelity, sweep "
@@ -108,7 +116,8 @@ TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps
     std::string header, row;
     std::getline(csv, header);
     std::getline(csv, row);
-    CHECK(header.rfind("key,sfx_version,sweep,point_index,started_at,finished_at,workload.scene,", 0) == 0);
+    CHECK(header.rfind("key,sfx_version,sweep,point_index,started_at,finished_at,workload.scene,",
+                       0) == 0);
     CHECK(header.find("hw.simd.width") != std::string::npos);
     CHECK(header.find("config_yaml") == std::string::npos);
     CHECK(header.find(",fps,") != std::string::npos);
@@ -117,13 +126,16 @@ TEST_CASE("The store keeps one row per key with typed, dotted columns", "[sweeps
     // Reopening keeps everything; a store of another schema version is refused.
     ResultsStore again(db);
     CHECK(again.keys().size() == 2);
-    sqlite3_exec(again.handle(), "UPDATE meta SET value = '9' WHERE key = 'schema_version'", nullptr, nullptr, nullptr);
+    sqlite3_exec(again.handle(), "UPDATE meta SET value = '9' WHERE key = 'schema_version'",
+                 nullptr, nullptr, nullptr);
     CHECK_THROWS_AS(ResultsStore(db), InputError);
-    std::ofstream((dir.path / "text.db").string()) << "not a database, just some text that is long enough\n";
+    std::ofstream((dir.path / "text.db").string())
+        << "not a database, just some text that is long enough\n";
     CHECK_THROWS_AS(ResultsStore((dir.path / "text.db").string()), InputError);
 }
 
-TEST_CASE("A point group runs from its JSON spec: one row per point, keys from the YAML", "[sweeps]") {
+TEST_CASE("A point group runs from its JSON spec: one row per point, keys from the YAML",
+          "[sweeps]") {
     const Sweep sweep = small_sweep();
     const nlohmann::json spec = group_spec_json(sweep, sweep.groups[0].points, 1);
     const std::vector<PointRun> rows = run_group(nlohmann::json::parse(spec.dump()));
@@ -132,7 +144,8 @@ TEST_CASE("A point group runs from its JSON spec: one row per point, keys from t
         CHECK(rows[i].key == sweep.points[sweep.groups[0].points[i]].key);
         CHECK(rows[i].sfx_version == sfx_version());
         // The JSON line a worker prints reads back the same.
-        const PointRun back = point_run_from_json(nlohmann::ordered_json::parse(point_run_json(rows[i]).dump()));
+        const PointRun back =
+            point_run_from_json(nlohmann::ordered_json::parse(point_run_json(rows[i]).dump()));
         CHECK(back.key == rows[i].key);
         REQUIRE(back.metrics.size() == rows[i].metrics.size());
         CHECK(back.metrics.front().first == "fps");
@@ -148,26 +161,31 @@ TEST_CASE("A point group runs from its JSON spec: one row per point, keys from t
     CHECK(small_sweep("sampled").points[0].fidelity == Fidelity::sampled);
     CHECK(small_sweep("full").points[0].fidelity == Fidelity::full);
     // Points of different renders cannot share a group.
-    const Sweep two = parse_sweep("version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16x16, spp: 1}\n"
-                                  "axes:\n  workload.seed: [1, 2]\n",
-                                  "two.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
+    const Sweep two = parse_sweep(
+        "version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16x16, spp: 1}\n"
+        "axes:\n  workload.seed: [1, 2]\n",
+        "two.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
     REQUIRE(two.groups.size() == 2);
     CHECK_THROWS_AS(run_group(group_spec_json(two, {0, 1}, 1)), InputError);
 }
 
-TEST_CASE("Two store selections are matched on every other input and compared by means", "[sweeps]") {
+TEST_CASE("Two store selections are matched on every other input and compared by means",
+          "[sweeps]") {
     TempDir dir;
     ResultsStore store((dir.path / "c.db").string());
-    const Sweep sweep = parse_sweep("version: 1\nhw: gr08.hw.yaml\n"
-                                    "workload: {scene: cornell, res: 16x16, spp: 1, tile: 8}\n"
-                                    "axes:\n  workload.seed: [1, 2]\n  hw.simd.width: [8, 16]\n"
-                                    "  hw.ray_buffer.banks: [16, 32]\n",
-                                    "c.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
+    const Sweep sweep = parse_sweep(
+        "version: 1\nhw: gr08.hw.yaml\n"
+        "workload: {scene: cornell, res: 16x16, spp: 1, tile: 8}\n"
+        "axes:\n  workload.seed: [1, 2]\n  hw.simd.width: [8, 16]\n"
+        "  hw.ray_buffer.banks: [16, 32]\n",
+        "c.sweep.yaml", SFX_SOURCE_DIR "/hw_model/presets");
     REQUIRE(sweep.points.size() == 8);
     // fps = width * seed; banks 32 rows are left out of the store except for width 8, seed 1.
     for (const SweepPoint& p : sweep.points) {
-        if (p.hw.ray_buffer.banks == 32 && !(p.hw.simd.width == 8 && p.workload.seed == 1)) continue;
-        store.write_point(p, sweep.name, fake_run(p.key, double(p.hw.simd.width * p.workload.seed)));
+        if (p.hw.ray_buffer.banks == 32 && !(p.hw.simd.width == 8 && p.workload.seed == 1))
+            continue;
+        store.write_point(p, sweep.name,
+                          fake_run(p.key, double(p.hw.simd.width * p.workload.seed)));
     }
     const StoreComparison c = compare_store(store, parse_selection("hw.simd.width=8", "--a"),
                                             parse_selection("hw.simd.width=16", "--b"));
@@ -178,8 +196,9 @@ TEST_CASE("Two store selections are matched on every other input and compared by
     CHECK(c.mean_b.at("fps") == Approx((16.0 + 32.0) / 2));
     CHECK(c.mean_a.count("point_index") == 0);  // bookkeeping is not a metric
     // Two conditions at once; text and number columns.
-    const StoreComparison d = compare_store(store, parse_selection("hw.simd.width=8,workload.seed=1", "--a"),
-                                            parse_selection("hw.simd.width=16,workload.seed=1", "--b"));
+    const StoreComparison d =
+        compare_store(store, parse_selection("hw.simd.width=8,workload.seed=1", "--a"),
+                      parse_selection("hw.simd.width=16,workload.seed=1", "--b"));
     CHECK(d.matched == 1);
     CHECK(d.mean_b.at("fps") == Approx(16.0));
     CHECK_THROWS_AS(compare_store(store, parse_selection("hw.simd.lanes=8", "--a"),
@@ -196,20 +215,54 @@ TEST_CASE("Another program's SQLite database is refused and left untouched", "[s
     const std::string db = (dir.path / "other.db").string();
     sqlite3* h = nullptr;
     REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
-    REQUIRE(sqlite3_exec(h, "CREATE TABLE t(x); INSERT INTO t VALUES (1)", nullptr, nullptr, nullptr) == SQLITE_OK);
+    REQUIRE(sqlite3_exec(h, "CREATE TABLE t(x); INSERT INTO t VALUES (1)", nullptr, nullptr,
+                         nullptr) == SQLITE_OK);
     sqlite3_close(h);
     auto bytes = [&] {
         std::ifstream in(db, std::ios::binary);
         return std::string(std::istreambuf_iterator<char>(in), {});
     };
     const std::string before = bytes();
-    CHECK_THROWS_WITH(ResultsStore(db), Catch::Contains("not an sfx results store (its tables: t;"));
+    CHECK_THROWS_WITH(ResultsStore(db),
+                      Catch::Contains("not an sfx results store (its tables: t;"));
     CHECK_THROWS_WITH(ResultsStore(db, ResultsStore::Access::read_only),
                       Catch::Contains("not an sfx results store"));
     CHECK(bytes() == before);
     CHECK_FALSE(fs::exists(db + "-wal"));
     // Read-only never creates a store.
-    CHECK_THROWS_WITH(ResultsStore((dir.path / "none.db").string(), ResultsStore::Access::read_only),
-                      Catch::Contains("no such results store"));
+    CHECK_THROWS_WITH(
+        ResultsStore((dir.path / "none.db").string(), ResultsStore::Access::read_only),
+        Catch::Contains("no such results store"));
     CHECK_FALSE(fs::exists(dir.path / "none.db"));
+}
+
+TEST_CASE("A store with NULLs where text belongs, or without sfx's columns, says what is wrong",
+          "[sweeps]") {
+    TempDir dir;
+    auto make = [&](const std::string& name, const char* sql) {
+        const std::string db = (dir.path / name).string();
+        sqlite3* h = nullptr;
+        REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
+        REQUIRE(sqlite3_exec(h, sql, nullptr, nullptr, nullptr) == SQLITE_OK);
+        sqlite3_close(h);
+        return db;
+    };
+    const std::string null_version =
+        make("null.db",
+             "CREATE TABLE meta(key TEXT, value TEXT); CREATE TABLE points(key TEXT);"
+             "INSERT INTO meta VALUES('schema_version', NULL)");
+    CHECK_THROWS_WITH(ResultsStore(null_version, ResultsStore::Access::read_only),
+                      Catch::Contains("meta.schema_version: results store has schema version ''"));
+    // A bare points table: no input column to compare on, and the message must not offer the
+    // missing column as an example.
+    const std::string bare =
+        make("bare.db",
+             "CREATE TABLE meta(key TEXT, value TEXT); CREATE TABLE points(key TEXT);"
+             "INSERT INTO meta VALUES('schema_version', '1')");
+    const ResultsStore store(bare, ResultsStore::Access::read_only);
+    CHECK_THROWS_WITH(
+        compare_store(store, parse_selection("hw.simd.width=8", "--a"),
+                      parse_selection("hw.simd.width=16", "--b")),
+        Catch::Equals("command line: --a: the store has no column 'hw.simd.width': it "
+                      "has no input columns at all"));
 }

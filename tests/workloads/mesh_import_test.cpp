@@ -1,12 +1,13 @@
 // Mesh import through assimp: tiny OBJ and PLY files written here, loaded directly and from a
 // scene file (relative path, transform).
 
+#include "workloads/mesh_import.h"
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 
 #include "tests/temp_dir.h"
-#include "workloads/mesh_import.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
@@ -103,4 +104,52 @@ TEST_CASE("mesh import: scene files place meshes relative to themselves", "[work
     CHECK(b.lo == Vec3(0.f, 0.f, -3.f));
     CHECK(b.hi == Vec3(2.f, 2.f, -1.f));
     CHECK(s.lights.empty());
+}
+
+// Found by the mesh_ply fuzzer (the inputs are in tests/fuzz/regressions/mesh_ply/): assimp
+// loops for ever on a malformed PLY header, and aborts the process on a face without indices.
+TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever", "[workloads]") {
+    using Catch::Matchers::Contains;
+    auto import_text = [](const std::string& name, const std::string& text) {
+        const fs::path p = test_dir() / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return import_mesh(p.string());
+    };
+    const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::string header =
+        "element vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\n"
+        "property list uchar int vertex_indices\n";
+    CHECK(import_text("ok.ply", "ply\nformat ascii 1.0\n" + header + "end_header\n" + body)
+              .triangle_count() == 1);
+    CHECK_THROWS_WITH(import_text("a.ply", "ply\nformat binary_little_endian 1.0\nply\n" + header +
+                                               "end_header\n"),
+                      Contains("line 3: not a PLY header"));
+    CHECK_THROWS_WITH(import_text("b.ply", "ply\nformat ascii 1.0\n" + header + body),
+                      Contains("no end_header"));
+    CHECK_THROWS_WITH(
+        import_text("c.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float\n" + header +
+                                 "end_header\n" + body),
+        Contains("line 4: not a PLY header: expected 'property TYPE NAME'"));
+    CHECK_THROWS_WITH(import_text("d.ply", "ply\nformat ascii 1.0\nelementr vertex 3\n" + header +
+                                               "end_header\n" + body),
+                      Contains("unknown keyword 'elementr'"));
+}
+
+TEST_CASE("mesh import: a PLY face without indices or with an index past the vertices is refused",
+          "[workloads]") {
+    using Catch::Matchers::Contains;
+    auto import_text = [](const std::string& name, const std::string& text) {
+        const fs::path p = test_dir() / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return import_mesh(p.string());
+    };
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    CHECK_THROWS_WITH(import_text("empty_face.ply", header + "0\n"),
+                      Contains("face 1 has no vertices"));
+    CHECK_THROWS_WITH(import_text("far_index.ply", header + "3 0 1 7\n"),
+                      Contains("face 1 names vertex 7 of 3"));
 }

@@ -1,15 +1,16 @@
 // The files a user names: only regular files are read, YAML holds one document with plain
 // keys, and outputs appear whole and together or not at all.
 
-#include <catch2/catch.hpp>
+#include "workloads/user_files.h"
+
 #include <sys/stat.h>
 
+#include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 
 #include "tests/temp_dir.h"
 #include "workloads/input_error.h"
-#include "workloads/user_files.h"
 
 using namespace sfx;
 namespace fs = std::filesystem;
@@ -19,8 +20,10 @@ TEST_CASE("user files: only regular files are read, never a FIFO or a directory"
     const std::string fifo = (dir.path / "in.fifo").string();
     REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
     // Without a writer, a blocking open would hang here.
-    CHECK_THROWS_WITH(read_input_file(fifo, "scene file"), Catch::Contains("a FIFO, not a regular file"));
-    CHECK_THROWS_WITH(read_input_file(dir.path.string(), "scene file"), Catch::Contains("a directory"));
+    CHECK_THROWS_WITH(read_input_file(fifo, "scene file"),
+                      Catch::Contains("a FIFO, not a regular file"));
+    CHECK_THROWS_WITH(read_input_file(dir.path.string(), "scene file"),
+                      Catch::Contains("a directory"));
     CHECK_THROWS_WITH(check_regular_file("/dev/null", "mesh"), Catch::Contains("character device"));
     CHECK_THROWS_WITH(read_input_file((dir.path / "none").string(), "mesh"),
                       Catch::Contains("No such file"));
@@ -48,12 +51,14 @@ TEST_CASE("user files: one YAML document with plain keys", "[workloads]") {
     CHECK_THROWS_AS(parse_yaml_document("a: [1, 2\n", "s.yaml"), InputError);
 }
 
-TEST_CASE("user files: outputs are checked first and appear together or not at all", "[workloads]") {
+TEST_CASE("user files: outputs are checked first and appear together or not at all",
+          "[workloads]") {
     const TempDir dir("sfx-user-files-test");
     const std::string a = (dir.path / "a.png").string(), b = (dir.path / "a.pfm").string();
     CHECK_THROWS_WITH(check_output_file((dir.path / "no" / "x.csv").string(), "--csv"),
                       Catch::Contains("--csv") && Catch::Contains("does not exist"));
-    CHECK_THROWS_WITH(check_output_file(dir.path.string(), "--output"), Catch::Contains("is a directory"));
+    CHECK_THROWS_WITH(check_output_file(dir.path.string(), "--output"),
+                      Catch::Contains("is a directory"));
     {
         OutputFiles out;
         std::ofstream(out.add(a, "--output")) << "png";
@@ -77,4 +82,19 @@ TEST_CASE("user files: outputs are checked first and appear together or not at a
     CHECK(fs::file_size(a) == 3);
     CHECK(fs::file_size(b) == 3);
     CHECK(std::distance(fs::directory_iterator(dir.path), fs::directory_iterator()) == 2);
+}
+
+// Found by the hw_config fuzzer (tests/fuzz/regressions/hw_config/): yaml-cpp's LoadAll loops
+// for ever, allocating, on a stray ',' at the top level. It must be a syntax error at once.
+TEST_CASE("user files: a stray top-level comma is a syntax error, not an endless loop",
+          "[workloads]") {
+    using Catch::Matchers::Contains;
+    CHECK_THROWS_WITH(parse_yaml_document(",\n", "c.yaml"),
+                      Contains("c.yaml:1: YAML syntax error: unexpected ','"));
+    CHECK_THROWS_WITH(parse_yaml_document("# a comment\n, # x\n", "c.yaml"),
+                      Contains("c.yaml:2: YAML syntax error"));
+    // Documents that are not stuck keep their own messages and lines.
+    CHECK(parse_yaml_document("---\na: 1\n...\n", "m.yaml")["a"].Scalar() == "1");
+    CHECK_THROWS_WITH(parse_yaml_document("a: 1\n---\n", "e.yaml"),
+                      Contains("a second YAML document"));
 }
