@@ -52,6 +52,13 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
                    fixed(100 * stat(p, std::string("ideal_simd_utilization.") + stage), 1) + "%)";
         });
     }
+    for (const char* stage : {"traversal", "intersection", "shading"}) {
+        row(std::string("stream length ") + stage, [&](const Prediction& p) {
+            return fixed(stat(p, std::string("stream_length.") + stage), 1);
+        });
+    }
+    row("option overhead (% of instructions)",
+        [&](const Prediction& p) { return fixed(stat(p, "op_mix.option_percent"), 2); });
     for (const char* cause : {"bank_conflict", "alignment", "address_fetch", "partition",
                               "scene_memory", "interconnect", "pipeline_fill"}) {
         row(std::string("stall ") + cause + " (% of cycles)", [&](const Prediction& p) {

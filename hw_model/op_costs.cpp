@@ -77,6 +77,16 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     set(OpKind::lambertian_indirect, hit, whole_ray, 64, 14, 64);
     set(OpKind::dielectric, hit, whole_ray, 72, 16, 64);
     set(OpKind::glossy, hit, whole_ray, 110, 18, 64);
+    // AEPSA (kernels/stream/entry_point.cpp): counted from our code, not from the paper (its
+    // costs are host times). The bounds fit the frustum in two sweeps over the stream: a sum of
+    // normalized directions (3 mul, 2 add, a square root and 3 divides: 9), then per ray three
+    // direction and three origin dot products (6 x 5), two slope divides and 10 min/max (42):
+    // 51, with a longest chain of dot, divide, min (7). The frustum test is five plane tests,
+    // each 3 selects, 3 products, 2 adds, a compare (11), and 4 ors (59); chain select, mul,
+    // add, add, compare, 3 ors (8). It reads the node (32 bytes) and no ray data: the frustum
+    // lives in the unit's registers.
+    set(OpKind::frustum_bounds, {"origin", "direction"}, {}, 51, 7, 0);
+    set(OpKind::frustum_test, {}, {}, 59, 8, 32);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
@@ -86,6 +96,7 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     const uint64_t materials_base = spheres_base + spheres * sphere_bytes;
     switch (kind) {
         case OpKind::box_test:
+        case OpKind::frustum_test:
             return uint64_t(object) * node_bytes;
         case OpKind::triangle_test:
             return triangles_base + uint64_t(object) * triangle_bytes;

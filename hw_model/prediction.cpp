@@ -45,6 +45,7 @@ OpMix& OpMix::operator+=(const OpMix& o) {
     compute += o.compute;
     scatter_gather += o.scatter_gather;
     partition += o.partition;
+    option += o.option;
     return *this;
 }
 
@@ -97,6 +98,7 @@ void for_each_counter(FrameTiming& t, const FrameTiming& o, F f) {
     f(t.mix.compute, o.mix.compute);
     f(t.mix.scatter_gather, o.mix.scatter_gather);
     f(t.mix.partition, o.mix.partition);
+    f(t.mix.option, o.mix.option);
     for (int s = 0; s < 2; ++s)
         for (uint32_t k = 0; k < k_op_stage_count; ++k) {
             f(t.stages[s][k].ops, o.stages[s][k].ops);
@@ -227,6 +229,8 @@ std::vector<Stat> Prediction::stats() const {
     add("op_mix.partition_percent", 100.0 * ratio(double(timing.mix.partition), mix_total), "%",
         "partition (Table 5)");
     add("op_mix.instructions", mix_total, "instructions", "SIMD instructions per frame");
+    add("op_mix.option_percent", 100.0 * ratio(double(timing.mix.option), mix_total), "%",
+        "instructions of the ops a workload option adds (its own overhead)");
 
     add("ray_buffer.bank_conflict_rate",
         ratio(double(timing.conflicted_accesses), double(timing.field_accesses)), "",

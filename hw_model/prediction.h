@@ -43,6 +43,9 @@ struct OpMix {
     uint64_t compute = 0;  // arithmetic on ray data
     uint64_t scatter_gather = 0;  // ray-record gathers and conditional scatters
     uint64_t partition = 0;       // comparator passes of the partition unit
+    // Of all the above, those issued for ops a workload option adds (is_option_kind): the
+    // option's own overhead. Not part of total().
+    uint64_t option = 0;
 
     uint64_t total() const { return load + store + compute + scatter_gather + partition; }
     OpMix& operator+=(const OpMix& o);

@@ -73,7 +73,10 @@ CountingSink::CountingSink(std::vector<uint32_t> widths) : m_widths(std::move(wi
         }
 }
 
-void CountingSink::begin_pass(const TilePass&) { ++m_passes; }
+void CountingSink::begin_pass(const TilePass&) {
+    ++m_passes;
+    m_traced_generation = -1;
+}
 
 void CountingSink::end_pass(const TilePass& p) { m_generations += p.generations; }
 
@@ -90,7 +93,10 @@ void CountingSink::op(const StreamOp& op) {
     ++s.histogram[bucket];
     ++m_kind_ops[uint32_t(op.kind)];
     m_kind_lanes[uint32_t(op.kind)] += op.length;
-    if (op.kind == OpKind::box_test && op.object == 0) m_rays += op.length;  // root: one per ray
+    if (op.kind == OpKind::box_test && int32_t(op.generation) != m_traced_generation) {
+        m_rays += op.length;  // the generation's entry test: one lane per ray
+        m_traced_generation = op.generation;
+    }
 }
 
 CountingSink& CountingSink::operator+=(const CountingSink& o) {

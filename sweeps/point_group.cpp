@@ -320,6 +320,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.spheres = scene.spheres.size();
     shape.bvh_nodes = bvh.nodes().size();
     shape.tile = settings.tile;
+    shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;
     return shape;
 }
 

@@ -27,7 +27,12 @@ struct WorkloadConfig {
     int64_t depth = k_scene_depth;
     uint32_t tile = 32;
     uint64_t seed = 0;
+    // The seed papers' alternatives, each a choice of words (k_*_choices, first = default).
+    std::string primary_entry = "root";  // root | aepsa (PrimaryEntry)
 
+    static constexpr const char* k_primary_entry_choices[] = {"root", "aepsa", nullptr};
+
+    // `choices` (null-terminated) lists the words a text field accepts (none: any text).
     // `special` names the word that stands for the field's sentinel value ("auto" for the tile).
     template <class V>
     void visit(V& v) {
@@ -42,7 +47,14 @@ struct WorkloadConfig {
                 "buffer)",
                 1, 4096, "auto");
         v.param("seed", seed, "", "random seed", 0, UINT64_MAX);
+        v.text("primary_entry", primary_entry,
+               "where primary-ray streams enter the BVH: root, or aepsa (a frustum per tile finds "
+               "the deepest node that holds every leaf it overlaps; seeds/004)",
+               k_primary_entry_choices);
     }
+
+    // The seed papers' options: absent from a point's YAML when at their default (sweep.cpp).
+    static bool is_option_field(const std::string& name) { return name == "primary_entry"; }
 
     bool resolved() const { return depth >= 0 && tile != k_auto_tile; }
     // The tracers' settings of a resolved configuration.

@@ -10,6 +10,7 @@
 
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/entry_point.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
 
@@ -88,9 +89,12 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
 // rays tighten their t as they find hits; shadow rays leave the stream once occluded.
 // The front child is chosen by a majority of the passing rays' direction signs on the split
 // axis: independent of the order of the stream, and for one ray the reference's choice.
+// `entry`: the node the stream enters at (the root, or a primary entry point whose subtree
+// holds every leaf the stream's rays can reach).
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
-              uint16_t generation, Trace& trace, uint64_t* leaf_tsc = nullptr) {
+              uint16_t generation, Trace& trace, uint32_t entry = 0,
+              uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
     const std::vector<BvhNode>& nodes = bvh.nodes();
     const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
@@ -104,7 +108,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     const uint8_t* any_hit = b.any_hit.data();
     auto& stack = b.stack;
     stack.clear();
-    stack.push_back({0u, n});
+    stack.push_back({entry, n});
     // Every stream on the stack is a prefix of the traversal stream: filters move passing ids
     // to the front and only permute inside a prefix, so (node, length) names a stream.
     while (!stack.empty()) {
@@ -198,6 +202,26 @@ struct StreamTracer::Impl {
           camera(s.camera, r.width, r.height),
           material_rays(s.materials.size(), 0) {}
 
+    // AEPSA for the tile's primary stream (trav_ids[0, n)): bounds the rays by a frustum (the
+    // frustum_bounds op over the stream), searches the entry point (one frustum_test op per
+    // node tested, one lane: the frustum) and returns it.
+    template <class Trace>
+    uint32_t primary_entry_point(uint32_t n, RenderStats& stats, Trace& trace) {
+        if (n == 0) return 0;
+        uint32_t* ids = b.trav_ids.data();
+        FrustumProxy frustum;
+        frustum.build(n, [&](uint32_t i) -> const RayPrecomp& { return b.pre[ids[i]]; });
+        if constexpr (Trace::k_enabled) std::fill(b.mask.begin(), b.mask.begin() + n, uint8_t(1));
+        trace.op(OpKind::frustum_bounds, 0, k_no_object, ids, n, b.mask.data(), n);
+        const EntryPoint e = find_entry_point(bvh, frustum, [&](uint32_t node, bool overlapped) {
+            const uint8_t passed = overlapped;
+            trace.op(OpKind::frustum_test, 0, node, ids, 1, &passed, passed);
+        });
+        ++stats.entry_searches;
+        stats.entry_depth_sum += e.depth;
+        return e.node;
+    }
+
     template <class Trace>
     void run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
              RenderStats& stats, Trace& trace, TraceSink* sink, RayObserver* observer);
@@ -252,16 +276,19 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         Ray* next = b.ray[cur ^ 1].data();
         for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
         const uint32_t traversal_rays = load_rays(b, rays, n);
+        uint32_t entry = 0;
+        if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
+            entry = primary_entry_point(traversal_rays, stats, trace);
         if (clock) {
             uint64_t leaf = 0;
             const uint64_t start = __rdtsc();
-            traverse(kernels, bvh, b, traversal_rays, generation, trace, &leaf);
+            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry, &leaf);
             const uint64_t spent = __rdtsc() - start;
             stats.stage_tsc[0] += spent - leaf;
             stats.stage_tsc[1] += leaf;
             traverse_tsc += spent;
         } else {
-            traverse(kernels, bvh, b, traversal_rays, generation, trace);
+            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry);
         }
         if (observer)
             for (uint32_t i = 0; i < n; ++i) {
