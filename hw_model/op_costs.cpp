@@ -87,6 +87,18 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // lives in the unit's registers.
     set(OpKind::frustum_bounds, {"origin", "direction"}, {}, 51, 7, 0);
     set(OpKind::frustum_test, {}, {}, 59, 8, 32);
+    // Hit-point reordering (kernels/stream/hit_point_reorder.h), counted from our code; the
+    // paper gives only host times. The simplified hierarchy's filter is the box test plus a
+    // compare and select keeping the nearest proxy entry (36, chain 10); the entry distance
+    // is assumed to live in a per-ray scratch word priced as t_max. The key: the hit point
+    // (3 mul, 3 add), grid coordinates (3 sub, 3 mul, 3 converts, 6 clamps), high and low cell
+    // indices (6 shifts and masks, 4 multiply-adds), the two Z-curve table reads the paper
+    // uses and a shift-or (4): 41, chain 12. A merge pass: per group, two key reads, a
+    // compare, two selects, an id store and an index update (8, chain 3; assumed, the merge of
+    // Sec. 5 is not given in instructions); keys and ids stay in the scratchpad.
+    set(OpKind::reorder_lod_test, {"origin", "inverse_direction", "t_max"}, {}, 36, 10, 32);
+    set(OpKind::reorder_key, {"origin", "direction", "t_max"}, {}, 41, 12, 0);
+    set(OpKind::reorder_sort, {}, {}, 8, 3, 0);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
@@ -97,6 +109,7 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     switch (kind) {
         case OpKind::box_test:
         case OpKind::frustum_test:
+        case OpKind::reorder_lod_test:
             return uint64_t(object) * node_bytes;
         case OpKind::triangle_test:
             return triangles_base + uint64_t(object) * triangle_bytes;

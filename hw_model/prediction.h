@@ -99,6 +99,10 @@ struct Prediction {
     // over all rays [stage].
     double ideal_utilization[2][k_op_stage_count] = {};
     double ideal_utilization_all[k_op_stage_count] = {};
+    // The workload's own measures (the same for every configuration of a render): box tests
+    // per traced ray [secondary] and the mean depth of primary entry points (root 0).
+    double box_tests_per_ray[2] = {};
+    double entry_depth = 0.0;
     double host_seconds = 0.0;   // the functional render's share plus this model's own time
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)

@@ -15,6 +15,9 @@ namespace sfx {
 // deepest node a frustum of the tile's rays proves enough (AEPSA, kernels/stream/entry_point.h).
 // Never changes a hit, so never the image.
 enum class PrimaryEntry : uint8_t { root, aepsa };
+// Whether the stream tracer sorts each generation's stream by approximate hit point before
+// tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit.
+enum class RayReorder : uint8_t { none, hit_point };
 
 struct RenderSettings {
     uint32_t width = 256;
@@ -29,6 +32,8 @@ struct RenderSettings {
     // stage_tsc); off by default (it costs a few cycles per leaf visited); never changes a bit.
     bool stage_clock = false;
     PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only; never changes a bit
+    RayReorder reorder = RayReorder::none;            // stream tracer only; never changes a bit
+    uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample

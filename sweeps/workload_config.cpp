@@ -100,12 +100,16 @@ RenderSettings WorkloadConfig::render_settings(uint32_t threads) const {
     s.seed = seed;
     s.threads = threads;
     s.primary_entry = primary_entry == "aepsa" ? PrimaryEntry::aepsa : PrimaryEntry::root;
+    s.reorder = reorder == "hit_point" ? RayReorder::hit_point : RayReorder::none;
+    s.reorder_lod_ppm = reorder_lod_ppm;
     return s;
 }
 
 bool WorkloadConfig::operator==(const WorkloadConfig& o) const {
     return scene == o.scene && width == o.width && height == o.height && spp == o.spp &&
-           depth == o.depth && tile == o.tile && seed == o.seed && primary_entry == o.primary_entry;
+           depth == o.depth && tile == o.tile && seed == o.seed &&
+           primary_entry == o.primary_entry && reorder == o.reorder &&
+           reorder_lod_ppm == o.reorder_lod_ppm;
 }
 
 std::vector<std::string> workload_field_names() {

@@ -11,6 +11,7 @@
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/entry_point.h"
+#include "kernels/stream/hit_point_reorder.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
 
@@ -193,6 +194,16 @@ struct StreamTracer::Impl {
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
     RayBuffers b;
+    // Hit-point reordering (RenderSettings::reorder): the simplified hierarchy and its buffers.
+    std::unique_ptr<HitPointReorder> reorder;
+    struct ReorderBuffers {
+        std::vector<RayPrecomp> pre;
+        std::vector<float> t, entry;  // per slot: nearest proxy entry so far, this node's entry
+        std::vector<uint64_t> key;
+        std::vector<uint32_t> ids, spill, merged;
+        std::vector<uint8_t> mask, ones;
+        std::vector<std::pair<uint32_t, uint32_t>> stack;
+    } rb;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
         : scene(s),
@@ -200,7 +211,104 @@ struct StreamTracer::Impl {
           settings(r),
           kernels(stream_kernels(resolve_isa(r.isa))),
           camera(s.camera, r.width, r.height),
-          material_rays(s.materials.size(), 0) {}
+          material_rays(s.materials.size(), 0) {
+        if (r.reorder == RayReorder::hit_point)
+            reorder = std::make_unique<HitPointReorder>(h, r.reorder_lod_ppm);
+    }
+
+    // Moon et al.'s reordering of the stream ids[0, n) before it is traced: approximate hit
+    // points by a traversal of the simplified hierarchy (reorder_lod_test ops, Fig. 3's
+    // filter over the proxies' tree), their keys (one reorder_key op over the stream), and a
+    // bottom-up 2-way merge sort of the stream by key (one reorder_sort op per merge pass,
+    // listing the stream in that pass's order; the paper's sort, Sec. 5). Stable, so equal
+    // keys keep their order and the result never depends on anything but the stream.
+    template <class Trace>
+    void reorder_stream(uint32_t* ids, uint32_t n, const Ray* rays, uint16_t generation,
+                        Trace& trace) {
+        if (n < 2) return;
+        ReorderBuffers& r = rb;
+        if (r.pre.size() < b.capacity) {
+            Ray unit;
+            unit.dir = {0.f, 0.f, 1.f};
+            r.pre.resize(b.capacity, RayPrecomp(unit));
+            r.t.resize(b.capacity);
+            r.entry.resize(b.capacity);
+            r.key.resize(b.capacity);
+            r.ids.resize(b.capacity);
+            r.spill.resize(b.capacity);
+            r.merged.resize(b.capacity);
+            r.mask.resize(b.capacity);
+            r.ones.assign(b.capacity, 1);
+        }
+        const std::vector<BvhNode>& nodes = bvh.nodes();
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t id = ids[i];
+            r.key[id] = HitPointReorder::k_no_key;
+            if (!ray_is_valid(rays[id])) continue;
+            r.pre[id] = RayPrecomp(rays[id]);
+            r.t[id] = rays[id].t_max;
+            r.ids[m++] = id;
+        }
+        r.stack.clear();
+        if (m && !nodes.empty()) r.stack.push_back({0u, m});
+        while (!r.stack.empty()) {
+            const auto [node_index, len] = r.stack.back();
+            r.stack.pop_back();
+            const BvhNode& node = nodes[node_index];
+            uint32_t passed = 0, spilled = 0, negative = 0;
+            for (uint32_t j = 0; j < len; ++j) {
+                const uint32_t id = r.ids[j];
+                r.entry[id] = intersect_box(r.pre[id], node.bounds, r.t[id]);
+                r.mask[j] = r.entry[id] != INFINITY;
+            }
+            trace.op(OpKind::reorder_lod_test, generation, node_index, r.ids.data(), len,
+                     r.mask.data(), uint32_t(std::count(r.mask.begin(), r.mask.begin() + len, 1)));
+            for (uint32_t j = 0; j < len; ++j) {  // passing ids first, in order
+                const uint32_t id = r.ids[j];
+                if (!r.mask[j]) {
+                    r.spill[spilled++] = id;
+                    continue;
+                }
+                r.ids[passed++] = id;
+                negative += r.pre[id].dir[node.axis] < 0.f;
+            }
+            std::copy(r.spill.begin(), r.spill.begin() + spilled, r.ids.begin() + passed);
+            if (passed == 0) continue;
+            if (reorder->is_proxy(node_index)) {
+                // A proxy box hit from outside: the nearest so far is the approximate hit.
+                for (uint32_t j = 0; j < passed; ++j) {
+                    const uint32_t id = r.ids[j];
+                    if (r.entry[id] > 0.f && r.entry[id] < r.t[id]) r.t[id] = r.entry[id];
+                }
+                continue;
+            }
+            const bool right_first = 2 * negative > passed;
+            const uint32_t left = BvhNode::left(node_index), right = node.right();
+            r.stack.push_back({right_first ? left : right, passed});
+            r.stack.push_back({right_first ? right : left, passed});
+        }
+        for (uint32_t i = 0; i < m; ++i) {
+            const uint32_t id = r.ids[i];
+            const Ray& ray = rays[id];
+            const float t =
+                r.t[id] < ray.t_max ? r.t[id] : reorder->scene_exit(r.pre[id], ray.t_max);
+            if (std::isfinite(t)) r.key[id] = reorder->key(ray.org + ray.dir * t);
+        }
+        trace.op(OpKind::reorder_key, generation, k_no_object, ids, n, r.ones.data(), n);
+        uint32_t* src = ids;
+        uint32_t* dst = r.merged.data();
+        const auto by_key = [&](uint32_t a, uint32_t c) { return r.key[a] < r.key[c]; };
+        for (uint32_t width = 1; width < n; width *= 2) {
+            for (uint32_t lo = 0; lo < n; lo += 2 * width) {
+                const uint32_t mid = std::min(n, lo + width), hi = std::min(n, lo + 2 * width);
+                std::merge(src + lo, src + mid, src + mid, src + hi, dst + lo, by_key);
+            }
+            std::swap(src, dst);
+            trace.op(OpKind::reorder_sort, generation, k_no_object, src, n, r.ones.data(), n);
+        }
+        if (src != ids) std::copy(src, src + n, ids);
+    }
 
     // AEPSA for the tile's primary stream (trav_ids[0, n)): bounds the rays by a frustum (the
     // frustum_bounds op over the stream), searches the entry point (one frustum_test op per
@@ -274,6 +382,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     while (n > 0) {
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
+        if (reorder) reorder_stream(ids, n, rays, generation, trace);
         for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
         const uint32_t traversal_rays = load_rays(b, rays, n);
         uint32_t entry = 0;

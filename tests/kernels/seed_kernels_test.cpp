@@ -7,6 +7,7 @@
 #include "hw_model/workload_shape.h"
 #include "kernels/bvh.h"
 #include "kernels/stream/entry_point.h"
+#include "kernels/stream/hit_point_reorder.h"
 #include "kernels/stream/stream_tracer.h"
 #include "tests/kernels/test_scenes.h"
 
@@ -30,13 +31,31 @@ RenderSettings settings_for(const Scene& s, uint32_t w, uint32_t h, uint32_t spp
     return r;
 }
 
-struct Run {
-    RenderResult result;
-    CountingSink counts{{8}};
+// Counts, and per pass and generation the slot order of the stream's first box test.
+struct OrderSink : CountingSink {
+    std::vector<std::vector<uint32_t>> entry_orders;
+    int32_t generation = -1;
+    OrderSink() : CountingSink({8}) {}
+    void begin_pass(const TilePass& p) override {
+        CountingSink::begin_pass(p);
+        generation = -1;
+    }
+    void op(const StreamOp& o) override {
+        CountingSink::op(o);
+        if (o.kind != OpKind::box_test || int32_t(o.generation) == generation) return;
+        generation = o.generation;
+        entry_orders.emplace_back(o.slots, o.slots + o.length);
+    }
 };
 
-Run run(const Scene& s, const Bvh& bvh, const RenderSettings& r) {
+struct Run {
+    RenderResult result;
+    OrderSink counts;
+};
+
+Run run(const Scene& s, const Bvh& bvh, RenderSettings r) {
     Run out;
+    r.threads = 1;  // the order sink needs passes in order
     out.result = render_stream(s, bvh, r, &out.counts);
     return out;
 }
@@ -140,4 +159,81 @@ TEST_CASE("Workload shape: frustum units exist only when the workload searches e
     shape.primary_entry_aepsa = true;
     CHECK(shape.needed_kinds()[size_t(OpKind::frustum_test)]);
     CHECK(shape.needed_kinds()[size_t(OpKind::frustum_bounds)]);
+}
+
+TEST_CASE("Hit-point reorder: proxies at the fraction asked, keys on a two-level Z-curve",
+          "[stream][seeds]") {
+    const Scene s = test::box_scene(test::Variant::lights);
+    const Bvh bvh(s);
+    const uint64_t prims = s.primitive_count();
+    const HitPointReorder all(bvh, 1000000);  // every primitive its own proxy: the leaves
+    CHECK(all.proxies() == bvh.stats().leaves);
+    const HitPointReorder tenth(bvh, 100000);  // proxies of at most 10 primitives
+    CHECK(tenth.proxies() >= prims / 10);
+    CHECK(tenth.proxies() < all.proxies());
+    const Bounds3 b = bvh.nodes()[0].bounds;
+    CHECK(all.key(b.lo) == 0);
+    // The high level decides first: a point in a later high-level cell sorts after any point
+    // of an earlier one, whatever its low-level cell.
+    const Vec3 e = b.extent();
+    const Vec3 late_low = b.lo + Vec3(e.x * (1.f / 64.f) * 0.99f, 0.f, 0.f);
+    const Vec3 next_high = b.lo + Vec3(e.x * (1.f / 64.f) * 1.01f, 0.f, 0.f);
+    CHECK(all.key(late_low) < all.key(next_high));
+    CHECK(all.key(late_low) < (uint64_t(1) << 18));
+    CHECK(all.key(next_high) == (uint64_t(1) << 18) + 0);
+}
+
+TEST_CASE(
+    "Hit-point reorder: the image is bit-identical, streams are sorted, traversal visits "
+    "the same nodes",
+    "[stream][seeds]") {
+    for (const Scene& s : {test::box_scene(test::Variant::lights), sphere_wall()}) {
+        const Bvh bvh(s);
+        RenderSettings r = settings_for(s, 32, 24, 2, 16);
+        const Run plain = run(s, bvh, r);
+        r.reorder = RayReorder::hit_point;
+        const Run sorted = run(s, bvh, r);
+        r.primary_entry = PrimaryEntry::aepsa;
+        const Run both = run(s, bvh, r);
+        INFO("scene " << s.name);
+        CHECK(same_bits(plain.result.image, sorted.result.image));
+        CHECK(same_bits(plain.result.image, both.result.image));
+        for (OpKind k : {OpKind::reorder_lod_test, OpKind::reorder_key, OpKind::reorder_sort}) {
+            CHECK(plain.counts.kind_ops(k) == 0);
+            CHECK(sorted.counts.kind_ops(k) > 0);
+        }
+        CHECK(sorted.counts.kind_ops(OpKind::frustum_test) == 0);
+        CHECK(both.counts.kind_ops(OpKind::frustum_test) > 0);
+        // One key op per generation that has two or more rays; the streams differ in order.
+        CHECK(sorted.counts.kind_ops(OpKind::reorder_key) <= sorted.counts.generations());
+        REQUIRE(plain.counts.entry_orders.size() == sorted.counts.entry_orders.size());
+        size_t reordered = 0;
+        for (size_t i = 0; i < plain.counts.entry_orders.size(); ++i) {
+            std::vector<uint32_t> a = plain.counts.entry_orders[i],
+                                  b = sorted.counts.entry_orders[i];
+            reordered += a != b;
+            std::sort(a.begin(), a.end());
+            std::sort(b.begin(), b.end());
+            CHECK(a == b);  // the same rays
+        }
+        CHECK(reordered > 0);
+        // Stream filtering tests whole streams against nodes: the order of a stream changes
+        // neither which nodes and primitives are tested nor how many lanes.
+        for (OpKind k : {OpKind::box_test, OpKind::triangle_test, OpKind::sphere_test}) {
+            CHECK(sorted.counts.kind_ops(k) == plain.counts.kind_ops(k));
+            CHECK(sorted.counts.kind_lanes(k) == plain.counts.kind_lanes(k));
+        }
+    }
+}
+
+TEST_CASE("Workload shape: reorder units exist only when the workload reorders",
+          "[stream][seeds]") {
+    WorkloadShape shape;
+    shape.features = test::box_scene(test::Variant::lights).features();
+    for (OpKind k : {OpKind::reorder_lod_test, OpKind::reorder_key, OpKind::reorder_sort})
+        CHECK_FALSE(shape.needed_kinds()[size_t(k)]);
+    shape.reorder_hit_point = true;
+    for (OpKind k : {OpKind::reorder_lod_test, OpKind::reorder_key, OpKind::reorder_sort})
+        CHECK(shape.needed_kinds()[size_t(k)]);
+    CHECK_FALSE(shape.needed_kinds()[size_t(OpKind::frustum_test)]);
 }
