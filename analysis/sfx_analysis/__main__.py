@@ -1,4 +1,4 @@
-"""Command line: `python3 -m sfx_analysis report DB -o DIR`, `python3 -m sfx_analysis tables DB`
+"""Command line: `python3 -m sfx_analysis report DB -o DIR`, `python3 -m sfx_analysis tables DB`,
 `python3 -m sfx_analysis paper DB -o PAGE.md`, `python3 -m sfx_analysis seed-kernels DB -o
 PAGE.md`. A store that cannot be reported on prints one line and exits 2 (no traceback)."""
 

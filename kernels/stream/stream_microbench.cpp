@@ -18,7 +18,7 @@ namespace sfx {
 uint32_t stream_slot_bytes() {
     // The per-slot arrays of the stream tracer's RayBuffers (stream_tracer.cpp): path state,
     // two ray generations, traversal ray, hit, any-hit flag, surface, six id lists and a mask.
-    return uint32_t(sizeof(PathState) + 2 * sizeof(Ray) + sizeof(TraversalRay) + sizeof(Hit) + 1 +
+    return uint32_t(sizeof(PathState) + 2 * sizeof(Ray) + sizeof(RayPrecomp) + traversal_field::count * sizeof(float) + sizeof(Hit) + 1 +
                     sizeof(SurfaceHit) + 6 * sizeof(uint32_t) + 1);
 }
 
@@ -53,7 +53,8 @@ Scene synthetic_scene() {
 struct Buffers {
     std::vector<PathState> path, saved_path;
     std::vector<Ray> ray, next;
-    std::vector<TraversalRay> trav, saved_trav;
+    TraversalRays trav, saved_trav;
+    std::vector<RayPrecomp> pre;
     std::vector<Hit> hit, saved_hit;
     std::vector<uint8_t> any_hit, mask;
     std::vector<SurfaceHit> surf;
@@ -70,7 +71,8 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     b.next.resize(slots);
     Ray unit;
     unit.dir = {0.f, 0.f, 1.f};
-    b.trav.resize(slots, TraversalRay{RayPrecomp(unit), 0.f});
+    b.trav.resize(slots);
+    b.pre.resize(slots, RayPrecomp(unit));
     b.hit.resize(slots);
     b.any_hit.resize(slots);
     b.surf.resize(slots);
@@ -86,7 +88,8 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
         const Vec3 target(4.5f * u(rng), 0.5f + u(rng), 4.5f * u(rng));
         r.dir = normalize(target - r.org);
         b.ray[i] = r;
-        b.trav[i] = TraversalRay{RayPrecomp(r), r.t_max};
+        b.pre[i] = RayPrecomp(r);
+        b.trav.set(i, b.pre[i], r.t_max);
         b.hit[i] = bvh.intersect(r);
         PathState& p = b.path[i];
         p.key = {7, i, 0};
@@ -169,7 +172,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     std::shuffle(order.begin(), order.end(), rng);
                     std::copy(order.begin(), order.begin() + n, b.ids.begin());
                     std::copy(b.saved_path.begin(), b.saved_path.end(), b.path.begin());
-                    std::copy(b.saved_trav.begin(), b.saved_trav.end(), b.trav.begin());
+                    b.trav = b.saved_trav;
                     // Intersection tests start from no hit, as after the tracer's load_rays;
                     // shading filters read the hits the setup found.
                     if (stage_of(kind) == OpStage::shading)
@@ -178,7 +181,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         std::fill(b.hit.begin(), b.hit.end(), Hit{});
                     float touch = 0.f;
                     for (uint32_t id : order)
-                        touch += b.ray[id].org.x + b.next[id].org.x + b.trav[id].t +
+                        touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
                                  b.surf[id].position.x + b.path[id].radiance.x + b.hit[id].t;
                     if (touch == 12345.f) b.mask[0] = 1;
 
@@ -213,7 +216,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 uint32_t negative = 0;
                                 const BvhNode& node = bvh.nodes()[0];
                                 passed =
-                                    kernels.box_filter(b.trav.data(), node.bounds, node.axis, ids,
+                                    kernels.box_filter(b.trav.view(), node.bounds, node.axis, ids,
                                                        n, ids, scratch, nullptr, negative);
                                 std::copy(scratch, scratch + (n - passed), ids + passed);
                                 break;
@@ -223,15 +226,15 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 const Triangle& tri = scene.triangles[prim];
                                 uint32_t* positions = b.positions.data();
                                 const uint32_t candidates = kernels.triangle_candidates(
-                                    b.trav.data(), scene.positions[tri.v0], scene.positions[tri.v1],
+                                    b.trav.view(), scene.positions[tri.v0], scene.positions[tri.v1],
                                     scene.positions[tri.v2], ids, n, positions);
                                 passed = 0;
                                 for (uint32_t j = 0; j < candidates; ++j) {
                                     const uint32_t id = ids[positions[j]];
-                                    TraversalRay& r = b.trav[id];
-                                    if (!bvh.intersect_primitive(r.pre, prim, r.t, b.hit[id]))
+                                    float& t = b.trav.t(id);
+                                    if (!bvh.intersect_primitive(b.pre[id], prim, t, b.hit[id]))
                                         continue;
-                                    r.t = b.any_hit[id] ? -1.f : b.hit[id].t;
+                                    t = b.any_hit[id] ? -1.f : b.hit[id].t;
                                     ++passed;
                                 }
                                 break;
@@ -239,10 +242,10 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             case OpKind::sphere_test: {
                                 const uint32_t prim = scene.triangle_count();
                                 passed = evaluate(ids, n, mask, [&](uint32_t id) {
-                                    TraversalRay& r = b.trav[id];
-                                    if (!bvh.intersect_primitive(r.pre, prim, r.t, b.hit[id]))
+                                    float& t = b.trav.t(id);
+                                    if (!bvh.intersect_primitive(b.pre[id], prim, t, b.hit[id]))
                                         return false;
-                                    r.t = b.any_hit[id] ? -1.f : b.hit[id].t;
+                                    t = b.any_hit[id] ? -1.f : b.hit[id].t;
                                     return true;
                                 });
                                 break;
@@ -364,7 +367,7 @@ std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t re
                     all.hi = Vec3(1e30f);
                     uint32_t negative = 0;
                     uint64_t s = __rdtsc();
-                    kernels.box_filter(b.trav.data(), all, 0, b.ids.data(), n, b.scratch.data(),
+                    kernels.box_filter(b.trav.view(), all, 0, b.ids.data(), n, b.scratch.data(),
                                        b.scratch2.data(), nullptr, negative);
                     uint64_t e = __rdtsc();
                     gather_t.push_back((double(e - s) - overhead) / n);
