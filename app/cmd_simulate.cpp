@@ -52,6 +52,17 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
                    fixed(100 * stat(p, std::string("ideal_simd_utilization.") + stage), 1) + "%)";
         });
     }
+    for (const char* stage : {"traversal", "intersection", "shading"}) {
+        row(std::string("stream length ") + stage, [&](const Prediction& p) {
+            return fixed(stat(p, std::string("stream_length.") + stage), 1);
+        });
+    }
+    row("option overhead (% of instructions)",
+        [&](const Prediction& p) { return fixed(stat(p, "op_mix.option_percent"), 2); });
+    row("box tests per ray (prim / sec)", [&](const Prediction& p) {
+        return fixed(p.box_tests_per_ray[0], 1) + " / " + fixed(p.box_tests_per_ray[1], 1);
+    });
+    row("primary entry depth", [&](const Prediction& p) { return fixed(p.entry_depth, 2); });
     for (const char* cause : {"bank_conflict", "alignment", "address_fetch", "partition",
                               "scene_memory", "interconnect", "pipeline_fill"}) {
         row(std::string("stall ") + cause + " (% of cycles)", [&](const Prediction& p) {
@@ -69,8 +80,9 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
     });
     for (size_t level = 0; level < predictions.front().config.scene_memory.caches.size(); ++level) {
         const std::string name = predictions.front().config.scene_memory.caches[level].name;
-        row("scene cache " + name + " hit rate", [&](const Prediction& p) {
-            return fixed(100 * stat(p, "scene_cache." + name + ".hit_rate"), 1) + "%";
+        row("scene cache " + name + " hit rate (misses)", [&](const Prediction& p) {
+            return fixed(100 * stat(p, "scene_cache." + name + ".hit_rate"), 1) + "% (" +
+                   fixed(stat(p, "scene_cache." + name + ".misses"), 0) + ")";
         });
     }
     // Area and energy per unit (the technology table's node), then the totals.

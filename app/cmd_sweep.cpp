@@ -43,11 +43,17 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
     const SweepPoint& p = sweep.points[points.front()];
     std::string scene = p.workload.scene;
     if (scene.find('/') != std::string::npos) scene = scene.substr(scene.find_last_of('/') + 1);
-    return scene + " " + std::to_string(p.workload.width) + "x" + std::to_string(p.workload.height) +
-           " spp " + std::to_string(p.workload.spp) + " depth " + std::to_string(p.workload.depth) +
-           " tile " + std::to_string(p.workload.tile) +
-           (p.workload.seed ? " seed " + std::to_string(p.workload.seed) : std::string()) + " " +
-           to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
+    return scene + " " + std::to_string(p.workload.width) + "x" +
+           std::to_string(p.workload.height) + " spp " + std::to_string(p.workload.spp) +
+           " depth " + std::to_string(p.workload.depth) + " tile " +
+           std::to_string(p.workload.tile) +
+           (p.workload.seed ? " seed " + std::to_string(p.workload.seed) : std::string()) +
+           (p.workload.primary_entry != "root" ? " entry " + p.workload.primary_entry
+                                               : std::string()) +
+           (p.workload.reorder != "none" ? " reorder " + p.workload.reorder + " " +
+                                               std::to_string(p.workload.reorder_lod_ppm) + " ppm"
+                                         : std::string()) +
+           " " + to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
            (points.size() == 1 ? "" : "s") + ")";
 }
 

@@ -40,6 +40,33 @@ struct TileRun {
     RenderStats stats;
 };
 
+// Box tests per traced ray (primary, secondary) and the primary entry search's cost and depth.
+struct SeedMeasures {
+    double box_per_ray[2] = {0.0, 0.0};
+    double entry_depth = 0.0;  // mean depth of the primary entry node (root: 0)
+    uint64_t entry_lanes = 0;  // lanes of the search's ops (frustum bounds and tests)
+    double reorder_lanes_per_ray = 0.0;  // lanes of the reordering's ops per traced ray
+};
+
+SeedMeasures seed_measures(const TileRun& r) {
+    SeedMeasures m;
+    const double rays[2] = {double(r.stats.camera_rays),
+                            double(r.stats.extension_rays + r.stats.shadow_rays)};
+    for (int g = 0; g < 2; ++g)
+        m.box_per_ray[g] =
+            rays[g] > 0 ? double(r.counts.kind_lanes(OpKind::box_test, g)) / rays[g] : 0.0;
+    const uint64_t search =
+        r.counts.kind_lanes(OpKind::frustum_bounds) + r.counts.kind_lanes(OpKind::frustum_test);
+    const uint64_t reorder = r.counts.kind_lanes(OpKind::reorder_lod_test) +
+                             r.counts.kind_lanes(OpKind::reorder_key) +
+                             r.counts.kind_lanes(OpKind::reorder_sort);
+    m.reorder_lanes_per_ray = r.stats.rays() ? double(reorder) / double(r.stats.rays()) : 0.0;
+    m.entry_depth =
+        r.stats.entry_searches ? double(r.stats.entry_depth_sum) / r.stats.entry_searches : 0.0;
+    m.entry_lanes = search;
+    return m;
+}
+
 std::string percent(double u) {
     char buf[16];
     std::snprintf(buf, sizeof buf, "%.0f", 100.0 * u);
@@ -97,6 +124,13 @@ void add_trace_stats_command(CLI::App& app) {
                 j[t + "intersection_ops"] = r.counts.kind_ops(OpKind::triangle_test) +
                                             r.counts.kind_ops(OpKind::sphere_test);
                 j[t + "host_seconds"] = r.stats.host_seconds;
+                const SeedMeasures m = seed_measures(r);
+                j[t + "box_tests_per_ray.primary"] = m.box_per_ray[0];
+                j[t + "box_tests_per_ray.secondary"] = m.box_per_ray[1];
+                j[t + "entry.frustum_tests"] = r.counts.kind_ops(OpKind::frustum_test);
+                j[t + "entry.mean_depth"] = m.entry_depth;
+                j[t + "entry.lanes"] = m.entry_lanes;
+                j[t + "reorder.lanes_per_ray"] = m.reorder_lanes_per_ray;
                 for (bool secondary : {false, true})
                     for (OpStage st : stages) {
                         const auto& s = r.counts.stage(secondary, st);
@@ -176,6 +210,23 @@ void add_trace_stats_command(CLI::App& app) {
                                          r.counts.kind_ops(OpKind::sphere_test))),
                               12)
                       << cell(sci(double(shade)), 12) << secs << "\n";
+        }
+        std::cout << "\nBox tests per ray; the primary entry search (--primary-entry "
+                  << options->workload.primary_entry << ") and the reordering's lanes per ray "
+                  << "(--reorder " << options->workload.reorder << ")\n"
+                  << "    " << cell("size", 10) << cell("primary", 10) << cell("secondary", 11)
+                  << cell("frustum tests", 15) << cell("mean entry depth", 18)
+                  << "reorder lanes/ray\n";
+        for (const TileRun& r : runs) {
+            const SeedMeasures m = seed_measures(r);
+            char buf[4][32];
+            std::snprintf(buf[0], sizeof buf[0], "%.2f", m.box_per_ray[0]);
+            std::snprintf(buf[1], sizeof buf[1], "%.2f", m.box_per_ray[1]);
+            std::snprintf(buf[2], sizeof buf[2], "%.2f", m.entry_depth);
+            std::snprintf(buf[3], sizeof buf[3], "%.2f", m.reorder_lanes_per_ray);
+            std::cout << "    " << cell(size(r.tile), 10) << cell(buf[0], 10) << cell(buf[1], 11)
+                      << cell(std::to_string(r.counts.kind_ops(OpKind::frustum_test)), 15)
+                      << cell(buf[2], 18) << buf[3] << "\n";
         }
     });
 }

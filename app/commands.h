@@ -22,6 +22,9 @@ struct WorkloadFlags {
     uint64_t seed = 0;
     uint32_t threads = 0;
     std::string isa = "auto";
+    std::string primary_entry = "root";
+    std::string reorder = "none";
+    uint32_t reorder_lod_ppm = 20000;
 
     void add_to(CLI::App* command);
     // The workload the flags give for `scene`; throws InputError (key = the flag) on a bad value.

@@ -19,6 +19,17 @@ void WorkloadFlags::add_to(CLI::App* c) {
                   "host SIMD back end of the stream filters: auto|avx512|avx2|scalar (never "
                   "changes the image or the trace)")
         ->capture_default_str();
+    c->add_option("--primary-entry", primary_entry,
+                  "where primary-ray streams enter the BVH: root|aepsa (frustum entry-point "
+                  "search; never changes the image)")
+        ->capture_default_str();
+    c->add_option("--reorder", reorder,
+                  "sort each generation by approximate hit point before tracing: none|hit_point "
+                  "(never changes the image)")
+        ->capture_default_str();
+    c->add_option("--reorder-lod-ppm", reorder_lod_ppm,
+                  "hit_point: simplified geometry, parts per million of the primitives")
+        ->capture_default_str();
 }
 
 WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
@@ -30,6 +41,10 @@ WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
         set_workload_field(w, "depth", std::to_string(depth), "command line", 0, "--depth");
     set_workload_field(w, "tile", tile, "command line", 0, "--tile");
     set_workload_field(w, "seed", std::to_string(seed), "command line", 0, "--seed");
+    set_workload_field(w, "primary_entry", primary_entry, "command line", 0, "--primary-entry");
+    set_workload_field(w, "reorder", reorder, "command line", 0, "--reorder");
+    set_workload_field(w, "reorder_lod_ppm", std::to_string(reorder_lod_ppm), "command line", 0,
+                       "--reorder-lod-ppm");
     return w;
 }
 

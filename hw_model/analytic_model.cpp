@@ -211,6 +211,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const auto& [secondary, kind, length] = key;
         if (length == 0) continue;
         const OpProfile& p = costs[kind];
+        const uint64_t mix_before = t.mix.total();
         const double ops = double(bucket.ops);
         const double pass_rate = double(bucket.passed) / (ops * double(length));
         const uint64_t groups = (uint64_t(length) + n - 1) / n;
@@ -323,6 +324,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         t.mix.partition += uint64_t(ops * compare);
         t.mix.store += uint64_t(ops * moves + ops * scatter_addresses);
         if (p.pushes_rays) t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
+        if (is_option_kind(kind)) t.mix.option += t.mix.total() - mix_before;
         t.field_accesses += uint64_t(std::llround(ops * accesses));
     }
     StallCycles::visit(t.stalls, stalls, [](const CounterInfo&, uint64_t& x, double y) {

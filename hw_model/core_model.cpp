@@ -59,6 +59,7 @@ void CoreModel::dispatch_op(uint32_t index) {
     const OpProfile& p = m_costs[op.kind];
     const uint32_t n = width();
     const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
+    const uint64_t mix_before = m_timing.mix.total();
     m_groups_left[index] = uint32_t(groups);
     StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
     stage.ops += 1;
@@ -85,6 +86,7 @@ void CoreModel::dispatch_op(uint32_t index) {
     }
     if (p.pushes_rays) mix.store += (uint64_t(op.pass_count) + n - 1) / n;
     if (p.pushes_rays) act.bank_writes += op.pass_count;  // ACTIONS: next generation's ids
+    if (is_option_kind(op.kind)) mix.option += mix.total() - mix_before;
 }
 
 void CoreModel::request_scene(uint32_t index, uint64_t now) {

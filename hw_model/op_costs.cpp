@@ -77,6 +77,28 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     set(OpKind::lambertian_indirect, hit, whole_ray, 64, 14, 64);
     set(OpKind::dielectric, hit, whole_ray, 72, 16, 64);
     set(OpKind::glossy, hit, whole_ray, 110, 18, 64);
+    // AEPSA (kernels/stream/entry_point.cpp): counted from our code, not from the paper (its
+    // costs are host times). The bounds fit the frustum in two sweeps over the stream: a sum of
+    // normalized directions (3 mul, 2 add, a square root and 3 divides: 9), then per ray three
+    // direction and three origin dot products (6 x 5), two slope divides and 10 min/max (42):
+    // 51, with a longest chain of dot, divide, min (7). The frustum test is five plane tests,
+    // each 3 selects, 3 products, 2 adds, a compare (11), and 4 ors (59); chain select, mul,
+    // add, add, compare, 3 ors (8). It reads the node (32 bytes) and no ray data: the frustum
+    // lives in the unit's registers.
+    set(OpKind::frustum_bounds, {"origin", "direction"}, {}, 51, 7, 0);
+    set(OpKind::frustum_test, {}, {}, 59, 8, 32);
+    // Hit-point reordering (kernels/stream/hit_point_reorder.h), counted from our code; the
+    // paper gives only host times. The simplified hierarchy's filter is the box test plus a
+    // compare and select keeping the nearest proxy entry (36, chain 10); the entry distance
+    // is assumed to live in a per-ray scratch word priced as t_max. The key: the hit point
+    // (3 mul, 3 add), grid coordinates (3 sub, 3 mul, 3 converts, 6 clamps), high and low cell
+    // indices (6 shifts and masks, 4 multiply-adds), the two Z-curve table reads the paper
+    // uses and a shift-or (4): 41, chain 12. A merge pass: per group, two key reads, a
+    // compare, two selects, an id store and an index update (8, chain 3; assumed, the merge of
+    // Sec. 5 is not given in instructions); keys and ids stay in the scratchpad.
+    set(OpKind::reorder_lod_test, {"origin", "inverse_direction", "t_max"}, {}, 36, 10, 32);
+    set(OpKind::reorder_key, {"origin", "direction", "t_max"}, {}, 41, 12, 0);
+    set(OpKind::reorder_sort, {}, {}, 8, 3, 0);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
@@ -86,6 +108,8 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     const uint64_t materials_base = spheres_base + spheres * sphere_bytes;
     switch (kind) {
         case OpKind::box_test:
+        case OpKind::frustum_test:
+        case OpKind::reorder_lod_test:
             return uint64_t(object) * node_bytes;
         case OpKind::triangle_test:
             return triangles_base + uint64_t(object) * triangle_bytes;

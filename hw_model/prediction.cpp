@@ -145,6 +145,16 @@ std::vector<Stat> Prediction::stats() const {
     }
     add("scene_memory.dram_reads", double(timing.dram_reads), "lines",
         "scene-data lines read from DRAM");
+    for (size_t i = 0; i < timing.cache_misses.size() && i < config.scene_memory.caches.size(); ++i)
+        add("scene_cache." + config.scene_memory.caches[i].name + ".misses",
+            double(timing.cache_misses[i]), "accesses",
+            "misses of scene-data cache level " + config.scene_memory.caches[i].name);
+    add("workload.box_tests_per_ray.primary", box_tests_per_ray[0], "lanes",
+        "box-test lanes per camera ray");
+    add("workload.box_tests_per_ray.secondary", box_tests_per_ray[1], "lanes",
+        "box-test lanes per secondary ray");
+    add("workload.entry_depth", entry_depth, "levels",
+        "mean BVH depth at which primary streams enter (root 0)");
 
     // Area and energy: the action counts priced with the technology table (area_energy.h).
     const TechTable& t = tech ? *tech : default_tech_table();

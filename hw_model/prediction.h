@@ -73,6 +73,9 @@ struct OpMix {
     uint64_t compute = 0;  // arithmetic on ray data
     uint64_t scatter_gather = 0;  // ray-record gathers and conditional scatters
     uint64_t partition = 0;       // comparator passes of the partition unit
+    // Of all the above, those issued for ops a workload option adds (is_option_kind): the
+    // option's own overhead. Not part of total().
+    uint64_t option = 0;
 
     template <class A, class B, class F>
     static void visit(A& a, B& b, F&& f) {
@@ -84,6 +87,10 @@ struct OpMix {
           a.scatter_gather, b.scatter_gather);
         f(CounterInfo("partition", "instructions", "partition (Table 5)"), a.partition,
           b.partition);
+        f(CounterInfo("option", "instructions",
+                      "instructions of the ops a workload option adds (its own overhead; also "
+                      "counted in the classes above)"),
+          a.option, b.option);
     }
     uint64_t total() const { return load + store + compute + scatter_gather + partition; }
     OpMix& operator+=(const OpMix& o);
@@ -192,6 +199,10 @@ struct Prediction {
     // over all rays [stage].
     double ideal_utilization[2][k_op_stage_count] = {};
     double ideal_utilization_all[k_op_stage_count] = {};
+    // The workload's own measures (the same for every configuration of a render): box tests
+    // per traced ray [secondary] and the mean depth of primary entry points (root 0).
+    double box_tests_per_ray[2] = {};
+    double entry_depth = 0.0;
     double host_seconds = 0.0;   // the functional render's share plus this model's own time
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)

@@ -1,7 +1,8 @@
 #pragma once
-// What a timing model must know of the workload besides the trace: the scene's features (they
-// fix the ray record and which units exist) and the sizes of its data (they place scene data
-// in memory). Built by whoever runs the tracer; the hardware model never sees the tracer.
+// What a timing model must know of the workload besides the trace: the scene's features and
+// the workload's options (they fix the ray record and which units exist) and the sizes of its
+// data (they place scene data in memory). Built by whoever runs the tracer; the hardware model
+// never sees the tracer.
 
 #include <array>
 #include <cstdint>
@@ -16,7 +17,9 @@ struct WorkloadShape {
     uint64_t triangles = 0;
     uint64_t spheres = 0;
     uint64_t bvh_nodes = 0;
-    uint32_t tile = 32;  // tile edge: tile^2 ray slots per pass
+    uint32_t tile = 32;                // tile edge: tile^2 ray slots per pass
+    bool primary_entry_aepsa = false;  // the workload searches primary entry points
+    bool reorder_hit_point = false;    // the workload sorts streams by approximate hit point
 
     uint32_t slots() const { return tile * tile; }
     // The operation kinds this scene can emit: their function units are elaborated, no others.
@@ -54,6 +57,12 @@ inline std::array<bool, k_op_kind_count> WorkloadShape::needed_kinds() const {
                 break;
             case OpFeature::glossy:
                 k[i] = features.glossy;
+                break;
+            case OpFeature::primary_entry_aepsa:
+                k[i] = primary_entry_aepsa;
+                break;
+            case OpFeature::reorder_hit_point:
+                k[i] = reorder_hit_point;
                 break;
         }
     }

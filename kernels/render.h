@@ -11,6 +11,14 @@
 
 namespace sfx {
 
+// How the stream tracer enters the BVH with a tile's primary rays: at the root, or at the
+// deepest node a frustum of the tile's rays proves enough (AEPSA, kernels/stream/entry_point.h).
+// Never changes a hit, so never the image.
+enum class PrimaryEntry : uint8_t { root, aepsa };
+// Whether the stream tracer sorts each generation's stream by approximate hit point before
+// tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit.
+enum class RayReorder : uint8_t { none, hit_point };
+
 struct RenderSettings {
     uint32_t width = 256;
     uint32_t height = 256;
@@ -23,6 +31,9 @@ struct RenderSettings {
     // The stream tracer reads the time-stamp counter at stage boundaries (RenderStats::
     // stage_tsc); off by default (it costs a few cycles per leaf visited); never changes a bit.
     bool stage_clock = false;
+    PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only; never changes a bit
+    RayReorder reorder = RayReorder::none;            // stream tracer only; never changes a bit
+    uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
@@ -47,6 +58,10 @@ struct RenderStats {
     uint64_t extension_rays = 0;
     uint64_t shadow_rays = 0;
     uint64_t nonfinite_paths = 0;  // paths whose radiance was NaN/Inf: zeroed, counted
+    // Primary entry search (PrimaryEntry::aepsa): frusta searched and the sum of the depths
+    // (root = 0) of the nodes their rays entered at.
+    uint64_t entry_searches = 0;
+    uint64_t entry_depth_sum = 0;
     double host_seconds = 0.0;
     // With RenderSettings::stage_clock (stream tracer): TSC ticks per stage, [traversal,
     // intersection, shading] as kernels/trace.h's OpStage; shading is the rest of each pass

@@ -41,6 +41,7 @@ CountingSink::CountingSink(std::vector<uint32_t> widths) : m_widths(std::move(wi
 
 void CountingSink::begin_pass(const TilePass&) {
     ++m_passes;
+    m_traced_generation = -1;
 }
 
 void CountingSink::end_pass(const TilePass& p) {
@@ -60,7 +61,12 @@ void CountingSink::op(const StreamOp& op) {
     ++s.histogram[bucket];
     ++m_kind_ops[uint32_t(op.kind)];
     m_kind_lanes[uint32_t(op.kind)] += op.length;
-    if (op.kind == OpKind::box_test && op.object == 0) m_rays += op.length;  // root: one per ray
+    m_kind_lanes_by_generation[op.generation > 0][uint32_t(op.kind)] += op.length;
+    if (op.kind == OpKind::box_test && int32_t(op.generation) != m_traced_generation) {
+        m_rays += op.length;  // the generation's entry test: one lane per ray
+        m_rays_by_generation[op.generation > 0] += op.length;
+        m_traced_generation = op.generation;
+    }
 }
 
 CountingSink& CountingSink::operator+=(const CountingSink& o) {
@@ -78,10 +84,13 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
     for (uint32_t k = 0; k < k_op_kind_count; ++k) {
         m_kind_ops[k] += o.m_kind_ops[k];
         m_kind_lanes[k] += o.m_kind_lanes[k];
+        for (int g = 0; g < 2; ++g)
+            m_kind_lanes_by_generation[g][k] += o.m_kind_lanes_by_generation[g][k];
     }
     m_passes += o.m_passes;
     m_generations += o.m_generations;
     m_rays += o.m_rays;
+    for (int g = 0; g < 2; ++g) m_rays_by_generation[g] += o.m_rays_by_generation[g];
     return *this;
 }
 

@@ -38,6 +38,13 @@ enum class OpKind : uint8_t {
     lambertian_indirect,  // shading: passed = a bounce ray was pushed
     dielectric,           // shading: passed = a reflected or refracted ray was pushed
     glossy,               // shading: passed = a glossy bounce ray was pushed
+    // Primary entry search (PrimaryEntry::aepsa, kernels/stream/entry_point.h):
+    frustum_bounds,  // traversal: reduce the tile's primary stream to a frustum; all pass
+    frustum_test,    // traversal: the frustum (one lane) against a node's box (object: node)
+    // Hit-point reordering (RayReorder::hit_point, kernels/stream/hit_point_reorder.h):
+    reorder_lod_test,  // traversal: the simplified hierarchy's box filter (object: node)
+    reorder_key,       // traversal: approximate hit point to a two-level Z-curve key; all pass
+    reorder_sort,      // traversal: one merge pass of the sort by key; all pass
     count
 };
 constexpr uint32_t k_op_kind_count = uint32_t(OpKind::count);
@@ -52,7 +59,9 @@ enum class OpFeature : uint8_t {
     lambertian,
     lambertian_and_lights,
     dielectric,
-    glossy
+    glossy,
+    primary_entry_aepsa,  // workload options, not scene features: RenderSettings::primary_entry
+    reorder_hit_point     // RenderSettings::reorder
 };
 
 // The op table: everything about a kind of operation that does not depend on the hardware, in
@@ -81,6 +90,11 @@ inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
     {"lambertian_indirect", OpStage::shading, false, true, OpFeature::lambertian},
     {"dielectric", OpStage::shading, false, true, OpFeature::dielectric},
     {"glossy", OpStage::shading, false, true, OpFeature::glossy},
+    {"frustum_bounds", OpStage::traversal, false, false, OpFeature::primary_entry_aepsa},
+    {"frustum_test", OpStage::traversal, false, false, OpFeature::primary_entry_aepsa},
+    {"reorder_lod_test", OpStage::traversal, true, false, OpFeature::reorder_hit_point},
+    {"reorder_key", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
+    {"reorder_sort", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
 };
 inline const OpKindInfo& op_info(OpKind kind) {
     return k_op_kinds[size_t(kind)];
@@ -90,6 +104,11 @@ inline const char* to_string(OpKind kind) {
 }
 inline OpStage stage_of(OpKind kind) {
     return op_info(kind).stage;
+}
+// The kind exists because of a workload option (a seed paper's alternative), not the scene.
+inline bool is_option_kind(OpKind kind) {
+    const OpFeature f = op_info(kind).feature;
+    return f == OpFeature::primary_entry_aepsa || f == OpFeature::reorder_hit_point;
 }
 
 constexpr uint32_t k_no_object = 0xffffffffu;
@@ -169,9 +188,16 @@ class CountingSink : public TraceSink {
     }
     uint64_t kind_ops(OpKind k) const { return m_kind_ops[uint32_t(k)]; }
     uint64_t kind_lanes(OpKind k) const { return m_kind_lanes[uint32_t(k)]; }
+    // Lanes of one kind in primary (generation 0) or secondary streams.
+    uint64_t kind_lanes(OpKind k, bool secondary) const {
+        return m_kind_lanes_by_generation[secondary][uint32_t(k)];
+    }
     uint64_t passes() const { return m_passes; }
     uint64_t generations() const { return m_generations; }
-    uint64_t rays() const { return m_rays; }  // rays traced: lanes of the root box tests + misses
+    // Rays traced: the lanes of each generation's first box test (its entry node: the root, or
+    // a primary entry point).
+    uint64_t rays() const { return m_rays; }
+    uint64_t rays(bool secondary) const { return m_rays_by_generation[secondary]; }
 
     CountingSink& operator+=(const CountingSink& o);
 
@@ -180,7 +206,10 @@ class CountingSink : public TraceSink {
     StageCounts m_stages[2][k_op_stage_count];
     uint64_t m_kind_ops[k_op_kind_count] = {};
     uint64_t m_kind_lanes[k_op_kind_count] = {};
+    uint64_t m_kind_lanes_by_generation[2][k_op_kind_count] = {};
     uint64_t m_passes = 0, m_generations = 0, m_rays = 0;
+    uint64_t m_rays_by_generation[2] = {};
+    int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
 };
 
 // Writes the trace to a binary file (format in trace.cpp); memory stays one op at a time.

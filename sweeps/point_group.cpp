@@ -70,6 +70,19 @@ void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t wi
     }
 }
 
+// What the workload did, whatever the hardware: box tests per traced ray (primary, secondary)
+// and the primary entry points' mean depth.
+void fill_workload(Prediction& p, const CountingSink& counts, const RenderStats& render) {
+    for (int sec = 0; sec < 2; ++sec) {
+        const uint64_t rays = counts.rays(sec);
+        p.box_tests_per_ray[sec] =
+            rays ? double(counts.kind_lanes(OpKind::box_test, sec)) / double(rays) : 0.0;
+    }
+    p.entry_depth = render.entry_searches
+                        ? double(render.entry_depth_sum) / double(render.entry_searches)
+                        : 0.0;
+}
+
 // Counts finished passes for a PassProgress (the trace arrives in order, one pass at a time).
 class ProgressSink : public TraceSink {
 public:
@@ -306,6 +319,7 @@ PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSet
         result.predictions.push_back(std::move(p));
     }
     for (const RenderStats& st : stats) result.render += st;
+    for (Prediction& p : result.predictions) fill_workload(p, counts, result.render);
     result.host_seconds = seconds_since(start);
     return result;
 }
@@ -320,6 +334,8 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.spheres = scene.spheres.size();
     shape.bvh_nodes = bvh.nodes().size();
     shape.tile = settings.tile;
+    shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;
+    shape.reorder_hit_point = settings.reorder == RayReorder::hit_point;
     return shape;
 }
 
@@ -390,6 +406,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
         // Full fidelity is the reference the other levels are measured against: no sampling
         // error. The analytic model's error is unknown until measured (sfx accuracy).
         if (fidelity == Fidelity::full) p.error_relative = 0.0;
+        fill_workload(p, counts, result.render);
         // The functional render and the shared simulation are split evenly over the group.
         p.host_seconds = shared_seconds / double(configs.size()) + seconds_since(model_start);
         result.predictions.push_back(std::move(p));

@@ -325,7 +325,10 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
         const std::vector<WorkloadColumn> workload = workload_columns(point.workload);
         std::vector<std::string> names = {"key",        "sfx_version", "sweep",      "point_index",
                                           "started_at", "finished_at", "config_yaml"};
-        for (const WorkloadColumn& c : workload) names.push_back(c.name);
+        for (const WorkloadColumn& c : workload) {
+            ensure_column(c.name, c.integer ? "INTEGER" : "TEXT");  // a store from before the field
+            names.push_back(c.name);
+        }
         names.push_back("fidelity");
         Statement unit(m_db,
                        "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");

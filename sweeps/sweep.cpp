@@ -512,15 +512,43 @@ Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets) 
 
 namespace {
 // Writes each workload field as YAML: the scene double-quoted, numbers as they are.
+// Option fields (WorkloadConfig::is_option_field) are written only when they differ from their
+// default, so points of workloads without the option keep the text, and the key, they had
+// before the option existed.
 struct WorkloadYamlWriter {
     YAML::Emitter& out;
-    void text(const char* name, std::string& value, const char*) {
-        out << YAML::Key << name << YAML::Value << YAML::DoubleQuoted << value;
+    std::vector<std::string> default_text;  // per field in visit() order, of `defaults`
+    size_t field = 0;
+
+    void write(const char* name, const std::string& value, bool quoted) {
+        const size_t i = field++;
+        if (i < default_text.size() && WorkloadConfig::is_option_field(name) &&
+            default_text[i] == value)
+            return;
+        out << YAML::Key << name << YAML::Value;
+        if (quoted) out << YAML::DoubleQuoted;
+        out << value;
+    }
+    void text(const char* name, std::string& value, const char*, const char* const* = nullptr) {
+        write(name, value, true);
     }
     template <class T>
     void param(const char* name, T& value, const char*, const char*, uint64_t, uint64_t,
                const char* = nullptr) {
-        out << YAML::Key << name << YAML::Value << value;
+        write(name, std::to_string(value), false);
+    }
+};
+
+// Each field's text, in visit() order.
+struct WorkloadTextCollector {
+    std::vector<std::string> values;
+    void text(const char*, std::string& value, const char*, const char* const* = nullptr) {
+        values.push_back(value);
+    }
+    template <class T>
+    void param(const char*, T& value, const char*, const char*, uint64_t, uint64_t,
+               const char* = nullptr) {
+        values.push_back(std::to_string(value));
     }
 };
 }  // namespace
@@ -531,7 +559,9 @@ std::string point_config_yaml(const HwConfig& hw, const WorkloadConfig& w, Fidel
     YAML::Emitter out;
     out << YAML::BeginMap << YAML::Key << "hw" << YAML::Value << YAML::Load(dump_hw_config(hw));
     out << YAML::Key << "workload" << YAML::Value << YAML::BeginMap;
-    WorkloadYamlWriter writer{out};
+    WorkloadTextCollector defaults;
+    WorkloadConfig().visit(defaults);
+    WorkloadYamlWriter writer{out, defaults.values};
     const_cast<WorkloadConfig&>(w).visit(writer);  // the writer only reads
     out << YAML::EndMap;
     out << YAML::Key << "fidelity" << YAML::Value << to_string(fidelity);
@@ -560,7 +590,10 @@ ParsedPoint parse_point_config(const std::string& text, const std::string& file)
     check_keys(w, file, "workload", fields);
     for (const std::string& k : fields) {
         const std::string key = "workload." + k;
-        if (!w[k]) throw InputError(file, line_of(w), key, "missing");
+        if (!w[k]) {
+            if (WorkloadConfig::is_option_field(k)) continue;  // absent: the default
+            throw InputError(file, line_of(w), key, "missing");
+        }
         // The scene is stored resolved (a built-in name or an absolute path): taken as is.
         set_workload_field(p.workload, k, scalar(w[k], file, key), file, line_of(w[k]), key);
     }

@@ -15,7 +15,9 @@ namespace {
 // Collects the field names.
 struct NameLister {
     std::vector<std::string> names;
-    void text(const char* name, std::string&, const char*) { names.push_back(name); }
+    void text(const char* name, std::string&, const char*, const char* const* = nullptr) {
+        names.push_back(name);
+    }
     template <class T>
     void param(const char* name, T&, const char*, const char*, uint64_t, uint64_t,
                const char* = nullptr) {
@@ -32,11 +34,24 @@ struct FieldSetter {
     const std::string& key;
     bool found = false;
 
-    void text(const char* name, std::string& target, const char*) {
+    void text(const char* name, std::string& target, const char*,
+              const char* const* choices = nullptr) {
         if (field != name) return;
         found = true;
-        if (value.empty()) throw InputError(file, line, key, "expected a scene name or path");
-        target = value;
+        if (!choices) {
+            if (value.empty()) throw InputError(file, line, key, "expected a scene name or path");
+            target = value;
+            return;
+        }
+        std::string list;
+        for (const char* const* c = choices; *c; ++c) {
+            if (value == *c) {
+                target = value;
+                return;
+            }
+            list += (list.empty() ? "" : "|") + std::string(*c);
+        }
+        throw InputError(file, line, key, "expected " + list + ", got '" + value + "'");
     }
     template <class T>
     void param(const char* name, T& target, const char*, const char*, uint64_t lo, uint64_t hi,
@@ -63,7 +78,8 @@ struct FieldSetter {
 // The store's columns: numbers as INTEGER, the scene as TEXT.
 struct ColumnWriter {
     std::vector<WorkloadColumn> columns;
-    void text(const char* name, std::string& value, const char* description) {
+    void text(const char* name, std::string& value, const char* description,
+              const char* const* = nullptr) {
         columns.push_back({std::string("workload.") + name, false, 0, value, "", description});
     }
     template <class T>
@@ -85,12 +101,17 @@ RenderSettings WorkloadConfig::render_settings(uint32_t threads) const {
     s.tile = tile;
     s.seed = seed;
     s.threads = threads;
+    s.primary_entry = primary_entry == "aepsa" ? PrimaryEntry::aepsa : PrimaryEntry::root;
+    s.reorder = reorder == "hit_point" ? RayReorder::hit_point : RayReorder::none;
+    s.reorder_lod_ppm = reorder_lod_ppm;
     return s;
 }
 
 bool WorkloadConfig::operator==(const WorkloadConfig& o) const {
     return scene == o.scene && width == o.width && height == o.height && spp == o.spp &&
-           depth == o.depth && tile == o.tile && seed == o.seed;
+           depth == o.depth && tile == o.tile && seed == o.seed &&
+           primary_entry == o.primary_entry && reorder == o.reorder &&
+           reorder_lod_ppm == o.reorder_lod_ppm;
 }
 
 std::vector<std::string> workload_field_names() {

@@ -27,7 +27,15 @@ struct WorkloadConfig {
     int64_t depth = k_scene_depth;
     uint32_t tile = 32;
     uint64_t seed = 0;
+    // The seed papers' alternatives, each a choice of words (k_*_choices, first = default).
+    std::string primary_entry = "root";  // root | aepsa (PrimaryEntry)
+    std::string reorder = "none";        // none | hit_point (RayReorder)
+    uint32_t reorder_lod_ppm = 20000;    // the paper's 2 %
 
+    static constexpr const char* k_primary_entry_choices[] = {"root", "aepsa", nullptr};
+    static constexpr const char* k_reorder_choices[] = {"none", "hit_point", nullptr};
+
+    // `choices` (null-terminated) lists the words a text field accepts (none: any text).
     // `special` names the word that stands for the field's sentinel value ("auto" for the tile).
     template <class V>
     void visit(V& v) {
@@ -42,6 +50,23 @@ struct WorkloadConfig {
                 "buffer)",
                 1, 4096, "auto");
         v.param("seed", seed, "", "random seed", 0, UINT64_MAX);
+        v.text("primary_entry", primary_entry,
+               "where primary-ray streams enter the BVH: root, or aepsa (a frustum per tile finds "
+               "the deepest node that holds every leaf it overlaps; seeds/004)",
+               k_primary_entry_choices);
+        v.text("reorder", reorder,
+               "sort each generation's stream by approximate hit point before tracing it: none, or "
+               "hit_point (seeds/001)",
+               k_reorder_choices);
+        v.param("reorder_lod_ppm", reorder_lod_ppm, "ppm",
+                "hit_point: the simplified geometry's size in parts per million of the primitives "
+                "(20000 = 2 %, the paper's)",
+                1, 1000000);
+    }
+
+    // The seed papers' options: absent from a point's YAML when at their default (sweep.cpp).
+    static bool is_option_field(const std::string& name) {
+        return name == "primary_entry" || name == "reorder" || name == "reorder_lod_ppm";
     }
 
     bool resolved() const { return depth >= 0 && tile != k_auto_tile; }

@@ -1,6 +1,6 @@
-"""Command line: `python3 -m sfx_analysis report DB -o DIR`, `python3 -m sfx_analysis tables DB`
-and `python3 -m sfx_analysis paper DB -o PAGE.md`. A store that cannot be reported on prints one
-line and exits 2 (no traceback)."""
+"""Command line: `python3 -m sfx_analysis report DB -o DIR`, `python3 -m sfx_analysis tables DB`,
+`python3 -m sfx_analysis paper DB -o PAGE.md`, `python3 -m sfx_analysis seed-kernels DB -o
+PAGE.md`. A store that cannot be reported on prints one line and exits 2 (no traceback)."""
 
 from __future__ import annotations
 
@@ -96,6 +96,18 @@ def _silicon(args) -> int:
     return 0
 
 
+def _seed_kernels(args) -> int:
+    from . import seed_kernels
+
+    store = load_store(args.db)
+    try:
+        seed_kernels.write_page(store, args.output, args.command)
+    except OSError as e:
+        raise StoreError(f"{args.output}: cannot write the page ({e.strerror})") from None
+    print(f"seed kernels: {os.path.abspath(args.output)}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="sfx_analysis",
                                      description="tables, plots and a report from a results store")
@@ -119,6 +131,11 @@ def main(argv=None) -> int:
     si.add_argument("--plot", default="silicon-check.png", help="plot file name, beside the page")
     si.add_argument("--header", required=True, help="Markdown put under the page's title")
     si.set_defaults(run=_silicon)
+    sk = sub.add_parser("seed-kernels", help="the seed papers' options (docs/seed-kernels.md)")
+    sk.add_argument("db")
+    sk.add_argument("-o", "--output", required=True, help="page to write (Markdown)")
+    sk.add_argument("--command", default="", help="the command named on the page as its source")
+    sk.set_defaults(run=_seed_kernels)
     t = sub.add_parser("tables", help="the paper's Tables 2-6 in Markdown on stdout")
     t.add_argument("db")
     t.set_defaults(run=_tables)

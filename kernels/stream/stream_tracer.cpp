@@ -10,6 +10,8 @@
 
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
+#include "kernels/stream/entry_point.h"
+#include "kernels/stream/hit_point_reorder.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
 
@@ -88,9 +90,12 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
 // rays tighten their t as they find hits; shadow rays leave the stream once occluded.
 // The front child is chosen by a majority of the passing rays' direction signs on the split
 // axis: independent of the order of the stream, and for one ray the reference's choice.
+// `entry`: the node the stream enters at (the root, or a primary entry point whose subtree
+// holds every leaf the stream's rays can reach).
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
-              uint16_t generation, Trace& trace, uint64_t* leaf_tsc = nullptr) {
+              uint16_t generation, Trace& trace, uint32_t entry = 0,
+              uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
     const std::vector<BvhNode>& nodes = bvh.nodes();
     const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
@@ -104,7 +109,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     const uint8_t* any_hit = b.any_hit.data();
     auto& stack = b.stack;
     stack.clear();
-    stack.push_back({0u, n});
+    stack.push_back({entry, n});
     // Every stream on the stack is a prefix of the traversal stream: filters move passing ids
     // to the front and only permute inside a prefix, so (node, length) names a stream.
     while (!stack.empty()) {
@@ -189,6 +194,16 @@ struct StreamTracer::Impl {
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
     RayBuffers b;
+    // Hit-point reordering (RenderSettings::reorder): the simplified hierarchy and its buffers.
+    std::unique_ptr<HitPointReorder> reorder;
+    struct ReorderBuffers {
+        std::vector<RayPrecomp> pre;
+        std::vector<float> t, entry;  // per slot: nearest proxy entry so far, this node's entry
+        std::vector<uint64_t> key;
+        std::vector<uint32_t> ids, spill, merged;
+        std::vector<uint8_t> mask, ones;
+        std::vector<std::pair<uint32_t, uint32_t>> stack;
+    } rb;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
         : scene(s),
@@ -196,7 +211,124 @@ struct StreamTracer::Impl {
           settings(r),
           kernels(stream_kernels(resolve_isa(r.isa))),
           camera(s.camera, r.width, r.height),
-          material_rays(s.materials.size(), 0) {}
+          material_rays(s.materials.size(), 0) {
+        if (r.reorder == RayReorder::hit_point)
+            reorder = std::make_unique<HitPointReorder>(h, r.reorder_lod_ppm);
+    }
+
+    // Moon et al.'s reordering of the stream ids[0, n) before it is traced: approximate hit
+    // points by a traversal of the simplified hierarchy (reorder_lod_test ops, Fig. 3's
+    // filter over the proxies' tree), their keys (one reorder_key op over the stream), and a
+    // bottom-up 2-way merge sort of the stream by key (one reorder_sort op per merge pass,
+    // listing the stream in that pass's order; the paper's sort, Sec. 5). Stable, so equal
+    // keys keep their order and the result never depends on anything but the stream.
+    template <class Trace>
+    void reorder_stream(uint32_t* ids, uint32_t n, const Ray* rays, uint16_t generation,
+                        Trace& trace) {
+        if (n < 2) return;
+        ReorderBuffers& r = rb;
+        if (r.pre.size() < b.capacity) {
+            Ray unit;
+            unit.dir = {0.f, 0.f, 1.f};
+            r.pre.resize(b.capacity, RayPrecomp(unit));
+            r.t.resize(b.capacity);
+            r.entry.resize(b.capacity);
+            r.key.resize(b.capacity);
+            r.ids.resize(b.capacity);
+            r.spill.resize(b.capacity);
+            r.merged.resize(b.capacity);
+            r.mask.resize(b.capacity);
+            r.ones.assign(b.capacity, 1);
+        }
+        const std::vector<BvhNode>& nodes = bvh.nodes();
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t id = ids[i];
+            r.key[id] = HitPointReorder::k_no_key;
+            if (!ray_is_valid(rays[id])) continue;
+            r.pre[id] = RayPrecomp(rays[id]);
+            r.t[id] = rays[id].t_max;
+            r.ids[m++] = id;
+        }
+        r.stack.clear();
+        if (m && !nodes.empty()) r.stack.push_back({0u, m});
+        while (!r.stack.empty()) {
+            const auto [node_index, len] = r.stack.back();
+            r.stack.pop_back();
+            const BvhNode& node = nodes[node_index];
+            uint32_t passed = 0, spilled = 0, negative = 0;
+            for (uint32_t j = 0; j < len; ++j) {
+                const uint32_t id = r.ids[j];
+                r.entry[id] = intersect_box(r.pre[id], node.bounds, r.t[id]);
+                r.mask[j] = r.entry[id] != INFINITY;
+            }
+            trace.op(OpKind::reorder_lod_test, generation, node_index, r.ids.data(), len,
+                     r.mask.data(), uint32_t(std::count(r.mask.begin(), r.mask.begin() + len, 1)));
+            for (uint32_t j = 0; j < len; ++j) {  // passing ids first, in order
+                const uint32_t id = r.ids[j];
+                if (!r.mask[j]) {
+                    r.spill[spilled++] = id;
+                    continue;
+                }
+                r.ids[passed++] = id;
+                negative += r.pre[id].dir[node.axis] < 0.f;
+            }
+            std::copy(r.spill.begin(), r.spill.begin() + spilled, r.ids.begin() + passed);
+            if (passed == 0) continue;
+            if (reorder->is_proxy(node_index)) {
+                // A proxy box hit from outside: the nearest so far is the approximate hit.
+                for (uint32_t j = 0; j < passed; ++j) {
+                    const uint32_t id = r.ids[j];
+                    if (r.entry[id] > 0.f && r.entry[id] < r.t[id]) r.t[id] = r.entry[id];
+                }
+                continue;
+            }
+            const bool right_first = 2 * negative > passed;
+            const uint32_t left = BvhNode::left(node_index), right = node.right();
+            r.stack.push_back({right_first ? left : right, passed});
+            r.stack.push_back({right_first ? right : left, passed});
+        }
+        for (uint32_t i = 0; i < m; ++i) {
+            const uint32_t id = r.ids[i];
+            const Ray& ray = rays[id];
+            const float t =
+                r.t[id] < ray.t_max ? r.t[id] : reorder->scene_exit(r.pre[id], ray.t_max);
+            if (std::isfinite(t)) r.key[id] = reorder->key(ray.org + ray.dir * t);
+        }
+        trace.op(OpKind::reorder_key, generation, k_no_object, ids, n, r.ones.data(), n);
+        uint32_t* src = ids;
+        uint32_t* dst = r.merged.data();
+        const auto by_key = [&](uint32_t a, uint32_t c) { return r.key[a] < r.key[c]; };
+        for (uint32_t width = 1; width < n; width *= 2) {
+            for (uint32_t lo = 0; lo < n; lo += 2 * width) {
+                const uint32_t mid = std::min(n, lo + width), hi = std::min(n, lo + 2 * width);
+                std::merge(src + lo, src + mid, src + mid, src + hi, dst + lo, by_key);
+            }
+            std::swap(src, dst);
+            trace.op(OpKind::reorder_sort, generation, k_no_object, src, n, r.ones.data(), n);
+        }
+        if (src != ids) std::copy(src, src + n, ids);
+    }
+
+    // AEPSA for the tile's primary stream (trav_ids[0, n)): bounds the rays by a frustum (the
+    // frustum_bounds op over the stream), searches the entry point (one frustum_test op per
+    // node tested, one lane: the frustum) and returns it.
+    template <class Trace>
+    uint32_t primary_entry_point(uint32_t n, RenderStats& stats, Trace& trace) {
+        if (n == 0) return 0;
+        uint32_t* ids = b.trav_ids.data();
+        FrustumProxy frustum;
+        frustum.build(n, [&](uint32_t i) -> const RayPrecomp& { return b.pre[ids[i]]; });
+        if constexpr (Trace::k_enabled) std::fill(b.mask.begin(), b.mask.begin() + n, uint8_t(1));
+        trace.op(OpKind::frustum_bounds, 0, k_no_object, ids, n, b.mask.data(), n);
+        const EntryPoint e = find_entry_point(bvh, frustum, [&](uint32_t node, bool overlapped) {
+            const uint8_t passed = overlapped;
+            trace.op(OpKind::frustum_test, 0, node, ids, 1, &passed, passed);
+        });
+        ++stats.entry_searches;
+        stats.entry_depth_sum += e.depth;
+        return e.node;
+    }
 
     template <class Trace>
     void run(const TileRect& rect, uint32_t tile_index, uint32_t sample, Vec3* sums,
@@ -250,18 +382,22 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     while (n > 0) {
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
+        if (reorder) reorder_stream(ids, n, rays, generation, trace);
         for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
         const uint32_t traversal_rays = load_rays(b, rays, n);
+        uint32_t entry = 0;
+        if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
+            entry = primary_entry_point(traversal_rays, stats, trace);
         if (clock) {
             uint64_t leaf = 0;
             const uint64_t start = __rdtsc();
-            traverse(kernels, bvh, b, traversal_rays, generation, trace, &leaf);
+            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry, &leaf);
             const uint64_t spent = __rdtsc() - start;
             stats.stage_tsc[0] += spent - leaf;
             stats.stage_tsc[1] += leaf;
             traverse_tsc += spent;
         } else {
-            traverse(kernels, bvh, b, traversal_rays, generation, trace);
+            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry);
         }
         if (observer)
             for (uint32_t i = 0; i < n; ++i) {

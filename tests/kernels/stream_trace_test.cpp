@@ -175,7 +175,8 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     CHECK(sink.stage(false, OpStage::traversal).lanes == 40);
     CHECK(sink.stage(true, OpStage::shading).ops == 0);
     CHECK(sink.kind_ops(OpKind::box_test) == 4);
-    CHECK(sink.rays() == 0);  // object 1 is not the root
+    // Each generation's first box test is its entry test, one lane per ray: 5 + 40.
+    CHECK(sink.rays() == 45);
 }
 
 TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[stream]") {

@@ -7,6 +7,7 @@
 
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
+#include "sweeps/sweep.h"
 #include "workloads/input_error.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
@@ -29,8 +30,9 @@ InputError field_error(const std::string& field, const std::string& value) {
 }  // namespace
 
 TEST_CASE("Workload fields: one list, strict values, columns in the same order", "[workload]") {
-    const std::vector<std::string> names = {"scene", "width", "height", "spp",
-                                            "depth", "tile",  "seed"};
+    const std::vector<std::string> names = {"scene",   "width",          "height", "spp",
+                                            "depth",   "tile",           "seed",   "primary_entry",
+                                            "reorder", "reorder_lod_ppm"};
     CHECK(workload_field_names() == names);
     WorkloadConfig w;
     set_workload_field(w, "scene", "cornell", "f", 1, "k");
@@ -51,7 +53,8 @@ TEST_CASE("Workload fields: one list, strict values, columns in the same order",
     CHECK(unknown.line() == 4);
     CHECK(unknown.key() == "workload.tiles");
     CHECK(unknown.message() ==
-          "no such workload field (scene, width, height, spp, depth, tile, seed, res)");
+          "no such workload field (scene, width, height, spp, depth, tile, seed, primary_entry, "
+          "reorder, reorder_lod_ppm, res)");
     CHECK(field_error("depth", "1001").message() == "expected an integer in [0, 1000], got '1001'");
     CHECK(field_error("tile", "0").message() ==
           "expected an integer in [1, 4096] or auto, got '0'");
@@ -59,6 +62,11 @@ TEST_CASE("Workload fields: one list, strict values, columns in the same order",
     CHECK(field_error("seed", "x").message() == "expected a non-negative integer, got 'x'");
     CHECK(field_error("res", "8by8").message() == "expected WxH with 1..65536, got '8by8'");
     CHECK(field_error("scene", "").message() == "expected a scene name or path");
+    CHECK(field_error("primary_entry", "frustum").message() ==
+          "expected root|aepsa, got 'frustum'");
+    CHECK(field_error("reorder", "morton").message() == "expected none|hit_point, got 'morton'");
+    CHECK(field_error("reorder_lod_ppm", "0").message() ==
+          "expected an integer in [1, 1000000], got '0'");
 
     w.tile = 16;
     const std::vector<WorkloadColumn> columns = workload_columns(w);
@@ -68,6 +76,32 @@ TEST_CASE("Workload fields: one list, strict values, columns in the same order",
     CHECK(columns[0].text == "cornell");
     CHECK(columns[5].integer);
     CHECK(columns[5].number == 16);
+}
+
+TEST_CASE("Workload options: render settings, and absent from a point's YAML at their default",
+          "[workload]") {
+    WorkloadConfig w;
+    w.scene = "cornell";
+    w.depth = 3;
+    CHECK(w.render_settings().primary_entry == PrimaryEntry::root);
+    const std::string plain = point_config_yaml(HwConfig(), w, Fidelity::full);
+    CHECK(plain.find("primary_entry") == std::string::npos);
+    WorkloadConfig a = w;
+    set_workload_field(a, "primary_entry", "aepsa", "f", 1, "k");
+    CHECK(a != w);
+    CHECK(a.render_settings().primary_entry == PrimaryEntry::aepsa);
+    const std::string yaml = point_config_yaml(HwConfig(), a, Fidelity::full);
+    CHECK(yaml.find("primary_entry: \"aepsa\"") != std::string::npos);
+    CHECK(parse_point_config(yaml, "row").workload == a);
+    CHECK(parse_point_config(plain, "row").workload == w);
+    WorkloadConfig r = w;
+    set_workload_field(r, "reorder", "hit_point", "f", 1, "k");
+    set_workload_field(r, "reorder_lod_ppm", "500", "f", 1, "k");
+    CHECK(r.render_settings().reorder == RayReorder::hit_point);
+    CHECK(r.render_settings().reorder_lod_ppm == 500);
+    const std::string ryaml = point_config_yaml(HwConfig(), r, Fidelity::full);
+    CHECK(ryaml.find("reorder_lod_ppm: 500") != std::string::npos);
+    CHECK(parse_point_config(ryaml, "row").workload == r);
 }
 
 TEST_CASE("resolve_workload: the scene's depth, tile auto and tile fits, as the model sees them",
