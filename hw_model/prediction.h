@@ -146,7 +146,6 @@ FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b);
 
 template <class A, class B, class F>
 void FrameTiming::visit(A& a, B& b, F&& f) {
-    static const char* k_secondary[] = {"primary", "secondary"};
     f(CounterInfo("cycles", "core-cycles", "cycles summed over passes"), a.cycles, b.cycles);
     StallCycles::visit(a.stalls, b.stalls,
                        [&](const CounterInfo& c, auto& x, auto& y) { f(c.under("stalls"), x, y); });
@@ -154,10 +153,13 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
                  [&](const CounterInfo& c, auto& x, auto& y) { f(c.under("mix"), x, y); });
     for (int s = 0; s < 2; ++s)
         for (uint32_t k = 0; k < k_op_stage_count; ++k)
-            StageTiming::visit(
-                a.stages[s][k], b.stages[s][k], [&](const CounterInfo& c, auto& x, auto& y) {
-                    f(c.under(to_string(OpStage(k))).under(k_secondary[s]).under("stages"), x, y);
-                });
+            StageTiming::visit(a.stages[s][k], b.stages[s][k],
+                               [&](const CounterInfo& c, auto& x, auto& y) {
+                                   f(c.under(to_string(OpStage(k)))
+                                         .under(s == 0 ? "primary" : "secondary")
+                                         .under("stages"),
+                                     x, y);
+                               });
     f(CounterInfo("field_accesses", "accesses", "one field word for one lane group"),
       a.field_accesses, b.field_accesses);
     f(CounterInfo("conflicted_accesses", "accesses", "field accesses that waited on a bank"),

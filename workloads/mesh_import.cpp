@@ -3,6 +3,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cerrno>
@@ -39,6 +40,18 @@ void check_ply_header(const std::string& text) {
     };
     const size_t header_end = text.find("end_header");
     if (header_end == std::string::npos) fail(1, "no end_header");
+    // A header is printable text; assimp 5.2 reads a binary body past its buffer when the
+    // end_header line runs on into it (found by fuzzing: regressions/mesh_ply/).
+    for (size_t i = 0; i < header_end; ++i) {
+        const unsigned char c = static_cast<unsigned char>(text[i]);
+        if ((c < 0x20 && c != '\n' && c != '\r' && c != '\t') || c == 0x7f)
+            fail(1 + int(std::count(text.begin(), text.begin() + long(i), '\n')),
+                 "a control character in the header");
+    }
+    const size_t after = header_end + std::string("end_header").size();
+    if (text.compare(after, 1, "\n") != 0 && text.compare(after, 2, "\r\n") != 0)
+        fail(1 + int(std::count(text.begin(), text.begin() + long(header_end), '\n')),
+             "end_header must end its line");
     std::istringstream in(text.substr(0, header_end));
     std::string row;
     int line = 0;

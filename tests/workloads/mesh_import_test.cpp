@@ -134,6 +134,15 @@ TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever",
     CHECK_THROWS_WITH(import_text("d.ply", "ply\nformat ascii 1.0\nelementr vertex 3\n" + header +
                                                "end_header\n" + body),
                       Contains("unknown keyword 'elementr'"));
+    CHECK_THROWS_WITH(
+        import_text("e.ply", "ply\nformat ascii 1.0\n" + header + "end_header " + body),
+        Contains("line 9: not a PLY header: end_header must end its line"));
+    CHECK_THROWS_WITH(
+        import_text(
+            "f.ply",
+            std::string("ply\nformat ascii 1.0\nelement vertex 3\nproperty float \0x\n", 56) +
+                "end_header\n" + body),
+        Contains("line 4: not a PLY header: a control character"));
 }
 
 TEST_CASE("mesh import: a PLY face without indices or with an index past the vertices is refused",
