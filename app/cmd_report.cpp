@@ -19,6 +19,7 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "workloads/input_error.h"
+#include "workloads/user_files.h"
 
 #ifndef SFX_ANALYSIS_DIR
 #error "SFX_ANALYSIS_DIR (the analysis/ folder) is set by app/CMakeLists.txt"
@@ -143,8 +144,9 @@ void add_report_command(CLI::App& app) {
     CLI::Option* output = c->get_option("-o");
     c->callback([options, output] {
         struct stat st;
-        if (stat(options->db.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+        if (stat(options->db.c_str(), &st) != 0)
             throw InputError(options->db, 0, "db", "no such results store");
+        check_regular_file(options->db, "results store");  // a directory, a FIFO: named as such
         // SFX_ANALYSIS_DIR in the environment overrides the baked-in path (an installed sfx).
         const std::string analysis = env_or("SFX_ANALYSIS_DIR", SFX_ANALYSIS_DIR);
         const std::string old_path = env_or("PYTHONPATH", "");

@@ -288,9 +288,13 @@ void add_sweep_command(CLI::App& app) {
     c->add_option("--csv", o->csv, "also write this sweep's rows as CSV");
     c->add_option("--engine", o->engine, "local | dask")->check(CLI::IsMember({"local", "dask"}))->capture_default_str();
     c->add_option("--scheduler", o->scheduler, "Dask scheduler address, tcp://HOST:PORT");
-    c->add_option("--jobs", o->jobs, "local: point groups at once (0: one per core)")->capture_default_str();
-    c->add_option("--threads", o->threads, "render threads per group (0: the cores divided among the jobs)")
-        ->capture_default_str();
+    c->add_option("--jobs", o->jobs, "local: point groups at once (0: one per core)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, k_max_threads));
+    c->add_option("--threads", o->threads,
+                  "render threads per group (0: the cores divided among the jobs)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, k_max_threads));
     c->add_option("--set", o->sets, "change the base point: PATH=VALUE (workload.res=64x64, hw.simd.width=8)");
     c->add_flag("--dry-run", o->dry_run, "check and expand the sweep, run nothing, write nothing");
     c->add_flag("--json", o->json, "print one JSON document");

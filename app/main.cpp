@@ -70,7 +70,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        // The same prefix as every other bad value (CLI11's own text names the flag).
+        std::cerr << "sfx: error: command line: " << e.what()
+                  << "\nRun with --help for more information.\n";
         return 2;
     } catch (const sfx::InputError& e) {
         std::cerr << "sfx: error: " << e.what() << "\n";

@@ -10,11 +10,13 @@ namespace sfx {
 
 void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--res", res, "image size WxH")->capture_default_str();
-    c->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(CLI::PositiveNumber);
+    c->add_option("--spp", spp, "samples per pixel")->capture_default_str();
     depth_flag = c->add_option("--depth", depth, "bounces after the camera ray (default: the scene's)");
     c->add_option("--tile", tile, "tile edge in pixels, or auto")->capture_default_str();
     c->add_option("--seed", seed, "random seed")->capture_default_str();
-    c->add_option("--threads", threads, "worker threads (0: all cores)")->capture_default_str();
+    c->add_option("--threads", threads, "worker threads (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, k_max_threads));
     c->add_option("--isa", isa,
                   "host SIMD back end of the stream filters: auto|avx512|avx2|scalar (never "
                   "changes the image or the trace)")

@@ -234,6 +234,8 @@ std::vector<std::string> builtin_preset_names() {
 }
 
 HwConfig load_hw_config(const std::string& path) {
+    if (path.empty())
+        throw InputError("command line", 0, "", "a hardware configuration name is empty");
     // A plain name that is not a file is a shipped preset (hw_model/presets/NAME.hw.yaml), as
     // scene names are shipped scenes.
     std::error_code ec;
@@ -244,6 +246,11 @@ HwConfig load_hw_config(const std::string& path) {
         if (!std::filesystem::is_regular_file(preset, ec)) {
             std::string list;
             for (const std::string& n : builtin_preset_names()) list += (list.empty() ? "" : ", ") + n;
+            // Name the directory searched when it lists nothing: SFX_PRESET_DIR may be wrong.
+            const char* env = std::getenv("SFX_PRESET_DIR");
+            if (list.empty())
+                list =
+                    "none in " + preset_dir().string() + (env && *env ? " (SFX_PRESET_DIR)" : "");
             throw InputError(path, 0, "", "no such hardware configuration file or preset (presets: " +
                                               list + ")");
         }

@@ -86,5 +86,8 @@ std::vector<TileRect> make_tiles(uint32_t width, uint32_t height, uint32_t tile_
 // Runs job(i) for i in [0, count) on `threads` threads (0: hardware concurrency), each index
 // exactly once; which thread runs which index never matters to callers.
 void parallel_for(uint32_t count, uint32_t threads, const std::function<void(uint32_t)>& job);
+// The most threads a --threads flag accepts: far above any host sfx runs on, and low enough
+// that a mistyped value is an error rather than a process that tries to start a million threads.
+constexpr uint32_t k_max_threads = 1024;
 
 }  // namespace sfx

@@ -204,12 +204,27 @@ private:
 
     void read_hw(const YAML::Node& root) {
         if (!root["hw"]) throw InputError(m_file, 1, "hw", "missing (a base hardware file, e.g. gr08.hw.yaml)");
-        fs::path p(scalar(root["hw"], m_file, "hw"));
+        const std::string value = scalar(root["hw"], m_file, "hw");
+        fs::path p(value);
         if (p.is_relative()) p = fs::path(m_base_dir) / p;
         std::error_code ec;
-        if (!fs::is_regular_file(p, ec))
+        // A plain name that is no file beside the sweep is a preset, as on the command line.
+        const bool plain =
+            value.find('/') == std::string::npos && value.find(".yaml") == std::string::npos;
+        if (plain && !fs::exists(p, ec)) {
+            const std::vector<std::string> presets = builtin_preset_names();
+            if (std::find(presets.begin(), presets.end(), value) == presets.end()) {
+                std::string list;
+                for (const std::string& n : presets) list += (list.empty() ? "" : ", ") + n;
+                throw InputError(m_file, line_of(root["hw"]), "hw",
+                                 "no such file or preset: '" + value + "' (presets: " + list + ")");
+            }
+            m_base = load_hw_config(value);
+        } else if (!fs::is_regular_file(p, ec)) {
             throw InputError(m_file, line_of(root["hw"]), "hw", "no such file: " + p.string());
-        m_base = load_hw_config(p.string());  // errors inside it name that file
+        } else {
+            m_base = load_hw_config(p.string());  // errors inside it name that file
+        }
         const YAML::Node over = root["hw_overrides"];
         if (!over) return;
         if (!over.IsMap())

@@ -46,11 +46,20 @@ std::string join(const std::string& prefix, const std::string& name) {
     return prefix.empty() ? name : prefix + "." + name;
 }
 
+// The most nodes a document may hold with its aliases expanded: every sfx file is far
+// smaller, and a few lines of nested aliases (`b: [*a, *a, ...]`) otherwise expand to
+// billions of nodes that each reader would walk.
+constexpr size_t k_max_yaml_nodes = 1000000;
+
 // Keys must be scalars: `? [a]\n: 1` would otherwise escape every parser as a bad conversion.
 void check_scalar_keys(const YAML::Node& node, const std::string& file, const std::string& path,
-                       int depth) {
+                       int depth, size_t& nodes) {
     if (depth > 256)
         throw InputError(file, line_of(node), path, "nested more than 256 levels deep");
+    if (++nodes > k_max_yaml_nodes)
+        throw InputError(
+            file, line_of(node), path,
+            "more than " + std::to_string(k_max_yaml_nodes) + " YAML nodes with aliases expanded");
     if (node.IsMap()) {
         for (const auto& kv : node) {
             if (!kv.first.IsScalar()) {
@@ -59,11 +68,12 @@ void check_scalar_keys(const YAML::Node& node, const std::string& file, const st
                 throw InputError(file, line_of(kv.first), join(path, key.c_str()),
                                  "a key must be a plain scalar, not a list or a mapping");
             }
-            check_scalar_keys(kv.second, file, join(path, kv.first.Scalar()), depth + 1);
+            check_scalar_keys(kv.second, file, join(path, kv.first.Scalar()), depth + 1, nodes);
         }
     } else if (node.IsSequence()) {
         for (size_t i = 0; i < node.size(); ++i)
-            check_scalar_keys(node[i], file, path + "[" + std::to_string(i) + "]", depth + 1);
+            check_scalar_keys(node[i], file, path + "[" + std::to_string(i) + "]", depth + 1,
+                              nodes);
     }
 }
 
@@ -175,7 +185,8 @@ YAML::Node parse_yaml_document(const std::string& text, const std::string& file)
         throw InputError(file, second_document_line(second_line, text), "",
                          "a second YAML document: the file must hold exactly one");
     }
-    check_scalar_keys(root, file, "", 0);
+    size_t nodes = 0;
+    check_scalar_keys(root, file, "", 0, nodes);
     return root;
 }
 

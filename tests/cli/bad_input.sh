@@ -31,6 +31,11 @@ numbers)  # range-checked, never wrapped, clamped, read as octal/hex or mapped t
     expect 2 "$flag" "$sfx" render cornell --res 8x8 -o out.png $args
   done
   expect 2 "--jobs" "$sfx" sweep "$slow" --dry-run --jobs -1
+  # Counts of threads and jobs have an upper bound too (a typo must not start a million threads).
+  expect 2 "^sfx: error: command line: --threads: .*1024" "$sfx" render cornell --res 8x8 -o out.png --threads 5000
+  expect 2 "--jobs: .*1024" "$sfx" sweep "$slow" --dry-run --jobs 5000
+  expect 2 "^sfx: error: command line: --spp: expected an integer in \[1, 1048576\], got '0'$" \
+    "$sfx" render cornell --res 8x8 -o out.png --spp 0
   expect 2 "--rays" "$sfx" validate cornell --rays 18446744073709551616
   expect 2 "--ulps" "$sfx" validate cornell --against embree --ulps nan
   expect 2 "--strata" "$sfx" simulate "$gr08" --scene cornell --res 8x8 --fidelity sampled --strata -1
@@ -62,6 +67,8 @@ not_regular)  # a FIFO, a device or a directory is refused at once, never opened
   expect 2 "/dev/zero: .*character device" "$sfx" sweep /dev/zero --dry-run
   expect 2 "fifo.db: .*a FIFO" "$sfx" sweep "$slow" --store fifo.db
   expect 2 "fifo.db: .*a FIFO" "$sfx" compare --store fifo.db --a hw.simd.width=8 --b hw.simd.width=16
+  mkdir dir.db
+  expect 2 "dir.db: .*a directory" "$sfx" report dir.db -o report
   scene_with_mesh fifo.obj
   expect 2 "objects\[0\]\.file: .*a FIFO" "$sfx" scene-info m.scene.yaml
   ;;

@@ -180,16 +180,21 @@ TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
     const std::string h = k_head;  // lines 1-4
     const std::vector<Case> cases = {
         {h + "axis: {}\n", 5, "axis", "unknown key"},
-        {h + "axes:\n  hw.simd.widht: [4]\n", 6, "axes.hw.simd.widht", "no such hardware parameter"},
+        {h + "axes:\n  hw.simd.widht: [4]\n", 6, "axes.hw.simd.widht",
+         "no such hardware parameter"},
         {h + "axes:\n  hw.simd.width: [4,\n    0]\n", 7, "axes.hw.simd.width", "outside"},
-        {h + "axes:\n  hw.ray_buffer.layout: [soa, diagonal]\n", 6, "axes.hw.ray_buffer.layout", "not an allowed value"},
+        {h + "axes:\n  hw.ray_buffer.layout: [soa, diagonal]\n", 6, "axes.hw.ray_buffer.layout",
+         "not an allowed value"},
         {h + "axes:\n  workload.tiles: [8]\n", 6, "axes.workload.tiles", "no such workload field"},
         {h + "axes:\n  simd.width: [8]\n", 6, "axes.simd.width", "starts with hw."},
-        {h + "axes:\n  workload.scene: [cornell, nowhere_scene]\n", 6, "axes.workload.scene", "no such scene"},
-        {h + "axes:\n  hw.simd.width: {from: 8, to: 4, step: 1}\n", 6, "axes.hw.simd.width.to", "below"},
+        {h + "axes:\n  workload.scene: [cornell, nowhere_scene]\n", 6, "axes.workload.scene",
+         "no such scene"},
+        {h + "axes:\n  hw.simd.width: {from: 8, to: 4, step: 1}\n", 6, "axes.hw.simd.width.to",
+         "below"},
         {h + "axes:\n  hw.simd.width: []\n", 6, "axes.hw.simd.width", "at least one"},
-        {h + "axes:\n  hw.simd.width: [4, 8]\n  workload.tile: [8]\nzip:\n  - [hw.simd.width, workload.tile]\n", 9,
-         "zip[0].workload.tile", "equal lengths"},
+        {h + "axes:\n  hw.simd.width: [4, 8]\n  workload.tile: [8]\nzip:\n  - [hw.simd.width, "
+             "workload.tile]\n",
+         9, "zip[0].workload.tile", "equal lengths"},
         {h + "axes:\n  hw.simd.width: [4, 8]\nzip:\n  - [hw.simd.width, hw.simd.lanes]\n", 8,
          "zip[0].hw.simd.lanes", "not an axis"},
         {h + "axes:\n  hw.ray_buffer.banks: [32, 48]\n", 6, "hw.ray_buffer.banks", "do not divide"},
@@ -200,12 +205,19 @@ TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
         {"version: 2\n", 1, "version", "only version 1"},
         {"hw: gr08.hw.yaml\n", 1, "version", "missing"},
         {"version: 1\nhw: nowhere.hw.yaml\nworkload: {scene: cornell}\n", 2, "hw", "no such file"},
-        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16x16, width: 8}\n", 3, "workload.res", "not both"},
-        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16by16}\n", 3, "workload.res", "WxH"},
-        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, tile: 0}\n", 3, "workload.tile", "[1, 4096]"},
-        {"version: 1\nhw: gr08.hw.yaml\nfidelity: fast\nworkload: {scene: cornell}\n", 3, "fidelity", "analytic, sampled or full"},
-        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell}\nhw_overrides: {simd.width: 100}\n", 4,
-         "hw_overrides.simd.width", "outside"},
+        {"version: 1\nhw: nowhere_preset\nworkload: {scene: cornell}\n", 2, "hw",
+         "no such file or preset"},
+        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16x16, width: 8}\n", 3,
+         "workload.res", "not both"},
+        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, res: 16by16}\n", 3,
+         "workload.res", "WxH"},
+        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell, tile: 0}\n", 3, "workload.tile",
+         "[1, 4096]"},
+        {"version: 1\nhw: gr08.hw.yaml\nfidelity: fast\nworkload: {scene: cornell}\n", 3,
+         "fidelity", "analytic, sampled or full"},
+        {"version: 1\nhw: gr08.hw.yaml\nworkload: {scene: cornell}\nhw_overrides: {simd.width: "
+         "100}\n",
+         4, "hw_overrides.simd.width", "outside"},
     };
     for (const Case& c : cases) {
         const InputError e = error_of(c.text);
@@ -221,6 +233,14 @@ TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
     CHECK(e.key() == "--set workload.spp");
     const InputError f = error_of(std::string(k_head), {"hw.simd.lanes=4"});
     CHECK(f.key() == "--set hw.simd.lanes");
+}
+
+TEST_CASE("A sweep's hw may name a preset, as the command line does", "[sweeps]") {
+    // Parsed from sweeps/, where no file is called gr08: the name is the shipped preset.
+    const Sweep s = parse_sweep("version: 1\nhw: gr08\nworkload: {scene: cornell, res: 16x16}\n",
+                                "t.sweep.yaml", SFX_SOURCE_DIR "/sweeps");
+    REQUIRE(s.points.size() == 1);
+    CHECK(dump_hw_config(s.points[0].hw) == dump_hw_config(load_hw_config("gr08")));
 }
 
 TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {

@@ -51,6 +51,21 @@ TEST_CASE("user files: one YAML document with plain keys", "[workloads]") {
     CHECK_THROWS_AS(parse_yaml_document("a: [1, 2\n", "s.yaml"), InputError);
 }
 
+TEST_CASE("user files: aliases may not expand a document past its node budget", "[workloads]") {
+    // Ten aliases a level, nine levels: 10^9 nodes from ten lines. Without the budget every
+    // reader walks them all (minutes, then memory); with it, one error at once.
+    std::string bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+    for (int i = 1; i < 10; ++i) {
+        bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+        for (int k = 0; k < 10; ++k) bomb += (k ? ", *a" : "*a") + std::to_string(i - 1);
+        bomb += "]\n";
+    }
+    CHECK_THROWS_WITH(parse_yaml_document(bomb, "bomb.yaml"),
+                      Catch::Contains("more than 1000000 YAML nodes with aliases expanded"));
+    // A few aliases stay usable.
+    CHECK(parse_yaml_document("a: &w 16\nb: *w\n", "ok.yaml")["b"].Scalar() == "16");
+}
+
 TEST_CASE("user files: outputs are checked first and appear together or not at all",
           "[workloads]") {
     const TempDir dir("sfx-user-files-test");
