@@ -128,6 +128,7 @@ void add_report_command(CLI::App& app) {
         bool quiet = false;
         std::string paper;        // --paper PAGE.md: the paper check instead of the report
         std::string trace_stats;  // sfx trace-stats conference --json, for the trace target
+        std::string silicon;      // sfx calibrate --check --json, for the silicon-check section
     };
     auto options = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand("report", "tables and plots from a results store (HTML)");
@@ -137,6 +138,10 @@ void add_report_command(CLI::App& app) {
     c->add_option("--paper", options->paper,
                   "write the comparison with the paper's tables (Markdown) to this file instead "
                   "of the report (docs/paper-check.md; see scripts/paper-check)");
+    c->add_option("--silicon", options->silicon,
+                  "`sfx calibrate --check --json` output (scripts/silicon-check writes "
+                  "out/silicon-check/rows.json): adds the timing model on silicon to the report")
+        ->check(CLI::ExistingFile);
     c->add_option("--trace-stats", options->trace_stats,
                   "with --paper: `sfx trace-stats conference --json` output, for the trace-side "
                   "target")
@@ -152,6 +157,9 @@ void add_report_command(CLI::App& app) {
         const std::string old_path = env_or("PYTHONPATH", "");
         const std::string path = analysis + (old_path.empty() ? "" : ":" + old_path);
         setenv("PYTHONPATH", path.c_str(), 1);
+        if (!options->silicon.empty() && !options->paper.empty())
+            throw InputError("command line", 0, "--silicon",
+                             "adds a section to the report, not to the --paper page");
         if (!options->trace_stats.empty() && options->paper.empty())
             throw InputError("command line", 0, "--trace-stats", "only used with --paper");
         if (!options->paper.empty() && output->count() > 0)
@@ -161,6 +169,7 @@ void add_report_command(CLI::App& app) {
         std::vector<std::string> args = {k_python, "-m", "sfx_analysis"};
         if (options->paper.empty()) {
             args.insert(args.end(), {"report", options->db, "-o", options->output});
+            if (!options->silicon.empty()) args.insert(args.end(), {"--silicon", options->silicon});
         } else {
             args.insert(args.end(), {"paper", options->db, "-o", options->paper});
             if (!options->trace_stats.empty())

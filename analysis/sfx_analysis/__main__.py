@@ -16,7 +16,7 @@ from .tables import build_tables, tables_markdown, to_markdown
 def _report(args) -> int:
     from .report import write_report  # imports matplotlib: only when drawing
 
-    report = write_report(args.db, args.output)
+    report = write_report(args.db, args.output, args.silicon or "")
     for w in report.store.warnings:
         print(f"sfx report: note: {w}", file=sys.stderr)
     if not args.quiet:
@@ -116,6 +116,8 @@ def main(argv=None) -> int:
     r.add_argument("db", help="results store (SQLite) written by `sfx sweep`")
     r.add_argument("-o", "--output", default="report", help="report directory (default: report)")
     r.add_argument("--quiet", action="store_true", help="print only where the files are")
+    r.add_argument("--silicon", help="`sfx calibrate --check --json` output: adds the "
+                                     "silicon-check section")
     r.set_defaults(run=_report)
     pp = sub.add_parser("paper", help="the paper check page (docs/paper-check.md) in Markdown")
     pp.add_argument("db")

@@ -4,7 +4,9 @@ mean absolute and worst relative error of frame cycles, the same per stage, the 
 ranking per scene (predicted against measured), a predicted-against-measured scatter plot with
 the y = x line, and the Markdown page `docs/silicon-check.md`."""
 
+import html
 import json
+import os
 
 import matplotlib
 
@@ -189,3 +191,34 @@ def write_page(df, page, plot_name, header):
     with open(page, "w") as f:
         f.write(text + "\n")
     return s
+
+
+def html_section(df, directory, plot_name="silicon-check.png"):
+    """The report's section (`sfx report DB --silicon ROWS`): the summary, the scatter plot
+    (drawn into the report directory) and the per-workload table."""
+    e = html.escape
+    scatter_plot(df, os.path.join(directory, plot_name))
+    items = "".join(f"<li>{e(line[2:])}</li>" for line in summary_text(summary(df)).splitlines())
+    head = ["scene", "res", "tile", "predicted Mcyc", "measured Mcyc", "error", "trav err",
+            "isect err", "shade err", "noise"]
+    rows = []
+    for _, r in df.iterrows():
+        cells = [r["scene"], r["res"], r["tile"], f"{r['predicted.frame_cycles'] / 1e6:.2f}",
+                 f"{r['measured.frame_cycles'] / 1e6:.2f}", pct(r["error.frame"]),
+                 pct(r["error.traversal"]), pct(r["error.intersection"]),
+                 pct(r["error.shading"]), f"{100 * r['noise']:.0f} %"]
+        rows.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in cells) + "</tr>")
+    return "\n".join([
+        "<h2>The timing model on silicon</h2>",
+        "<p>The host CPU described as a hardware configuration (<code>sfx calibrate "
+        "--describe-host</code>, per-op costs fitted only on microbenchmarks) predicting the "
+        "native stream tracer's cycles per frame on held-out workloads (<code>sfx calibrate "
+        "--check</code>; <code>scripts/silicon-check</code> writes the same as "
+        "<code>docs/silicon-check.md</code>). Error = predicted / measured &minus; 1.</p>",
+        f"<ul class=\"notes\">{items}</ul>",
+        f'<figure><img src="{e(plot_name)}" alt="predicted against measured cycles">'
+        "<figcaption>Predicted against measured Mcycles per frame and per stage, with the "
+        "y = x line (and &plusmn;25 % dotted).</figcaption></figure>",
+        '<table class="paper"><caption>Per workload</caption><tr>'
+        + "".join(f"<th>{e(h)}</th>" for h in head) + "</tr>" + "".join(rows) + "</table>",
+    ])

@@ -64,3 +64,26 @@ def test_bad_rows(tmp_path):
     header = tmp_path / "h.md"
     header.write_text("")
     assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 2
+
+
+def test_report_section(rows_file, tmp_path):
+    from conftest import accuracy_store
+    from sfx_analysis.report import write_report
+    report = write_report(accuracy_store(tmp_path), str(tmp_path / "r"), str(rows_file))
+    html = open(report.index, encoding="utf-8").read()
+    assert "The timing model on silicon" in html
+    assert "tile ranking right in 1 of 2" in html
+    assert "<td>a</td><td>64x64</td><td>64</td><td>0.00</td><td>0.00</td><td>+25.0 %</td>" in html
+    assert (tmp_path / "r" / "silicon-check.png").stat().st_size > 1000
+    # Without rows there is no such section.
+    (tmp_path / "p").mkdir()
+    plain = write_report(accuracy_store(tmp_path / "p"), str(tmp_path / "p" / "r"))
+    assert "on silicon" not in open(plain.index, encoding="utf-8").read()
+
+
+def test_report_bad_rows(tmp_path):
+    from conftest import accuracy_store
+    p = tmp_path / "rows.json"
+    p.write_text("{}")
+    assert main(["report", accuracy_store(tmp_path), "-o", str(tmp_path / "r"),
+                 "--silicon", str(p)]) == 2
