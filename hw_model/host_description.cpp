@@ -169,9 +169,13 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz) {
     for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
     size_t at = 0;
     for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i) at = chase[at];  // warm
-    const size_t loads = 1u << 19;  // a fraction of a second even from DRAM
+    // Many short runs, the fastest kept: on a shared machine a run is often descheduled, and
+    // the TSC keeps counting then (three runs of 2^19 loads each read 4-5x the true latency at
+    // a load average of 8). A run of 2^12 loads (well under a millisecond even from DRAM) is
+    // usually not interrupted at all.
+    const size_t loads = 1u << 12;
     double best = 1e30;
-    for (int rep = 0; rep < 3; ++rep) {  // the fastest of three: the least disturbed
+    for (int rep = 0; rep < 128; ++rep) {
         const uint64_t c0 = __rdtsc();
         for (size_t i = 0; i < loads; ++i) at = chase[at];
         const uint64_t c1 = __rdtsc();
