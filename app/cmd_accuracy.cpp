@@ -14,8 +14,8 @@
 #include "app/progress.h"
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/user_files.h"
 #include "workloads/scene_loader.h"
 
 #ifndef SFX_ACCURACY_PLOT

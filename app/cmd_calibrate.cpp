@@ -13,10 +13,10 @@
 #include "app/progress.h"
 #include "kernels/bvh.h"
 #include "sweeps/host_calibration.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
-#include "workloads/strict_number.h"
-#include "workloads/user_files.h"
+#include "base/strict_number.h"
+#include "base/user_files.h"
 
 namespace sfx {
 

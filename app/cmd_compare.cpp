@@ -13,7 +13,7 @@
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
 #include "sweeps/store_compare.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
 
 namespace sfx {

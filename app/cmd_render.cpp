@@ -7,9 +7,9 @@
 #include "kernels/bvh.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/stream_tracer.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
-#include "workloads/user_files.h"
+#include "base/user_files.h"
 
 namespace sfx {
 

@@ -18,8 +18,8 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/user_files.h"
 
 #ifndef SFX_ANALYSIS_DIR
 #error "SFX_ANALYSIS_DIR (the analysis/ folder) is set by app/CMakeLists.txt"

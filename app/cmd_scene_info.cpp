@@ -7,7 +7,7 @@
 
 #include "app/commands.h"
 #include "kernels/bvh.h"
-#include "workloads/host_clock.h"
+#include "base/host_clock.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 

@@ -26,9 +26,9 @@
 #include "sweeps/group_runner.h"
 #include "sweeps/results_store.h"
 #include "sweeps/sweep.h"
-#include "workloads/host_clock.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/host_clock.h"
+#include "base/input_error.h"
+#include "base/user_files.h"
 
 namespace sfx {
 namespace {

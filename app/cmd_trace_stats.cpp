@@ -10,7 +10,7 @@
 #include "app/commands.h"
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
 
 namespace sfx {

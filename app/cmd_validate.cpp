@@ -16,8 +16,8 @@
 #include "kernels/embree/embree_check.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/stream_tracer.h"
-#include "workloads/host_clock.h"
-#include "workloads/input_error.h"
+#include "base/host_clock.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
 
 namespace sfx {

@@ -3,11 +3,8 @@
 // "99999999999999999999999" as 2^64-1, "010" as octal and "0x10" as hex; here each is an error
 // naming the flag (exit 2).
 
-#include <cerrno>
-#include <cstdlib>
-
 #include "app/commands.h"
-#include "workloads/strict_number.h"
+#include "base/strict_number.h"
 
 namespace sfx {
 namespace {
@@ -22,13 +19,8 @@ std::string strict_unsigned(std::string& text) {
 }
 
 std::string strict_signed(std::string& text) {
-    const bool digits = !text.empty() &&
-                        text.find_first_not_of("0123456789", text[0] == '-') == std::string::npos &&
-                        text != "-";
-    char* end = nullptr;
-    errno = 0;
-    const long long v = digits ? std::strtoll(text.c_str(), &end, 10) : 0;
-    if (!digits || errno) return "expected a decimal integer, got '" + text + "'";
+    int64_t v = 0;
+    if (!parse_signed(text, v)) return "expected a decimal integer, got '" + text + "'";
     text = std::to_string(v);
     return "";
 }

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "app/commands.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 // libsystemc.so defines main() and calls sc_main(); sfx has its own main(), so this is never
 // called, but the library needs the symbol to link.

@@ -24,7 +24,7 @@ Progress::Progress(std::string what, uint64_t total, std::string unit, double lo
       m_total(total),
       m_log_every(log_every),
       m_tty(isatty(2)),
-      m_start(std::chrono::steady_clock::now()),
+      m_start(HostClock::now()),
       m_last_output(m_start) {}
 
 Progress::~Progress() {
@@ -47,7 +47,7 @@ void Progress::set_done(uint64_t done) {
 }
 
 double Progress::elapsed() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+    return seconds_since(m_start);
 }
 
 std::string Progress::eta() const {
@@ -62,8 +62,8 @@ std::string Progress::status() const {
 
 void Progress::update(bool force) {
     if (m_finished) return;
-    const auto now = std::chrono::steady_clock::now();
-    const double since = std::chrono::duration<double>(now - m_last_output).count();
+    const auto now = HostClock::now();
+    const double since = seconds_between(m_last_output, now);
     if (m_tty) {
         // Redrawing costs a write: at most ten a second, and always for a new label.
         if (force || since >= 0.1) draw();
@@ -84,7 +84,7 @@ void Progress::draw() {
     if (line.size() > 110) line.resize(110);
     std::cerr << "\r\033[K" << line << std::flush;
     m_drawn = true;
-    m_last_output = std::chrono::steady_clock::now();
+    m_last_output = HostClock::now();
 }
 
 void Progress::clear() {
@@ -95,7 +95,7 @@ void Progress::clear() {
 void Progress::log(const std::string& line) {
     clear();
     std::cerr << line << "\n";
-    m_last_output = std::chrono::steady_clock::now();
+    m_last_output = HostClock::now();
     if (m_tty && !m_finished) draw();
 }
 

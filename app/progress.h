@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <string>
 
+#include "base/host_clock.h"
+
 namespace sfx {
 
 // "42s", "3m07s", "1h05m"; "?" for a negative or absurd value.
@@ -47,7 +49,7 @@ private:
     uint64_t m_total, m_done = 0;
     double m_log_every;
     bool m_tty, m_drawn = false, m_finished = false, m_logged = false;
-    std::chrono::steady_clock::time_point m_start, m_last_output;
+    HostClock::time_point m_start, m_last_output;
 };
 
 }  // namespace sfx

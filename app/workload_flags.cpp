@@ -3,8 +3,8 @@
 
 #include "app/commands.h"
 #include "hw_model/tech_table.h"
-#include "workloads/input_error.h"
-#include "workloads/strict_number.h"
+#include "base/input_error.h"
+#include "base/strict_number.h"
 
 namespace sfx {
 

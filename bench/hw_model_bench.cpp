@@ -19,7 +19,7 @@
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
-#include "workloads/host_clock.h"
+#include "base/host_clock.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;

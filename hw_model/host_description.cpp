@@ -12,7 +12,8 @@
 #include <sstream>
 #include <thread>
 
-#include "workloads/strict_number.h"
+#include "base/host_clock.h"
+#include "base/strict_number.h"
 
 namespace sfx {
 
@@ -148,14 +149,13 @@ uint64_t read_tsc() {
 }
 
 double measure_tsc_mhz(double seconds) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
+    const auto t0 = HostClock::now();
     const uint64_t c0 = __rdtsc();
     auto t1 = t0;
-    while (std::chrono::duration<double>((t1 = Clock::now()) - t0).count() < seconds) {
+    while (seconds_between(t0, t1 = HostClock::now()) < seconds) {
     }
     const uint64_t c1 = __rdtsc();
-    return double(c1 - c0) / std::chrono::duration<double, std::micro>(t1 - t0).count();
+    return double(c1 - c0) / (seconds_between(t0, t1) * 1e6);
 }
 
 double measure_load_latency_ns(uint64_t bytes, double tsc_mhz) {

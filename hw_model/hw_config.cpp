@@ -1,6 +1,6 @@
 #include "hw_model/hw_config.h"
 
-#include "hw_model/strict_yaml.h"
+#include "base/strict_yaml.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -14,9 +14,10 @@
 #include <sstream>
 
 #include "kernels/trace.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
-#include "workloads/strict_number.h"
+#include "base/input_error.h"
+#include "base/shipped_files.h"
+#include "base/user_files.h"
+#include "base/strict_number.h"
 
 #ifndef SFX_PRESET_DIR
 #define SFX_PRESET_DIR "hw_model/presets"
@@ -215,23 +216,9 @@ HwConfig parse_hw_config(const std::string& text, const std::string& file) {
     return config;
 }
 
-static std::filesystem::path preset_dir() {
-    if (const char* env = std::getenv("SFX_PRESET_DIR"); env && *env) return env;
-    return SFX_PRESET_DIR;
-}
+static std::filesystem::path preset_dir() { return shipped_dir("SFX_PRESET_DIR", SFX_PRESET_DIR); }
 
-std::vector<std::string> builtin_preset_names() {
-    std::vector<std::string> names;
-    std::error_code ec;
-    for (const auto& entry : std::filesystem::directory_iterator(preset_dir(), ec)) {
-        const std::string file = entry.path().filename().string();
-        const std::string suffix = ".hw.yaml";
-        if (file.size() > suffix.size() && file.compare(file.size() - suffix.size(), suffix.size(), suffix) == 0)
-            names.push_back(file.substr(0, file.size() - suffix.size()));
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
+std::vector<std::string> builtin_preset_names() { return shipped_names(preset_dir(), ".hw.yaml"); }
 
 HwConfig load_hw_config(const std::string& path) {
     if (path.empty())
@@ -239,9 +226,7 @@ HwConfig load_hw_config(const std::string& path) {
     // A plain name that is not a file is a shipped preset (hw_model/presets/NAME.hw.yaml), as
     // scene names are shipped scenes.
     std::error_code ec;
-    const bool plain_name = !path.empty() && path.find('/') == std::string::npos &&
-                            path.find(".yaml") == std::string::npos;
-    if (plain_name && !std::filesystem::exists(path, ec)) {
+    if (is_shipped_name(path) && !std::filesystem::exists(path, ec)) {
         const std::filesystem::path preset = preset_dir() / (path + ".hw.yaml");
         if (!std::filesystem::is_regular_file(preset, ec)) {
             std::string list;

@@ -3,7 +3,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "hw_model/strict_yaml.h"
+#include "base/strict_yaml.h"
 #include "hw_model/tech/builtin_tech.h"  // generated: k_builtin_tech[] = {name, yaml text}
 
 namespace sfx {

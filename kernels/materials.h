@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "kernels/sampling.h"
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

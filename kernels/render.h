@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "kernels/simd/isa.h"
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "base/hash.h"
+
 namespace sfx {
 
 // Dimensions consumed per bounce; named so both tracers draw the same number for the same use.
@@ -22,13 +24,6 @@ enum class RngDim : uint32_t {
     light_w,
     count
 };
-
-// SplitMix64 finaliser: a strong 64-bit mixer (Steele, Lea, Flood 2014).
-constexpr uint64_t mix64(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
 
 constexpr uint32_t random_bits(uint64_t seed, uint32_t pixel, uint32_t sample, uint32_t bounce,
                                uint32_t dim) {

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

@@ -5,8 +5,8 @@
 #include <memory>
 #include <stdexcept>
 
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/user_files.h"
 
 namespace sfx {
 

@@ -5,7 +5,7 @@
 
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
 
 namespace sfx {

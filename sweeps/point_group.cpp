@@ -10,8 +10,8 @@
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/stream/stream_tracer.h"
-#include "workloads/host_clock.h"
-#include "workloads/input_error.h"
+#include "base/host_clock.h"
+#include "base/input_error.h"
 #include "workloads/ray_layout.h"
 
 namespace sfx {

@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "workloads/input_error.h"
-#include "workloads/strict_number.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/strict_number.h"
+#include "base/user_files.h"
 
 namespace sfx {
 namespace {

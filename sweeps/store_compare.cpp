@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <set>
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 namespace sfx {
 namespace {

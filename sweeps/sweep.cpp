@@ -16,11 +16,12 @@
 
 #include "sweeps/point_group.h"
 #include "sweeps/sha256.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/user_files.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
-#include "workloads/strict_number.h"
+#include "base/strict_number.h"
+#include "base/strict_yaml.h"
 
 #ifndef SFX_VERSION
 #define SFX_VERSION "unknown"
@@ -38,7 +39,7 @@ namespace {
 // anything runs, about 0.5 ms each, so the cap keeps a --dry-run within seconds.
 constexpr size_t k_max_points = 10000;
 
-int line_of(const YAML::Node& n) { return n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+using strict_yaml::line_of;
 
 // Checks a mapping's keys against an allowed list: unknown and duplicate keys are errors.
 void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
@@ -131,6 +132,11 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     check_keys(node, file, key, {"from", "to", "step"});
     for (const char* k : {"from", "to", "step"})
         if (!node[k]) throw InputError(file, line_of(node), key + "." + k, "missing (a range needs from, to and step)");
+    // A range's bounds are numbers, so plain scalars (base/strict_yaml.h); axis values are
+    // text, as on the command line (--set), and checked by the field they set.
+    for (const char* k : {"from", "to", "step"})
+        if (node[k].IsScalar() && !strict_yaml::is_plain_scalar(node[k]))
+            throw InputError(file, line_of(node[k]), key + "." + k, "expected a number");
     const std::string from = scalar(node["from"], file, key + ".from");
     const std::string to = scalar(node["to"], file, key + ".to");
     const std::string step = scalar(node["step"], file, key + ".step");

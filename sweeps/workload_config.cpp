@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <type_traits>
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/ray_layout.h"
-#include "workloads/strict_number.h"
+#include "base/strict_number.h"
 
 namespace sfx {
 namespace {

@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "workloads/user_files.h"
+#include "base/user_files.h"
 
 namespace sfx {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

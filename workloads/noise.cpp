@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "kernels/rng.h"
+#include "base/hash.h"
 #include "workloads/generators.h"
 
 namespace sfx {

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/hash.h"
+
 namespace sfx {
 
 const char* to_string(MaterialKind kind) {
@@ -138,12 +140,7 @@ uint64_t Scene::geometry_bytes() const {
 // FNV-1a over the bytes that decide a trace; kept one structure a line, as a checklist.
 // clang-format off
 namespace {
-struct Fnv {
-    uint64_t h = 0xcbf29ce484222325ull;
-    void bytes(const void* p, size_t n) {
-        const auto* b = static_cast<const uint8_t*>(p);
-        for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
-    }
+struct Fnv : Fnv1a {
     void f(float v) { bytes(&v, 4); }
     void u(uint32_t v) { bytes(&v, 4); }
     void v3(const Vec3& v) { f(v.x); f(v.y); f(v.z); }

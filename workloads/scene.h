@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vec.h"
+#include "base/vec.h"
 
 namespace sfx {
 

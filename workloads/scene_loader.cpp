@@ -15,8 +15,11 @@
 #include <set>
 
 #include "workloads/generators.h"
-#include "workloads/input_error.h"
-#include "workloads/user_files.h"
+#include "base/input_error.h"
+#include "base/shipped_files.h"
+#include "base/strict_number.h"
+#include "base/strict_yaml.h"
+#include "base/user_files.h"
 #include "workloads/mesh_import.h"
 
 #ifndef SFX_SCENE_DIR
@@ -60,17 +63,20 @@ public:
             if (!seen.count(r)) fail(node, join(path, r), "missing required key");
     }
 
+    // Numbers follow the rules of every YAML reader (base/strict_yaml.h): a quoted "1.5" is
+    // text, refused rather than guessed at.
     double number(const YAML::Node& node, const std::string& key) const {
-        // A quoted scalar ("1.5") is a string in YAML: refuse it rather than guess.
-        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected a number");
-        double v;
-        try {
-            v = node.as<double>();
-        } catch (const YAML::Exception&) {
-            fail(node, key, "expected a number, got '" + node.Scalar() + "'");
+        if (!strict_yaml::is_plain_scalar(node)) fail(node, key, "expected a number");
+        double v = 0;
+        switch (strict_yaml::read_finite(node, v)) {
+            case strict_yaml::NumberText::finite:
+                return v;
+            case strict_yaml::NumberText::not_finite:
+                fail(node, key, "must be finite, got '" + node.Scalar() + "'");
+            case strict_yaml::NumberText::not_a_number:
+                fail(node, key, "expected a number, got '" + node.Scalar() + "'");
         }
-        if (!std::isfinite(v)) fail(node, key, "must be finite, got '" + node.Scalar() + "'");
-        return v;
+        fail(node, key, "expected a number");
     }
 
     double number_in(const YAML::Node& node, const std::string& key, double lo, double hi,
@@ -83,13 +89,10 @@ public:
     }
 
     int64_t integer(const YAML::Node& node, const std::string& key, int64_t lo, int64_t hi) const {
-        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected an integer");
-        long long v;
-        try {
-            v = node.as<long long>();
-        } catch (const YAML::Exception&) {
+        if (!strict_yaml::is_plain_scalar(node)) fail(node, key, "expected an integer");
+        int64_t v = 0;
+        if (!parse_signed(node.Scalar(), v))
             fail(node, key, "expected an integer, got '" + node.Scalar() + "'");
-        }
         if (v < lo || v > hi)
             fail(node, key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                                 "], got " + node.Scalar());
@@ -97,14 +100,11 @@ public:
     }
 
     uint64_t seed(const YAML::Node& node, const std::string& key) const {
-        if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected a non-negative integer");
-        try {
-            const std::string& s = node.Scalar();
-            if (s.empty() || s[0] == '-') throw YAML::Exception(node.Mark(), "negative");
-            return node.as<uint64_t>();
-        } catch (const YAML::Exception&) {
+        uint64_t v = 0;
+        if (!strict_yaml::is_plain_scalar(node)) fail(node, key, "expected a non-negative integer");
+        if (!parse_unsigned(node.Scalar(), v))
             fail(node, key, "expected a non-negative integer, got '" + node.Scalar() + "'");
-        }
+        return v;
     }
 
     std::string string(const YAML::Node& node, const std::string& key) const {
@@ -124,7 +124,7 @@ public:
     const std::string& file() const { return m_file; }
 
     static std::string join(const std::string& path, const std::string& key) {
-        return path.empty() ? key : path + "." + key;
+        return strict_yaml::join(path, key);
     }
 
 private:
@@ -396,10 +396,7 @@ private:
     std::map<std::string, uint32_t> m_material_index;
 };
 
-fs::path scene_dir() {
-    if (const char* env = std::getenv("SFX_SCENE_DIR"); env && *env) return env;
-    return SFX_SCENE_DIR;
-}
+fs::path scene_dir() { return shipped_dir("SFX_SCENE_DIR", SFX_SCENE_DIR); }
 
 const char* const k_shipped[] = {"cornell", "furnace", "atrium", "conference", "temple"};
 
@@ -407,8 +404,7 @@ const char* const k_shipped[] = {"cornell", "furnace", "atrium", "conference", "
 
 Scene load_scene(const std::string& name_or_path) {
     std::error_code ec;
-    const bool plain_name = name_or_path.find('/') == std::string::npos &&
-                            name_or_path.find(".yaml") == std::string::npos && !name_or_path.empty();
+    const bool plain_name = is_shipped_name(name_or_path);
     // Anything else that exists is read as a path (and refused there if it is not a regular
     // file); a directory that happens to share a built-in scene's name is not.
     const fs::file_status st = fs::status(name_or_path, ec);
@@ -427,20 +423,11 @@ Scene load_scene(const std::string& name_or_path) {
 std::vector<std::string> builtin_scene_names() {
     // The shipped scenes first in a fixed order, then any other scene files, sorted.
     std::vector<std::string> names;
-    std::vector<std::string> extra;
     std::error_code ec;
     for (const char* n : k_shipped)
         if (fs::is_regular_file(scene_dir() / (std::string(n) + ".scene.yaml"), ec)) names.push_back(n);
-    for (fs::directory_iterator it(scene_dir(), ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string f = it->path().filename().string();
-        const std::string suffix = ".scene.yaml";
-        if (f.size() <= suffix.size() || f.compare(f.size() - suffix.size(), std::string::npos, suffix) != 0)
-            continue;
-        const std::string n = f.substr(0, f.size() - suffix.size());
-        if (std::find(names.begin(), names.end(), n) == names.end()) extra.push_back(n);
-    }
-    std::sort(extra.begin(), extra.end());
-    names.insert(names.end(), extra.begin(), extra.end());
+    for (const std::string& n : shipped_names(scene_dir(), ".scene.yaml"))
+        if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
     return names;
 }
 

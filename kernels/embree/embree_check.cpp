@@ -14,7 +14,7 @@
 #include "kernels/intersect.h"
 #include "kernels/render.h"
 #include "kernels/sampling.h"
-#include "workloads/host_clock.h"
+#include "base/host_clock.h"
 
 namespace sfx {
 

@@ -3,7 +3,7 @@
 #include <mutex>
 
 #include "kernels/camera.h"
-#include "workloads/host_clock.h"
+#include "base/host_clock.h"
 
 namespace sfx {
 

@@ -1,6 +1,6 @@
 #include "kernels/simd/isa.h"
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 namespace sfx {
 

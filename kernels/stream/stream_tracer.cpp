@@ -1,13 +1,13 @@
 #include "kernels/stream/stream_tracer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
 
 #include <x86intrin.h>
 
+#include "base/host_clock.h"
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/entry_point.h"
@@ -552,7 +552,7 @@ void StreamTracer::trace_pass(const TileRect& rect, uint32_t tile_index, uint32_
 
 RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                            TraceSink* sink) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = HostClock::now();
     RenderResult result;
     result.image = Image(settings.width, settings.height);
     const std::vector<TileRect> tiles = make_tiles(settings.width, settings.height, settings.tile);
@@ -636,8 +636,7 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
         pool.push_back(std::move(tracer));
     });
     if (sink) sink->end_frame();
-    result.stats.host_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.stats.host_seconds = seconds_since(start);
     return result;
 }
 

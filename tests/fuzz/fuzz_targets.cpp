@@ -14,7 +14,7 @@
 #include "kernels/trace.h"
 #include "sweeps/results_store.h"
 #include "sweeps/sweep.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/mesh_import.h"
 #include "workloads/scene_loader.h"
 

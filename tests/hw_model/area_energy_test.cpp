@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 

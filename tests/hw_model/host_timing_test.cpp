@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include "hw_model/host_description.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 
@@ -90,6 +90,20 @@ TEST_CASE("Bad hardware values name file, line and dotted key", "[hw_config]") {
 
     CHECK(parse_error("simd: [1, 2]\n").key() == "simd");
     CHECK(parse_error("simd:\n  width: 16\n  width: 8\n").line() > 0);
+}
+
+TEST_CASE("Hardware numbers follow the rules of every YAML reader (base/strict_yaml.h)", "[hw_config]") {
+    // A quoted scalar is text, never a number or a boolean; numbers are plain decimal.
+    for (const char* text : {"simd:\n  width: '16'\n", "simd:\n  width: 0x10\n",
+                             "simd:\n  width: +16\n", "clock:\n  core_mhz: \"500\"\n",
+                             "clock:\n  core_mhz: 0x1f4\n", "clock:\n  core_mhz: .inf\n",
+                             "clock:\n  core_mhz: 1e999\n"}) {
+        INFO(text);
+        CHECK(parse_error(text).line() == 2);
+    }
+    CHECK(parse_error("simd:\n  width: '16'\n").message() == "expected a non-negative integer");
+    CHECK(parse_hw_config("simd:\n  width: 8\n", "ok.hw.yaml").simd.width == 8);
+    CHECK(parse_hw_config("clock:\n  core_mhz: 5e2\n", "ok.hw.yaml").clock.core_mhz == 500);
 }
 
 TEST_CASE("Parameters are flattened to dotted names and set by path", "[hw_config]") {

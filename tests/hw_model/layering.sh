@@ -14,7 +14,7 @@ while IFS= read -r line; do
     echo "the trace library must be a leaf: $line"
     bad=1
 done < <(grep -n '#include "' kernels/trace.h kernels/trace.cpp | grep -v '#include "kernels/trace.h"' |
-                   grep -v '#include "workloads/input_error.h"' |
-                   grep -v '#include "workloads/user_files.h"' || true)
+                   grep -v '#include "base/input_error.h"' |
+                   grep -v '#include "base/user_files.h"' || true)
 if [ "$bad" = 0 ]; then echo "layering: hw_model/ sees kernels/ only through kernels/trace.h; trace library uses only the error and file helpers"; fi
 exit "$bad"

@@ -11,7 +11,7 @@
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 

@@ -13,7 +13,7 @@
 #include "kernels/camera.h"
 #include "kernels/stream/stream_tracer.h"
 #include "tests/temp_dir.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 

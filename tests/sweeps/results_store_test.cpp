@@ -17,7 +17,7 @@
 #include "sweeps/store_compare.h"
 #include "sweeps/sweep.h"
 #include "tests/temp_dir.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 namespace fs = std::filesystem;

@@ -8,7 +8,7 @@
 
 #include "sweeps/sha256.h"
 #include "sweeps/sweep.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 
@@ -191,6 +191,10 @@ TEST_CASE("Bad sweeps name file, line and dotted path", "[sweeps]") {
          "no such scene"},
         {h + "axes:\n  hw.simd.width: {from: 8, to: 4, step: 1}\n", 6, "axes.hw.simd.width.to",
          "below"},
+        {h + "axes:\n  hw.simd.width: {from: 4, to: '8', step: 1}\n", 6, "axes.hw.simd.width.to",
+         "expected a number"},
+        {h + "axes:\n  hw.clock.core_mhz: {from: 0x10, to: 20, step: 1}\n", 6,
+         "axes.hw.clock.core_mhz.from", "expected a number"},
         {h + "axes:\n  hw.simd.width: []\n", 6, "axes.hw.simd.width", "at least one"},
         {h + "axes:\n  hw.simd.width: [4, 8]\n  workload.tile: [8]\nzip:\n  - [hw.simd.width, "
              "workload.tile]\n",

@@ -8,7 +8,7 @@
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
 #include "sweeps/sweep.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "tests/temp_dir.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
@@ -155,6 +155,15 @@ TEST_CASE("scene loader: wrong types and bad values", "[workloads]") {
                  "objects[0].center[1]", "finite");
     expect_error(h + "  - {type: sphere, material: white, center: [0, 0, .inf], radius: 1}\n", 7,
                  "objects[0].center[2]", "finite");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 1e999], radius: 1}\n", 7,
+                 "objects[0].center[2]", "finite");
+    // The number rules every YAML reader shares (base/strict_yaml.h): decimal only, one spelling.
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: 0x1}\n", 7,
+                 "objects[0].radius", "expected a number, got '0x1'");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: inf}\n", 7,
+                 "objects[0].radius", "expected a number, got 'inf'");
+    expect_error(h + "  - {type: sphere, material: white, center: [0, 0, 0], radius: +1}\n", 7,
+                 "objects[0].radius", "expected a number, got '+1'");
     expect_error(h + "  - {type: sphere, material: chalk, center: [0, 0, 0], radius: 1}\n", 7,
                  "objects[0].material", "unknown material 'chalk'");
     expect_error(h + "  - {type: cone, material: white}\n", 7, "objects[0].type", "unknown object type");

@@ -1,7 +1,7 @@
 // The files a user names: only regular files are read, YAML holds one document with plain
 // keys, and outputs appear whole and together or not at all.
 
-#include "workloads/user_files.h"
+#include "base/user_files.h"
 
 #include <sys/stat.h>
 
@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "tests/temp_dir.h"
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 using namespace sfx;
 namespace fs = std::filesystem;

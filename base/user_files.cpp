@@ -1,4 +1,4 @@
-#include "workloads/user_files.h"
+#include "base/user_files.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,7 +13,7 @@
 #include <sstream>
 #include <vector>
 
-#include "workloads/input_error.h"
+#include "base/input_error.h"
 
 namespace sfx {
 namespace {

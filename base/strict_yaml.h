@@ -1,21 +1,50 @@
 #pragma once
-// Strict YAML reading of any struct described by a visit() (param / choice / group / list):
-// every key must be visited, every value must parse and lie in range; errors name file, line
-// and dotted key. Hardware configurations and technology tables share it.
+// Strict YAML: the scalar rules of every YAML reader (scenes, hardware configurations,
+// technology tables, sweeps), and the reader of any struct described by a visit() (param /
+// choice / group / list): every key must be visited, every value must parse and lie in range;
+// errors name file, line and dotted key.
+//
+// The rules: a number or a boolean is a plain scalar (a quoted '1' is text); its whole text is
+// the number, decimal only (base/strict_number.h); YAML's .inf and .nan, and decimal text beyond
+// the double range, are numbers that are not finite, and refused as such.
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <vector>
 
-#include "workloads/input_error.h"
-#include "workloads/strict_number.h"
+#include "base/input_error.h"
+#include "base/strict_number.h"
 
 namespace sfx {
 
 namespace strict_yaml {
+
+// A scalar written without quotes: only those can be numbers or booleans.
+inline bool is_plain_scalar(const YAML::Node& n) {
+    return n.IsScalar() && n.Tag() != "!";
+}
+
+enum class NumberText { finite, not_finite, not_a_number };
+
+// Reads a plain scalar as a finite number, saying why it is not one.
+inline NumberText read_finite(const YAML::Node& n, double& out) {
+    if (!is_plain_scalar(n)) return NumberText::not_a_number;
+    const std::string& s = n.Scalar();
+    if (parse_finite(s, out)) return NumberText::finite;
+    static const std::set<std::string> k_yaml_non_finite = {
+        ".inf", ".Inf", ".INF", "+.inf", "+.Inf", "+.INF", "-.inf", "-.Inf", "-.INF",
+        ".nan", ".NaN", ".NAN"};
+    char* end = nullptr;
+    if (k_yaml_non_finite.count(s) ||
+        (is_decimal_text(s) && (std::strtod(s.c_str(), &end), *end == '\0')))
+        return NumberText::not_finite;
+    return NumberText::not_a_number;
+}
 
 // Scalar text <-> typed values, strictly: "16x", "-1" for unsigned, "1e999" are errors.
 inline bool parse_scalar(const std::string& s, uint32_t& out) {
@@ -159,7 +188,10 @@ class YamlReader {
         m_seen.insert(name);
         const YAML::Node child = m_node[name];
         if (!child) return false;
-        if (!child.IsScalar() || !parse_scalar(child.Scalar(), value))
+        // Numbers and booleans must be plain scalars; a string may be quoted.
+        const bool typed_scalar = std::is_same<T, std::string>::value ? child.IsScalar()
+                                                                      : is_plain_scalar(child);
+        if (!typed_scalar || !parse_scalar(child.Scalar(), value))
             throw InputError(m_file, line_of(child), join(m_prefix, name),
                              std::string("expected ") + type_name(value));
         m_lines[join(m_prefix, name)] = line_of(child);

@@ -8,9 +8,14 @@ namespace sfx {
 
 using HostClock = std::chrono::steady_clock;
 
+// Seconds from `start` to `end`, two HostClock::now() readings.
+inline double seconds_between(HostClock::time_point start, HostClock::time_point end) {
+    return std::chrono::duration<double>(end - start).count();
+}
+
 // Seconds elapsed since `start`, a HostClock::now() taken earlier.
 inline double seconds_since(HostClock::time_point start) {
-    return std::chrono::duration<double>(HostClock::now() - start).count();
+    return seconds_between(start, HostClock::now());
 }
 
 }  // namespace sfx
