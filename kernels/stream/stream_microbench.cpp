@@ -330,7 +330,14 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                                           b.surf[id], b.ray[id], b.next[id]);
                                 });
                                 break;
-                            default:
+                            // Not microbenchmarked (the host's seed-kernel ops); no default, so
+                            // a new kind (a new material's filter) is a compile error here.
+                            case OpKind::frustum_bounds:
+                            case OpKind::frustum_test:
+                            case OpKind::reorder_lod_test:
+                            case OpKind::reorder_key:
+                            case OpKind::reorder_sort:
+                            case OpKind::count:
                                 break;
                         }
                     const uint64_t end = __rdtsc();
