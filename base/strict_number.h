@@ -38,7 +38,7 @@ inline bool parse_signed(const std::string& s, int64_t& out) {
 
 // Text made of what a decimal number may hold: strtod alone would also read hex, "inf", "nan".
 inline bool is_decimal_text(const std::string& s) {
-    return !s.empty() && s[0] != '+' && s.find_first_not_of("0123456789-.eE") == std::string::npos;
+    return !s.empty() && s[0] != '+' && s.find_first_not_of("0123456789+-.eE") == std::string::npos;
 }
 
 inline bool parse_finite(const std::string& s, double& out) {
