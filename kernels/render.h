@@ -6,34 +6,21 @@
 #include <string>
 #include <vector>
 
-#include "kernels/simd/isa.h"
 #include "base/vec.h"
+#include "kernels/simd/isa.h"
+#include "kernels/trace.h"
 
 namespace sfx {
 
-// How the stream tracer enters the BVH with a tile's primary rays: at the root, or at the
-// deepest node a frustum of the tile's rays proves enough (AEPSA, kernels/stream/entry_point.h).
-// Never changes a hit, so never the image.
-enum class PrimaryEntry : uint8_t { root, aepsa };
-// Whether the stream tracer sorts each generation's stream by approximate hit point before
-// tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit.
-enum class RayReorder : uint8_t { none, hit_point };
-
-struct RenderSettings {
-    uint32_t width = 256;
-    uint32_t height = 256;
-    uint32_t spp = 4;
-    uint32_t max_depth = 3;  // bounces after the camera ray (the scene's value unless overridden)
-    uint32_t tile = 32;      // tile edge in pixels; the stream tracer's stream is tile^2 rays
-    uint32_t threads = 0;    // 0: all hardware threads
-    uint64_t seed = 0;
+// The frame (resolution, samples, depth, tile, seed, the seed papers' options) is a
+// TraceFrame, declared once in kernels/trace.h: the trace header carries the same fields.
+// What is added here changes neither the image nor the trace.
+struct RenderSettings : TraceFrame {
+    uint32_t threads = 0;      // 0: all hardware threads
     Isa isa = Isa::automatic;  // the stream filters' host back end; never changes a bit
     // The stream tracer reads the time-stamp counter at stage boundaries (RenderStats::
     // stage_tsc); off by default (it costs a few cycles per leaf visited); never changes a bit.
     bool stage_clock = false;
-    PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only; never changes a bit
-    RayReorder reorder = RayReorder::none;            // stream tracer only; never changes a bit
-    uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
 
 #include "base/input_error.h"
 #include "base/user_files.h"
@@ -130,14 +131,10 @@ static void put(std::vector<uint8_t>& out, T v) {
 
 void TraceFileWriter::begin_frame(const TraceHeader& h) {
     std::vector<uint8_t> b(k_magic, k_magic + 8);
-    put(b, h.version);
+    put(b, TraceHeader::k_version);
     put(b, h.scene_hash);
-    put(b, h.width);
-    put(b, h.height);
-    put(b, h.spp);
-    put(b, h.tile);
-    put(b, h.max_depth);
-    put(b, h.seed);
+    TraceFrame frame = h;
+    frame.visit([&](auto& field) { put(b, field); });
     write(b.data(), b.size());
 }
 
@@ -223,17 +220,20 @@ TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
     if (std::memcmp(magic, k_magic, 8) != 0) throw InputError(path, 0, "", "not an sfx trace");
     TraceHeader h;
     h.version = r.get<uint32_t>();
-    if (h.version != TraceHeader::k_version)
+    if (h.version < 1 || h.version > TraceHeader::k_version)
         throw InputError(path, 0, "",
-                         "trace version " + std::to_string(h.version) + ", this sfx reads " +
+                         "trace version " + std::to_string(h.version) + ", this sfx reads 1 to " +
                              std::to_string(TraceHeader::k_version));
     h.scene_hash = r.get<uint64_t>();
-    h.width = r.get<uint32_t>();
-    h.height = r.get<uint32_t>();
-    h.spp = r.get<uint32_t>();
-    h.tile = r.get<uint32_t>();
-    h.max_depth = r.get<uint32_t>();
-    h.seed = r.get<uint64_t>();
+    // A version-1 header ends after the seed: the later fields keep their defaults.
+    const uint32_t fields = h.version == 1 ? TraceFrame::k_version1_fields : ~0u;
+    uint32_t field = 0;
+    h.visit([&](auto& v) {
+        if (field++ < fields) v = r.get<std::remove_reference_t<decltype(v)>>();
+    });
+    if (uint8_t(h.primary_entry) > uint8_t(PrimaryEntry::aepsa) ||
+        uint8_t(h.reorder) > uint8_t(RayReorder::hit_point))
+        r.fail("unknown primary_entry or reorder in the header");
     sink.begin_frame(h);
     TilePass pass;
     bool in_pass = false;

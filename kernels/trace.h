@@ -134,13 +134,52 @@ struct TilePass {
     uint32_t generations = 0;  // set at end_pass: how many generations were traced
 };
 
-// What a trace is of; written at the head of a trace file.
-struct TraceHeader {
-    static constexpr uint32_t k_version = 1;
+// How the stream tracer enters the BVH with a tile's primary rays: at the root, or at the
+// deepest node a frustum of the tile's rays proves enough (AEPSA, kernels/stream/entry_point.h).
+// Never changes a hit, so never the image; adds the search's ops to the trace.
+enum class PrimaryEntry : uint8_t { root, aepsa };
+// Whether the stream tracer sorts each generation's stream by approximate hit point before
+// tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit of the
+// image; reorders the trace's streams and adds the sort's ops.
+enum class RayReorder : uint8_t { none, hit_point };
+
+// Everything besides the scene that decides a render's trace, declared once: the tracers'
+// RenderSettings derive from it and the trace header carries it, so a new such knob is one
+// member here and one line in visit() (which is also its place in the trace file; a new field
+// goes last, with a new TraceHeader::k_version).
+struct TraceFrame {
+    uint32_t width = 256;
+    uint32_t height = 256;
+    uint32_t spp = 4;
+    uint32_t max_depth = 3;  // bounces after the camera ray (the scene's value unless overridden)
+    uint32_t tile = 32;      // tile edge in pixels; the stream tracer's stream is tile^2 rays
+    uint64_t seed = 0;
+    PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only
+    RayReorder reorder = RayReorder::none;            // stream tracer only
+    uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
+
+    // Every field in trace-file order (version 1 ends after seed).
+    template <class V>
+    void visit(V&& v) {
+        v(width);
+        v(height);
+        v(spp);
+        v(tile);
+        v(max_depth);
+        v(seed);
+        v(primary_entry);
+        v(reorder);
+        v(reorder_lod_ppm);
+    }
+    static constexpr uint32_t k_version1_fields = 6;
+};
+
+// What a trace is of; written at the head of a trace file. Version 2 added the seed papers'
+// options (primary_entry, reorder, reorder_lod_ppm); a version-1 file reads with their defaults.
+struct TraceHeader : TraceFrame {
+    static constexpr uint32_t k_version = 2;
     uint32_t version = k_version;
     uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
-    uint32_t width = 0, height = 0, spp = 0, tile = 0, max_depth = 0;
-    uint64_t seed = 0;
 };
 
 // Receives a trace. Calls come from one thread at a time, in tile order, sample order.

@@ -562,12 +562,7 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
     if (sink) {
         TraceHeader header;
         if (!sink->counts_only()) header.scene_hash = scene_hash(scene);
-        header.width = settings.width;
-        header.height = settings.height;
-        header.spp = settings.spp;
-        header.tile = settings.tile;
-        header.max_depth = settings.max_depth;
-        header.seed = settings.seed;
+        static_cast<TraceFrame&>(header) = settings;
         sink->begin_frame(header);
     }
 

@@ -314,7 +314,7 @@ void put(std::string& b, T v) {
 std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_count,
                           const std::vector<uint32_t>& slots, uint8_t bits, bool finish = true) {
     std::string b = "SFXTRACE";
-    put(b, TraceHeader::k_version);
+    put(b, uint32_t(1));  // a version-1 header (read still): no seed-paper options
     put(b, uint64_t(7));
     for (uint32_t v : {4u, 4u, 1u, 4u, 3u}) put(b, v);  // width height spp tile max_depth
     put(b, uint64_t(0));
@@ -337,6 +337,36 @@ std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_co
     return b;
 }
 }  // namespace
+
+TEST_CASE("Trace file version 2: the header carries the whole frame, the seed papers' options too",
+          "[stream]") {
+    const Scene s = cluster_scene(true);
+    const Bvh bvh(s);
+    RenderSettings r = settings_for(s, 16, 1, 8);
+    r.primary_entry = PrimaryEntry::aepsa;
+    r.reorder = RayReorder::hit_point;
+    r.reorder_lod_ppm = 5000;
+    TempDir dir("trace_v2");
+    const std::string path = (dir.path / "frame.trc").string();
+    {
+        TraceFileWriter w(path);
+        render_stream(s, bvh, r, &w);
+    }
+    CountingSink sink({8});
+    const TraceHeader h = read_trace_file(path, sink);
+    CHECK(h.version == 2);
+    CHECK(h.width == r.width);
+    CHECK(h.height == r.height);
+    CHECK(h.spp == r.spp);
+    CHECK(h.tile == r.tile);
+    CHECK(h.max_depth == r.max_depth);
+    CHECK(h.seed == r.seed);
+    CHECK(h.primary_entry == PrimaryEntry::aepsa);
+    CHECK(h.reorder == RayReorder::hit_point);
+    CHECK(h.reorder_lod_ppm == 5000);
+    CHECK(sink.kind_ops(OpKind::frustum_test) > 0);
+    CHECK(sink.kind_ops(OpKind::reorder_key) > 0);
+}
 
 TEST_CASE("Trace file: a damaged file is an InputError naming the byte, never a huge allocation",
           "[stream]") {
