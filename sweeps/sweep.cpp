@@ -21,6 +21,7 @@
 #include "workloads/ray_layout.h"
 #include "workloads/scene_loader.h"
 #include "base/strict_number.h"
+#include "base/shipped_files.h"
 #include "base/strict_yaml.h"
 
 #ifndef SFX_VERSION
@@ -215,9 +216,7 @@ private:
         if (p.is_relative()) p = fs::path(m_base_dir) / p;
         std::error_code ec;
         // A plain name that is no file beside the sweep is a preset, as on the command line.
-        const bool plain =
-            value.find('/') == std::string::npos && value.find(".yaml") == std::string::npos;
-        if (plain && !fs::exists(p, ec)) {
+        if (is_shipped_name(value) && !fs::exists(p, ec)) {
             const std::vector<std::string> presets = builtin_preset_names();
             if (std::find(presets.begin(), presets.end(), value) == presets.end()) {
                 std::string list;
