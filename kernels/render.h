@@ -18,6 +18,10 @@ enum class PrimaryEntry : uint8_t { root, aepsa };
 // Whether the stream tracer sorts each generation's stream by approximate hit point before
 // tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit.
 enum class RayReorder : uint8_t { none, hit_point };
+// Whether the stream tracer batches secondary rays in the cells of a cut of the BVH and traces
+// each cell's queue against the cell's subtree (Bikker's RayGrid, kernels/stream/ray_grid.h).
+// Never changes a bit.
+enum class RayBatching : uint8_t { none, raygrid };
 
 struct RenderSettings {
     uint32_t width = 256;
@@ -34,6 +38,9 @@ struct RenderSettings {
     PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only; never changes a bit
     RayReorder reorder = RayReorder::none;            // stream tracer only; never changes a bit
     uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
+    RayBatching batching = RayBatching::none;  // stream tracer only; never changes a bit
+    uint32_t batching_queue = 384;             // raygrid: rays per queue (seeds/000 Sec. 3.5)
+    uint32_t batching_cell_prims = 4096;       // raygrid: most primitives under one cell
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
@@ -62,6 +69,10 @@ struct RenderStats {
     // (root = 0) of the nodes their rays entered at.
     uint64_t entry_searches = 0;
     uint64_t entry_depth_sum = 0;
+    // RayGrid batching: queues traced, how many of them were full, and the rays they held.
+    uint64_t batch_queues = 0;
+    uint64_t batch_full_queues = 0;
+    uint64_t batch_queued_rays = 0;
     double host_seconds = 0.0;
     // With RenderSettings::stage_clock (stream tracer): TSC ticks per stage, [traversal,
     // intersection, shading] as kernels/trace.h's OpStage; shading is the rest of each pass

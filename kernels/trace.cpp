@@ -1,5 +1,6 @@
 #include "kernels/trace.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -62,7 +63,17 @@ void CountingSink::op(const StreamOp& op) {
     ++m_kind_ops[uint32_t(op.kind)];
     m_kind_lanes[uint32_t(op.kind)] += op.length;
     m_kind_lanes_by_generation[op.generation > 0][uint32_t(op.kind)] += op.length;
-    if (op.kind == OpKind::box_test && int32_t(op.generation) != m_traced_generation) {
+    BounceCounts& b = m_bounce[std::min<uint32_t>(op.generation, k_bounce_slots - 1)];
+    if (op.kind == OpKind::box_test) {
+        ++b.box_ops;
+        b.box_lanes += op.length;
+    } else if (op.kind == OpKind::triangle_test || op.kind == OpKind::sphere_test) {
+        ++b.prim_ops;
+        b.prim_lanes += op.length;
+    }
+    // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
+    if ((op.kind == OpKind::box_test || op.kind == OpKind::raygrid_walk) &&
+        int32_t(op.generation) != m_traced_generation) {
         m_rays += op.length;  // the generation's entry test: one lane per ray
         m_rays_by_generation[op.generation > 0] += op.length;
         m_traced_generation = op.generation;
@@ -91,6 +102,12 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
     m_generations += o.m_generations;
     m_rays += o.m_rays;
     for (int g = 0; g < 2; ++g) m_rays_by_generation[g] += o.m_rays_by_generation[g];
+    for (uint32_t g = 0; g < k_bounce_slots; ++g) {
+        m_bounce[g].box_ops += o.m_bounce[g].box_ops;
+        m_bounce[g].box_lanes += o.m_bounce[g].box_lanes;
+        m_bounce[g].prim_ops += o.m_bounce[g].prim_ops;
+        m_bounce[g].prim_lanes += o.m_bounce[g].prim_lanes;
+    }
     return *this;
 }
 

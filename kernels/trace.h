@@ -45,6 +45,10 @@ enum class OpKind : uint8_t {
     reorder_lod_test,  // traversal: the simplified hierarchy's box filter (object: node)
     reorder_key,       // traversal: approximate hit point to a two-level Z-curve key; all pass
     reorder_sort,      // traversal: one merge pass of the sort by key; all pass
+    // RayGrid batching (RayBatching::raygrid, kernels/stream/ray_grid.h):
+    raygrid_walk,     // traversal: the cell walk's filter over a node above or at the cell cut
+                      // (object: node); passed = the ray may find its next cell below it
+    raygrid_enqueue,  // traversal: append the rays that found a next cell to its queue; all pass
     count
 };
 constexpr uint32_t k_op_kind_count = uint32_t(OpKind::count);
@@ -61,7 +65,8 @@ enum class OpFeature : uint8_t {
     dielectric,
     glossy,
     primary_entry_aepsa,  // workload options, not scene features: RenderSettings::primary_entry
-    reorder_hit_point     // RenderSettings::reorder
+    reorder_hit_point,    // RenderSettings::reorder
+    batching_raygrid      // RenderSettings::batching
 };
 
 // The op table: everything about a kind of operation that does not depend on the hardware, in
@@ -95,6 +100,8 @@ inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
     {"reorder_lod_test", OpStage::traversal, true, false, OpFeature::reorder_hit_point},
     {"reorder_key", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
     {"reorder_sort", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
+    {"raygrid_walk", OpStage::traversal, true, false, OpFeature::batching_raygrid},
+    {"raygrid_enqueue", OpStage::traversal, false, false, OpFeature::batching_raygrid},
 };
 inline const OpKindInfo& op_info(OpKind kind) {
     return k_op_kinds[size_t(kind)];
@@ -108,7 +115,8 @@ inline OpStage stage_of(OpKind kind) {
 // The kind exists because of a workload option (a seed paper's alternative), not the scene.
 inline bool is_option_kind(OpKind kind) {
     const OpFeature f = op_info(kind).feature;
-    return f == OpFeature::primary_entry_aepsa || f == OpFeature::reorder_hit_point;
+    return f == OpFeature::primary_entry_aepsa || f == OpFeature::reorder_hit_point ||
+           f == OpFeature::batching_raygrid;
 }
 
 constexpr uint32_t k_no_object = 0xffffffffu;
@@ -198,6 +206,16 @@ class CountingSink : public TraceSink {
     // a primary entry point).
     uint64_t rays() const { return m_rays; }
     uint64_t rays(bool secondary) const { return m_rays_by_generation[secondary]; }
+    // Per generation (bounce; the last slot holds every later one): box tests (ops, lanes: rays
+    // per visited node, seeds/000 Tables 2 and 4) and primitive tests (each op of a leaf carries
+    // the rays that reached it: rays per visited leaf).
+    struct BounceCounts {
+        uint64_t box_ops = 0, box_lanes = 0, prim_ops = 0, prim_lanes = 0;
+    };
+    static constexpr uint32_t k_bounce_slots = 5;
+    const BounceCounts& bounce(uint32_t generation) const {
+        return m_bounce[generation < k_bounce_slots ? generation : k_bounce_slots - 1];
+    }
 
     CountingSink& operator+=(const CountingSink& o);
 
@@ -209,6 +227,7 @@ class CountingSink : public TraceSink {
     uint64_t m_kind_lanes_by_generation[2][k_op_kind_count] = {};
     uint64_t m_passes = 0, m_generations = 0, m_rays = 0;
     uint64_t m_rays_by_generation[2] = {};
+    BounceCounts m_bounce[k_bounce_slots];
     int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
 };
 

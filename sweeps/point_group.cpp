@@ -336,6 +336,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.tile = settings.tile;
     shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;
     shape.reorder_hit_point = settings.reorder == RayReorder::hit_point;
+    shape.batching_raygrid = settings.batching == RayBatching::raygrid;
     return shape;
 }
 
