@@ -155,6 +155,20 @@ std::vector<Stat> Prediction::stats() const {
         "box-test lanes per secondary ray");
     add("workload.entry_depth", entry_depth, "levels",
         "mean BVH depth at which primary streams enter (root 0)");
+    for (uint32_t g = 0; g < k_bounces; ++g) {
+        const std::string b = "workload.bounce" + std::to_string(g) + ".";
+        const std::string of = g == 0 ? "camera rays" : "rays of bounce " + std::to_string(g);
+        add(b + "rays_per_node", rays_per_node[g], "rays",
+            "mean box-test stream length (rays per visited node), " + of);
+        add(b + "rays_per_leaf", rays_per_leaf[g], "rays",
+            "mean primitive-test stream length (rays per visited leaf), " + of);
+        add(b + "box_tests_per_ray", bounce_box_tests_per_ray[g], "lanes",
+            "box-test lanes per ray, " + of);
+    }
+    add("workload.batching.mean_queue_length", batch_mean_queue, "rays",
+        "RayGrid: mean rays per traced queue");
+    add("workload.batching.full_queue_share", batch_full_share, "",
+        "RayGrid: share of traced queues that were full");
 
     // Area and energy: the action counts priced with the technology table (area_energy.h).
     const TechTable& t = tech ? *tech : default_tech_table();

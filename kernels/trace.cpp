@@ -75,6 +75,7 @@ void CountingSink::op(const StreamOp& op) {
     if ((op.kind == OpKind::box_test || op.kind == OpKind::raygrid_walk) &&
         int32_t(op.generation) != m_traced_generation) {
         m_rays += op.length;  // the generation's entry test: one lane per ray
+        b.rays += op.length;
         m_rays_by_generation[op.generation > 0] += op.length;
         m_traced_generation = op.generation;
     }
@@ -103,6 +104,7 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
     m_rays += o.m_rays;
     for (int g = 0; g < 2; ++g) m_rays_by_generation[g] += o.m_rays_by_generation[g];
     for (uint32_t g = 0; g < k_bounce_slots; ++g) {
+        m_bounce[g].rays += o.m_bounce[g].rays;
         m_bounce[g].box_ops += o.m_bounce[g].box_ops;
         m_bounce[g].box_lanes += o.m_bounce[g].box_lanes;
         m_bounce[g].prim_ops += o.m_bounce[g].prim_ops;

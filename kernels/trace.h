@@ -206,11 +206,14 @@ class CountingSink : public TraceSink {
     // a primary entry point).
     uint64_t rays() const { return m_rays; }
     uint64_t rays(bool secondary) const { return m_rays_by_generation[secondary]; }
-    // Per generation (bounce; the last slot holds every later one): box tests (ops, lanes: rays
-    // per visited node, seeds/000 Tables 2 and 4) and primitive tests (each op of a leaf carries
-    // the rays that reached it: rays per visited leaf).
+    // Per generation (bounce; the last slot holds every later one): rays traced, box tests
+    // (ops, lanes: rays per visited node, seeds/000 Tables 2 and 4) and primitive tests (each op
+    // of a leaf carries the rays that reached it: rays per visited leaf).
     struct BounceCounts {
-        uint64_t box_ops = 0, box_lanes = 0, prim_ops = 0, prim_lanes = 0;
+        uint64_t rays = 0, box_ops = 0, box_lanes = 0, prim_ops = 0, prim_lanes = 0;
+        double rays_per_node() const { return box_ops ? double(box_lanes) / box_ops : 0.0; }
+        double rays_per_leaf() const { return prim_ops ? double(prim_lanes) / prim_ops : 0.0; }
+        double box_tests_per_ray() const { return rays ? double(box_lanes) / rays : 0.0; }
     };
     static constexpr uint32_t k_bounce_slots = 5;
     const BounceCounts& bounce(uint32_t generation) const {
