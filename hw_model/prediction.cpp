@@ -169,6 +169,8 @@ std::vector<Stat> Prediction::stats() const {
         "RayGrid: mean rays per traced queue");
     add("workload.batching.full_queue_share", batch_full_share, "",
         "RayGrid: share of traced queues that were full");
+    add("workload.batching.lanes_per_ray", batch_lanes_per_ray, "lanes",
+        "RayGrid: cell-walk and enqueue lanes per secondary ray");
 
     // Area and energy: the action counts priced with the technology table (area_energy.h).
     const TechTable& t = tech ? *tech : default_tech_table();

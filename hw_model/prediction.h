@@ -214,6 +214,7 @@ struct Prediction {
     // RayGrid batching: mean rays per traced queue, and the share of queues that were full.
     double batch_mean_queue = 0.0;
     double batch_full_share = 0.0;
+    double batch_lanes_per_ray = 0.0;  // walk and enqueue lanes per secondary ray
     double host_seconds = 0.0;   // the functional render's share plus this model's own time
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)

@@ -87,6 +87,10 @@ void fill_workload(Prediction& p, const CountingSink& counts, const RenderStats&
         p.rays_per_leaf[g] = b.rays_per_leaf();
         p.bounce_box_tests_per_ray[g] = b.box_tests_per_ray();
     }
+    if (const uint64_t rays = counts.rays(true))
+        p.batch_lanes_per_ray = double(counts.kind_lanes(OpKind::raygrid_walk) +
+                                       counts.kind_lanes(OpKind::raygrid_enqueue)) /
+                                double(rays);
     if (render.batch_queues) {
         p.batch_mean_queue = double(render.batch_queued_rays) / double(render.batch_queues);
         p.batch_full_share = double(render.batch_full_queues) / double(render.batch_queues);
