@@ -3,6 +3,9 @@
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 #include "hw_model/workload_shape.h"
 #include "kernels/bvh.h"
@@ -360,4 +363,45 @@ TEST_CASE("Workload shape: RayGrid units exist only when the workload batches", 
     for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue})
         CHECK(shape.needed_kinds()[size_t(k)]);
     CHECK_FALSE(shape.needed_kinds()[size_t(OpKind::reorder_key)]);
+}
+
+TEST_CASE("RayGrid: its trace is the same on any thread count and reads back from a file",
+          "[stream][seeds]") {
+    const Scene s = test::box_scene(test::Variant::lights);
+    const Bvh bvh(s);
+    RenderSettings r = settings_for(s, 24, 16, 2, 8);
+    r.batching = RayBatching::raygrid;
+    r.batching_queue = 8;
+    r.batching_cell_prims = 4;
+    const std::string base = (std::filesystem::temp_directory_path() /
+                              ("sfx_raygrid_trace_" + std::to_string(::getpid())))
+                                 .string();
+    const std::string p1 = base + "_1.trc", p2 = base + "_2.trc";
+    r.threads = 1;
+    CountingSink direct({8});
+    render_stream(s, bvh, r, &direct);
+    {
+        TraceFileWriter w(p1);
+        render_stream(s, bvh, r, &w);
+    }
+    r.threads = 2;
+    {
+        TraceFileWriter w(p2);
+        render_stream(s, bvh, r, &w);
+    }
+    auto bytes = [](const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    CHECK(bytes(p1) == bytes(p2));
+    CountingSink replayed({8});
+    read_trace_file(p1, replayed);
+    for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue, OpKind::box_test}) {
+        CHECK(replayed.kind_ops(k) == direct.kind_ops(k));
+        CHECK(replayed.kind_lanes(k) == direct.kind_lanes(k));
+    }
+    CHECK(direct.kind_ops(OpKind::raygrid_walk) > 0);
+    CHECK(replayed.rays() == direct.rays());
+    std::filesystem::remove(p1);
+    std::filesystem::remove(p2);
 }
