@@ -81,11 +81,11 @@ def aepsa_section(df: pd.DataFrame) -> str:
     for _, r in p.iterrows():
         rows.append([str(r["workload.scene"]), str(int(r["workload.tile"])),
                      str(int(r["hw.simd.width"])),
-                     _num(r["workload.box_tests_per_ray.primary.off"], 1),
-                     _num(r["workload.box_tests_per_ray.primary.on"], 1),
-                     _pct(r["workload.box_tests_per_ray.primary.off"],
-                          r["workload.box_tests_per_ray.primary.on"]),
-                     _num(r["workload.entry_depth.on"]),
+                     _num(r["trace.box_tests_per_ray.primary.off"], 1),
+                     _num(r["trace.box_tests_per_ray.primary.on"], 1),
+                     _pct(r["trace.box_tests_per_ray.primary.off"],
+                          r["trace.box_tests_per_ray.primary.on"]),
+                     _num(r["trace.entry_depth.on"]),
                      _num(r["op_mix.option_percent.on"]),
                      _num(r["fps.off"], 1), _num(r["fps.on"], 1),
                      _pct(r["fps.off"], r["fps.on"])])
@@ -129,8 +129,8 @@ def reorder_section(df: pd.DataFrame) -> str:
                      _num(r[miss + ".off"], 0) if miss else "n/a",
                      _num(r[miss + ".on"], 0) if miss else "n/a",
                      _pct(r[miss + ".off"], r[miss + ".on"]) if miss else "n/a",
-                     _num(r["workload.box_tests_per_ray.secondary.off"], 1),
-                     _num(r["workload.box_tests_per_ray.secondary.on"], 1),
+                     _num(r["trace.box_tests_per_ray.secondary.off"], 1),
+                     _num(r["trace.box_tests_per_ray.secondary.on"], 1),
                      _num(r["op_mix.option_percent.on"], 1),
                      _num(r["fps.off"], 1), _num(r["fps.on"], 1), _pct(r["fps.off"], r["fps.on"])])
     table = _table(["scene", "tile", "width", f"{l2} misses (none)", "(hit_point)", "change",
@@ -203,15 +203,15 @@ def raygrid_section(df: pd.DataFrame) -> str:
                                   else "n/a")
         rows.append([str(r["workload.scene"]), str(int(r["workload.tile"])),
                      str(int(r["hw.simd.width"])),
-                     _col(r, "workload.box_tests_per_ray.secondary.off"),
-                     _col(r, "workload.box_tests_per_ray.secondary.on"),
+                     _col(r, "trace.box_tests_per_ray.secondary.off"),
+                     _col(r, "trace.box_tests_per_ray.secondary.on"),
                      _num(100 * r["ideal_simd_utilization.secondary.traversal.off"], 1),
                      _num(100 * r["ideal_simd_utilization.secondary.traversal.on"], 1),
                      f"{hit(l1, 'off')} / {hit(l2, 'off')}", f"{hit(l1, 'on')} / {hit(l2, 'on')}",
-                     _col(r, "workload.batching.mean_queue_length.on"),
-                     _num(100 * r["workload.batching.full_queue_share.on"], 0)
-                     if "workload.batching.full_queue_share.on" in r.index else "n/a",
-                     _col(r, "workload.batching.lanes_per_ray.on"),
+                     _col(r, "trace.batching.mean_queue_length.on"),
+                     _num(100 * r["trace.batching.full_queue_share.on"], 0)
+                     if "trace.batching.full_queue_share.on" in r.index else "n/a",
+                     _col(r, "trace.batching.lanes_per_ray.on"),
                      _col(r, "op_mix.option_percent.on"),
                      _num(r["fps.off"], 1), _num(r["fps.on"], 1), _pct(r["fps.off"], r["fps.on"])])
     table = _table(["scene", "tile", "width", "box tests / secondary ray (none)", "(raygrid)",
@@ -243,7 +243,7 @@ def raygrid_section(df: pd.DataFrame) -> str:
                 else None
             if gain is not None:
                 gains.append(gain)
-            b = f"workload.bounce{k}."
+            b = f"trace.bounce{k}."
             bounce_rows.append([scene, str(k),
                                 _col(deepest, b + "rays_per_node.off"),
                                 _col(deepest, b + "rays_per_node.on"),
@@ -255,9 +255,9 @@ def raygrid_section(df: pd.DataFrame) -> str:
                            "rays / leaf (none)", "(raygrid)", "bounce ms (none)", "(raygrid)",
                            "gain"], bounce_rows) if bounce_rows else "(no points)"
     fps = [float(r[-1].strip(" %+")) for r in rows if r[-1] != "n/a"]
-    queues = [(r["workload.batching.mean_queue_length.on"],
-               r["workload.batching.full_queue_share.on"]) for _, r in full_depth.iterrows()
-              if "workload.batching.mean_queue_length.on" in r.index]
+    queues = [(r["trace.batching.mean_queue_length.on"],
+               r["trace.batching.full_queue_share.on"]) for _, r in full_depth.iterrows()
+              if "trace.batching.mean_queue_length.on" in r.index]
     queue_text = (f"{min(q for q, _ in queues):.0f} to {max(q for q, _ in queues):.0f} rays "
                   f"against the paper's 384, and at most {100 * max(f for _, f in queues):.0f} % "
                   "of the queues fill" if queues else "few rays")

@@ -10,8 +10,8 @@ def seed_point(entry, reorder, fps, box_primary, misses, ppm=20000, option=0.0, 
     return {"workload.scene": "conference", "workload.tile": 16, "hw.simd.width": 16.0,
             "fidelity": "full", "workload.primary_entry": entry, "workload.reorder": reorder,
             "workload.reorder_lod_ppm": ppm, "fps": fps,
-            "workload.box_tests_per_ray.primary": box_primary,
-            "workload.box_tests_per_ray.secondary": 50.0, "workload.entry_depth": depth,
+            "trace.box_tests_per_ray.primary": box_primary,
+            "trace.box_tests_per_ray.secondary": 50.0, "trace.entry_depth": depth,
             "op_mix.option_percent": option, "scene_cache.l1.misses": 1.0,
             "scene_cache.l2.misses": misses, "scene_cache.l3.misses": 1.0}
 
@@ -40,13 +40,13 @@ def raygrid_point(batching, depth, fps, box_secondary, node1, option=0.0):
     p = seed_point("root", "none", fps, 40.0, 1000.0, option=option)
     p.update({"workload.tile": 32, "workload.depth": depth, "workload.batching": batching,
               "workload.batching_queue": 384, "workload.batching_cell_prims": 4096,
-              "workload.box_tests_per_ray.secondary": box_secondary,
+              "trace.box_tests_per_ray.secondary": box_secondary,
               "ideal_simd_utilization.secondary.traversal": 0.5,
               "scene_cache.l1.hit_rate": 0.5, "scene_cache.l2.hit_rate": 0.25,
-              "workload.bounce1.rays_per_node": node1, "workload.bounce1.rays_per_leaf": 2.0,
-              "workload.batching.mean_queue_length": 20.0 if batching == "raygrid" else 0.0,
-              "workload.batching.full_queue_share": 0.1 if batching == "raygrid" else 0.0,
-              "workload.batching.lanes_per_ray": 55.0 if batching == "raygrid" else 0.0})
+              "trace.bounce1.rays_per_node": node1, "trace.bounce1.rays_per_leaf": 2.0,
+              "trace.batching.mean_queue_length": 20.0 if batching == "raygrid" else 0.0,
+              "trace.batching.full_queue_share": 0.1 if batching == "raygrid" else 0.0,
+              "trace.batching.lanes_per_ray": 55.0 if batching == "raygrid" else 0.0})
     return p
 
 
