@@ -1,12 +1,12 @@
 #include "kernels/stream/stream_tracer.h"
 
-#include <x86intrin.h>
-
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
+
+#include <x86intrin.h>
 
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
