@@ -64,7 +64,7 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
     });
     row("primary entry depth", [&](const Prediction& p) { return fixed(p.entry_depth, 2); });
     for (uint32_t g = 1; g < Prediction::k_bounces; ++g)
-        row("bounce " + std::to_string(g) + ": rays per node / leaf, box tests per ray",
+        row("bounce " + std::to_string(g) + " rays/node, /leaf, box/ray",
             [&](const Prediction& p) {
                 return fixed(p.rays_per_node[g], 1) + " / " + fixed(p.rays_per_leaf[g], 1) + ", " +
                        fixed(p.bounce_box_tests_per_ray[g], 1);
