@@ -63,6 +63,14 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
         return fixed(p.box_tests_per_ray[0], 1) + " / " + fixed(p.box_tests_per_ray[1], 1);
     });
     row("primary entry depth", [&](const Prediction& p) { return fixed(p.entry_depth, 2); });
+    for (uint32_t g = 1; g < Prediction::k_bounces; ++g)
+        row("bounce " + std::to_string(g) + " rays/node, /leaf, box/ray", [&](const Prediction& p) {
+            return fixed(p.rays_per_node[g], 1) + " / " + fixed(p.rays_per_leaf[g], 1) + ", " +
+                   fixed(p.bounce_box_tests_per_ray[g], 1);
+        });
+    row("raygrid queue length (full %)", [&](const Prediction& p) {
+        return fixed(p.batch_mean_queue, 1) + " (" + fixed(100 * p.batch_full_share, 0) + "%)";
+    });
     for (const char* cause : {"bank_conflict", "alignment", "address_fetch", "partition",
                               "scene_memory", "interconnect", "pipeline_fill"}) {
         row(std::string("stall ") + cause + " (% of cycles)", [&](const Prediction& p) {

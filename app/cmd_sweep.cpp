@@ -53,6 +53,11 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
            (p.workload.reorder != "none" ? " reorder " + p.workload.reorder + " " +
                                                std::to_string(p.workload.reorder_lod_ppm) + " ppm"
                                          : std::string()) +
+           (p.workload.batching != "none"
+                ? " batching " + p.workload.batching + " " +
+                      std::to_string(p.workload.batching_queue) + " rays/queue " +
+                      std::to_string(p.workload.batching_cell_prims) + " prims/cell"
+                : std::string()) +
            " " + to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
            (points.size() == 1 ? "" : "s") + ")";
 }

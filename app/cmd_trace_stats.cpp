@@ -46,6 +46,11 @@ struct SeedMeasures {
     double entry_depth = 0.0;  // mean depth of the primary entry node (root: 0)
     uint64_t entry_lanes = 0;  // lanes of the search's ops (frustum bounds and tests)
     double reorder_lanes_per_ray = 0.0;  // lanes of the reordering's ops per traced ray
+    // RayGrid: walk and enqueue lanes per secondary ray, queues traced, their mean length and
+    // the share of them that were full.
+    double batching_lanes_per_ray = 0.0;
+    uint64_t queues = 0;
+    double mean_queue = 0.0, full_share = 0.0;
 };
 
 SeedMeasures seed_measures(const TileRun& r) {
@@ -64,6 +69,14 @@ SeedMeasures seed_measures(const TileRun& r) {
     m.entry_depth =
         r.stats.entry_searches ? double(r.stats.entry_depth_sum) / r.stats.entry_searches : 0.0;
     m.entry_lanes = search;
+    const uint64_t batching =
+        r.counts.kind_lanes(OpKind::raygrid_walk) + r.counts.kind_lanes(OpKind::raygrid_enqueue);
+    m.batching_lanes_per_ray = rays[1] > 0 ? double(batching) / rays[1] : 0.0;
+    m.queues = r.stats.batch_queues;
+    if (m.queues) {
+        m.mean_queue = double(r.stats.batch_queued_rays) / double(m.queues);
+        m.full_share = double(r.stats.batch_full_queues) / double(m.queues);
+    }
     return m;
 }
 
@@ -131,6 +144,18 @@ void add_trace_stats_command(CLI::App& app) {
                 j[t + "entry.mean_depth"] = m.entry_depth;
                 j[t + "entry.lanes"] = m.entry_lanes;
                 j[t + "reorder.lanes_per_ray"] = m.reorder_lanes_per_ray;
+                j[t + "batching.lanes_per_ray"] = m.batching_lanes_per_ray;
+                j[t + "batching.queues"] = m.queues;
+                j[t + "batching.mean_queue_length"] = m.mean_queue;
+                j[t + "batching.full_queue_share"] = m.full_share;
+                for (uint32_t g = 0; g < 4; ++g) {
+                    const auto& b = r.counts.bounce(g);
+                    const std::string k = t + "bounce_" + std::to_string(g) + ".";
+                    j[k + "rays"] = b.rays;
+                    j[k + "rays_per_node"] = b.rays_per_node();
+                    j[k + "rays_per_leaf"] = b.rays_per_leaf();
+                    j[k + "box_tests_per_ray"] = b.box_tests_per_ray();
+                }
                 for (bool secondary : {false, true})
                     for (OpStage st : stages) {
                         const auto& s = r.counts.stage(secondary, st);
@@ -227,6 +252,37 @@ void add_trace_stats_command(CLI::App& app) {
             std::cout << "    " << cell(size(r.tile), 10) << cell(buf[0], 10) << cell(buf[1], 11)
                       << cell(std::to_string(r.counts.kind_ops(OpKind::frustum_test)), 15)
                       << cell(buf[2], 18) << buf[3] << "\n";
+        }
+        std::cout << "\nPer bounce (seeds/000 Tables 2 and 4): rays per visited node (box-test "
+                     "stream length), per visited leaf (primitive-test stream length), box tests "
+                     "per ray; RayGrid (--batching "
+                  << options->workload.batching << ")\n"
+                  << "    " << cell("size", 10) << cell("bounce", 8) << cell("rays", 11)
+                  << cell("rays/node", 11) << cell("rays/leaf", 11) << "box tests/ray\n";
+        for (const TileRun& r : runs)
+            for (uint32_t g = 0; g < 4 && g <= settings.max_depth; ++g) {
+                const auto& b = r.counts.bounce(g);
+                char buf[3][32];
+                std::snprintf(buf[0], sizeof buf[0], "%.2f", b.rays_per_node());
+                std::snprintf(buf[1], sizeof buf[1], "%.2f", b.rays_per_leaf());
+                std::snprintf(buf[2], sizeof buf[2], "%.2f", b.box_tests_per_ray());
+                std::cout << "    " << cell(size(r.tile), 10)
+                          << cell(g == 0 ? std::string("primary") : std::to_string(g), 8)
+                          << cell(std::to_string(b.rays), 11) << cell(buf[0], 11)
+                          << cell(buf[1], 11) << buf[2] << "\n";
+            }
+        if (options->workload.batching != "none") {
+            std::cout << "    " << cell("size", 10) << cell("queues", 10) << cell("mean length", 13)
+                      << cell("full", 8) << "walk+enqueue lanes per secondary ray\n";
+            for (const TileRun& r : runs) {
+                const SeedMeasures m = seed_measures(r);
+                char buf[3][32];
+                std::snprintf(buf[0], sizeof buf[0], "%.1f", m.mean_queue);
+                std::snprintf(buf[1], sizeof buf[1], "%.0f%%", 100.0 * m.full_share);
+                std::snprintf(buf[2], sizeof buf[2], "%.2f", m.batching_lanes_per_ray);
+                std::cout << "    " << cell(size(r.tile), 10) << cell(std::to_string(m.queues), 10)
+                          << cell(buf[0], 13) << cell(buf[1], 8) << buf[2] << "\n";
+            }
         }
     });
 }

@@ -25,6 +25,9 @@ struct WorkloadFlags {
     std::string primary_entry = "root";
     std::string reorder = "none";
     uint32_t reorder_lod_ppm = 20000;
+    std::string batching = "none";
+    uint32_t batching_queue = 384;
+    uint32_t batching_cell_prims = 4096;
 
     void add_to(CLI::App* command);
     // The workload the flags give for `scene`; throws InputError (key = the flag) on a bad value.

@@ -32,6 +32,15 @@ void WorkloadFlags::add_to(CLI::App* c) {
     c->add_option("--reorder-lod-ppm", reorder_lod_ppm,
                   "hit_point: simplified geometry, parts per million of the primitives")
         ->capture_default_str();
+    c->add_option("--batching", batching,
+                  "batch secondary rays in the cells of a top cut of the BVH (RayGrid): "
+                  "none|raygrid (never changes the image)")
+        ->capture_default_str();
+    c->add_option("--batching-queue", batching_queue, "raygrid: rays per queue")
+        ->capture_default_str();
+    c->add_option("--batching-cell-prims", batching_cell_prims,
+                  "raygrid: the most primitives under one cell")
+        ->capture_default_str();
 }
 
 WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
@@ -47,6 +56,11 @@ WorkloadConfig WorkloadFlags::config(const std::string& scene) const {
     set_workload_field(w, "reorder", reorder, "command line", 0, "--reorder");
     set_workload_field(w, "reorder_lod_ppm", std::to_string(reorder_lod_ppm), "command line", 0,
                        "--reorder-lod-ppm");
+    set_workload_field(w, "batching", batching, "command line", 0, "--batching");
+    set_workload_field(w, "batching_queue", std::to_string(batching_queue), "command line", 0,
+                       "--batching-queue");
+    set_workload_field(w, "batching_cell_prims", std::to_string(batching_cell_prims),
+                       "command line", 0, "--batching-cell-prims");
     return w;
 }
 

@@ -99,6 +99,19 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     set(OpKind::reorder_lod_test, {"origin", "inverse_direction", "t_max"}, {}, 36, 10, 32);
     set(OpKind::reorder_key, {"origin", "direction", "t_max"}, {}, 41, 12, 0);
     set(OpKind::reorder_sort, {}, {}, 8, 3, 0);
+    // RayGrid batching (kernels/stream/ray_grid.h, the tracer's grid_walk), counted from our
+    // code; the paper gives only host time shares (47 % octree traversal, Sec. 4.1). A walk
+    // step is the slab test (34, chain 9, as box_test) plus the walk's bookkeeping: at a cell,
+    // two lexicographic (entry, cell) compares against the last and best cell and two selects
+    // keeping the best (8); above the cut, the exit distance (3 sub, 3 mul, 3 scales, 2 min:
+    // 11) and two compares against the best entry and the last entry (2): 47, chain 9 + 4
+    // (exit, compare, and, select) = 13. Last entry, last and best cell live in two per-ray
+    // scratch words priced as t_max. It reads the node (32 bytes). Enqueue: per ray, the
+    // cell's queue tail (a load), the id store, the tail's increment and store, the compare
+    // against the queue size and the select that hands a full queue on (6, chain 4: load,
+    // add, compare, select); queues hold ray ids, as the paper allows (Sec. 3.2.3).
+    set(OpKind::raygrid_walk, {"origin", "inverse_direction", "t_max"}, {"t_max"}, 47, 13, 32);
+    set(OpKind::raygrid_enqueue, {"t_max"}, {}, 6, 4, 0);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
@@ -110,6 +123,7 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
         case OpKind::box_test:
         case OpKind::frustum_test:
         case OpKind::reorder_lod_test:
+        case OpKind::raygrid_walk:
             return uint64_t(object) * node_bytes;
         case OpKind::triangle_test:
             return triangles_base + uint64_t(object) * triangle_bytes;

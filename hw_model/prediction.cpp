@@ -149,12 +149,28 @@ std::vector<Stat> Prediction::stats() const {
         add("scene_cache." + config.scene_memory.caches[i].name + ".misses",
             double(timing.cache_misses[i]), "accesses",
             "misses of scene-data cache level " + config.scene_memory.caches[i].name);
-    add("workload.box_tests_per_ray.primary", box_tests_per_ray[0], "lanes",
+    add("trace.box_tests_per_ray.primary", box_tests_per_ray[0], "lanes",
         "box-test lanes per camera ray");
-    add("workload.box_tests_per_ray.secondary", box_tests_per_ray[1], "lanes",
+    add("trace.box_tests_per_ray.secondary", box_tests_per_ray[1], "lanes",
         "box-test lanes per secondary ray");
-    add("workload.entry_depth", entry_depth, "levels",
+    add("trace.entry_depth", entry_depth, "levels",
         "mean BVH depth at which primary streams enter (root 0)");
+    for (uint32_t g = 0; g < k_bounces; ++g) {
+        const std::string b = "trace.bounce" + std::to_string(g) + ".";
+        const std::string of = g == 0 ? "camera rays" : "rays of bounce " + std::to_string(g);
+        add(b + "rays_per_node", rays_per_node[g], "rays",
+            "mean box-test stream length (rays per visited node), " + of);
+        add(b + "rays_per_leaf", rays_per_leaf[g], "rays",
+            "mean primitive-test stream length (rays per visited leaf), " + of);
+        add(b + "box_tests_per_ray", bounce_box_tests_per_ray[g], "lanes",
+            "box-test lanes per ray, " + of);
+    }
+    add("trace.batching.mean_queue_length", batch_mean_queue, "rays",
+        "RayGrid: mean rays per traced queue");
+    add("trace.batching.full_queue_share", batch_full_share, "",
+        "RayGrid: share of traced queues that were full");
+    add("trace.batching.lanes_per_ray", batch_lanes_per_ray, "lanes",
+        "RayGrid: cell-walk and enqueue lanes per secondary ray");
 
     // Area and energy: the action counts priced with the technology table (area_energy.h).
     const TechTable& t = tech ? *tech : default_tech_table();

@@ -205,6 +205,16 @@ struct Prediction {
     // per traced ray [secondary] and the mean depth of primary entry points (root 0).
     double box_tests_per_ray[2] = {};
     double entry_depth = 0.0;
+    // Per bounce (0 = primary .. 3; seeds/000 Tables 2 and 4): rays per visited node (box-test
+    // stream length), per visited leaf (primitive-test stream length), box tests per ray.
+    static constexpr uint32_t k_bounces = 4;
+    double rays_per_node[k_bounces] = {};
+    double rays_per_leaf[k_bounces] = {};
+    double bounce_box_tests_per_ray[k_bounces] = {};
+    // RayGrid batching: mean rays per traced queue, and the share of queues that were full.
+    double batch_mean_queue = 0.0;
+    double batch_full_share = 0.0;
+    double batch_lanes_per_ray = 0.0;  // walk and enqueue lanes per secondary ray
     double host_seconds = 0.0;   // the functional render's share plus this model's own time
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)

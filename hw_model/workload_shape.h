@@ -20,6 +20,7 @@ struct WorkloadShape {
     uint32_t tile = 32;                // tile edge: tile^2 ray slots per pass
     bool primary_entry_aepsa = false;  // the workload searches primary entry points
     bool reorder_hit_point = false;    // the workload sorts streams by approximate hit point
+    bool batching_raygrid = false;     // the workload batches secondary rays in cell queues
 
     uint32_t slots() const { return tile * tile; }
     // The operation kinds this scene can emit: their function units are elaborated, no others.
@@ -63,6 +64,9 @@ inline std::array<bool, k_op_kind_count> WorkloadShape::needed_kinds() const {
                 break;
             case OpFeature::reorder_hit_point:
                 k[i] = reorder_hit_point;
+                break;
+            case OpFeature::batching_raygrid:
+                k[i] = batching_raygrid;
                 break;
         }
     }

@@ -30,6 +30,9 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     for (int i = 0; i < 3; ++i) stage_tsc[i] += o.stage_tsc[i];
     entry_searches += o.entry_searches;
     entry_depth_sum += o.entry_depth_sum;
+    batch_queues += o.batch_queues;
+    batch_full_queues += o.batch_full_queues;
+    batch_queued_rays += o.batch_queued_rays;
     return *this;
 }
 

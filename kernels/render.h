@@ -49,6 +49,10 @@ struct RenderStats {
     // (root = 0) of the nodes their rays entered at.
     uint64_t entry_searches = 0;
     uint64_t entry_depth_sum = 0;
+    // RayGrid batching: queues traced, how many of them were full, and the rays they held.
+    uint64_t batch_queues = 0;
+    uint64_t batch_full_queues = 0;
+    uint64_t batch_queued_rays = 0;
     double host_seconds = 0.0;
     // With RenderSettings::stage_clock (stream tracer): TSC ticks per stage, [traversal,
     // intersection, shading] as kernels/trace.h's OpStage; shading is the rest of each pass

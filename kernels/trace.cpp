@@ -1,5 +1,6 @@
 #include "kernels/trace.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -63,8 +64,19 @@ void CountingSink::op(const StreamOp& op) {
     ++m_kind_ops[uint32_t(op.kind)];
     m_kind_lanes[uint32_t(op.kind)] += op.length;
     m_kind_lanes_by_generation[op.generation > 0][uint32_t(op.kind)] += op.length;
-    if (op.kind == OpKind::box_test && int32_t(op.generation) != m_traced_generation) {
+    BounceCounts& b = m_bounce[std::min<uint32_t>(op.generation, k_bounce_slots - 1)];
+    if (op.kind == OpKind::box_test) {
+        ++b.box_ops;
+        b.box_lanes += op.length;
+    } else if (op.kind == OpKind::triangle_test || op.kind == OpKind::sphere_test) {
+        ++b.prim_ops;
+        b.prim_lanes += op.length;
+    }
+    // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
+    if ((op.kind == OpKind::box_test || op.kind == OpKind::raygrid_walk) &&
+        int32_t(op.generation) != m_traced_generation) {
         m_rays += op.length;  // the generation's entry test: one lane per ray
+        b.rays += op.length;
         m_rays_by_generation[op.generation > 0] += op.length;
         m_traced_generation = op.generation;
     }
@@ -92,12 +104,21 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
     m_generations += o.m_generations;
     m_rays += o.m_rays;
     for (int g = 0; g < 2; ++g) m_rays_by_generation[g] += o.m_rays_by_generation[g];
+    for (uint32_t g = 0; g < k_bounce_slots; ++g) {
+        m_bounce[g].rays += o.m_bounce[g].rays;
+        m_bounce[g].box_ops += o.m_bounce[g].box_ops;
+        m_bounce[g].box_lanes += o.m_bounce[g].box_lanes;
+        m_bounce[g].prim_ops += o.m_bounce[g].prim_ops;
+        m_bounce[g].prim_lanes += o.m_bounce[g].prim_lanes;
+    }
     return *this;
 }
 
 // ---- Trace file ---------------------------------------------------------------------------
 // Little-endian, as the host writes it (the tree targets x86-64 and aarch64 hosts):
-//   header: "SFXTRACE" u32 version u64 scene_hash u32 width height spp tile max_depth u64 seed
+//   header: "SFXTRACE" u32 version u64 scene_hash, then TraceFrame's fields in its visit()
+//           order (u32 width height spp tile max_depth u64 seed u8 primary_entry reorder
+//           u32 reorder_lod_ppm u8 batching u32 batching_queue batching_cell_prims)
 //   pass:   u8 'P' u32 tile x0 y0 x1 y1 sample slot_count
 //   op:     u8 'O' u8 kind u8 stage u16 generation u32 object length pass_count
 //           u32 slots[length] u8 passed_bits[ceil(length/8)] (bit i of byte i/8, LSB first)
@@ -225,15 +246,18 @@ TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
                          "trace version " + std::to_string(h.version) + ", this sfx reads 1 to " +
                              std::to_string(TraceHeader::k_version));
     h.scene_hash = r.get<uint64_t>();
-    // A version-1 header ends after the seed: the later fields keep their defaults.
-    const uint32_t fields = h.version == 1 ? TraceFrame::k_version1_fields : ~0u;
+    // An older header ends early: the later fields keep their defaults.
+    const uint32_t fields = h.version == 1   ? TraceFrame::k_version1_fields
+                            : h.version == 2 ? TraceFrame::k_version2_fields
+                                             : ~0u;
     uint32_t field = 0;
     h.visit([&](auto& v) {
         if (field++ < fields) v = r.get<std::remove_reference_t<decltype(v)>>();
     });
     if (uint8_t(h.primary_entry) > uint8_t(PrimaryEntry::aepsa) ||
-        uint8_t(h.reorder) > uint8_t(RayReorder::hit_point))
-        r.fail("unknown primary_entry or reorder in the header");
+        uint8_t(h.reorder) > uint8_t(RayReorder::hit_point) ||
+        uint8_t(h.batching) > uint8_t(RayBatching::raygrid))
+        r.fail("unknown primary_entry, reorder or batching in the header");
     sink.begin_frame(h);
     TilePass pass;
     bool in_pass = false;

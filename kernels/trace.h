@@ -45,6 +45,10 @@ enum class OpKind : uint8_t {
     reorder_lod_test,  // traversal: the simplified hierarchy's box filter (object: node)
     reorder_key,       // traversal: approximate hit point to a two-level Z-curve key; all pass
     reorder_sort,      // traversal: one merge pass of the sort by key; all pass
+    // RayGrid batching (RayBatching::raygrid, kernels/stream/ray_grid.h):
+    raygrid_walk,     // traversal: the cell walk's filter over a node above or at the cell cut
+                      // (object: node); passed = the ray may find its next cell below it
+    raygrid_enqueue,  // traversal: append the rays that found a next cell to its queue; all pass
     count
 };
 constexpr uint32_t k_op_kind_count = uint32_t(OpKind::count);
@@ -61,7 +65,8 @@ enum class OpFeature : uint8_t {
     dielectric,
     glossy,
     primary_entry_aepsa,  // workload options, not scene features: RenderSettings::primary_entry
-    reorder_hit_point     // RenderSettings::reorder
+    reorder_hit_point,    // RenderSettings::reorder
+    batching_raygrid      // RenderSettings::batching
 };
 
 // The op table: everything about a kind of operation that does not depend on the hardware, in
@@ -95,6 +100,8 @@ inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
     {"reorder_lod_test", OpStage::traversal, true, false, OpFeature::reorder_hit_point},
     {"reorder_key", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
     {"reorder_sort", OpStage::traversal, false, false, OpFeature::reorder_hit_point},
+    {"raygrid_walk", OpStage::traversal, true, false, OpFeature::batching_raygrid},
+    {"raygrid_enqueue", OpStage::traversal, false, false, OpFeature::batching_raygrid},
 };
 inline const OpKindInfo& op_info(OpKind kind) {
     return k_op_kinds[size_t(kind)];
@@ -108,7 +115,8 @@ inline OpStage stage_of(OpKind kind) {
 // The kind exists because of a workload option (a seed paper's alternative), not the scene.
 inline bool is_option_kind(OpKind kind) {
     const OpFeature f = op_info(kind).feature;
-    return f == OpFeature::primary_entry_aepsa || f == OpFeature::reorder_hit_point;
+    return f == OpFeature::primary_entry_aepsa || f == OpFeature::reorder_hit_point ||
+           f == OpFeature::batching_raygrid;
 }
 
 constexpr uint32_t k_no_object = 0xffffffffu;
@@ -142,6 +150,11 @@ enum class PrimaryEntry : uint8_t { root, aepsa };
 // tracing it (Moon et al., kernels/stream/hit_point_reorder.h). Never changes a bit of the
 // image; reorders the trace's streams and adds the sort's ops.
 enum class RayReorder : uint8_t { none, hit_point };
+// Whether the stream tracer batches secondary rays in the cells of a cut of the BVH and traces
+// each cell's queue against the cell's subtree (Bikker's RayGrid, kernels/stream/ray_grid.h).
+// Never changes a bit of the image; splits the trace's secondary streams by cell and adds the
+// queueing's ops.
+enum class RayBatching : uint8_t { none, raygrid };
 
 // Everything besides the scene that decides a render's trace, declared once: the tracers'
 // RenderSettings derive from it and the trace header carries it, so a new such knob is one
@@ -157,8 +170,12 @@ struct TraceFrame {
     PrimaryEntry primary_entry = PrimaryEntry::root;  // stream tracer only
     RayReorder reorder = RayReorder::none;            // stream tracer only
     uint32_t reorder_lod_ppm = 20000;  // simplified geometry: parts per million of the primitives
+    RayBatching batching = RayBatching::none;  // stream tracer only
+    uint32_t batching_queue = 384;             // raygrid: rays per queue (seeds/000 Sec. 3.5)
+    uint32_t batching_cell_prims = 4096;       // raygrid: most primitives under one cell
 
-    // Every field in trace-file order (version 1 ends after seed).
+    // Every field in trace-file order (version 1 ends after seed, version 2 after
+    // reorder_lod_ppm).
     template <class V>
     void visit(V&& v) {
         v(width);
@@ -170,14 +187,19 @@ struct TraceFrame {
         v(primary_entry);
         v(reorder);
         v(reorder_lod_ppm);
+        v(batching);
+        v(batching_queue);
+        v(batching_cell_prims);
     }
     static constexpr uint32_t k_version1_fields = 6;
+    static constexpr uint32_t k_version2_fields = 9;
 };
 
 // What a trace is of; written at the head of a trace file. Version 2 added the seed papers'
-// options (primary_entry, reorder, reorder_lod_ppm); a version-1 file reads with their defaults.
+// options (primary_entry, reorder, reorder_lod_ppm), version 3 RayGrid batching (batching,
+// batching_queue, batching_cell_prims); an older file reads with the later fields' defaults.
 struct TraceHeader : TraceFrame {
-    static constexpr uint32_t k_version = 2;
+    static constexpr uint32_t k_version = 3;
     uint32_t version = k_version;
     uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
 };
@@ -237,6 +259,19 @@ class CountingSink : public TraceSink {
     // a primary entry point).
     uint64_t rays() const { return m_rays; }
     uint64_t rays(bool secondary) const { return m_rays_by_generation[secondary]; }
+    // Per generation (bounce; the last slot holds every later one): rays traced, box tests
+    // (ops, lanes: rays per visited node, seeds/000 Tables 2 and 4) and primitive tests (each op
+    // of a leaf carries the rays that reached it: rays per visited leaf).
+    struct BounceCounts {
+        uint64_t rays = 0, box_ops = 0, box_lanes = 0, prim_ops = 0, prim_lanes = 0;
+        double rays_per_node() const { return box_ops ? double(box_lanes) / box_ops : 0.0; }
+        double rays_per_leaf() const { return prim_ops ? double(prim_lanes) / prim_ops : 0.0; }
+        double box_tests_per_ray() const { return rays ? double(box_lanes) / rays : 0.0; }
+    };
+    static constexpr uint32_t k_bounce_slots = 5;
+    const BounceCounts& bounce(uint32_t generation) const {
+        return m_bounce[generation < k_bounce_slots ? generation : k_bounce_slots - 1];
+    }
 
     CountingSink& operator+=(const CountingSink& o);
 
@@ -248,6 +283,7 @@ class CountingSink : public TraceSink {
     uint64_t m_kind_lanes_by_generation[2][k_op_kind_count] = {};
     uint64_t m_passes = 0, m_generations = 0, m_rays = 0;
     uint64_t m_rays_by_generation[2] = {};
+    BounceCounts m_bounce[k_bounce_slots];
     int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
 };
 

@@ -70,8 +70,8 @@ void fill_ideal(Prediction& p, const CountingSink& counts, size_t i, uint32_t wi
     }
 }
 
-// What the workload did, whatever the hardware: box tests per traced ray (primary, secondary)
-// and the primary entry points' mean depth.
+// What the workload did, whatever the hardware: box tests per traced ray (primary, secondary),
+// the primary entry points' mean depth, rays per node per bounce, RayGrid's queues.
 void fill_workload(Prediction& p, const CountingSink& counts, const RenderStats& render) {
     for (int sec = 0; sec < 2; ++sec) {
         const uint64_t rays = counts.rays(sec);
@@ -81,6 +81,20 @@ void fill_workload(Prediction& p, const CountingSink& counts, const RenderStats&
     p.entry_depth = render.entry_searches
                         ? double(render.entry_depth_sum) / double(render.entry_searches)
                         : 0.0;
+    for (uint32_t g = 0; g < Prediction::k_bounces; ++g) {
+        const CountingSink::BounceCounts& b = counts.bounce(g);
+        p.rays_per_node[g] = b.rays_per_node();
+        p.rays_per_leaf[g] = b.rays_per_leaf();
+        p.bounce_box_tests_per_ray[g] = b.box_tests_per_ray();
+    }
+    if (const uint64_t rays = counts.rays(true))
+        p.batch_lanes_per_ray = double(counts.kind_lanes(OpKind::raygrid_walk) +
+                                       counts.kind_lanes(OpKind::raygrid_enqueue)) /
+                                double(rays);
+    if (render.batch_queues) {
+        p.batch_mean_queue = double(render.batch_queued_rays) / double(render.batch_queues);
+        p.batch_full_share = double(render.batch_full_queues) / double(render.batch_queues);
+    }
 }
 
 // Counts finished passes for a PassProgress (the trace arrives in order, one pass at a time).
@@ -336,6 +350,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.tile = settings.tile;
     shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;
     shape.reorder_hit_point = settings.reorder == RayReorder::hit_point;
+    shape.batching_raygrid = settings.batching == RayBatching::raygrid;
     return shape;
 }
 

@@ -104,6 +104,9 @@ RenderSettings WorkloadConfig::render_settings(uint32_t threads) const {
     s.primary_entry = primary_entry == "aepsa" ? PrimaryEntry::aepsa : PrimaryEntry::root;
     s.reorder = reorder == "hit_point" ? RayReorder::hit_point : RayReorder::none;
     s.reorder_lod_ppm = reorder_lod_ppm;
+    s.batching = batching == "raygrid" ? RayBatching::raygrid : RayBatching::none;
+    s.batching_queue = batching_queue;
+    s.batching_cell_prims = batching_cell_prims;
     return s;
 }
 
@@ -111,7 +114,8 @@ bool WorkloadConfig::operator==(const WorkloadConfig& o) const {
     return scene == o.scene && width == o.width && height == o.height && spp == o.spp &&
            depth == o.depth && tile == o.tile && seed == o.seed &&
            primary_entry == o.primary_entry && reorder == o.reorder &&
-           reorder_lod_ppm == o.reorder_lod_ppm;
+           reorder_lod_ppm == o.reorder_lod_ppm && batching == o.batching &&
+           batching_queue == o.batching_queue && batching_cell_prims == o.batching_cell_prims;
 }
 
 std::vector<std::string> workload_field_names() {

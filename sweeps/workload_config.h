@@ -31,9 +31,13 @@ struct WorkloadConfig {
     std::string primary_entry = "root";  // root | aepsa (PrimaryEntry)
     std::string reorder = "none";        // none | hit_point (RayReorder)
     uint32_t reorder_lod_ppm = 20000;    // the paper's 2 %
+    std::string batching = "none";       // none | raygrid (RayBatching)
+    uint32_t batching_queue = 384;       // seeds/000 Sec. 3.5: M = 384
+    uint32_t batching_cell_prims = 4096;  // seeds/000 Sec. 3.5: 4096 primitives per leaf
 
     static constexpr const char* k_primary_entry_choices[] = {"root", "aepsa", nullptr};
     static constexpr const char* k_reorder_choices[] = {"none", "hit_point", nullptr};
+    static constexpr const char* k_batching_choices[] = {"none", "raygrid", nullptr};
 
     // `choices` (null-terminated) lists the words a text field accepts (none: any text).
     // `special` names the word that stands for the field's sentinel value ("auto" for the tile).
@@ -62,11 +66,23 @@ struct WorkloadConfig {
                 "hit_point: the simplified geometry's size in parts per million of the primitives "
                 "(20000 = 2 %, the paper's)",
                 1, 1000000);
+        v.text("batching", batching,
+               "batch secondary rays in the cells of a top cut of the BVH, each queue traced "
+               "against its cell's subtree: none, or raygrid (seeds/000 Sec. 3)",
+               k_batching_choices);
+        v.param("batching_queue", batching_queue, "rays",
+                "raygrid: rays per queue; a full queue is traced first (384, the paper's)", 1,
+                1u << 24);
+        v.param("batching_cell_prims", batching_cell_prims, "primitives",
+                "raygrid: the most primitives under one cell of the cut (4096, the paper's per "
+                "octree leaf)",
+                1, UINT32_MAX);
     }
 
     // The seed papers' options: absent from a point's YAML when at their default (sweep.cpp).
     static bool is_option_field(const std::string& name) {
-        return name == "primary_entry" || name == "reorder" || name == "reorder_lod_ppm";
+        return name == "primary_entry" || name == "reorder" || name == "reorder_lod_ppm" ||
+               name == "batching" || name == "batching_queue" || name == "batching_cell_prims";
     }
 
     bool resolved() const { return depth >= 0 && tile != k_auto_tile; }

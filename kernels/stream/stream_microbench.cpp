@@ -337,6 +337,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             case OpKind::reorder_lod_test:
                             case OpKind::reorder_key:
                             case OpKind::reorder_sort:
+                            case OpKind::raygrid_walk:
+                            case OpKind::raygrid_enqueue:
                             case OpKind::count:
                                 break;
                         }

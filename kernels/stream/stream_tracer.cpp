@@ -1,17 +1,18 @@
 #include "kernels/stream/stream_tracer.h"
 
+#include <x86intrin.h>
+
 #include <algorithm>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
-
-#include <x86intrin.h>
 
 #include "base/host_clock.h"
 #include "kernels/camera.h"
 #include "kernels/reference/reference_tracer.h"
 #include "kernels/stream/entry_point.h"
 #include "kernels/stream/hit_point_reorder.h"
+#include "kernels/stream/ray_grid.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
 
@@ -204,6 +205,18 @@ struct StreamTracer::Impl {
         std::vector<uint8_t> mask, ones;
         std::vector<std::pair<uint32_t, uint32_t>> stack;
     } rb;
+    // RayGrid batching (RenderSettings::batching): the cell cut, per-slot walk state, queues.
+    std::unique_ptr<RayGrid> grid;
+    struct GridBuffers {
+        std::vector<float> last_entry, best_entry;  // per slot: the cell it was in, the next one
+        std::vector<uint32_t> last_cell, best_cell;
+        std::vector<uint32_t> ids, spill, pushed;
+        std::vector<uint8_t> mask, ones;
+        std::vector<std::pair<uint32_t, uint32_t>> stack;
+        std::vector<std::vector<uint32_t>> open;  // per cell: its partially filled queue
+        std::vector<std::pair<uint32_t, std::vector<uint32_t>>> full;  // full queues, in order
+        std::vector<std::vector<uint32_t>> empty;                      // storage to reuse
+    } gb;
 
     Impl(const Scene& s, const Bvh& h, const RenderSettings& r)
         : scene(s),
@@ -214,6 +227,157 @@ struct StreamTracer::Impl {
           material_rays(s.materials.size(), 0) {
         if (r.reorder == RayReorder::hit_point)
             reorder = std::make_unique<HitPointReorder>(h, r.reorder_lod_ppm);
+        if (r.batching == RayBatching::raygrid && !h.nodes().empty()) {
+            grid = std::make_unique<RayGrid>(h, r.batching_cell_prims);
+            gb.open.resize(grid->cell_count());
+        }
+    }
+
+    // The cell walk of RayGrid for ids[0, n): each ray's next cell after (last_entry,
+    // last_cell), the smallest (entry, cell) beyond it among the cut's boxes its slab test
+    // passes with its current t. A stream filter over the nodes above the cut, branch and
+    // bound per ray: a node passes a ray if the ray enters it no later than its best cell so
+    // far and leaves it no earlier than its last cell (one raygrid_walk op per node). Then the
+    // rays that found a cell are appended to its queue (one raygrid_enqueue op); the others
+    // are done with this generation.
+    template <class Trace>
+    void grid_walk(const uint32_t* ids, uint32_t n, uint16_t generation, Trace& trace) {
+        GridBuffers& g = gb;
+        const std::vector<BvhNode>& nodes = bvh.nodes();
+        TraversalRays& rays = b.trav;
+        for (uint32_t i = 0; i < n; ++i) {
+            g.ids[i] = ids[i];
+            g.best_entry[ids[i]] = INFINITY;
+            g.best_cell[ids[i]] = RayGrid::k_no_cell;
+        }
+        g.stack.clear();
+        if (n) g.stack.push_back({0u, n});
+        while (!g.stack.empty()) {
+            const auto [node_index, len] = g.stack.back();
+            g.stack.pop_back();
+            const BvhNode& node = nodes[node_index];
+            const uint32_t cell = grid->cell_of(node_index);
+            uint32_t passed = 0;
+            for (uint32_t j = 0; j < len; ++j) {
+                const uint32_t id = g.ids[j];
+                const float e = intersect_box(b.pre[id], node.bounds, rays.t(id));
+                bool pass = e != INFINITY;
+                if (pass && cell != RayGrid::k_no_cell) {
+                    const auto key = std::make_pair(e, cell);
+                    pass = key > std::make_pair(g.last_entry[id], g.last_cell[id]) &&
+                           key < std::make_pair(g.best_entry[id], g.best_cell[id]);
+                    if (pass) g.best_entry[id] = e, g.best_cell[id] = cell;
+                } else if (pass) {
+                    pass = e <= g.best_entry[id] &&
+                           RayGrid::box_exit(b.pre[id], node.bounds) >= g.last_entry[id];
+                }
+                g.mask[j] = pass;
+                passed += pass;
+            }
+            trace.op(OpKind::raygrid_walk, generation, node_index, g.ids.data(), len, g.mask.data(),
+                     passed);
+            if (passed == 0 || cell != RayGrid::k_no_cell) continue;
+            uint32_t front = 0, spilled = 0, negative = 0;
+            for (uint32_t j = 0; j < len; ++j) {  // passing ids first, in order
+                const uint32_t id = g.ids[j];
+                if (!g.mask[j]) {
+                    g.spill[spilled++] = id;
+                    continue;
+                }
+                g.ids[front++] = id;
+                negative += b.pre[id].dir[node.axis] < 0.f;
+            }
+            std::copy(g.spill.begin(), g.spill.begin() + spilled, g.ids.begin() + front);
+            const bool right_first = 2 * negative > passed;
+            const uint32_t left = BvhNode::left(node_index), right = node.right();
+            g.stack.push_back({right_first ? left : right, passed});
+            g.stack.push_back({right_first ? right : left, passed});
+        }
+        uint32_t pushed = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t id = ids[i], cell = g.best_cell[id];
+            if (cell == RayGrid::k_no_cell) continue;
+            g.last_entry[id] = g.best_entry[id];
+            g.last_cell[id] = cell;
+            g.pushed[pushed++] = id;
+            std::vector<uint32_t>& q = g.open[cell];
+            if (q.capacity() == 0 && !g.empty.empty()) {
+                q = std::move(g.empty.back());
+                g.empty.pop_back();
+            }
+            q.push_back(id);
+            if (q.size() >= settings.batching_queue) {  // decoupled from the cell, traced first
+                g.full.emplace_back(cell, std::move(q));
+                q = {};
+            }
+        }
+        if (pushed)
+            trace.op(OpKind::raygrid_enqueue, generation, k_no_object, g.pushed.data(), pushed,
+                     g.ones.data(), pushed);
+    }
+
+    // A generation's traversal stream trav_ids[0, n) by RayGrid (Algorithm 1): every ray to
+    // its first cell's queue, then queues traced against their cell's subtree, full ones
+    // first, then the partial ones, largest first (ties: lower cell), each followed by the
+    // walk of its rays to their next cells, until every queue is empty.
+    template <class Trace>
+    void traverse_batched(uint32_t n, uint16_t generation, RenderStats& stats, Trace& trace,
+                          uint64_t* leaf_tsc) {
+        GridBuffers& g = gb;
+        if (g.ids.size() < b.capacity) {
+            g.last_entry.resize(b.capacity);
+            g.best_entry.resize(b.capacity);
+            g.last_cell.resize(b.capacity);
+            g.best_cell.resize(b.capacity);
+            g.ids.resize(b.capacity);
+            g.spill.resize(b.capacity);
+            g.pushed.resize(b.capacity);
+            g.mask.resize(b.capacity);
+            g.ones.assign(b.capacity, 1);
+        }
+        std::vector<uint32_t> stream(b.trav_ids.begin(), b.trav_ids.begin() + n);
+        for (uint32_t id : stream) {
+            g.last_entry[id] = -INFINITY;
+            g.last_cell[id] = 0;
+        }
+        grid_walk(stream.data(), n, generation, trace);
+        size_t next_full = 0;
+        while (true) {
+            uint32_t cell = RayGrid::k_no_cell;
+            std::vector<uint32_t> q;
+            if (next_full < g.full.size()) {
+                cell = g.full[next_full].first;
+                q = std::move(g.full[next_full].second);
+                ++next_full;
+                ++stats.batch_full_queues;
+            } else {
+                size_t largest = 0;
+                for (uint32_t c = 0; c < g.open.size(); ++c)
+                    if (g.open[c].size() > largest) largest = g.open[c].size(), cell = c;
+                if (cell == RayGrid::k_no_cell) break;
+                q = std::move(g.open[cell]);
+                g.open[cell] = {};
+            }
+            ++stats.batch_queues;
+            stats.batch_queued_rays += q.size();
+            const uint32_t len = uint32_t(q.size());
+            std::copy(q.begin(), q.end(), b.trav_ids.begin());
+            traverse(kernels, bvh, b, len, generation, trace, grid->cell_node(cell), leaf_tsc);
+            grid_walk(q.data(), len, generation, trace);
+            q.clear();
+            g.empty.push_back(std::move(q));
+        }
+        g.full.clear();
+    }
+
+    // The generation's traversal: plain (Fig. 3 from `entry`), or batched for secondary rays.
+    template <class Trace>
+    void traverse_generation(uint32_t n, uint16_t generation, uint32_t entry, RenderStats& stats,
+                             Trace& trace, uint64_t* leaf_tsc) {
+        if (grid && generation > 0)
+            traverse_batched(n, generation, stats, trace, leaf_tsc);
+        else
+            traverse(kernels, bvh, b, n, generation, trace, entry, leaf_tsc);
     }
 
     // Moon et al.'s reordering of the stream ids[0, n) before it is traced: approximate hit
@@ -391,13 +555,13 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         if (clock) {
             uint64_t leaf = 0;
             const uint64_t start = __rdtsc();
-            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry, &leaf);
+            traverse_generation(traversal_rays, generation, entry, stats, trace, &leaf);
             const uint64_t spent = __rdtsc() - start;
             stats.stage_tsc[0] += spent - leaf;
             stats.stage_tsc[1] += leaf;
             traverse_tsc += spent;
         } else {
-            traverse(kernels, bvh, b, traversal_rays, generation, trace, entry);
+            traverse_generation(traversal_rays, generation, entry, stats, trace, nullptr);
         }
         if (observer)
             for (uint32_t i = 0; i < n; ++i) {

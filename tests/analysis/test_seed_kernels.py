@@ -10,8 +10,8 @@ def seed_point(entry, reorder, fps, box_primary, misses, ppm=20000, option=0.0, 
     return {"workload.scene": "conference", "workload.tile": 16, "hw.simd.width": 16.0,
             "fidelity": "full", "workload.primary_entry": entry, "workload.reorder": reorder,
             "workload.reorder_lod_ppm": ppm, "fps": fps,
-            "workload.box_tests_per_ray.primary": box_primary,
-            "workload.box_tests_per_ray.secondary": 50.0, "workload.entry_depth": depth,
+            "trace.box_tests_per_ray.primary": box_primary,
+            "trace.box_tests_per_ray.secondary": 50.0, "trace.entry_depth": depth,
             "op_mix.option_percent": option, "scene_cache.l1.misses": 1.0,
             "scene_cache.l2.misses": misses, "scene_cache.l3.misses": 1.0}
 
@@ -33,4 +33,35 @@ def test_page_pairs_points_by_option(tmp_path):
     assert "| 0.05 % | 20.0 | 35.0 | -12.5 % |" in page
     assert "| 2 % | 28.0 | 30.0 | -25.0 % |" in page
     assert "does not appear on our model" in page
-    assert "RayGrid batching (seeds/000 Sec. 3): not built" in page
+    assert "## RayGrid batching (seeds/000 Sec. 3)" in page
+
+
+def raygrid_point(batching, depth, fps, box_secondary, node1, option=0.0):
+    p = seed_point("root", "none", fps, 40.0, 1000.0, option=option)
+    p.update({"workload.tile": 32, "workload.depth": depth, "workload.batching": batching,
+              "workload.batching_queue": 384, "workload.batching_cell_prims": 4096,
+              "trace.box_tests_per_ray.secondary": box_secondary,
+              "ideal_simd_utilization.secondary.traversal": 0.5,
+              "scene_cache.l1.hit_rate": 0.5, "scene_cache.l2.hit_rate": 0.25,
+              "trace.bounce1.rays_per_node": node1, "trace.bounce1.rays_per_leaf": 2.0,
+              "trace.batching.mean_queue_length": 20.0 if batching == "raygrid" else 0.0,
+              "trace.batching.full_queue_share": 0.1 if batching == "raygrid" else 0.0,
+              "trace.batching.lanes_per_ray": 55.0 if batching == "raygrid" else 0.0})
+    return p
+
+
+def test_raygrid_section_pairs_by_batching_and_reads_bounce_steps(tmp_path):
+    # Frame times (ms): none 10 -> 12.5 from depth 0 to 1 (bounce 1 costs 2.5 ms); raygrid
+    # 10 -> 15 (5 ms): bounce 1 is half as fast, a gain of -50 %.
+    points = [raygrid_point("none", 0, 100.0, 0.0, 0.0),
+              raygrid_point("raygrid", 0, 100.0, 0.0, 0.0),
+              raygrid_point("none", 1, 80.0, 50.0, 14.0),
+              raygrid_point("raygrid", 1, 1000.0 / 15.0, 40.0, 8.0, option=30.0)]
+    for p in points:  # the options table reads the batching columns of conference points
+        p["workload.primary_entry"] = "root"
+    store = load_store(write_store(str(tmp_path / "r.db"), points))
+    page = build_page(store)
+    # Depth 1 row: box tests 50 -> 40, fps 80 -> 66.7 (-16.7 %).
+    assert "| conference | 32 | 16 | 50.0 | 40.0 | 50.0 | 50.0 | 50.0 / 25.0 | 50.0 / 25.0 | 20.0 | 10 | 55.0 | 30.0 | 80.0 | 66.7 | -16.7 % |" in page
+    assert "| conference | 1 | 14.0 | 8.0 | 2.0 | 2.0 | 2.50 | 5.00 | -50.0 % |" in page
+    assert "The paper's gain does not appear" in page

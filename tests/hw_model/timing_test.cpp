@@ -463,3 +463,18 @@ TEST_CASE("FrameTiming's counters: one visit, unique names with units, sums and 
                                   a.stalls.interconnect + a.stalls.pipeline_fill +
                                   a.stalls.unit_idle);
 }
+
+TEST_CASE(
+    "Prediction stats never take an input's prefix (the analysis reads workload.* and "
+    "hw.* columns as the sweep's inputs)",
+    "[hw]") {
+    Prediction p;
+    p.timing.cache_hits = {1, 2, 3};
+    p.timing.cache_misses = {1, 1, 1};
+    for (const Stat& s : p.stats()) {
+        INFO(s.name);
+        CHECK(s.name.rfind("workload.", 0) != 0);
+        CHECK(s.name.rfind("hw.", 0) != 0);
+        CHECK(s.name != "fidelity");
+    }
+}

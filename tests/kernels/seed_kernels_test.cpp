@@ -1,13 +1,18 @@
 // The seed papers' alternatives as stream-tracer options: each leaves the image bit-identical,
 // appears in the trace as its own kinds of op, and only when it is on.
 
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include "hw_model/workload_shape.h"
 #include "kernels/bvh.h"
 #include "kernels/stream/entry_point.h"
 #include "kernels/stream/hit_point_reorder.h"
+#include "kernels/stream/ray_grid.h"
 #include "kernels/stream/stream_tracer.h"
 #include "tests/kernels/test_scenes.h"
 
@@ -237,4 +242,167 @@ TEST_CASE("Workload shape: reorder units exist only when the workload reorders",
     for (OpKind k : {OpKind::reorder_lod_test, OpKind::reorder_key, OpKind::reorder_sort})
         CHECK(shape.needed_kinds()[size_t(k)]);
     CHECK_FALSE(shape.needed_kinds()[size_t(OpKind::frustum_test)]);
+}
+
+TEST_CASE("RayGrid: the cut's cells hold every primitive once, none more than asked",
+          "[stream][seeds]") {
+    const Scene s = test::box_scene(test::Variant::lights);
+    const Bvh bvh(s);
+    const std::vector<BvhNode>& nodes = bvh.nodes();
+    for (uint32_t cell_prims : {1u, 4u, 16u, 1000000u}) {
+        const RayGrid grid(bvh, cell_prims);
+        INFO("cell_prims " << cell_prims);
+        uint64_t held = 0;
+        for (uint32_t c = 0; c < grid.cell_count(); ++c) {
+            const uint32_t node = grid.cell_node(c);
+            CHECK(grid.cell_of(node) == c);
+            CHECK((c == 0 || grid.cell_node(c - 1) < node));  // cells in node order
+            // The subtree's primitives: its leaves lie in [node, next node outside it).
+            uint64_t prims = 0;
+            std::vector<uint32_t> stack = {node};
+            while (!stack.empty()) {
+                const BvhNode& n = nodes[stack.back()];
+                const uint32_t i = stack.back();
+                stack.pop_back();
+                if (n.is_leaf()) {
+                    prims += n.count;
+                } else {
+                    stack.push_back(BvhNode::left(i));
+                    stack.push_back(n.right());
+                }
+            }
+            CHECK((prims <= cell_prims || nodes[node].is_leaf()));
+            held += prims;
+        }
+        CHECK(held == s.primitive_count());
+        if (cell_prims >= s.primitive_count()) {
+            CHECK(grid.cell_count() == 1);  // the root is the one cell
+            CHECK(grid.top_nodes() == 0);
+        } else {
+            CHECK(grid.cell_count() > 1);
+            CHECK(grid.top_nodes() + 1 == grid.cell_count());  // a binary tree above the cut
+        }
+    }
+}
+
+TEST_CASE(
+    "RayGrid: the image is bit-identical alone, with reordering and with AEPSA, at every SIMD "
+    "back end; primary streams are untouched",
+    "[stream][seeds]") {
+    std::vector<Isa> isas = {Isa::scalar};
+    for (const Isa isa : {Isa::avx2, Isa::avx512})
+        if (isa_supported(isa)) isas.push_back(isa);
+    for (const Scene& s : {test::box_scene(test::Variant::lights), sphere_wall()}) {
+        const Bvh bvh(s);
+        RenderSettings r = settings_for(s, 32, 24, 2, 16);
+        const Run plain = run(s, bvh, r);
+        CHECK(plain.result.stats.batch_queues == 0);
+        for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue})
+            CHECK(plain.counts.kind_ops(k) == 0);
+        for (const Isa isa : isas)
+            for (uint32_t queue : {8u, 384u}) {
+                RenderSettings g = r;
+                g.isa = isa;
+                g.batching = RayBatching::raygrid;
+                g.batching_queue = queue;
+                g.batching_cell_prims = 8;  // many cells in a small scene
+                const Run batched = run(s, bvh, g);
+                g.reorder = RayReorder::hit_point;
+                const Run with_reorder = run(s, bvh, g);
+                g.primary_entry = PrimaryEntry::aepsa;
+                const Run all_three = run(s, bvh, g);
+                g.reorder = RayReorder::none;
+                const Run with_aepsa = run(s, bvh, g);
+                INFO("scene " << s.name << " isa " << int(isa) << " queue " << queue);
+                CHECK(same_bits(plain.result.image, batched.result.image));
+                CHECK(same_bits(plain.result.image, with_reorder.result.image));
+                CHECK(same_bits(plain.result.image, with_aepsa.result.image));
+                CHECK(same_bits(plain.result.image, all_three.result.image));
+                CHECK(batched.result.stats.rays() == plain.result.stats.rays());
+                CHECK(batched.counts.rays() == plain.counts.rays());
+                for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue}) {
+                    CHECK(batched.counts.kind_ops(k) > 0);
+                    CHECK(batched.counts.kind_lanes(k, false) == 0);  // no primary ray batched
+                }
+                CHECK(batched.result.stats.batch_queues > 0);
+                // Every queued ray was walked to its cell by one enqueue lane.
+                CHECK(batched.result.stats.batch_queued_rays ==
+                      batched.counts.kind_lanes(OpKind::raygrid_enqueue));
+                if (queue == 8) CHECK(batched.result.stats.batch_full_queues > 0);
+                // Primary rays are traced as before, op for op.
+                CHECK(batched.counts.kind_lanes(OpKind::box_test, false) ==
+                      plain.counts.kind_lanes(OpKind::box_test, false));
+                CHECK(batched.counts.bounce(0).box_ops == plain.counts.bounce(0).box_ops);
+            }
+    }
+}
+
+TEST_CASE("RayGrid: a ray that hits in its first cell tests no box of a later cell",
+          "[stream][seeds]") {
+    // The sphere wall: secondary rays leave a sphere and mostly hit a neighbour or nothing.
+    // Cells walked front to back stop a ray at its hit, so the secondary box-test lanes can
+    // only fall, and the walk's bookkeeping is the price.
+    const Scene s = sphere_wall();
+    const Bvh bvh(s);
+    RenderSettings r = settings_for(s, 32, 32, 1, 32);
+    const Run plain = run(s, bvh, r);
+    r.batching = RayBatching::raygrid;
+    r.batching_cell_prims = 4;
+    const Run batched = run(s, bvh, r);
+    CHECK(same_bits(plain.result.image, batched.result.image));
+    CHECK(batched.counts.kind_lanes(OpKind::box_test, true) <
+          plain.counts.kind_lanes(OpKind::box_test, true));
+    CHECK(batched.counts.kind_lanes(OpKind::raygrid_walk, true) > 0);
+}
+
+TEST_CASE("Workload shape: RayGrid units exist only when the workload batches", "[stream][seeds]") {
+    WorkloadShape shape;
+    shape.features = test::box_scene(test::Variant::lights).features();
+    for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue})
+        CHECK_FALSE(shape.needed_kinds()[size_t(k)]);
+    shape.batching_raygrid = true;
+    for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue})
+        CHECK(shape.needed_kinds()[size_t(k)]);
+    CHECK_FALSE(shape.needed_kinds()[size_t(OpKind::reorder_key)]);
+}
+
+TEST_CASE("RayGrid: its trace is the same on any thread count and reads back from a file",
+          "[stream][seeds]") {
+    const Scene s = test::box_scene(test::Variant::lights);
+    const Bvh bvh(s);
+    RenderSettings r = settings_for(s, 24, 16, 2, 8);
+    r.batching = RayBatching::raygrid;
+    r.batching_queue = 8;
+    r.batching_cell_prims = 4;
+    const std::string base = (std::filesystem::temp_directory_path() /
+                              ("sfx_raygrid_trace_" + std::to_string(::getpid())))
+                                 .string();
+    const std::string p1 = base + "_1.trc", p2 = base + "_2.trc";
+    r.threads = 1;
+    CountingSink direct({8});
+    render_stream(s, bvh, r, &direct);
+    {
+        TraceFileWriter w(p1);
+        render_stream(s, bvh, r, &w);
+    }
+    r.threads = 2;
+    {
+        TraceFileWriter w(p2);
+        render_stream(s, bvh, r, &w);
+    }
+    auto bytes = [](const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    CHECK(bytes(p1) == bytes(p2));
+    CountingSink replayed({8});
+    read_trace_file(p1, replayed);
+    for (OpKind k : {OpKind::raygrid_walk, OpKind::raygrid_enqueue, OpKind::box_test}) {
+        CHECK(replayed.kind_ops(k) == direct.kind_ops(k));
+        CHECK(replayed.kind_lanes(k) == direct.kind_lanes(k));
+    }
+    CHECK(direct.kind_ops(OpKind::raygrid_walk) > 0);
+    CHECK(replayed.rays() == direct.rays());
+    std::filesystem::remove(p1);
+    std::filesystem::remove(p2);
 }

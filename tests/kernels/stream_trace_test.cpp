@@ -338,7 +338,7 @@ std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_co
 }
 }  // namespace
 
-TEST_CASE("Trace file version 2: the header carries the whole frame, the seed papers' options too",
+TEST_CASE("Trace file version 3: the header carries the whole frame, the seed papers' options too",
           "[stream]") {
     const Scene s = cluster_scene(true);
     const Bvh bvh(s);
@@ -346,7 +346,10 @@ TEST_CASE("Trace file version 2: the header carries the whole frame, the seed pa
     r.primary_entry = PrimaryEntry::aepsa;
     r.reorder = RayReorder::hit_point;
     r.reorder_lod_ppm = 5000;
-    TempDir dir("trace_v2");
+    r.batching = RayBatching::raygrid;
+    r.batching_queue = 8;
+    r.batching_cell_prims = 64;
+    TempDir dir("trace_v3");
     const std::string path = (dir.path / "frame.trc").string();
     {
         TraceFileWriter w(path);
@@ -354,7 +357,7 @@ TEST_CASE("Trace file version 2: the header carries the whole frame, the seed pa
     }
     CountingSink sink({8});
     const TraceHeader h = read_trace_file(path, sink);
-    CHECK(h.version == 2);
+    CHECK(h.version == 3);
     CHECK(h.width == r.width);
     CHECK(h.height == r.height);
     CHECK(h.spp == r.spp);
@@ -364,8 +367,34 @@ TEST_CASE("Trace file version 2: the header carries the whole frame, the seed pa
     CHECK(h.primary_entry == PrimaryEntry::aepsa);
     CHECK(h.reorder == RayReorder::hit_point);
     CHECK(h.reorder_lod_ppm == 5000);
+    CHECK(h.batching == RayBatching::raygrid);
+    CHECK(h.batching_queue == 8);
+    CHECK(h.batching_cell_prims == 64);
     CHECK(sink.kind_ops(OpKind::frustum_test) > 0);
     CHECK(sink.kind_ops(OpKind::reorder_key) > 0);
+    CHECK(sink.kind_ops(OpKind::raygrid_enqueue) > 0);
+}
+
+TEST_CASE("Trace file version 2 still reads: batching at its defaults", "[stream]") {
+    std::string b = "SFXTRACE";
+    put(b, uint32_t(2));
+    put(b, uint64_t(7));
+    for (uint32_t v : {4u, 4u, 1u, 4u, 3u}) put(b, v);  // width height spp tile max_depth
+    put(b, uint64_t(0));                                // seed
+    b += char(PrimaryEntry::aepsa);
+    b += char(RayReorder::hit_point);
+    put(b, uint32_t(5000));  // reorder_lod_ppm: the last field of version 2
+    b += 'F';
+    const TempDir dir("sfx-trace-v2");
+    const std::string path = (dir.path / "v2.trc").string();
+    std::ofstream(path, std::ios::binary) << b;
+    CountingSink sink({8});
+    const TraceHeader h = read_trace_file(path, sink);
+    CHECK(h.version == 2);
+    CHECK(h.reorder == RayReorder::hit_point);
+    CHECK(h.reorder_lod_ppm == 5000);
+    CHECK(h.batching == RayBatching::none);
+    CHECK(h.batching_queue == TraceFrame{}.batching_queue);
 }
 
 TEST_CASE("Trace file: a damaged file is an InputError naming the byte, never a huge allocation",

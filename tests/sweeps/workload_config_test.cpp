@@ -30,9 +30,19 @@ InputError field_error(const std::string& field, const std::string& value) {
 }  // namespace
 
 TEST_CASE("Workload fields: one list, strict values, columns in the same order", "[workload]") {
-    const std::vector<std::string> names = {"scene",   "width",          "height", "spp",
-                                            "depth",   "tile",           "seed",   "primary_entry",
-                                            "reorder", "reorder_lod_ppm"};
+    const std::vector<std::string> names = {"scene",
+                                            "width",
+                                            "height",
+                                            "spp",
+                                            "depth",
+                                            "tile",
+                                            "seed",
+                                            "primary_entry",
+                                            "reorder",
+                                            "reorder_lod_ppm",
+                                            "batching",
+                                            "batching_queue",
+                                            "batching_cell_prims"};
     CHECK(workload_field_names() == names);
     WorkloadConfig w;
     set_workload_field(w, "scene", "cornell", "f", 1, "k");
@@ -54,7 +64,7 @@ TEST_CASE("Workload fields: one list, strict values, columns in the same order",
     CHECK(unknown.key() == "workload.tiles");
     CHECK(unknown.message() ==
           "no such workload field (scene, width, height, spp, depth, tile, seed, primary_entry, "
-          "reorder, reorder_lod_ppm, res)");
+          "reorder, reorder_lod_ppm, batching, batching_queue, batching_cell_prims, res)");
     CHECK(field_error("depth", "1001").message() == "expected an integer in [0, 1000], got '1001'");
     CHECK(field_error("tile", "0").message() ==
           "expected an integer in [1, 4096] or auto, got '0'");
@@ -67,6 +77,11 @@ TEST_CASE("Workload fields: one list, strict values, columns in the same order",
     CHECK(field_error("reorder", "morton").message() == "expected none|hit_point, got 'morton'");
     CHECK(field_error("reorder_lod_ppm", "0").message() ==
           "expected an integer in [1, 1000000], got '0'");
+    CHECK(field_error("batching", "octree").message() == "expected none|raygrid, got 'octree'");
+    CHECK(field_error("batching_queue", "0").message() ==
+          "expected an integer in [1, 16777216], got '0'");
+    CHECK(field_error("batching_cell_prims", "0").message() ==
+          "expected an integer in [1, 4294967295], got '0'");
 
     w.tile = 16;
     const std::vector<WorkloadColumn> columns = workload_columns(w);
@@ -102,6 +117,19 @@ TEST_CASE("Workload options: render settings, and absent from a point's YAML at 
     const std::string ryaml = point_config_yaml(HwConfig(), r, Fidelity::full);
     CHECK(ryaml.find("reorder_lod_ppm: 500") != std::string::npos);
     CHECK(parse_point_config(ryaml, "row").workload == r);
+    CHECK(plain.find("batching") == std::string::npos);
+    WorkloadConfig g = w;
+    set_workload_field(g, "batching", "raygrid", "f", 1, "k");
+    set_workload_field(g, "batching_queue", "64", "f", 1, "k");
+    set_workload_field(g, "batching_cell_prims", "512", "f", 1, "k");
+    CHECK(g != w);
+    CHECK(g.render_settings().batching == RayBatching::raygrid);
+    CHECK(g.render_settings().batching_queue == 64);
+    CHECK(g.render_settings().batching_cell_prims == 512);
+    const std::string gyaml = point_config_yaml(HwConfig(), g, Fidelity::full);
+    CHECK(gyaml.find("batching: \"raygrid\"") != std::string::npos);
+    CHECK(gyaml.find("batching_queue: 64") != std::string::npos);
+    CHECK(parse_point_config(gyaml, "row").workload == g);
 }
 
 TEST_CASE("resolve_workload: the scene's depth, tile auto and tile fits, as the model sees them",
