@@ -121,6 +121,11 @@ def _paper_section(store: Store, tables, plots) -> str:
     return paper_module.html_section(store)  # empty without the paper's scenes
 
 
+def _seed_options_section(store: Store, tables, plots) -> str:
+    from . import seed_kernels
+    return seed_kernels.html_section(store)  # empty when no point has an option on
+
+
 # The page, top to bottom: each section is a function (store, tables, plots) -> HTML. A new
 # kind of answer adds its function here.
 SECTIONS: List[Callable[[Store, list, list], str]] = [
@@ -128,6 +133,7 @@ SECTIONS: List[Callable[[Store, list, list], str]] = [
     _plots_section,
     _tables_section,
     _paper_section,
+    _seed_options_section,
 ]
 
 

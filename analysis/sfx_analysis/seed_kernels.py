@@ -411,3 +411,48 @@ def write_page(store: Store, path: str, command: str = "") -> None:
         f.write(text)
     import os
     os.replace(tmp, path)
+
+
+# The report's columns for the options, in order: (store column, heading, digits).
+REPORT_COLUMNS = [("fps", "fps", 1),
+                  ("ideal_simd_utilization.secondary.traversal", "ideal sec. trav. util", 2),
+                  ("trace.box_tests_per_ray.primary", "box tests / primary ray", 1),
+                  ("trace.box_tests_per_ray.secondary", "box tests / sec. ray", 1),
+                  ("scene_cache.l1.hit_rate", "L1 hit rate", 3),
+                  ("scene_cache.l2.hit_rate", "L2 hit rate", 3),
+                  ("op_mix.option_percent", "options' overhead %", 1)]
+REPORT_MAX_ROWS = 80
+
+
+def html_section(store: Store) -> str:
+    """The report's section: with and without each seed-paper option, side by side. Empty when
+    every point of the store has every option off."""
+    import html
+    df = store.points
+    options = [c for c in OFF if c in df.columns]
+    if not options or all((df[c].fillna(OPTION_DEFAULTS[c]) == OFF[c]).all() for c in options):
+        return ""
+    df = _points(store)
+    group = [c for c in ["workload.scene", "workload.tile", "hw.simd.width", "fidelity"]
+             if c in df.columns] + [c for c in OPTION_DEFAULTS if c in df.columns]
+    cols = [(c, h, d) for c, h, d in REPORT_COLUMNS if c in df.columns]
+    agg = df.groupby(group, dropna=False)[[c for c, _, _ in cols]].mean().reset_index()
+    shown = agg.head(REPORT_MAX_ROWS)
+    e = html.escape
+    head = "".join(f"<th>{e(c.split('.', 1)[-1])}</th>" for c in group) + \
+        "".join(f"<th>{e(h)}</th>" for _, h, _ in cols)
+    rows = []
+    for _, r in shown.iterrows():
+        cells = [str(int(r[c])) if isinstance(r[c], float) and float(r[c]).is_integer()
+                 else str(r[c]) for c in group] + [_num(r[c], d) for c, _, d in cols]
+        rows.append("<tr>" + "".join(f"<td>{e(x)}</td>" for x in cells) + "</tr>")
+    more = (f"<p>{len(agg) - len(shown)} more rows in points.csv.</p>"
+            if len(agg) > len(shown) else "")
+    return "\n".join([
+        "<h2>Seed-paper options</h2>",
+        "<p>AEPSA entry points (<code>primary_entry</code>), hit-point reordering "
+        "(<code>reorder</code>) and RayGrid batching (<code>batching</code>), each with its "
+        "parameters, as the store's points have them; means over the other inputs. The options "
+        "never change the image; <code>scripts/seed-kernels</code> compares each with its "
+        "paper (<code>docs/seed-kernels.md</code>).</p>",
+        f'<table class="paper"><tr>{head}</tr>' + "".join(rows) + "</table>", more])

@@ -65,3 +65,19 @@ def test_raygrid_section_pairs_by_batching_and_reads_bounce_steps(tmp_path):
     assert "| conference | 32 | 16 | 50.0 | 40.0 | 50.0 | 50.0 | 50.0 / 25.0 | 50.0 / 25.0 | 20.0 | 10 | 55.0 | 30.0 | 80.0 | 66.7 | -16.7 % |" in page
     assert "| conference | 1 | 14.0 | 8.0 | 2.0 | 2.0 | 2.50 | 5.00 | -50.0 % |" in page
     assert "The paper's gain does not appear" in page
+
+
+def test_report_section_shows_options_side_by_side(tmp_path):
+    from sfx_analysis.seed_kernels import html_section
+    points = [seed_point("root", "none", 40.0, 40.0, 1000.0),
+              seed_point("aepsa", "none", 44.0, 30.0, 1000.0, option=1.5, depth=2.25)]
+    store = load_store(write_store(str(tmp_path / "s.db"), points))
+    section = html_section(store)
+    assert "<h2>Seed-paper options</h2>" in section
+    # One row per option combination: fps, then box tests per primary ray.
+    assert "<td>aepsa</td><td>none</td>" in section
+    assert "<td>44.0</td>" in section and "<td>30.0</td>" in section
+    # A store with every option off has no such section.
+    plain = load_store(write_store(str(tmp_path / "p.db"),
+                                   [seed_point("root", "none", 40.0, 40.0, 1000.0)]))
+    assert html_section(plain) == ""
