@@ -10,6 +10,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -110,6 +111,26 @@ inline std::string join(const std::string& prefix, const std::string& name) {
     return prefix.empty() ? name : prefix + "." + name;
 }
 
+// Checks a mapping's keys against the allowed ones: an unknown key (the allowed ones listed)
+// or a repeated key is an InputError naming file, line and dotted key. The one key rule of
+// every reader: scenes, sweeps, and hardware configurations (YamlReader::finish).
+inline void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
+                       const std::vector<std::string>& allowed) {
+    std::set<std::string> seen;
+    for (const auto& kv : map) {
+        const std::string key = kv.first.Scalar();
+        const std::string dotted = join(prefix, key);
+        if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+            std::string list;
+            for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+            throw InputError(file, line_of(kv.first), dotted,
+                             "unknown key (allowed: " + list + ")");
+        }
+        if (!seen.insert(key).second)
+            throw InputError(file, line_of(kv.first), dotted, "duplicate key");
+    }
+}
+
 // Reads a YAML map into a config: every key must be visited, every value must parse and lie
 // in range. Absent keys keep their defaults.
 class YamlReader {
@@ -172,14 +193,8 @@ class YamlReader {
         }
     }
     void finish() const {
-        std::set<std::string> keys;
-        for (const auto& kv : m_node) {
-            const std::string key = kv.first.as<std::string>();
-            if (!m_seen.count(key))
-                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "unknown key");
-            if (!keys.insert(key).second)
-                throw InputError(m_file, line_of(kv.first), join(m_prefix, key), "duplicate key");
-        }
+        check_keys(m_node, m_file, m_prefix,
+                   std::vector<std::string>(m_seen.begin(), m_seen.end()));
     }
 
   private:

@@ -42,21 +42,7 @@ constexpr size_t k_max_points = 10000;
 
 using strict_yaml::line_of;
 
-// Checks a mapping's keys against an allowed list: unknown and duplicate keys are errors.
-void check_keys(const YAML::Node& map, const std::string& file, const std::string& prefix,
-                const std::vector<std::string>& allowed) {
-    std::set<std::string> seen;
-    for (const auto& kv : map) {
-        const std::string key = kv.first.as<std::string>();
-        const std::string dotted = prefix.empty() ? key : prefix + "." + key;
-        if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-            std::string list;
-            for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-            throw InputError(file, line_of(kv.first), dotted, "unknown key (expected one of: " + list + ")");
-        }
-        if (!seen.insert(key).second) throw InputError(file, line_of(kv.first), dotted, "duplicate key");
-    }
-}
+using strict_yaml::check_keys;
 
 std::string scalar(const YAML::Node& n, const std::string& file, const std::string& key) {
     if (!n.IsScalar()) throw InputError(file, line_of(n), key, "expected a single value");

@@ -47,20 +47,10 @@ public:
     void check_map(const YAML::Node& node, const std::string& path,
                    const std::set<std::string>& allowed, const std::set<std::string>& required) const {
         if (!node.IsMap()) fail(node, path, "expected a mapping");
-        std::set<std::string> seen;
-        for (auto it = node.begin(); it != node.end(); ++it) {
-            if (!it->first.IsScalar()) fail(it->first, path, "keys must be plain names");
-            const std::string key = it->first.Scalar();
-            const std::string full = join(path, key);
-            if (!allowed.count(key)) {
-                std::string list;
-                for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-                fail(it->first, full, "unknown key (allowed: " + list + ")");
-            }
-            if (!seen.insert(key).second) fail(it->first, full, "duplicate key");
-        }
+        strict_yaml::check_keys(node, m_file, path,
+                                std::vector<std::string>(allowed.begin(), allowed.end()));
         for (const std::string& r : required)
-            if (!seen.count(r)) fail(node, join(path, r), "missing required key");
+            if (!node[r]) fail(node, join(path, r), "missing required key");
     }
 
     // Numbers follow the rules of every YAML reader (base/strict_yaml.h): a quoted "1.5" is

@@ -106,6 +106,15 @@ TEST_CASE("Hardware numbers follow the rules of every YAML reader (base/strict_y
     CHECK(parse_hw_config("clock:\n  core_mhz: 5e2\n", "ok.hw.yaml").clock.core_mhz == 500);
 }
 
+TEST_CASE("An unknown key lists the allowed ones, as every YAML reader does", "[hw_config]") {
+    const InputError e = parse_error("simd:\n  lanes: 8\n");
+    CHECK(e.line() == 2);
+    CHECK(e.key() == "simd.lanes");
+    // base/strict_yaml.h's check_keys: the same words for scenes and sweeps.
+    CHECK_THAT(e.message(), Catch::StartsWith("unknown key (allowed: ") &&
+                                Catch::Contains("units") && Catch::Contains("width"));
+}
+
 TEST_CASE("Parameters are flattened to dotted names and set by path", "[hw_config]") {
     HwConfig c;
     const std::vector<HwParamInfo> params = flatten_hw_config(c);
