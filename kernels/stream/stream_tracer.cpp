@@ -61,6 +61,26 @@ struct RayBuffers {
     }
 };
 
+// Stable partition of ids[0, len) by mask (passing ids first, in order; failing ones after,
+// through `spill`) for the scalar traversals of the seed options (the RayGrid walk, the
+// reordering's proxy hierarchy). Returns the passing count; `negative` counts the passing
+// rays whose direction is negative on `axis` (the front-child vote).
+uint32_t partition_and_vote(uint32_t* ids, uint32_t len, const uint8_t* mask, uint32_t* spill,
+                            const RayPrecomp* pre, int axis, uint32_t& negative) {
+    uint32_t passed = 0, spilled = 0;
+    for (uint32_t j = 0; j < len; ++j) {
+        const uint32_t id = ids[j];
+        if (!mask[j]) {
+            spill[spilled++] = id;
+            continue;
+        }
+        ids[passed++] = id;
+        negative += pre[id].dir[axis] < 0.f;
+    }
+    std::copy(spill, spill + spilled, ids + passed);
+    return passed;
+}
+
 // The box filter of Fig. 5 by the back end's kernel: passing ids first, failing ids after
 // them (the prefix [0, len) keeps its set of ids, so the streams on the stack stay valid).
 template <class Trace>
@@ -277,17 +297,9 @@ struct StreamTracer::Impl {
             trace.op(OpKind::raygrid_walk, generation, node_index, g.ids.data(), len, g.mask.data(),
                      passed);
             if (passed == 0 || cell != RayGrid::k_no_cell) continue;
-            uint32_t front = 0, spilled = 0, negative = 0;
-            for (uint32_t j = 0; j < len; ++j) {  // passing ids first, in order
-                const uint32_t id = g.ids[j];
-                if (!g.mask[j]) {
-                    g.spill[spilled++] = id;
-                    continue;
-                }
-                g.ids[front++] = id;
-                negative += b.pre[id].dir[node.axis] < 0.f;
-            }
-            std::copy(g.spill.begin(), g.spill.begin() + spilled, g.ids.begin() + front);
+            uint32_t negative = 0;
+            partition_and_vote(g.ids.data(), len, g.mask.data(), g.spill.data(), b.pre.data(),
+                               node.axis, negative);
             const bool right_first = 2 * negative > passed;
             const uint32_t left = BvhNode::left(node_index), right = node.right();
             g.stack.push_back({right_first ? left : right, passed});
@@ -420,7 +432,6 @@ struct StreamTracer::Impl {
             const auto [node_index, len] = r.stack.back();
             r.stack.pop_back();
             const BvhNode& node = nodes[node_index];
-            uint32_t passed = 0, spilled = 0, negative = 0;
             for (uint32_t j = 0; j < len; ++j) {
                 const uint32_t id = r.ids[j];
                 r.entry[id] = intersect_box(r.pre[id], node.bounds, r.t[id]);
@@ -428,16 +439,10 @@ struct StreamTracer::Impl {
             }
             trace.op(OpKind::reorder_lod_test, generation, node_index, r.ids.data(), len,
                      r.mask.data(), uint32_t(std::count(r.mask.begin(), r.mask.begin() + len, 1)));
-            for (uint32_t j = 0; j < len; ++j) {  // passing ids first, in order
-                const uint32_t id = r.ids[j];
-                if (!r.mask[j]) {
-                    r.spill[spilled++] = id;
-                    continue;
-                }
-                r.ids[passed++] = id;
-                negative += r.pre[id].dir[node.axis] < 0.f;
-            }
-            std::copy(r.spill.begin(), r.spill.begin() + spilled, r.ids.begin() + passed);
+            uint32_t negative = 0;
+            const uint32_t passed = partition_and_vote(r.ids.data(), len, r.mask.data(),
+                                                       r.spill.data(), r.pre.data(), node.axis,
+                                                       negative);
             if (passed == 0) continue;
             if (reorder->is_proxy(node_index)) {
                 // A proxy box hit from outside: the nearest so far is the approximate hit.
