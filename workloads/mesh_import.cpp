@@ -8,8 +8,10 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -29,12 +31,54 @@ bool finite_number(const std::string& token) {
            token.find_first_of("xXpP") == std::string::npos;  // no hex floats either
 }
 
+// A PLY header's elements, as far as the body checks need them.
+struct PlyProperty {
+    bool list = false;
+    std::string count_type;  // a list's count type
+    std::string value_type;  // the property's type, or a list's item type
+};
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+struct PlyLayout {
+    std::string format;
+    std::vector<PlyElement> elements;
+    size_t body = 0;  // offset of the first byte after the end_header line
+    int body_line = 0;
+};
+
+// Bytes of a PLY scalar type in a binary body.
+size_t ply_type_size(const std::string& type) {
+    static const std::map<std::string, size_t> sizes = {
+        {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+        {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
+        {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+    return sizes.at(type);
+}
+
+// Largest list length a count type can hold.
+uint64_t ply_count_max(const std::string& type) {
+    switch (ply_type_size(type)) {
+        case 1:
+            return type == "char" || type == "int8" ? 127 : 255;
+        case 2:
+            return type == "short" || type == "int16" ? 32767 : 65535;
+        default:
+            return type == "int" || type == "int32" ? 2147483647ull : 4294967295ull;
+    }
+}
+
 // assimp 5.2 loops for ever on some malformed PLY headers (a second `format` line, an
 // unknown keyword, no end_header): the header is checked against the PLY grammar first.
-void check_ply_header(const std::string& text) {
+PlyLayout check_ply_header(const std::string& text) {
     static const std::set<std::string> types = {
         "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    static const std::set<std::string> count_types = {"char",  "uchar",  "short", "ushort",
+                                                      "int",   "uint",   "int8",  "uint8",
+                                                      "int16", "uint16", "int32", "uint32"};
     auto fail = [](int line, const std::string& what) {
         throw std::runtime_error("line " + std::to_string(line) + ": not a PLY header: " + what);
     };
@@ -52,10 +96,11 @@ void check_ply_header(const std::string& text) {
     if (text.compare(after, 1, "\n") != 0 && text.compare(after, 2, "\r\n") != 0)
         fail(1 + int(std::count(text.begin(), text.begin() + long(header_end), '\n')),
              "end_header must end its line");
+    PlyLayout layout;
+    layout.body = text.find('\n', after) + 1;
     std::istringstream in(text.substr(0, header_end));
     std::string row;
     int line = 0;
-    bool element = false;
     while (std::getline(in, row)) {
         ++line;
         if (!row.empty() && row.back() == '\r') row.pop_back();
@@ -70,19 +115,28 @@ void check_ply_header(const std::string& text) {
                 fail(line,
                      "the second line must be 'format ascii|binary_little_endian|binary_big_endian "
                      "1.0'");
+            layout.format = t[1];
         } else if (t.empty() || t[0] == "comment" || t[0] == "obj_info") {
         } else if (t[0] == "element") {
             if (t.size() != 3 || t[2].find_first_not_of("0123456789") != std::string::npos ||
                 t[2].size() > 10)
                 fail(line, "expected 'element NAME COUNT'");
-            element = true;
+            // assimp 5.2 reads the count of an element whose name it does not know from the
+            // front of the name (found by fuzzing: "element 4294967295vertex 5").
+            if (std::isdigit(static_cast<unsigned char>(t[1][0])))
+                fail(line, "an element's name must not start with a digit");
+            layout.elements.push_back({t[1], std::stoull(t[2]), {}});
         } else if (t[0] == "property") {
             const bool list =
                 t.size() == 5 && t[1] == "list" && types.count(t[2]) && types.count(t[3]);
-            if (!element || !(list || (t.size() == 3 && types.count(t[1]))))
+            if (layout.elements.empty() || !(list || (t.size() == 3 && types.count(t[1]))))
                 fail(line,
                      "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an "
                      "element");
+            if (list && !count_types.count(t[2]))
+                fail(line, "a list's count type must be an integer type, not '" + t[2] + "'");
+            layout.elements.back().properties.push_back(list ? PlyProperty{true, t[2], t[3]}
+                                                             : PlyProperty{false, "", t[1]});
         } else {
             fail(line, "unknown keyword '" + t[0] + "'");
         }
@@ -90,6 +144,88 @@ void check_ply_header(const std::string& text) {
     // end_header must be a line of its own, after a newline.
     if (header_end == 0 || text[header_end - 1] != '\n')
         fail(line + 1, "end_header must start a line");
+    layout.body_line = line + 2;
+    return layout;
+}
+
+// assimp 5.2 sizes its arrays from the counts a PLY file states (each element's count, each
+// list's count) before reading what follows: a count of billions in a small file takes
+// gigabytes (found by fuzzing: regressions/mesh_ply/). The body is walked as the header lays it
+// out, and every count must fit in what is left of the file.
+void check_ply_body(const std::string& text, const PlyLayout& layout) {
+    const std::string where = layout.format == "ascii" ? "line " : "byte ";
+    auto fail = [&](uint64_t at, const std::string& what) {
+        throw std::runtime_error(where + std::to_string(at) + ": " + what);
+    };
+    for (const PlyElement& e : layout.elements)
+        if (e.properties.empty() && e.count > text.size() - layout.body)
+            fail(layout.format == "ascii" ? uint64_t(layout.body_line) : layout.body,
+                 "element '" + e.name + "' states " + std::to_string(e.count) +
+                     " instances without properties; more than the file could hold");
+    if (layout.format == "ascii") {
+        // Tokens of the body with their line numbers.
+        std::vector<std::pair<std::string, int>> tokens;
+        std::istringstream in(text.substr(layout.body));
+        int line = layout.body_line;
+        for (std::string row; std::getline(in, row); ++line) {
+            std::istringstream words(row);
+            for (std::string w; words >> w;) tokens.emplace_back(w, line);
+        }
+        size_t next = 0;
+        auto ran_out = [&](const PlyElement& e, uint64_t i) {
+            fail(uint64_t(line), "the body ends in instance " + std::to_string(i) + " of the " +
+                                     std::to_string(e.count) + " '" + e.name + "' elements");
+        };
+        for (const PlyElement& e : layout.elements) {
+            for (uint64_t i = 0; i < e.count; ++i) {
+                for (const PlyProperty& p : e.properties) {
+                    if (next >= tokens.size()) ran_out(e, i);
+                    if (!p.list) {
+                        ++next;
+                        continue;
+                    }
+                    const auto& [count, at] = tokens[next++];
+                    if (count.empty() || count.size() > 10 ||
+                        count.find_first_not_of("0123456789") != std::string::npos ||
+                        std::stoull(count) > ply_count_max(p.count_type))
+                        fail(uint64_t(at),
+                             "'" + count + "' is not a list length of type " + p.count_type);
+                    if (std::stoull(count) > tokens.size() - next)
+                        fail(uint64_t(at),
+                             "a list of " + count + " items, more than the file has left");
+                    next += std::stoull(count);
+                }
+            }
+        }
+        return;
+    }
+    const bool big_endian = layout.format == "binary_big_endian";
+    size_t at = layout.body;
+    for (const PlyElement& e : layout.elements) {
+        for (uint64_t i = 0; i < e.count; ++i) {
+            for (const PlyProperty& p : e.properties) {
+                const size_t size = ply_type_size(p.list ? p.count_type : p.value_type);
+                if (size > text.size() - at)
+                    fail(at, "the body ends in instance " + std::to_string(i) + " of the " +
+                                 std::to_string(e.count) + " '" + e.name + "' elements");
+                if (!p.list) {
+                    at += size;
+                    continue;
+                }
+                uint64_t count = 0;
+                for (size_t b = 0; b < size; ++b) {
+                    const size_t byte = big_endian ? at + b : at + size - 1 - b;
+                    count = count << 8 | static_cast<unsigned char>(text[byte]);
+                }
+                // A negative count in a signed type reads as a huge one here, and is refused.
+                if (count > ply_count_max(p.count_type) ||
+                    count > (text.size() - at - size) / ply_type_size(p.value_type))
+                    fail(at, "a list of " + std::to_string(count) +
+                                 " items, more than the file has left");
+                at += size + count * ply_type_size(p.value_type);
+            }
+        }
+    }
 }
 
 // assimp's number reader takes "1.#INF" (an old C library's infinity) as 1 and "0x1p200" as 0:
@@ -101,7 +237,7 @@ void check_text_formats(const std::string& path) {
     const std::string text = read_input_file(path, "mesh");
     const bool obj = ext == ".obj";
     if (ext == ".ply" || text.compare(0, 4, "ply\n") == 0 || text.compare(0, 5, "ply\r\n") == 0)
-        check_ply_header(text);
+        check_ply_body(text, check_ply_header(text));
     const bool ascii_ply =
         text.compare(0, 3, "ply") == 0 && text.find("format ascii") < text.find("end_header");
     if (!obj && !ascii_ply) return;

@@ -162,3 +162,59 @@ TEST_CASE("mesh import: a PLY face without indices or with an index past the ver
     CHECK_THROWS_WITH(import_text("far_index.ply", header + "3 0 1 7\n"),
                       Contains("face 1 names vertex 7 of 3"));
 }
+
+// Found by the mesh_ply fuzzer (regressions/mesh_ply/): assimp sizes its arrays from the
+// counts a PLY file states, so a count of billions in a small file took gigabytes.
+TEST_CASE("mesh import: a PLY count larger than the file is refused before assimp reads it",
+          "[workloads]") {
+    using Catch::Matchers::Contains;
+    auto import_text = [](const std::string& name, const std::string& text) {
+        const fs::path p = test_dir() / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return import_mesh(p.string());
+    };
+    const std::string vertices =
+        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string ascii = "ply\nformat ascii 1.0\n" + vertices +
+                              "element face 1\nproperty list uint int vertex_indices\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\n";
+    CHECK(import_text("ok.ply", ascii + "3 0 1 2\n").triangle_count() == 1);
+    CHECK_THROWS_WITH(import_text("long_list.ply", ascii + "4000000000 0 1 2\n"),
+                      Contains("line 13: a list of 4000000000 items, more than the file has left"));
+    CHECK_THROWS_WITH(import_text("past_type.ply", ascii + "8888888888888888888888888 0 1 2\n"),
+                      Contains("line 13: '8888888888888888888888888' is not a list length"));
+    CHECK_THROWS_WITH(import_text("short.ply", ascii),
+                      Contains("the body ends in instance 0 of the 1 'face' elements"));
+    CHECK_THROWS_WITH(
+        import_text("many.ply", "ply\nformat ascii 1.0\n" + vertices +
+                                    "element face 4000000000\nproperty list uchar int v\n"
+                                    "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+        Contains("the body ends in instance 1 of the 4000000000 'face' elements"));
+    CHECK_THROWS_WITH(import_text("empty_elements.ply", "ply\nformat ascii 1.0\n" + vertices +
+                                                            "element nothing 4000000000\n"
+                                                            "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
+                      Contains("'nothing' states 4000000000 instances without properties"));
+    CHECK_THROWS_WITH(import_text("float_count.ply",
+                                  "ply\nformat ascii 1.0\n" + vertices +
+                                      "element face 1\nproperty list float int v\nend_header\n"),
+                      Contains("line 8: not a PLY header: a list's count type must be an integer"));
+    CHECK_THROWS_WITH(
+        import_text("digit_name.ply",
+                    "ply\nformat ascii 1.0\nelement 4294967295vertex 3\n"
+                    "property float x\nend_header\n0\n1\n2\n"),
+        Contains("line 3: not a PLY header: an element's name must not start with a digit"));
+    // Binary: three vertices, then a face whose uint count says four billion.
+    std::string binary = "ply\nformat binary_little_endian 1.0\n" + vertices +
+                         "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+    const size_t body = binary.size();
+    binary += std::string(36, '\0') + std::string("\x00\x28\x6b\xee", 4) + std::string(12, '\0');
+    CHECK_THROWS_WITH(import_text("long_list_binary.ply", binary),
+                      Contains("byte " + std::to_string(body + 36) +
+                               ": a list of 4000000000 items, more than the file has left"));
+    binary.replace(body + 36, 4, std::string("\x03\x00\x00\x00", 4));
+    binary.replace(body + 40, 12,
+                   std::string("\x00\x00\x00\x00\x01\x00\x00\x00\x02\x00\x00\x00", 12));
+    CHECK(import_text("ok_binary.ply", binary).triangle_count() == 1);
+    CHECK_THROWS_WITH(import_text("short_binary.ply", binary.substr(0, binary.size() - 1)),
+                      Contains("a list of 3 items, more than the file has left"));
+}
