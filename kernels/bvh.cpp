@@ -24,6 +24,16 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : m_scene(&scene) {
         return;
     }
     build(0, n, prim_bounds, centroids, options, 0);
+    m_leaf.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t prim = m_prim_ids[i];
+        m_leaf[i].prim = prim;
+        if (scene.is_sphere(prim)) continue;
+        const Triangle& tri = scene.triangles[prim];
+        m_leaf[i].p0 = scene.positions[tri.v0];
+        m_leaf[i].p1 = scene.positions[tri.v1];
+        m_leaf[i].p2 = scene.positions[tri.v2];
+    }
 }
 
 uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& prim_bounds,
@@ -130,16 +140,16 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& pr
     return index;
 }
 
-bool Bvh::intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const {
-    const Scene& s = *m_scene;
+namespace {
+// The primitive test behind both entry points: `vertices` is the triangle's, or null for a
+// sphere.
+bool test_primitive(const Scene& s, const RayPrecomp& r, uint32_t prim, const Vec3* p0,
+                    const Vec3* p1, const Vec3* p2, float t_max, Hit& hit) {
     float t, u = 0.f, v = 0.f;
     if (s.is_sphere(prim)) {
         if (!intersect_sphere(r, s.sphere(prim), t_max, t)) return false;
-    } else {
-        const Triangle& tri = s.triangles[prim];
-        if (!intersect_triangle(r, s.positions[tri.v0], s.positions[tri.v1], s.positions[tri.v2],
-                                t_max, t, u, v))
-            return false;
+    } else if (!intersect_triangle(r, *p0, *p1, *p2, t_max, t, u, v)) {
+        return false;
     }
     if (!closer(t, prim, hit)) return false;
     hit.t = t;
@@ -147,6 +157,20 @@ bool Bvh::intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, H
     hit.v = v;
     hit.prim = prim;
     return true;
+}
+}  // namespace
+
+bool Bvh::intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const {
+    const Scene& s = *m_scene;
+    if (s.is_sphere(prim)) return test_primitive(s, r, prim, nullptr, nullptr, nullptr, t_max, hit);
+    const Triangle& tri = s.triangles[prim];
+    return test_primitive(s, r, prim, &s.positions[tri.v0], &s.positions[tri.v1],
+                          &s.positions[tri.v2], t_max, hit);
+}
+
+bool Bvh::intersect_leaf_primitive(const RayPrecomp& r, uint32_t i, float t_max, Hit& hit) const {
+    const LeafPrimitive& l = m_leaf[i];
+    return test_primitive(*m_scene, r, l.prim, &l.p0, &l.p1, &l.p2, t_max, hit);
 }
 
 template <class Counts>
@@ -166,7 +190,7 @@ Hit Bvh::intersect(const Ray& ray, Counts& counts) const {
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
                 counts.primitive();
-                if (intersect_primitive(r, m_prim_ids[i], t_max, hit)) t_max = hit.t;
+                if (intersect_leaf_primitive(r, i, t_max, hit)) t_max = hit.t;
             }
         } else {
             const bool right_first = visit_right_first(node, r.dir);
@@ -194,7 +218,7 @@ bool Bvh::occluded(const Ray& ray) const {
         if (intersect_box(r, node.bounds, ray.t_max) == INFINITY) continue;
         if (node.is_leaf()) {
             for (uint32_t i = node.first; i < node.first + node.count; ++i)
-                if (intersect_primitive(r, m_prim_ids[i], ray.t_max, hit)) return true;
+                if (intersect_leaf_primitive(r, i, ray.t_max, hit)) return true;
         } else {
             stack[top++] = node.right();
             stack[top++] = BvhNode::left(index);

@@ -45,6 +45,16 @@ struct BvhStats {
     uint64_t bytes = 0;
 };
 
+// One primitive of Bvh::prim_ids' order with its triangle's vertices beside it: a leaf's
+// primitives are one contiguous block, read without going through prim_ids, Scene::triangles
+// and Scene::positions (three dependent cache misses a primitive on scattered rays). A
+// sphere's vertices are unused. The same vertex values, so the same bits.
+struct LeafPrimitive {
+    Vec3 p0, p1, p2;
+    uint32_t prim = 0;
+};
+static_assert(sizeof(LeafPrimitive) == 40, "LeafPrimitive: three vertices and an id");
+
 // Counting policies of Bvh::intersect: none (compiles away), or box and primitive tests.
 struct NoTraversalCounts {
     void box() {}
@@ -66,6 +76,8 @@ public:
 
     const std::vector<BvhNode>& nodes() const { return m_nodes; }
     const std::vector<uint32_t>& prim_ids() const { return m_prim_ids; }
+    // prim_ids' primitives with their vertices, in the same order (LeafPrimitive).
+    const std::vector<LeafPrimitive>& leaf_primitives() const { return m_leaf; }
     const Scene& scene() const { return *m_scene; }
     BvhStats stats() const;
 
@@ -82,6 +94,8 @@ public:
 
     // One primitive test (used by both tracers, so both compute the same bits).
     bool intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const;
+    // The same test of the primitive at position i of prim_ids, from leaf_primitives().
+    bool intersect_leaf_primitive(const RayPrecomp& r, uint32_t i, float t_max, Hit& hit) const;
 
 private:
     uint32_t build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& prim_bounds,
@@ -91,6 +105,7 @@ private:
     const Scene* m_scene = nullptr;
     std::vector<BvhNode> m_nodes;
     std::vector<uint32_t> m_prim_ids;
+    std::vector<LeafPrimitive> m_leaf;
 };
 
 // Front child first: the child on the side the direction comes from.

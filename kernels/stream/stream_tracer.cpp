@@ -119,7 +119,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
               uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
     const std::vector<BvhNode>& nodes = bvh.nodes();
-    const std::vector<uint32_t>& prim_ids = bvh.prim_ids();
+    const LeafPrimitive* leaf = bvh.leaf_primitives().data();
     const Scene& scene = bvh.scene();
     uint32_t* ids = b.trav_ids.data();
     uint8_t* mask = b.mask.data();
@@ -140,6 +140,11 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
         if (!node.is_leaf()) {  // the children arrive while this node's filter runs
             __builtin_prefetch(&nodes[BvhNode::left(node_index)]);
             __builtin_prefetch(&nodes[node.right()]);
+        } else {  // and a leaf's primitives (four by default: 160 bytes)
+            const char* first = reinterpret_cast<const char*>(&leaf[node.first]);
+            const char* last = reinterpret_cast<const char*>(&leaf[node.first + node.count]) - 1;
+            for (const char* p = first; p < last; p += 64) __builtin_prefetch(p);
+            __builtin_prefetch(last);
         }
         uint32_t negative = 0;
         const uint32_t k = box_filter(kernels, trace, node, node_index, generation, rays.view(),
@@ -148,12 +153,13 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
         if (node.is_leaf()) {
             const uint64_t leaf_start = leaf_tsc ? __rdtsc() : 0;
             for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                const uint32_t prim = prim_ids[i];
+                const LeafPrimitive& leaf_prim = leaf[i];
+                const uint32_t prim = leaf_prim.prim;
                 // Closest hit: later tests need t or less. Any hit: the ray is done, and with
                 // t = -1 every later box and primitive test misses it.
                 auto test = [&](uint32_t id) {
                     float& t = rays.t(id);
-                    if (!bvh.intersect_primitive(pre[id], prim, t, hit[id])) return false;
+                    if (!bvh.intersect_leaf_primitive(pre[id], i, t, hit[id])) return false;
                     t = any_hit[id] ? -1.f : hit[id].t;
                     return true;
                 };
@@ -164,10 +170,9 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
                 }
                 // Triangles: the float stage of the watertight test at the back end's width
                 // rejects most lanes; the full test runs on the candidates it leaves.
-                const Triangle& tri = scene.triangles[prim];
-                const uint32_t candidates = kernels.triangle_candidates(
-                    rays.view(), scene.positions[tri.v0], scene.positions[tri.v1],
-                    scene.positions[tri.v2], ids, k, positions);
+                const uint32_t candidates =
+                    kernels.triangle_candidates(rays.view(), leaf_prim.p0, leaf_prim.p1,
+                                                leaf_prim.p2, ids, k, positions);
                 if constexpr (Trace::k_lanes) std::fill(mask, mask + k, uint8_t(0));
                 uint32_t passed = 0;
                 for (uint32_t j = 0; j < candidates; ++j) {
