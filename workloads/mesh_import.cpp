@@ -36,6 +36,7 @@ struct PlyProperty {
     bool list = false;
     std::string count_type;  // a list's count type
     std::string value_type;  // the property's type, or a list's item type
+    std::string name;
 };
 struct PlyElement {
     std::string name;
@@ -125,6 +126,15 @@ PlyLayout check_ply_header(const std::string& text) {
             // front of the name (found by fuzzing: "element 4294967295vertex 5").
             if (std::isdigit(static_cast<unsigned char>(t[1][0])))
                 fail(line, "an element's name must not start with a digit");
+            // assimp 5.2 sizes its vertex and face arrays by the first such element and
+            // writes every later one's instances past them (found by fuzzing: a corrupted
+            // heap; regressions/mesh_ply/).
+            for (const PlyElement& e : layout.elements) {
+                if (e.name == t[1]) fail(line, "a second element '" + t[1] + "'");
+                if ((e.name == "face" && t[1] == "tristrips") ||
+                    (e.name == "tristrips" && t[1] == "face"))
+                    fail(line, "both 'face' and 'tristrips' elements");
+            }
             layout.elements.push_back({t[1], std::stoull(t[2]), {}});
         } else if (t[0] == "property") {
             const bool list =
@@ -135,8 +145,8 @@ PlyLayout check_ply_header(const std::string& text) {
                      "element");
             if (list && !count_types.count(t[2]))
                 fail(line, "a list's count type must be an integer type, not '" + t[2] + "'");
-            layout.elements.back().properties.push_back(list ? PlyProperty{true, t[2], t[3]}
-                                                             : PlyProperty{false, "", t[1]});
+            layout.elements.back().properties.push_back(list ? PlyProperty{true, t[2], t[3], t[4]}
+                                                             : PlyProperty{false, "", t[1], t[2]});
         } else {
             fail(line, "unknown keyword '" + t[0] + "'");
         }
@@ -147,6 +157,23 @@ PlyLayout check_ply_header(const std::string& text) {
     layout.body_line = line + 2;
     return layout;
 }
+
+// A face's vertex index and texture coordinate lists: assimp 5.2 reads a texcoord list of six
+// to eight items as two per vertex index, past the face's indices when it has fewer than four.
+struct FaceLists {
+    uint64_t indices = 0, texcoords = 0, texcoords_at = 0;
+    void add(const PlyProperty& p, uint64_t count, uint64_t at) {
+        if (p.name == "vertex_indices" || p.name == "vertex_index") indices = count;
+        if (p.name == "texcoord") texcoords = count, texcoords_at = at;
+    }
+    template <class Fail>
+    void check(Fail& fail) const {
+        if (texcoords > 2 * indices)
+            fail(texcoords_at, "a face's texcoord list of " + std::to_string(texcoords) +
+                                   " items, more than two for each of its " +
+                                   std::to_string(indices) + " vertex indices");
+    }
+};
 
 // assimp 5.2 sizes its arrays from the counts a PLY file states (each element's count, each
 // list's count) before reading what follows: a count of billions in a small file takes
@@ -178,6 +205,7 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
         };
         for (const PlyElement& e : layout.elements) {
             for (uint64_t i = 0; i < e.count; ++i) {
+                FaceLists face;
                 for (const PlyProperty& p : e.properties) {
                     if (next >= tokens.size()) ran_out(e, i);
                     if (!p.list) {
@@ -185,6 +213,8 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
                         continue;
                     }
                     const auto& [count, at] = tokens[next++];
+                    face.add(p, count.size() <= 10 ? std::strtoull(count.c_str(), nullptr, 10) : 0,
+                             uint64_t(at));
                     if (count.empty() || count.size() > 10 ||
                         count.find_first_not_of("0123456789") != std::string::npos ||
                         std::stoull(count) > ply_count_max(p.count_type))
@@ -195,6 +225,7 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
                              "a list of " + count + " items, more than the file has left");
                     next += std::stoull(count);
                 }
+                if (e.name == "face") face.check(fail);
             }
         }
         return;
@@ -203,6 +234,7 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
     size_t at = layout.body;
     for (const PlyElement& e : layout.elements) {
         for (uint64_t i = 0; i < e.count; ++i) {
+            FaceLists face;
             for (const PlyProperty& p : e.properties) {
                 const size_t size = ply_type_size(p.list ? p.count_type : p.value_type);
                 if (size > text.size() - at)
@@ -222,8 +254,10 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
                     count > (text.size() - at - size) / ply_type_size(p.value_type))
                     fail(at, "a list of " + std::to_string(count) +
                                  " items, more than the file has left");
+                face.add(p, count, at);
                 at += size + count * ply_type_size(p.value_type);
             }
+            if (e.name == "face") face.check(fail);
         }
     }
 }

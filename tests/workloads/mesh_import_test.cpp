@@ -218,3 +218,37 @@ TEST_CASE("mesh import: a PLY count larger than the file is refused before assim
     CHECK_THROWS_WITH(import_text("short_binary.ply", binary.substr(0, binary.size() - 1)),
                       Contains("a list of 3 items, more than the file has left"));
 }
+
+// Found by fuzzing (a corrupted heap, regressions/mesh_ply/): assimp 5.2 sizes its vertex and
+// face arrays by the first element of each kind and writes later ones past them; it reads a
+// face's texcoord list of six to eight items past the face's indices.
+TEST_CASE("mesh import: PLY layouts that assimp writes or reads out of bounds are refused",
+          "[workloads]") {
+    using Catch::Matchers::Contains;
+    auto import_text = [](const std::string& name, const std::string& text) {
+        const fs::path p = test_dir() / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return import_mesh(p.string());
+    };
+    const std::string vertex = "property float x\nproperty float y\nproperty float z\n";
+    CHECK_THROWS_WITH(
+        import_text("two_vertex.ply", "ply\nformat ascii 1.0\nelement vertex 1\n" + vertex +
+                                          "element vertex 3\n" + vertex + "end_header\n" +
+                                          "0 0 0\n0 0 0\n1 0 0\n0 1 0\n"),
+        Contains("line 7: not a PLY header: a second element 'vertex'"));
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\n" + vertex;
+    CHECK_THROWS_WITH(
+        import_text("face_strips.ply",
+                    head + "element face 1\nproperty list uchar int vertex_indices\n"
+                           "element tristrips 1\nproperty list int int vertex_indices\n"
+                           "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"),
+        Contains("line 9: not a PLY header: both 'face' and 'tristrips' elements"));
+    const std::string faces = head +
+                              "element face 1\nproperty list uchar int vertex_indices\n"
+                              "property list uchar float texcoord\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\n";
+    CHECK(import_text("texcoord_ok.ply", faces + "3 0 1 2 6 0 0 1 0 0 1\n").triangle_count() == 1);
+    CHECK_THROWS_WITH(
+        import_text("texcoord_long.ply", faces + "3 0 1 2 8 0 0 1 0 0 1 1 1\n"),
+        Contains("line 14: a face's texcoord list of 8 items, more than two for each of its 3"));
+}
