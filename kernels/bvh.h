@@ -45,16 +45,6 @@ struct BvhStats {
     uint64_t bytes = 0;
 };
 
-// One primitive of Bvh::prim_ids' order with its triangle's vertices beside it: a leaf's
-// primitives are one contiguous block, read without going through prim_ids, Scene::triangles
-// and Scene::positions (three dependent cache misses a primitive on scattered rays). A
-// sphere's vertices are unused. The same vertex values, so the same bits.
-struct LeafPrimitive {
-    Vec3 p0, p1, p2;
-    uint32_t prim = 0;
-};
-static_assert(sizeof(LeafPrimitive) == 40, "LeafPrimitive: three vertices and an id");
-
 // Counting policies of Bvh::intersect: none (compiles away), or box and primitive tests.
 struct NoTraversalCounts {
     void box() {}

@@ -89,6 +89,16 @@ inline float intersect_box(const RayPrecomp& r, const Bounds3& b, float t_max) {
     return slab_test<1>(org, inv_dir, t_max, b, t0) ? t0 : INFINITY;
 }
 
+// One primitive of Bvh::prim_ids' order (kernels/bvh.h) with its triangle's vertices beside it: a
+// leaf's primitives are one contiguous block, read without going through prim_ids, Scene::triangles
+// and Scene::positions (three dependent cache misses a primitive on scattered rays). A
+// sphere's vertices are unused. The same vertex values, so the same bits.
+struct LeafPrimitive {
+    Vec3 p0, p1, p2;
+    uint32_t prim = 0;
+};
+static_assert(sizeof(LeafPrimitive) == 40, "LeafPrimitive: three vertices and an id");
+
 // The first stage of the watertight triangle test (Woop et al.) for Width rays against one
 // triangle, shared by intersect_triangle (Width 1) and the stream's triangle filter: the
 // vertices relative to the origin, sheared so the ray runs along +z, and the scaled

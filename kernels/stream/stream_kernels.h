@@ -70,6 +70,9 @@ class TraversalRays {
 // writes whole vectors.
 constexpr uint32_t k_stream_padding = 16;
 
+// Triangles a leaf_candidates call takes at most (the default leaf size).
+constexpr uint32_t k_leaf_batch = 4;
+
 struct StreamKernels {
     Isa isa;
     uint32_t width;
@@ -88,6 +91,13 @@ struct StreamKernels {
     uint32_t (*triangle_candidates)(TraversalView rays, const Vec3& p0, const Vec3& p1,
                                     const Vec3& p2, const uint32_t* ids, uint32_t n,
                                     uint32_t* positions);
+
+    // triangle_candidates for up to k_leaf_batch triangles of a leaf at once (each group's ray
+    // fields are read once for all of them): the positions triangle j does not reject go to
+    // positions + j * stride, their count to found[j].
+    void (*leaf_candidates)(TraversalView rays, const LeafPrimitive* triangles, uint32_t count,
+                            const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
+                            uint32_t* found);
 
     // Stable partition of ids[0, n) by mask[i] != 0, passing first, by compress; returns the
     // passing count; writes nothing past ids[n). `scratch` holds n + k_stream_padding ids.

@@ -126,6 +126,30 @@ uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1,
 }
 
 template <int Width>
+void leaf_candidates(TraversalView rays, const LeafPrimitive* triangles, uint32_t count,
+                     const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
+                     uint32_t* found) {
+    namespace f = traversal_field;
+    for (uint32_t j = 0; j < count; ++j) found[j] = 0;
+    for (uint32_t g = 0; g < n; g += Width) {
+        const uint32_t active = active_bits<Width>(n - g);
+        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
+        const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
+        const vint<Width> kx = r.read_int(f::kx), ky = r.read_int(f::ky), kz = r.read_int(f::kz);
+        const vfloat<Width> sx = r.read(f::sx), sy = r.read(f::sy);
+        const vint<Width> position = lane_index<Width>() + broadcast_int<Width>(int32_t(g));
+        for (uint32_t j = 0; j < count; ++j) {
+            const LeafPrimitive& tri = triangles[j];
+            const ShearedTriangle<Width> s =
+                shear_triangle<Width>(org, kx, ky, kz, sx, sy, tri.p0, tri.p1, tri.p2);
+            const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
+            found[j] += compress_store<Width>(keep, position,
+                                              positions + j * stride + found[j]);  // room past n
+        }
+    }
+}
+
+template <int Width>
 uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch) {
     uint32_t front = 0, back = 0;
     for (uint32_t g = 0; g < n; g += Width) {
@@ -148,6 +172,7 @@ StreamKernels make_kernels(Isa isa) {
     k.width = Width;
     k.box_filter = &box_filter<Width>;
     k.triangle_candidates = &triangle_candidates<Width>;
+    k.leaf_candidates = &leaf_candidates<Width>;
     k.partition = &partition<Width>;
     return k;
 }

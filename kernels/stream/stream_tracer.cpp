@@ -56,7 +56,7 @@ struct RayBuffers {
         trav_ids.resize(padded);
         scratch.resize(padded);
         scratch2.resize(padded);
-        positions.resize(padded);
+        positions.resize(size_t(k_leaf_batch) * padded);
         mask.resize(padded);
     }
 };
@@ -152,36 +152,47 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
         if (k == 0) continue;
         if (node.is_leaf()) {
             const uint64_t leaf_start = leaf_tsc ? __rdtsc() : 0;
-            for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-                const LeafPrimitive& leaf_prim = leaf[i];
-                const uint32_t prim = leaf_prim.prim;
-                // Closest hit: later tests need t or less. Any hit: the ray is done, and with
-                // t = -1 every later box and primitive test misses it.
-                auto test = [&](uint32_t id) {
-                    float& t = rays.t(id);
-                    if (!bvh.intersect_leaf_primitive(pre[id], i, t, hit[id])) return false;
-                    t = any_hit[id] ? -1.f : hit[id].t;
-                    return true;
-                };
-                if (scene.is_sphere(prim)) {
-                    const uint32_t passed = evaluate(ids, k, mask, test);
-                    trace.op(OpKind::sphere_test, generation, prim, ids, k, mask, passed);
+            // Closest hit: later tests need t or less. Any hit: the ray is done, and with
+            // t = -1 every later box and primitive test misses it.
+            auto full_test = [&](uint32_t i, uint32_t id) {
+                float& t = rays.t(id);
+                if (!bvh.intersect_leaf_primitive(pre[id], i, t, hit[id])) return false;
+                t = any_hit[id] ? -1.f : hit[id].t;
+                return true;
+            };
+            const uint32_t end = node.first + node.count;
+            for (uint32_t i = node.first; i < end;) {
+                if (scene.is_sphere(leaf[i].prim)) {
+                    const uint32_t passed =
+                        evaluate(ids, k, mask, [&](uint32_t id) { return full_test(i, id); });
+                    trace.op(OpKind::sphere_test, generation, leaf[i].prim, ids, k, mask, passed);
+                    ++i;
                     continue;
                 }
-                // Triangles: the float stage of the watertight test at the back end's width
-                // rejects most lanes; the full test runs on the candidates it leaves.
-                const uint32_t candidates =
-                    kernels.triangle_candidates(rays.view(), leaf_prim.p0, leaf_prim.p1,
-                                                leaf_prim.p2, ids, k, positions);
-                if constexpr (Trace::k_lanes) std::fill(mask, mask + k, uint8_t(0));
-                uint32_t passed = 0;
-                for (uint32_t j = 0; j < candidates; ++j) {
-                    const uint32_t at = positions[j];
-                    if (!test(ids[at])) continue;
-                    ++passed;
-                    if constexpr (Trace::k_lanes) mask[at] = 1;
+                // A run of up to k_leaf_batch triangles: the float stage of the watertight test
+                // at the back end's width, each group's rays read once for all of them, rejects
+                // most lanes (it does not depend on t); the full tests run on the candidates it
+                // leaves, triangle by triangle in order.
+                uint32_t batch = 1;
+                while (batch < k_leaf_batch && i + batch < end &&
+                       !scene.is_sphere(leaf[i + batch].prim))
+                    ++batch;
+                uint32_t found[k_leaf_batch];
+                const uint32_t stride = k + k_stream_padding;
+                kernels.leaf_candidates(rays.view(), &leaf[i], batch, ids, k, positions, stride,
+                                        found);
+                for (uint32_t j = 0; j < batch; ++j, ++i) {
+                    const uint32_t* candidates = positions + j * stride;
+                    if constexpr (Trace::k_lanes) std::fill(mask, mask + k, uint8_t(0));
+                    uint32_t passed = 0;
+                    for (uint32_t c = 0; c < found[j]; ++c) {
+                        const uint32_t at = candidates[c];
+                        if (!full_test(i, ids[at])) continue;
+                        ++passed;
+                        if constexpr (Trace::k_lanes) mask[at] = 1;
+                    }
+                    trace.op(OpKind::triangle_test, generation, leaf[i].prim, ids, k, mask, passed);
                 }
-                trace.op(OpKind::triangle_test, generation, prim, ids, k, mask, passed);
             }
             if (leaf_tsc) *leaf_tsc += __rdtsc() - leaf_start;
         } else {
