@@ -135,7 +135,16 @@ PlyLayout check_ply_header(const std::string& text) {
                     (e.name == "tristrips" && t[1] == "face"))
                     fail(line, "both 'face' and 'tristrips' elements");
             }
-            layout.elements.push_back({t[1], std::stoull(t[2]), {}});
+            // assimp 5.2 reads the count of an element only for the names it knows; for any
+            // other it reads the front of the name (0, as no name starts with a digit) and so
+            // no instances: the body is walked as assimp will read it (found by fuzzing).
+            static const std::set<std::string> known = {"vertex", "face", "tristrips", "edge",
+                                                        "material"};
+            std::string lower = t[1];
+            for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+            if (lower == "texturefile" || (!known.count(t[1]) && known.count(lower)))
+                fail(line, "element '" + t[1] + "' is not supported");
+            layout.elements.push_back({t[1], known.count(t[1]) ? std::stoull(t[2]) : 0, {}});
         } else if (t[0] == "property") {
             const bool list =
                 t.size() == 5 && t[1] == "list" && types.count(t[2]) && types.count(t[3]);
