@@ -199,39 +199,51 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
                  "element '" + e.name + "' states " + std::to_string(e.count) +
                      " instances without properties; more than the file could hold");
     if (layout.format == "ascii") {
-        // Tokens of the body with their line numbers.
-        std::vector<std::pair<std::string, int>> tokens;
-        std::istringstream in(text.substr(layout.body));
+        // assimp 5.2 reads an ASCII body a line per instance (a NUL, a form feed or a lone
+        // carriage return also ends its lines, and it then drops the rest of the line): the
+        // body may hold printable text, tabs and line ends only, and each instance is checked
+        // on its own line, where a list must find its items.
         int line = layout.body_line;
-        for (std::string row; std::getline(in, row); ++line) {
-            std::istringstream words(row);
-            for (std::string w; words >> w;) tokens.emplace_back(w, line);
+        for (size_t i = layout.body; i < text.size(); ++i) {
+            const unsigned char c = static_cast<unsigned char>(text[i]);
+            if (c == '\n') ++line;
+            const bool crlf = c == '\r' && i + 1 < text.size() && text[i + 1] == '\n';
+            if ((c < 0x20 && c != '\n' && c != '\t' && !crlf) || c == 0x7f)
+                fail(uint64_t(line), "a control character in the body");
         }
-        size_t next = 0;
-        auto ran_out = [&](const PlyElement& e, uint64_t i) {
-            fail(uint64_t(line), "the body ends in instance " + std::to_string(i) + " of the " +
-                                     std::to_string(e.count) + " '" + e.name + "' elements");
-        };
+        std::istringstream in(text.substr(layout.body));
+        line = layout.body_line - 1;
+        std::string row;
         for (const PlyElement& e : layout.elements) {
             for (uint64_t i = 0; i < e.count; ++i) {
+                if (!std::getline(in, row))
+                    fail(uint64_t(line), "the body ends before instance " + std::to_string(i) +
+                                             " of the " + std::to_string(e.count) + " '" + e.name +
+                                             "' elements");
+                ++line;
+                std::istringstream words(row);
+                std::vector<std::string> tokens;
+                for (std::string w; words >> w;) tokens.push_back(w);
+                size_t next = 0;
                 FaceLists face;
                 for (const PlyProperty& p : e.properties) {
-                    if (next >= tokens.size()) ran_out(e, i);
+                    if (next >= tokens.size())
+                        fail(uint64_t(line), "too few numbers for instance " + std::to_string(i) +
+                                                 " of the '" + e.name + "' elements");
                     if (!p.list) {
                         ++next;
                         continue;
                     }
-                    const auto& [count, at] = tokens[next++];
-                    face.add(p, count.size() <= 10 ? std::strtoull(count.c_str(), nullptr, 10) : 0,
-                             uint64_t(at));
-                    if (count.empty() || count.size() > 10 ||
+                    const std::string& count = tokens[next++];
+                    if (count.size() > 10 ||
                         count.find_first_not_of("0123456789") != std::string::npos ||
                         std::stoull(count) > ply_count_max(p.count_type))
-                        fail(uint64_t(at),
+                        fail(uint64_t(line),
                              "'" + count + "' is not a list length of type " + p.count_type);
                     if (std::stoull(count) > tokens.size() - next)
-                        fail(uint64_t(at),
-                             "a list of " + count + " items, more than the file has left");
+                        fail(uint64_t(line),
+                             "a list of " + count + " items, more than its line holds");
+                    face.add(p, std::stoull(count), uint64_t(line));
                     next += std::stoull(count);
                 }
                 if (e.name == "face") face.check(fail);

@@ -180,16 +180,16 @@ TEST_CASE("mesh import: a PLY count larger than the file is refused before assim
                               "0 0 0\n1 0 0\n0 1 0\n";
     CHECK(import_text("ok.ply", ascii + "3 0 1 2\n").triangle_count() == 1);
     CHECK_THROWS_WITH(import_text("long_list.ply", ascii + "4000000000 0 1 2\n"),
-                      Contains("line 13: a list of 4000000000 items, more than the file has left"));
+                      Contains("line 13: a list of 4000000000 items, more than its line holds"));
     CHECK_THROWS_WITH(import_text("past_type.ply", ascii + "8888888888888888888888888 0 1 2\n"),
                       Contains("line 13: '8888888888888888888888888' is not a list length"));
     CHECK_THROWS_WITH(import_text("short.ply", ascii),
-                      Contains("the body ends in instance 0 of the 1 'face' elements"));
+                      Contains("the body ends before instance 0 of the 1 'face' elements"));
     CHECK_THROWS_WITH(
         import_text("many.ply", "ply\nformat ascii 1.0\n" + vertices +
                                     "element face 4000000000\nproperty list uchar int v\n"
                                     "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
-        Contains("the body ends in instance 1 of the 4000000000 'face' elements"));
+        Contains("the body ends before instance 1 of the 4000000000 'face' elements"));
     CHECK_THROWS_WITH(import_text("empty_elements.ply", "ply\nformat ascii 1.0\n" + vertices +
                                                             "element edge 4000000000\n"
                                                             "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
@@ -277,7 +277,17 @@ TEST_CASE("mesh import: a PLY body is checked as assimp reads it", "[workloads]"
                                       "element verpex 1\nproperty uchar n\nelement face 1\n"
                                       "property list uchar uint vertex_indices\nend_header\n"
                                       "0 0 0\n1 0 0\n0 1 0\n7\n3 0 1 2\n"),
-        Contains("line 15: a list of 7 items, more than the file has left"));
+        Contains("line 15: a list of 7 items, more than its line holds"));
+    // assimp reads an instance from one line: a list's items must be on it.
+    const std::string faces = "ply\nformat ascii 1.0\n" + vertex +
+                              "element face 1\nproperty list uchar uint vertex_indices\n"
+                              "end_header\n0 0 0\n1 0 0\n0 1 0\n";
+    CHECK_THROWS_WITH(import_text("split.ply", faces + "3\n0 1 2\n"),
+                      Contains("line 13: a list of 3 items, more than its line holds"));
+    CHECK_THROWS_WITH(import_text("nul.ply", faces + std::string("3 0 1 2\0 9\n", 11)),
+                      Contains("line 13: a control character in the body"));
+    CHECK_THROWS_WITH(import_text("few.ply", faces.substr(0, faces.size() - 2) + "\n3 0 1 2\n"),
+                      Contains("line 12: too few numbers for instance 2 of the 'vertex' elements"));
     CHECK_THROWS_WITH(import_text("case.ply",
                                   "ply\nformat ascii 1.0\nelement Vertex 3\n"
                                   "property float x\nend_header\n0\n1\n2\n"),
