@@ -163,6 +163,9 @@ PlyLayout check_ply_header(const std::string& text) {
     // end_header must be a line of its own, after a newline.
     if (header_end == 0 || text[header_end - 1] != '\n')
         fail(line + 1, "end_header must start a line");
+    // assimp 5.2 starts a binary body right after the first line-end byte: at the LF of a CRLF.
+    if (layout.format != "ascii" && text.compare(after, 1, "\n") != 0)
+        fail(line + 1, "a binary body's end_header line must end with a bare LF");
     layout.body_line = line + 2;
     return layout;
 }

@@ -215,6 +215,11 @@ TEST_CASE("mesh import: a PLY count larger than the file is refused before assim
     binary.replace(body + 40, 12,
                    std::string("\x00\x00\x00\x00\x01\x00\x00\x00\x02\x00\x00\x00", 12));
     CHECK(import_text("ok_binary.ply", binary).triangle_count() == 1);
+    std::string crlf = binary;
+    crlf.replace(body - 1, 1, "\r\n");
+    CHECK_THROWS_WITH(import_text("crlf_binary.ply", crlf),
+                      Contains("line 9: not a PLY header: a binary body's end_header line must "
+                               "end with a bare LF"));
     CHECK_THROWS_WITH(import_text("short_binary.ply", binary.substr(0, binary.size() - 1)),
                       Contains("a list of 3 items, more than the file has left"));
 }
