@@ -22,6 +22,13 @@ fs::path test_dir() {
     return dir.path;
 }
 
+// Writes `text` byte for byte to `name` in the test directory and imports it.
+TriangleMesh import_text(const std::string& name, const std::string& text) {
+    const fs::path p = test_dir() / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return import_mesh(p.string());
+}
+
 // A unit square made of one quad face (triangulated on import) plus one triangle.
 const char* const k_obj =
     "# square and a triangle\n"
@@ -110,11 +117,6 @@ TEST_CASE("mesh import: scene files place meshes relative to themselves", "[work
 // loops for ever on a malformed PLY header, and aborts the process on a face without indices.
 TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever", "[workloads]") {
     using Catch::Matchers::Contains;
-    auto import_text = [](const std::string& name, const std::string& text) {
-        const fs::path p = test_dir() / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return import_mesh(p.string());
-    };
     const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     const std::string header =
         "element vertex 3\nproperty float x\nproperty float y\n"
@@ -148,11 +150,6 @@ TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever",
 TEST_CASE("mesh import: a PLY face without indices or with an index past the vertices is refused",
           "[workloads]") {
     using Catch::Matchers::Contains;
-    auto import_text = [](const std::string& name, const std::string& text) {
-        const fs::path p = test_dir() / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return import_mesh(p.string());
-    };
     const std::string header =
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
         "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
@@ -168,11 +165,6 @@ TEST_CASE("mesh import: a PLY face without indices or with an index past the ver
 TEST_CASE("mesh import: a PLY count larger than the file is refused before assimp reads it",
           "[workloads]") {
     using Catch::Matchers::Contains;
-    auto import_text = [](const std::string& name, const std::string& text) {
-        const fs::path p = test_dir() / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return import_mesh(p.string());
-    };
     const std::string vertices =
         "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
     const std::string ascii = "ply\nformat ascii 1.0\n" + vertices +
@@ -230,11 +222,6 @@ TEST_CASE("mesh import: a PLY count larger than the file is refused before assim
 TEST_CASE("mesh import: PLY layouts that assimp writes or reads out of bounds are refused",
           "[workloads]") {
     using Catch::Matchers::Contains;
-    auto import_text = [](const std::string& name, const std::string& text) {
-        const fs::path p = test_dir() / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return import_mesh(p.string());
-    };
     const std::string vertex = "property float x\nproperty float y\nproperty float z\n";
     CHECK_THROWS_WITH(
         import_text("two_vertex.ply", "ply\nformat ascii 1.0\nelement vertex 1\n" + vertex +
@@ -262,11 +249,6 @@ TEST_CASE("mesh import: PLY layouts that assimp writes or reads out of bounds ar
 // name it does not know, so the next element reads that element's numbers.
 TEST_CASE("mesh import: a PLY body is checked as assimp reads it", "[workloads]") {
     using Catch::Matchers::Contains;
-    auto import_text = [](const std::string& name, const std::string& text) {
-        const fs::path p = test_dir() / name;
-        std::ofstream(p, std::ios::binary) << text;
-        return import_mesh(p.string());
-    };
     const std::string vertex =
         "element vertex 3\nproperty float x\nproperty float y\n"
         "property float z\n";
