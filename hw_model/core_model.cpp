@@ -10,6 +10,11 @@ uint64_t ceil_cycle(double t) {
     return uint64_t(std::ceil(t - 1e-9));
 }
 
+// Cycles a bank is held by one access: one when pipelined, else the whole access latency.
+uint32_t bank_occupancy(const RayBufferConfig& c) {
+    return c.pipelined ? 1 : c.access_latency_cycles;
+}
+
 uint64_t overlap(uint64_t a0, uint64_t a1, uint64_t b0, uint64_t b1) {
     const uint64_t lo = std::max(a0, b0), hi = std::min(a1, b1);
     return hi > lo ? hi - lo : 0;
@@ -25,7 +30,8 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_map(map),
       m_core(core_index),
       m_layout(config.ray_buffer, record_words, slot_capacity),
-      m_banks(2 * size_t(config.ray_buffer.banks)),
+      m_banks{BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer)),
+              BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer))},
       m_agu(double(config.agu.count) * config.agu.addresses_per_cycle),
       m_interconnect(double(config.interconnect.width_words) * config.clock.interconnect_mhz /
                      config.clock.core_mhz),
@@ -102,12 +108,9 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
 
 uint64_t CoreModel::book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
                               uint64_t issue) {
-    const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
-    SlotServer* banks = &m_banks[size_t(buffer) * m_layout.banks()];
-    uint64_t last = issue;
-    for (uint32_t i = 0; i < lanes; ++i)
-        last = std::max(last, banks[m_layout.bank_of(word, slots[i])].book(issue, occupancy));
-    return last;
+    m_lane_banks.resize(lanes);
+    for (uint32_t i = 0; i < lanes; ++i) m_lane_banks[i] = m_layout.bank_of(word, slots[i]);
+    return m_banks[buffer].book(m_lane_banks.data(), lanes, issue);
 }
 
 uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,
@@ -128,7 +131,7 @@ uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& wor
         // the growth of the last grant is charged, once, below.
         last_grant = std::max(last_grant, book_word(buffer, words[w], slots, lanes, at));
     }
-    const uint32_t occupancy = m_layout.pipelined() ? 1 : m_config.ray_buffer.access_latency_cycles;
+    const uint32_t occupancy = bank_occupancy(m_config.ray_buffer);
     const uint64_t ideal =
         at + (uint64_t(lanes + m_layout.banks() - 1) / m_layout.banks() - 1) * occupancy;
     if (last_grant > ideal) conflict_cycles += last_grant - ideal;

@@ -99,7 +99,7 @@ class CoreModel {
     SceneDataMap m_map;
     uint32_t m_core;
     RayBufferModel m_layout;
-    std::vector<SlotServer> m_banks;  // buffers * banks
+    BankSchedule m_banks[2];  // the current generation's buffer and the next one's
     CapacityServer m_agu, m_interconnect, m_scratchpad;
     uint64_t m_crossing_cycles;
     std::shared_ptr<SceneMemoryModel> m_scene_memory;
@@ -114,6 +114,7 @@ class CoreModel {
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;
+    std::vector<uint32_t> m_lane_banks;  // scratch: one word's bank per lane
     std::vector<uint64_t> m_ready_at;
 };
 

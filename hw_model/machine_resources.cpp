@@ -4,74 +4,96 @@
 
 namespace sfx {
 
-bool SlotServer::is_free(uint64_t cycle) const {
-    const uint64_t offset = cycle - m_base;
-    const uint64_t word = m_bits[(m_head + offset / 64) % k_words];
-    return (word >> (offset % 64) & 1) == 0;
+BankSchedule::BankSchedule(uint32_t banks, uint32_t occupancy)
+    : m_banks(banks),
+      m_words((banks + 63) / 64),
+      m_occupancy(occupancy == 0 ? 1 : occupancy),
+      m_ring(size_t(k_window) * (m_words + 1), 0),
+      m_grant(m_words, 0) {
+    for (size_t i = 0; i < k_window; ++i) m_ring[i * (m_words + 1)] = ~uint64_t(0);
 }
 
-void SlotServer::mark(uint64_t cycle) {
-    const uint64_t offset = cycle - m_base;
-    m_bits[(m_head + offset / 64) % k_words] |= uint64_t(1) << (offset % 64);
-}
-
-void SlotServer::slide_to(uint64_t last) {
-    if (last >= m_base + 2 * uint64_t(k_window)) {  // far ahead: nothing booked survives
-        m_bits.fill(0);
-        m_head = 0;
-        m_base = (last / 64) * 64 - (k_window - 64);
-        return;
-    }
-    while (last >= m_base + k_window) {
-        m_bits[m_head] = 0;
-        m_head = (m_head + 1) % k_words;
-        m_base += 64;
-    }
-}
-
-uint64_t SlotServer::book_slow(uint64_t ready, uint32_t occupancy) {
-    if (occupancy == 0) occupancy = 1;
-    // Cycles before the window were forgotten when a later booking moved it: never book them.
-    uint64_t cycle = ready > m_base ? ready : m_base;
-    if (occupancy == 1) {
-        // A pipelined bank: the first free cycle, found a 64-cycle word at a time (a conflict
-        // queues behind every booking in flight, so runs of booked cycles are common).
-        for (;;) {
-            slide_to(cycle);
-            const uint64_t offset = cycle - m_base;
-            uint64_t& word = m_bits[(m_head + offset / 64) % k_words];
-            const uint64_t free = ~word >> (offset % 64);
-            if (free) {
-                const uint32_t skip = uint32_t(__builtin_ctzll(free));
-                word |= uint64_t(1) << (offset % 64 + skip);
-                return cycle + skip;
+uint64_t BankSchedule::book(const uint32_t* banks, uint32_t count, uint64_t ready) {
+    if (count == 0) return ready;
+    // A unary count per bank, bit-sliced: layer k holds the banks with more than k requests.
+    const uint32_t words = m_words;
+    if (words == 1) {
+        // At most 64 banks: the layers in registers, branch-free, while no bank has more than
+        // k_fast_layers requests (lanes of a SIMD access often share banks).
+        constexpr uint32_t k_fast_layers = 4;
+        uint64_t layer[k_fast_layers] = {};
+        uint64_t overflow = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+            uint64_t carry = uint64_t(1) << banks[i];
+            for (uint32_t k = 0; k < k_fast_layers; ++k) {
+                const uint64_t had = layer[k] & carry;
+                layer[k] |= carry;
+                carry = had;
             }
-            cycle += 64 - offset % 64;
+            overflow |= carry;
+        }
+        if (!overflow) {
+            if (m_want.size() < k_fast_layers) m_want.resize(k_fast_layers);
+            uint32_t layers = 0;
+            while (layers < k_fast_layers && layer[layers]) {
+                m_want[layers] = layer[layers];
+                ++layers;
+            }
+            return grant<true>(layers, ready);
         }
     }
-    for (;;) {
-        slide_to(cycle + occupancy - 1);
-        if (cycle < m_base) cycle = m_base;
-        uint32_t free_run = 0;
-        while (free_run < occupancy && is_free(cycle + free_run)) ++free_run;
-        if (free_run == occupancy) break;
-        cycle += free_run + 1;
+    if (m_want.size() < size_t(count) * words) m_want.resize(size_t(count) * words);
+    uint32_t layers = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t j = banks[i] / 64;
+        const uint64_t bit = uint64_t(1) << (banks[i] % 64);
+        uint32_t k = 0;
+        while (k < layers && (m_want[size_t(k) * words + j] & bit)) ++k;
+        if (k == layers) {
+            std::fill_n(&m_want[size_t(k) * words], words, 0);
+            ++layers;
+        }
+        m_want[size_t(k) * words + j] |= bit;
     }
-    for (uint32_t i = 0; i < occupancy; ++i) mark(cycle + i);
-    return cycle;
+    return words == 1 ? grant<true>(layers, ready) : grant<false>(layers, ready);
 }
 
-void CapacityServer::slide_to(uint64_t cycle) {
-    if (cycle >= m_base + 2 * uint64_t(k_window)) {  // far ahead: nothing booked survives
-        m_used.fill(0.0);
-        m_head = 0;
-        m_base = cycle - (k_window - 1);
-        return;
-    }
-    while (cycle >= m_base + k_window) {
-        m_used[m_head] = 0.0;
-        m_head = (m_head + 1) % k_window;
-        ++m_base;
+template <bool OneWord>
+uint64_t BankSchedule::grant(uint32_t layers, uint64_t ready) {
+    const uint32_t words = OneWord ? 1 : m_words;
+    uint64_t* want = m_want.data();
+    uint64_t* granted = m_grant.data();
+    // Cycles before the window were forgotten when a later booking moved it: never book them.
+    uint64_t cycle = ready > m_base ? ready : m_base;
+    for (;; ++cycle) {
+        // Banks free for the whole occupancy from this cycle on get their next request.
+        bool any = false;
+        for (uint32_t j = 0; j < words; ++j) granted[j] = want[j];
+        for (uint32_t i = 0; i < m_occupancy; ++i) {
+            const uint64_t* bits = busy<OneWord>(cycle + i);
+            for (uint32_t j = 0; j < words; ++j) granted[j] &= ~bits[j];
+        }
+        for (uint32_t j = 0; j < words; ++j) any |= granted[j] != 0;
+        if (!any) continue;
+        for (uint32_t i = 0; i < m_occupancy; ++i) {
+            uint64_t* bits = busy<OneWord>(cycle + i);
+            for (uint32_t j = 0; j < words; ++j) bits[j] |= granted[j];
+        }
+        // One request fewer for each granted bank: layer k keeps a granted bank only if layer
+        // k + 1 has it.
+        for (uint32_t k = 0; k + 1 < layers; ++k)
+            for (uint32_t j = 0; j < words; ++j)
+                want[k * words + j] &= ~granted[j] | want[(k + 1) * words + j];
+        for (uint32_t j = 0; j < words; ++j) want[(layers - 1) * words + j] &= ~granted[j];
+        bool left = false;
+        for (uint32_t j = 0; j < words; ++j) left |= want[j] != 0;
+        if (!left) return cycle;
+        while (layers > 1) {
+            bool top = false;
+            for (uint32_t j = 0; j < words; ++j) top |= want[(layers - 1) * words + j] != 0;
+            if (top) break;
+            --layers;
+        }
     }
 }
 

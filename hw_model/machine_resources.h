@@ -6,53 +6,69 @@
 // book them at their own simulated time.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace sfx {
 
-// A server that accepts one request per cycle and keeps each for `occupancy` cycles (a ray-
-// buffer bank: occupancy 1 when pipelined, the access latency when not). Booked cycles are kept
-// exactly, holes included, in a window of k_window cycles: a request takes the first free cycle
-// at or after it is ready, whichever unit booked the others.
-class SlotServer {
+// The banks of one ray buffer. A bank accepts one request per cycle and keeps it for
+// `occupancy` cycles (1 when pipelined, the access latency when not). A request takes the first
+// cycle at or after it is ready from which its bank is free for `occupancy` cycles, whichever
+// unit booked the others; requests to one bank queue in order.
+//
+// Bookings are kept as one bit per bank per cycle, cycle-major, so the lanes of a SIMD access
+// (one request each, all ready in one cycle) are granted a whole cycle at a time with bit
+// operations instead of a search per lane. The buffer keeps the last k_window cycles touched
+// (a ring whose entries are tagged with their cycle, so moving on costs nothing); a request
+// older than that waits until the window's first cycle. Requests come at or after the current
+// simulated cycle and a few hundred cycles ahead at most, so nothing still wanted is forgotten
+// (tests/hw_model/machine_resources_test.cpp checks that against a bank that never forgets).
+class BankSchedule {
   public:
-    static constexpr uint32_t k_window = 512;
+    static constexpr uint32_t k_window = 1024;
 
-    // The first cycle >= ready from which `occupancy` cycles are free; books them.
-    uint64_t book(uint64_t ready, uint32_t occupancy = 1) {
-        // The common case, a free bank inside the window, without the general search.
-        if (occupancy == 1 && ready >= m_base && ready < m_base + k_window) {
-            const uint64_t offset = ready - m_base;
-            uint64_t& word = m_bits[(m_head + offset / 64) % k_words];
-            const uint64_t bit = uint64_t(1) << (offset % 64);
-            if (!(word & bit)) {
-                word |= bit;
-                return ready;
-            }
-        }
-        return book_slow(ready, occupancy);
-    }
+    BankSchedule(uint32_t banks, uint32_t occupancy);
+
+    // Books one request to banks[i] for each i < count, all ready at `ready`; returns the cycle
+    // of the last grant (`ready` when count is 0).
+    uint64_t book(const uint32_t* banks, uint32_t count, uint64_t ready);
+    uint32_t banks() const { return m_banks; }
 
   private:
-    uint64_t book_slow(uint64_t ready, uint32_t occupancy);
-    bool is_free(uint64_t cycle) const;
-    void mark(uint64_t cycle);
-    void slide_to(uint64_t last);  // moves the window forward until `last` lies in it
+    // Bank bits of `cycle` (moves the window to reach it; a stale entry reads as free).
+    template <bool OneWord>
+    uint64_t* busy(uint64_t cycle) {
+        if (cycle >= m_base + k_window) m_base = cycle - (k_window - 1);
+        const uint32_t ring = uint32_t(cycle % k_window);
+        uint64_t* entry = &m_ring[size_t(ring) * (m_words + 1)];  // tag, then the bank bits
+        if (entry[0] != cycle) {
+            entry[0] = cycle;
+            for (uint32_t j = 1; j <= (OneWord ? 1 : m_words); ++j) entry[j] = 0;
+        }
+        return entry + 1;
+    }
+    template <bool OneWord>
+    uint64_t grant(uint32_t layers, uint64_t ready);
 
-    static constexpr uint32_t k_words = k_window / 64;
-    uint64_t m_base = 0;  // first cycle of the window, a multiple of 64
-    uint32_t m_head = 0;  // ring index of the word holding m_base
-    std::array<uint64_t, k_words> m_bits{};
+    uint32_t m_banks, m_words, m_occupancy;
+    uint64_t m_base = 0;            // first cycle of the window
+    std::vector<uint64_t> m_ring;   // k_window entries: the cycle held, then m_words bank words
+    std::vector<uint64_t> m_want;   // scratch: per layer k, the banks with more than k requests
+    std::vector<uint64_t> m_grant;  // scratch: one cycle's grants
 };
 
 // A pool with a capacity per cycle (the address-generation units: addresses per cycle; the
 // interconnect: words per core cycle). Work takes what each cycle has left from the cycle it is
 // ready, so a later request may use capacity an earlier-booked one left free. Bookings are kept
-// per cycle in a window of k_window cycles, like SlotServer's.
+// per cycle in a window of k_window cycles, tagged with their cycle like BankSchedule's.
 class CapacityServer {
   public:
     static constexpr uint32_t k_window = 1024;
-    explicit CapacityServer(double per_cycle) : m_per_cycle(per_cycle) { m_used.fill(0.0); }
+    explicit CapacityServer(double per_cycle) : m_per_cycle(per_cycle) {
+        m_used.fill(0.0);
+        m_tag.fill(~uint64_t(0));
+    }
 
     // Serves `amount` from cycle `ready` on; returns the cycle in which its last part is served
     // (it is usable from the next one). Zero work returns `ready`.
@@ -61,13 +77,23 @@ class CapacityServer {
     double work() const { return m_work; }
 
   private:
-    void slide_to(uint64_t cycle);
-    double& used(uint64_t cycle) { return m_used[(m_head + (cycle - m_base)) % k_window]; }
+    void slide_to(uint64_t cycle) {
+        if (cycle >= m_base + k_window) m_base = cycle - (k_window - 1);
+    }
+    // The capacity used in `cycle` (inside the window), made current.
+    double& used(uint64_t cycle) {
+        const uint32_t ring = uint32_t(cycle % k_window);
+        if (m_tag[ring] != cycle) {
+            m_tag[ring] = cycle;
+            m_used[ring] = 0.0;
+        }
+        return m_used[ring];
+    }
 
     double m_per_cycle;
     uint64_t m_base = 0;
-    uint32_t m_head = 0;
     std::array<double, k_window> m_used;
+    std::array<uint64_t, k_window> m_tag;  // the cycle each entry holds
     double m_work = 0.0;
 };
 
