@@ -32,6 +32,20 @@ uint64_t BankSchedule::book(const uint32_t* banks, uint32_t count, uint64_t read
             }
             overflow |= carry;
         }
+        if (!overflow && m_occupancy == 1) {
+            // Pipelined banks: each cycle grants every wanting bank that is free in it.
+            uint64_t cycle = ready > m_base ? ready : m_base;
+            for (;; ++cycle) {
+                uint64_t& bits = *busy<true>(cycle);
+                const uint64_t granted = layer[0] & ~bits;
+                if (!granted) continue;
+                bits |= granted;
+                for (uint32_t k = 0; k + 1 < k_fast_layers; ++k)
+                    layer[k] &= ~granted | layer[k + 1];
+                layer[k_fast_layers - 1] &= ~granted;
+                if (!layer[0]) return cycle;
+            }
+        }
         if (!overflow) {
             if (m_want.size() < k_fast_layers) m_want.resize(k_fast_layers);
             uint32_t layers = 0;
