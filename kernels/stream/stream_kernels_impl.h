@@ -74,33 +74,53 @@ struct GroupReader {
     }
 };
 
+// One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
+template <int Width>
+SFX_LANES_INLINE void box_group(TraversalView rays, const Bounds3& box, int axis,
+                                const uint32_t* ids, uint32_t left, uint32_t* pass_out,
+                                uint32_t* fail_out, uint8_t* mask, uint32_t& front,
+                                uint32_t& back, uint32_t& negatives) {
+    namespace f = traversal_field;
+    const uint32_t active = active_bits<Width>(left);
+    const GroupReader<Width> r(rays, load_ids<Width>(ids, active), int32_t(ids[0]));
+    vfloat<Width> org[3], inv_dir[3];
+    for (int a = 0; a < 3; ++a) {
+        org[a] = r.read(f::org + a);
+        inv_dir[a] = r.read(f::inv_dir + a);
+    }
+    const vfloat<Width> t_max = r.read(f::t);
+    vfloat<Width> t0;
+    const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
+    // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
+    // flushes denormals, so a negative normal dir has a finite inverse).
+    const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
+    const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
+    negatives += uint32_t(__builtin_popcount(
+        bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
+    if (mask) store_mask_bytes<Width>(pass, mask);
+    const bool full = left >= uint32_t(Width);
+    front += compress_append<Width>(pass, r.id, pass_out + front, full);
+    back += compress_append<Width>(~pass & active, r.id, fail_out + back, full);
+}
+
 template <int Width>
 uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint32_t* ids,
                     uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
                     uint32_t& negative) {
-    namespace f = traversal_field;
     uint32_t front = 0, back = 0, negatives = 0;
     for (uint32_t g = 0; g < n; g += Width) {
-        const uint32_t active = active_bits<Width>(n - g);
-        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
-        vfloat<Width> org[3], inv_dir[3];
-        for (int a = 0; a < 3; ++a) {
-            org[a] = r.read(f::org + a);
-            inv_dir[a] = r.read(f::inv_dir + a);
+        uint8_t* group_mask = mask ? mask + g : nullptr;
+        // At 16 lanes, a group of at most 8 ids runs at 8: half the gathers (secondary streams
+        // are short). The lanes' math is the same at every width, so are the results.
+        if constexpr (Width == 16) {
+            if (n - g <= 8) {
+                box_group<8>(rays, box, axis, ids + g, n - g, pass_out, fail_out, group_mask,
+                             front, back, negatives);
+                break;
+            }
         }
-        const vfloat<Width> t_max = r.read(f::t);
-        vfloat<Width> t0;
-        const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
-        // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
-        // flushes denormals, so a negative normal dir has a finite inverse).
-        const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
-        const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
-        negatives += uint32_t(__builtin_popcount(
-            bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
-        if (mask) store_mask_bytes<Width>(pass, mask + g);
-        const bool full = g + Width <= n;
-        front += compress_append<Width>(pass, r.id, pass_out + front, full);
-        back += compress_append<Width>(~pass & active, r.id, fail_out + back, full);
+        box_group<Width>(rays, box, axis, ids + g, n - g, pass_out, fail_out, group_mask, front,
+                         back, negatives);
     }
     negative += negatives;
     return front;
@@ -125,40 +145,68 @@ uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1,
     return k;
 }
 
+// One group of leaf_candidates: the `left` ids from ids + g on.
+template <int Width>
+SFX_LANES_INLINE void leaf_group(TraversalView rays, const LeafPrimitive* triangles,
+                                 uint32_t count, const uint32_t* ids, uint32_t g, uint32_t left,
+                                 uint32_t* positions, uint32_t stride, uint32_t* found) {
+    namespace f = traversal_field;
+    const uint32_t active = active_bits<Width>(left);
+    const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
+    const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
+    const vint<Width> kx = r.read_int(f::kx), ky = r.read_int(f::ky), kz = r.read_int(f::kz);
+    const vfloat<Width> sx = r.read(f::sx), sy = r.read(f::sy);
+    const vint<Width> position = lane_index<Width>() + broadcast_int<Width>(int32_t(g));
+    for (uint32_t j = 0; j < count; ++j) {
+        const LeafPrimitive& tri = triangles[j];
+        const ShearedTriangle<Width> s =
+            shear_triangle<Width>(org, kx, ky, kz, sx, sy, tri.p0, tri.p1, tri.p2);
+        const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
+        found[j] += compress_store<Width>(keep, position,
+                                          positions + j * stride + found[j]);  // room past n
+    }
+}
+
 template <int Width>
 void leaf_candidates(TraversalView rays, const LeafPrimitive* triangles, uint32_t count,
                      const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
                      uint32_t* found) {
-    namespace f = traversal_field;
     for (uint32_t j = 0; j < count; ++j) found[j] = 0;
     for (uint32_t g = 0; g < n; g += Width) {
-        const uint32_t active = active_bits<Width>(n - g);
-        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
-        const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
-        const vint<Width> kx = r.read_int(f::kx), ky = r.read_int(f::ky), kz = r.read_int(f::kz);
-        const vfloat<Width> sx = r.read(f::sx), sy = r.read(f::sy);
-        const vint<Width> position = lane_index<Width>() + broadcast_int<Width>(int32_t(g));
-        for (uint32_t j = 0; j < count; ++j) {
-            const LeafPrimitive& tri = triangles[j];
-            const ShearedTriangle<Width> s =
-                shear_triangle<Width>(org, kx, ky, kz, sx, sy, tri.p0, tri.p1, tri.p2);
-            const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
-            found[j] += compress_store<Width>(keep, position,
-                                              positions + j * stride + found[j]);  // room past n
+        if constexpr (Width == 16) {  // a short group at 8 lanes, as in box_filter
+            if (n - g <= 8) {
+                leaf_group<8>(rays, triangles, count, ids, g, n - g, positions, stride, found);
+                break;
+            }
         }
+        leaf_group<Width>(rays, triangles, count, ids, g, n - g, positions, stride, found);
     }
+}
+
+// One group of partition: the `left` ids from ids + g on.
+template <int Width>
+SFX_LANES_INLINE void partition_group(uint32_t* ids, uint32_t g, uint32_t left,
+                                      const uint8_t* mask, uint32_t* scratch, uint32_t& front,
+                                      uint32_t& back) {
+    const uint32_t active = active_bits<Width>(left);
+    const vint<Width> id = load_int<Width>(ids + g);
+    const uint32_t pass = load_mask_bytes<Width>(mask + g) & active;
+    const bool full = left >= uint32_t(Width);  // front <= g: ids[front, g + Width) are read
+    front += compress_append<Width>(pass, id, ids + front, full);
+    back += compress_append<Width>(~pass & active, id, scratch + back, full);
 }
 
 template <int Width>
 uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch) {
     uint32_t front = 0, back = 0;
     for (uint32_t g = 0; g < n; g += Width) {
-        const uint32_t active = active_bits<Width>(n - g);
-        const vint<Width> id = load_int<Width>(ids + g);
-        const uint32_t pass = load_mask_bytes<Width>(mask + g) & active;
-        const bool full = g + Width <= n;  // front <= g: ids[front, g + Width) are read
-        front += compress_append<Width>(pass, id, ids + front, full);
-        back += compress_append<Width>(~pass & active, id, scratch + back, full);
+        if constexpr (Width == 16) {  // a short group at 8 lanes, as in box_filter
+            if (n - g <= 8) {
+                partition_group<8>(ids, g, n - g, mask, scratch, front, back);
+                break;
+            }
+        }
+        partition_group<Width>(ids, g, n - g, mask, scratch, front, back);
     }
     // Always: the whole-vector stores overwrote ids[0, n) past the passing prefix.
     if (back != 0) std::memcpy(ids + front, scratch, back * sizeof(uint32_t));

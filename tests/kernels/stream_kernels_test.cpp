@@ -147,7 +147,7 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
     for (const Isa isa : supported_isas()) {
         const StreamKernels& kernels = stream_kernels(isa);
         INFO("back end " << isa_name(isa));
-        uint64_t lost_hits = 0, differ = 0;
+        uint64_t lost_hits = 0, differ = 0, leaf_differ = 0, leaf_lanes = 0;
         for (uint32_t i = 0; i < 1500; ++i) {
             Vec3 p[3];
             for (int v = 0; v < 3; ++v)
@@ -176,6 +176,26 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
             const uint32_t c_scalar = scalar.triangle_candidates(rays.view(), p[0], p[1], p[2],
                                                                  ids.data(), n, want.data());
             differ += c != c_scalar || !std::equal(got.begin(), got.begin() + c, want.begin());
+            // A leaf's run of 1-4 triangles (this one and shifted copies) in one pass: per
+            // triangle, the same candidates as the scalar filter of that triangle alone.
+            const uint32_t batch = 1 + i % k_leaf_batch, stride = n + k_stream_padding;
+            LeafPrimitive leaf[k_leaf_batch];
+            for (uint32_t j = 0; j < batch; ++j) {
+                const Vec3 shift(0.25f * float(j), 0.f, 0.f);
+                leaf[j] = {p[0] + shift, p[1] + shift, p[2] + shift, j};
+            }
+            std::vector<uint32_t> positions(size_t(k_leaf_batch) * stride);
+            uint32_t found[k_leaf_batch];
+            kernels.leaf_candidates(rays.view(), leaf, batch, ids.data(), n, positions.data(),
+                                    stride, found);
+            for (uint32_t j = 0; j < batch; ++j) {
+                const uint32_t cj = scalar.triangle_candidates(rays.view(), leaf[j].p0, leaf[j].p1,
+                                                               leaf[j].p2, ids.data(), n,
+                                                               want.data());
+                const auto first = positions.begin() + j * stride;
+                leaf_differ += found[j] != cj || !std::equal(first, first + cj, want.begin());
+                leaf_lanes += n;
+            }
             for (uint32_t l = 0; l < n; ++l) {
                 float t, u, v;
                 const bool hit =
@@ -189,6 +209,8 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
         }
         CHECK(lost_hits == 0);
         CHECK(differ == 0);
+        CHECK(leaf_differ == 0);
+        CHECK(leaf_lanes > 2 * 1500);
     }
     CHECK(total_hits > 0);
     CHECK(total_candidates < lanes);  // the filter rejects something
