@@ -106,18 +106,16 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
         m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
 }
 
-uint64_t CoreModel::book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
-                              uint64_t issue) {
-    m_lane_banks.resize(lanes);
-    for (uint32_t i = 0; i < lanes; ++i) m_lane_banks[i] = m_layout.bank_of(word, slots[i]);
-    return m_banks[buffer].book(m_lane_banks.data(), lanes, issue);
-}
-
 uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,
                                const uint32_t* slots, uint32_t lanes, uint64_t issue,
                                const std::vector<uint64_t>* ready_at, uint64_t& conflict_cycles,
                                uint64_t& address_cycles) {
     uint64_t last_grant = issue, at = issue;
+    // Every word's lanes go to the slots' banks, turned by the word's offset.
+    BankSchedule& banks = m_banks[buffer];
+    m_lane_banks.resize(lanes);
+    for (uint32_t i = 0; i < lanes; ++i) m_lane_banks[i] = m_layout.slot_bank(slots[i]);
+    banks.set_lanes(m_lane_banks.data(), lanes);
     for (size_t w = 0; w < words.size(); ++w) {
         if (w > 0) at += 1;  // one word's requests leave the access side per cycle
         if (ready_at) {
@@ -129,7 +127,7 @@ uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& wor
         }
         // A conflict delays this word; later words queue behind it in the same banks, so only
         // the growth of the last grant is charged, once, below.
-        last_grant = std::max(last_grant, book_word(buffer, words[w], slots, lanes, at));
+        last_grant = std::max(last_grant, banks.book_lanes(m_layout.field_rotation(words[w]), at));
     }
     const uint32_t occupancy = bank_occupancy(m_config.ray_buffer);
     const uint64_t ideal =

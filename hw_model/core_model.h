@@ -78,12 +78,9 @@ class CoreModel {
     const PassBuffer& pass() const { return *m_pass; }
 
   private:
-    // Books one field word for each of `lanes` slots of `buffer` (0: current generation, 1:
-    // next), the requests issued at `issue`; returns the last grant.
-    uint64_t book_word(uint32_t buffer, uint32_t word, const uint32_t* slots, uint32_t lanes,
-                       uint64_t issue);
-    // Books `words` for the lanes, one word per cycle at the earliest; returns the cycle the
-    // last word's data is out of its bank.
+    // Books `words` for `lanes` slots of `buffer` (0: current generation, 1: next), one word's
+    // requests per cycle at the earliest, from `issue`; returns the cycle the last word's data
+    // is out of its bank.
     // `ready_at[w]`, when given, is the first cycle word w's addresses can be used.
     uint64_t book_words(uint32_t buffer, const std::vector<uint32_t>& words, const uint32_t* slots,
                         uint32_t lanes, uint64_t issue, const std::vector<uint64_t>* ready_at,
@@ -114,7 +111,7 @@ class CoreModel {
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;
-    std::vector<uint32_t> m_lane_banks;  // scratch: one word's bank per lane
+    std::vector<uint32_t> m_lane_banks;  // scratch: each lane's slot bank
     std::vector<uint64_t> m_ready_at;
 };
 

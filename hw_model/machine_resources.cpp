@@ -8,23 +8,20 @@ BankSchedule::BankSchedule(uint32_t banks, uint32_t occupancy)
     : m_banks(banks),
       m_words((banks + 63) / 64),
       m_occupancy(occupancy == 0 ? 1 : occupancy),
+      m_full(banks >= 64 ? ~uint64_t(0) : (uint64_t(1) << banks) - 1),
       m_ring(size_t(k_window) * (m_words + 1), 0),
       m_grant(m_words, 0) {
     for (size_t i = 0; i < k_window; ++i) m_ring[i * (m_words + 1)] = ~uint64_t(0);
 }
 
-uint64_t BankSchedule::book(const uint32_t* banks, uint32_t count, uint64_t ready) {
-    if (count == 0) return ready;
-    // A unary count per bank, bit-sliced: layer k holds the banks with more than k requests.
-    const uint32_t words = m_words;
-    if (words == 1) {
-        // At most 64 banks: the layers in registers, branch-free, while no bank has more than
-        // k_fast_layers requests (lanes of a SIMD access often share banks).
-        constexpr uint32_t k_fast_layers = 4;
-        uint64_t layer[k_fast_layers] = {};
-        uint64_t overflow = 0;
+void BankSchedule::set_lanes(const uint32_t* lane_banks, uint32_t count) {
+    m_lane_count = count;
+    m_fast = m_words == 1;
+    if (m_fast) {
+        // The layers branch-free: each lane's bit carries up to the first layer without it.
+        uint64_t layer[k_fast_layers] = {}, overflow = 0;
         for (uint32_t i = 0; i < count; ++i) {
-            uint64_t carry = uint64_t(1) << banks[i];
+            uint64_t carry = uint64_t(1) << lane_banks[i];
             for (uint32_t k = 0; k < k_fast_layers; ++k) {
                 const uint64_t had = layer[k] & carry;
                 layer[k] |= carry;
@@ -32,7 +29,18 @@ uint64_t BankSchedule::book(const uint32_t* banks, uint32_t count, uint64_t read
             }
             overflow |= carry;
         }
-        if (!overflow && m_occupancy == 1) {
+        m_fast = overflow == 0;
+        std::copy(layer, layer + k_fast_layers, m_layer);
+    }
+    if (!m_fast) m_lanes.assign(lane_banks, lane_banks + count);
+}
+
+uint64_t BankSchedule::book_lanes(uint32_t rotation, uint64_t ready) {
+    if (m_lane_count == 0) return ready;
+    if (m_fast) {
+        uint64_t layer[k_fast_layers];
+        for (uint32_t k = 0; k < k_fast_layers; ++k) layer[k] = rotate(m_layer[k], rotation);
+        if (m_occupancy == 1) {
             // Pipelined banks: each cycle grants every wanting bank that is free in it.
             uint64_t cycle = ready > m_base ? ready : m_base;
             for (;; ++cycle) {
@@ -40,27 +48,29 @@ uint64_t BankSchedule::book(const uint32_t* banks, uint32_t count, uint64_t read
                 const uint64_t granted = layer[0] & ~bits;
                 if (!granted) continue;
                 bits |= granted;
+                // One request fewer per granted bank: layer k keeps it only if layer k+1 has it.
                 for (uint32_t k = 0; k + 1 < k_fast_layers; ++k)
                     layer[k] &= ~granted | layer[k + 1];
                 layer[k_fast_layers - 1] &= ~granted;
                 if (!layer[0]) return cycle;
             }
         }
-        if (!overflow) {
-            if (m_want.size() < k_fast_layers) m_want.resize(k_fast_layers);
-            uint32_t layers = 0;
-            while (layers < k_fast_layers && layer[layers]) {
-                m_want[layers] = layer[layers];
-                ++layers;
-            }
-            return grant<true>(layers, ready);
+        if (m_want.size() < k_fast_layers) m_want.resize(k_fast_layers);
+        uint32_t layers = 0;
+        while (layers < k_fast_layers && layer[layers]) {
+            m_want[layers] = layer[layers];
+            ++layers;
         }
+        return grant<true>(layers, ready);
     }
+    // The general case: the layers a bit per lane, as many as the most requests to one bank.
+    const uint32_t words = m_words, count = m_lane_count;
     if (m_want.size() < size_t(count) * words) m_want.resize(size_t(count) * words);
     uint32_t layers = 0;
     for (uint32_t i = 0; i < count; ++i) {
-        const uint32_t j = banks[i] / 64;
-        const uint64_t bit = uint64_t(1) << (banks[i] % 64);
+        const uint32_t bank = (m_lanes[i] + rotation) % m_banks;
+        const uint32_t j = bank / 64;
+        const uint64_t bit = uint64_t(1) << (bank % 64);
         uint32_t k = 0;
         while (k < layers && (m_want[size_t(k) * words + j] & bit)) ++k;
         if (k == layers) {

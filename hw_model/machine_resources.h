@@ -30,9 +30,18 @@ class BankSchedule {
 
     BankSchedule(uint32_t banks, uint32_t occupancy);
 
-    // Books one request to banks[i] for each i < count, all ready at `ready`; returns the cycle
-    // of the last grant (`ready` when count is 0).
-    uint64_t book(const uint32_t* banks, uint32_t count, uint64_t ready);
+    // The lanes of the next accesses: one request each, to bank lane_banks[i] turned by the
+    // access's rotation (a ray buffer's field words differ from each other by one: see
+    // RayBufferModel::field_rotation), so the lanes are sorted into banks once per group.
+    void set_lanes(const uint32_t* lane_banks, uint32_t count);
+    // Books the lanes' requests to banks (lane_banks[i] + rotation) % banks, all ready at
+    // `ready`; returns the cycle of the last grant (`ready` when there are no lanes).
+    uint64_t book_lanes(uint32_t rotation, uint64_t ready);
+    // set_lanes and book_lanes at rotation 0.
+    uint64_t book(const uint32_t* banks, uint32_t count, uint64_t ready) {
+        set_lanes(banks, count);
+        return book_lanes(0, ready);
+    }
     uint32_t banks() const { return m_banks; }
 
   private:
@@ -50,8 +59,20 @@ class BankSchedule {
     }
     template <bool OneWord>
     uint64_t grant(uint32_t layers, uint64_t ready);
+    uint64_t rotate(uint64_t bits, uint32_t by) const {  // within a ring of m_banks <= 64 bits
+        if (by == 0) return bits;
+        return ((bits << by) | (bits >> (m_banks - by))) & m_full;
+    }
 
+    static constexpr uint32_t k_fast_layers = 4;
     uint32_t m_banks, m_words, m_occupancy;
+    uint64_t m_full;  // the bank bits of one word, when m_words is 1
+    // The lanes: at most 64 banks and k_fast_layers requests per bank, as bit layers (layer k:
+    // the banks with more than k requests); else each lane's bank.
+    bool m_fast = true;
+    uint32_t m_lane_count = 0;
+    uint64_t m_layer[k_fast_layers] = {};
+    std::vector<uint32_t> m_lanes;
     uint64_t m_base = 0;            // first cycle of the window
     std::vector<uint64_t> m_ring;   // k_window entries: the cycle held, then m_words bank words
     std::vector<uint64_t> m_want;   // scratch: per layer k, the banks with more than k requests

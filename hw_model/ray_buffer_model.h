@@ -23,7 +23,16 @@ public:
     uint32_t bank_of(uint32_t field_word, uint32_t slot) const {
         const uint64_t word = m_aos ? uint64_t(slot) * m_record_words + field_word
                                     : uint64_t(field_word) * m_slot_count + slot;
-        return m_bank_mask ? uint32_t(word & m_bank_mask) : uint32_t(word % m_banks);
+        return bank_mod(word);
+    }
+    // bank_of(field_word, slot) == (slot_bank(slot) + field_rotation(field_word)) % banks(): a
+    // word's address is a slot's part plus a field's, so one field's lanes fall in the slots'
+    // banks turned by the field's offset.
+    uint32_t slot_bank(uint32_t slot) const {
+        return bank_mod(m_aos ? uint64_t(slot) * m_record_words : uint64_t(slot));
+    }
+    uint32_t field_rotation(uint32_t field_word) const {
+        return bank_mod(m_aos ? uint64_t(field_word) : uint64_t(field_word) * m_slot_count);
     }
 
     // Issue cycles to access one field word of each lane's slot (a gather or a scatter of one
@@ -63,6 +72,10 @@ public:
     uint32_t line_words() const { return m_line_words; }
 
 private:
+    uint32_t bank_mod(uint64_t word) const {
+        return m_bank_mask ? uint32_t(word & m_bank_mask) : uint32_t(word % m_banks);
+    }
+
     uint32_t m_banks, m_line_words, m_latency, m_slot_count, m_record_words;
     uint32_t m_bank_mask = 0;  // banks - 1 when banks is a power of two: no division per lane
     bool m_pipelined, m_aos;

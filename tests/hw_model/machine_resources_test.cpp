@@ -64,6 +64,32 @@ TEST_CASE("bank schedule grants a SIMD access's lanes as banks that never forget
     }
 }
 
+TEST_CASE("bank schedule books lanes turned by a rotation as the turned banks", "[machine]") {
+    for (const uint32_t bank_count : {32u, 24u, 64u, 100u}) {
+        for (const uint32_t occupancy : {1u, 2u}) {
+            std::mt19937 rng(bank_count + occupancy);
+            BankSchedule turned(bank_count, occupancy), plain(bank_count, occupancy);
+            uint64_t now = 0;
+            for (int i = 0; i < 5000; ++i) {
+                const uint32_t lanes = 1 + rng() % 16;
+                std::vector<uint32_t> banks(lanes), rotated(lanes);
+                for (uint32_t& b : banks) b = uint32_t(rng()) % (1 + rng() % bank_count);
+                turned.set_lanes(banks.data(), lanes);
+                // Several words of one group: the lanes set once, each word at its rotation.
+                for (int w = 0; w < 3; ++w) {
+                    const uint32_t rotation = uint32_t(rng()) % bank_count;
+                    for (uint32_t l = 0; l < lanes; ++l)
+                        rotated[l] = (banks[l] + rotation) % bank_count;
+                    const uint64_t ready = now + rng() % 50;
+                    REQUIRE(turned.book_lanes(rotation, ready) ==
+                            plain.book(rotated.data(), lanes, ready));
+                }
+                now += rng() % (6 * occupancy);
+            }
+        }
+    }
+}
+
 TEST_CASE("bank schedule queues lanes of one bank and never books a forgotten cycle",
           "[machine]") {
     BankSchedule schedule(32, 1);

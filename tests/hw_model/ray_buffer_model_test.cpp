@@ -100,3 +100,24 @@ TEST_CASE("Record layout: soa spreads consecutive slots, aos strides by the reco
     const RayBufferModel odd(c, 25, 4096);  // an odd record size spreads again
     CHECK(odd.access_field(0, slots.data(), 16).conflict_cycles == 0);
 }
+
+TEST_CASE("A field's banks are the slots' banks turned by the field's offset", "[hw_model]") {
+    // Power-of-two and other bank counts, both layouts, slot counts that do and do not divide.
+    for (const uint32_t banks : {32u, 12u, 64u}) {
+        for (const char* layout : {"soa", "aos"}) {
+            for (const uint32_t slot_count : {4096u, 1000u}) {
+                RayBufferConfig c;
+                c.banks = banks;
+                c.layout = layout;
+                const RayBufferModel buffer(c, 25, slot_count);
+                INFO(banks << " banks, " << layout << ", " << slot_count << " slots");
+                uint32_t wrong = 0;
+                for (uint32_t word = 0; word < 25; ++word)
+                    for (uint32_t slot = 0; slot < slot_count; slot += 7)
+                        wrong += buffer.bank_of(word, slot) !=
+                                 (buffer.slot_bank(slot) + buffer.field_rotation(word)) % banks;
+                CHECK(wrong == 0);
+            }
+        }
+    }
+}
