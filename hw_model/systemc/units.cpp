@@ -75,8 +75,9 @@ Core::Core(sc_core::sc_module_name name, const HwConfig& config, const OpCostTab
 
 void Core::op_finished(uint64_t cycle) {
     m_last_completion = std::max(m_last_completion, cycle);
-    --m_outstanding;
-    m_op_event.notify(sc_core::SC_ZERO_TIME);
+    // The dispatcher waits on this only for the pass's last op (it re-waits while ops are
+    // outstanding): waking it for every op cost a delta cycle each and changed nothing.
+    if (--m_outstanding == 0) m_op_event.notify(sc_core::SC_ZERO_TIME);
 }
 
 void Core::partition_done(uint64_t start, uint64_t end) {
