@@ -16,7 +16,7 @@ BankSchedule::BankSchedule(uint32_t banks, uint32_t occupancy)
 
 void BankSchedule::set_lanes(const uint32_t* lane_banks, uint32_t count) {
     m_lane_count = count;
-    m_fast = m_words == 1;
+    m_fast = m_words == 1 && m_occupancy == 1;
     if (m_fast) {
         // The layers branch-free: each lane's bit carries up to the first layer without it.
         uint64_t layer[k_fast_layers] = {}, overflow = 0;
@@ -38,30 +38,19 @@ void BankSchedule::set_lanes(const uint32_t* lane_banks, uint32_t count) {
 uint64_t BankSchedule::book_lanes(uint32_t rotation, uint64_t ready) {
     if (m_lane_count == 0) return ready;
     if (m_fast) {
+        // Pipelined banks: each cycle grants every wanting bank that is free in it.
         uint64_t layer[k_fast_layers];
         for (uint32_t k = 0; k < k_fast_layers; ++k) layer[k] = rotate(m_layer[k], rotation);
-        if (m_occupancy == 1) {
-            // Pipelined banks: each cycle grants every wanting bank that is free in it.
-            uint64_t cycle = ready > m_base ? ready : m_base;
-            for (;; ++cycle) {
-                uint64_t& bits = *busy<true>(cycle);
-                const uint64_t granted = layer[0] & ~bits;
-                if (!granted) continue;
-                bits |= granted;
-                // One request fewer per granted bank: layer k keeps it only if layer k+1 has it.
-                for (uint32_t k = 0; k + 1 < k_fast_layers; ++k)
-                    layer[k] &= ~granted | layer[k + 1];
-                layer[k_fast_layers - 1] &= ~granted;
-                if (!layer[0]) return cycle;
-            }
+        for (uint64_t cycle = ready > m_base ? ready : m_base;; ++cycle) {
+            uint64_t& bits = *busy<true>(cycle);
+            const uint64_t granted = layer[0] & ~bits;
+            if (!granted) continue;
+            bits |= granted;
+            // One request fewer per granted bank: layer k keeps it only if layer k+1 has it.
+            for (uint32_t k = 0; k + 1 < k_fast_layers; ++k) layer[k] &= ~granted | layer[k + 1];
+            layer[k_fast_layers - 1] &= ~granted;
+            if (!layer[0]) return cycle;
         }
-        if (m_want.size() < k_fast_layers) m_want.resize(k_fast_layers);
-        uint32_t layers = 0;
-        while (layers < k_fast_layers && layer[layers]) {
-            m_want[layers] = layer[layers];
-            ++layers;
-        }
-        return grant<true>(layers, ready);
     }
     // The general case: the layers a bit per lane, as many as the most requests to one bank.
     const uint32_t words = m_words, count = m_lane_count;

@@ -31,8 +31,9 @@ class BankSchedule {
     BankSchedule(uint32_t banks, uint32_t occupancy);
 
     // The lanes of the next accesses: one request each, to bank lane_banks[i] turned by the
-    // access's rotation (a ray buffer's field words differ from each other by one: see
-    // RayBufferModel::field_rotation), so the lanes are sorted into banks once per group.
+    // access's rotation (each field word of a group falls in the slots' banks turned by the
+    // field's offset: RayBufferModel::field_rotation), so the lanes are sorted into banks once
+    // per group.
     void set_lanes(const uint32_t* lane_banks, uint32_t count);
     // Books the lanes' requests to banks (lane_banks[i] + rotation) % banks, all ready at
     // `ready`; returns the cycle of the last grant (`ready` when there are no lanes).
@@ -42,7 +43,6 @@ class BankSchedule {
         set_lanes(banks, count);
         return book_lanes(0, ready);
     }
-    uint32_t banks() const { return m_banks; }
 
   private:
     // Bank bits of `cycle` (moves the window to reach it; a stale entry reads as free).
@@ -67,8 +67,8 @@ class BankSchedule {
     static constexpr uint32_t k_fast_layers = 4;
     uint32_t m_banks, m_words, m_occupancy;
     uint64_t m_full;  // the bank bits of one word, when m_words is 1
-    // The lanes: at most 64 banks and k_fast_layers requests per bank, as bit layers (layer k:
-    // the banks with more than k requests); else each lane's bank.
+    // The lanes: with pipelined banks, at most 64 of them and k_fast_layers requests per bank,
+    // as bit layers (layer k: the banks with more than k requests); else each lane's bank.
     bool m_fast = true;
     uint32_t m_lane_count = 0;
     uint64_t m_layer[k_fast_layers] = {};
@@ -87,8 +87,7 @@ class CapacityServer {
   public:
     static constexpr uint32_t k_window = 1024;
     explicit CapacityServer(double per_cycle) : m_per_cycle(per_cycle) {
-        m_used.fill(0.0);
-        m_tag.fill(~uint64_t(0));
+        m_tag.fill(~uint64_t(0));  // every entry stale: used() zeroes it when first touched
     }
 
     // Serves `amount` from cycle `ready` on; returns the cycle in which its last part is served
