@@ -7,6 +7,7 @@
 // so no out-of-line function compiled with wide instructions escapes its namespace.
 
 #include <cstring>
+#include <type_traits>
 
 #include "kernels/intersect.h"
 #include "kernels/simd/lanes.h"
@@ -43,6 +44,20 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
     const uint32_t count = compress_store<Width>(mask_bits, values, tmp);
     std::memcpy(out, tmp, count * sizeof(uint32_t));
     return count;
+}
+
+// Calls group(std::integral_constant<int, W>(), g) for each group of Width ids from g = 0 while
+// g < n. At 16 lanes a last group of at most 8 ids (a short stream, or a stream's tail) runs at
+// 8: half the gathers on short secondary streams; the lane math is the same at every width, so
+// are the results.
+template <int Width, class Group>
+SFX_LANES_INLINE void for_each_group(uint32_t n, Group&& group) {
+    for (uint32_t g = 0; g < n; g += Width) {
+        if constexpr (Width == 16) {
+            if (n - g <= 8) return group(std::integral_constant<int, 8>(), g);
+        }
+        group(std::integral_constant<int, Width>(), g);
+    }
 }
 
 // The ids of one group and how its fields are read: by window (plain loads and permutes)
@@ -108,20 +123,10 @@ uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint
                     uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
                     uint32_t& negative) {
     uint32_t front = 0, back = 0, negatives = 0;
-    for (uint32_t g = 0; g < n; g += Width) {
-        uint8_t* group_mask = mask ? mask + g : nullptr;
-        // At 16 lanes, a group of at most 8 ids runs at 8: half the gathers (secondary streams
-        // are short). The lanes' math is the same at every width, so are the results.
-        if constexpr (Width == 16) {
-            if (n - g <= 8) {
-                box_group<8>(rays, box, axis, ids + g, n - g, pass_out, fail_out, group_mask,
-                             front, back, negatives);
-                break;
-            }
-        }
-        box_group<Width>(rays, box, axis, ids + g, n - g, pass_out, fail_out, group_mask, front,
-                         back, negatives);
-    }
+    for_each_group<Width>(n, [&](auto width, uint32_t g) {
+        box_group<decltype(width)::value>(rays, box, axis, ids + g, n - g, pass_out, fail_out,
+                                          mask ? mask + g : nullptr, front, back, negatives);
+    });
     negative += negatives;
     return front;
 }
@@ -172,15 +177,10 @@ void leaf_candidates(TraversalView rays, const LeafPrimitive* triangles, uint32_
                      const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
                      uint32_t* found) {
     for (uint32_t j = 0; j < count; ++j) found[j] = 0;
-    for (uint32_t g = 0; g < n; g += Width) {
-        if constexpr (Width == 16) {  // a short group at 8 lanes, as in box_filter
-            if (n - g <= 8) {
-                leaf_group<8>(rays, triangles, count, ids, g, n - g, positions, stride, found);
-                break;
-            }
-        }
-        leaf_group<Width>(rays, triangles, count, ids, g, n - g, positions, stride, found);
-    }
+    for_each_group<Width>(n, [&](auto width, uint32_t g) {
+        leaf_group<decltype(width)::value>(rays, triangles, count, ids, g, n - g, positions, stride,
+                                           found);
+    });
 }
 
 // One group of partition: the `left` ids from ids + g on.
@@ -199,15 +199,9 @@ SFX_LANES_INLINE void partition_group(uint32_t* ids, uint32_t g, uint32_t left,
 template <int Width>
 uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch) {
     uint32_t front = 0, back = 0;
-    for (uint32_t g = 0; g < n; g += Width) {
-        if constexpr (Width == 16) {  // a short group at 8 lanes, as in box_filter
-            if (n - g <= 8) {
-                partition_group<8>(ids, g, n - g, mask, scratch, front, back);
-                break;
-            }
-        }
-        partition_group<Width>(ids, g, n - g, mask, scratch, front, back);
-    }
+    for_each_group<Width>(n, [&](auto width, uint32_t g) {
+        partition_group<decltype(width)::value>(ids, g, n - g, mask, scratch, front, back);
+    });
     // Always: the whole-vector stores overwrote ids[0, n) past the passing prefix.
     if (back != 0) std::memcpy(ids + front, scratch, back * sizeof(uint32_t));
     return front;
