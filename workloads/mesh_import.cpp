@@ -238,16 +238,17 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
                         continue;
                     }
                     const std::string& count = tokens[next++];
-                    if (count.size() > 10 ||
-                        count.find_first_not_of("0123456789") != std::string::npos ||
-                        std::stoull(count) > ply_count_max(p.count_type))
+                    const bool digits = count.size() <= 10 &&
+                                        count.find_first_not_of("0123456789") == std::string::npos;
+                    const uint64_t items = digits ? std::stoull(count) : 0;
+                    if (!digits || items > ply_count_max(p.count_type))
                         fail(uint64_t(line),
                              "'" + count + "' is not a list length of type " + p.count_type);
-                    if (std::stoull(count) > tokens.size() - next)
+                    if (items > tokens.size() - next)
                         fail(uint64_t(line),
                              "a list of " + count + " items, more than its line holds");
-                    face.add(p, std::stoull(count), uint64_t(line));
-                    next += std::stoull(count);
+                    face.add(p, items, uint64_t(line));
+                    next += items;
                 }
                 if (e.name == "face") face.check(fail);
             }
