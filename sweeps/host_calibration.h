@@ -23,7 +23,7 @@ struct HostCalibration {
     HostDescription host;
     std::vector<OpCostConfig> op_costs;
     std::vector<MicrobenchSample> samples;
-    std::vector<KernelRate> rates;  // gather and compress by themselves (reported, not fitted)
+    std::vector<KernelRate> rates;  // field read and compress by themselves (reported, not fitted)
     // Per fitted kind: the fit's (median, worst) relative error on its own samples.
     std::vector<std::pair<double, double>> fit_errors;
     std::string yaml;  // host.hw.yaml

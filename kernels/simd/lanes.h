@@ -224,83 +224,77 @@ SFX_LANES_INLINE vfloat<Width> gather(const float* base, vint<Width> index) {
         return v;
     }
 }
+// Eight consecutive floats per lane, as eight vectors: lane l of out[f] = base[index[l] + f].
+// Each lane's eight floats (32-byte aligned) come by one load and a transpose makes them lanes,
+// so a lane touches one cache line where eight gathers would touch it eight times; the same
+// bits as gathers. At 16 lanes: 256-bit halves of lanes l and l + 4 share a register, 4x4
+// transposes within 128-bit blocks, then one block shuffle per field; at 8 lanes: 128-bit
+// halves of lanes l and l + 4, two 4x4 transposes.
 template <int Width>
-SFX_LANES_INLINE vint<Width> gather_int(const int32_t* base, vint<Width> index) {
+SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
+                                       vfloat<Width> out[8]) {
     if constexpr (Width == 1) {
-        return base[index];
+        for (int f = 0; f < 8; ++f) out[f] = base[index[0] + f];
     } else {
 #if defined(__AVX512F__)
-        if constexpr (Width == 16)
-            return vint<Width>(_mm512_mask_i32gather_epi32(
-                _mm512_setzero_si512(), __mmask16(0xffff), __m512i(index), base, 4));
-#endif
-#if defined(__AVX2__)
-        if constexpr (Width == 8)
-            return vint<Width>(_mm256_i32gather_epi32(base, __m256i(index), 4));
-#endif
-        vint<Width> v;
-        for (int l = 0; l < Width; ++l) v[l] = base[index[l]];
-        return v;
-    }
-}
-
-// A gather whose indices all lie in one window [lo, lo + window_slots<Width>()): lane l =
-// base[lo + offset[l]], read by plain loads at base + lo and permutes across them instead of
-// Width separate loads. The stream's ids come in runs (stable partitions keep the order of
-// the passing ids), so the ray fields of a group are usually a few cache lines apart. Reads
-// base[lo, lo + window_slots): the caller pads the array. Same bits as gather().
-// The window: four vectors at 16 lanes (two two-register permutes and a blend), two at 8.
-template <int Width>
-constexpr int32_t window_slots() {
-    return Width == 16 ? 4 * Width : 2 * Width;
-}
-template <int Width>
-SFX_LANES_INLINE bool in_window(vint<Width> index, int32_t lo) {
-    if constexpr (Width == 1) {
-        return true;
-    } else {
-        const vint<Width> offset = index - broadcast_int<Width>(lo);
-#if defined(__AVX512F__)
-        if constexpr (Width == 16)
-            return _mm512_cmpge_epu32_mask(__m512i(offset),
-                                           _mm512_set1_epi32(window_slots<Width>())) == 0;
-#endif
-#if defined(__AVX2__)
-        if constexpr (Width == 8)  // offset < 16 unsigned: no bit above the low four
-            return _mm256_testz_si256(__m256i(offset), _mm256_set1_epi32(~15)) != 0;
-#endif
-        for (int l = 0; l < Width; ++l)
-            if (uint32_t(offset[l]) >= uint32_t(window_slots<Width>())) return false;
-        return true;
-    }
-}
-template <int Width>
-SFX_LANES_INLINE vfloat<Width> gather_window(const float* base, int32_t lo, vint<Width> offset) {
-    if constexpr (Width == 1) {
-        return base[lo + offset];
-    } else {
-        const float* p = base + lo;
-#if defined(__AVX512F__)
-        if constexpr (Width == 16) {  // bits 0-4 pick within a pair of vectors, bit 5 the pair
-            const __m512i o = __m512i(offset);
-            const __m512 a = _mm512_permutex2var_ps(_mm512_loadu_ps(p), o, _mm512_loadu_ps(p + 16));
-            const __m512 b =
-                _mm512_permutex2var_ps(_mm512_loadu_ps(p + 32), o, _mm512_loadu_ps(p + 48));
-            return vfloat<Width>(
-                _mm512_mask_blend_ps(_mm512_test_epi32_mask(o, _mm512_set1_epi32(32)), a, b));
+        if constexpr (Width == 16) {
+            auto row = [&](int a, int b) {  // a's 256 bits, then b's
+                const vfloat<8> low = vfloat<8>(_mm256_load_ps(base + index[a]));
+                const vfloat<8> high = vfloat<8>(_mm256_load_ps(base + index[b]));
+                return __m512(__builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10,
+                                                      11, 12, 13, 14, 15));
+            };
+            // The all-lanes masked forms (and a vector shuffle above): GCC 12's plain ones read
+            // an "undefined" register that -Wmaybe-uninitialized reports.
+            auto unpacklo = [](__m512 a, __m512 b) {
+                return _mm512_mask_unpacklo_ps(a, 0xffff, a, b);
+            };
+            auto unpackhi = [](__m512 a, __m512 b) {
+                return _mm512_mask_unpackhi_ps(a, 0xffff, a, b);
+            };
+            auto transpose4 = [&](__m512 r0, __m512 r1, __m512 r2, __m512 r3, __m512 u[4]) {
+                const __m512 t0 = unpacklo(r0, r1), t1 = unpackhi(r0, r1);
+                const __m512 t2 = unpacklo(r2, r3), t3 = unpackhi(r2, r3);
+                u[0] = _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+                u[1] = _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+                u[2] = _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+                u[3] = _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+            };
+            // u[k]'s 128-bit blocks: field k of lanes 0-3, field k + 4 of lanes 0-3, field k of
+            // lanes 4-7, field k + 4 of lanes 4-7; v[k] the same for lanes 8-15.
+            __m512 u[4], v[4];
+            transpose4(row(0, 4), row(1, 5), row(2, 6), row(3, 7), u);
+            transpose4(row(8, 12), row(9, 13), row(10, 14), row(11, 15), v);
+            for (int k = 0; k < 4; ++k) {
+                out[k] = vfloat<Width>(
+                    _mm512_mask_shuffle_f32x4(u[k], 0xffff, u[k], v[k], _MM_SHUFFLE(2, 0, 2, 0)));
+                out[k + 4] = vfloat<Width>(
+                    _mm512_mask_shuffle_f32x4(u[k], 0xffff, u[k], v[k], _MM_SHUFFLE(3, 1, 3, 1)));
+            }
+            return;
         }
 #endif
 #if defined(__AVX2__)
-        if constexpr (Width == 8) {  // each half permuted, bit 3 of the offset picks the half
-            const __m256 a = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), __m256i(offset));
-            const __m256 b = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p + 8), __m256i(offset));
-            return vfloat<Width>(_mm256_blendv_ps(
-                a, b, _mm256_castsi256_ps(_mm256_slli_epi32(__m256i(offset), 28))));
+        if constexpr (Width == 8) {
+            for (int h = 0; h < 8; h += 4) {
+                auto row = [&](int a, int b) {
+                    return _mm256_insertf128_ps(
+                        _mm256_castps128_ps256(_mm_load_ps(base + index[a] + h)),
+                        _mm_load_ps(base + index[b] + h), 1);
+                };
+                const __m256 r0 = row(0, 4), r1 = row(1, 5), r2 = row(2, 6), r3 = row(3, 7);
+                const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+                const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+                out[h] = vfloat<Width>(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+                out[h + 1] = vfloat<Width>(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+                out[h + 2] = vfloat<Width>(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+                out[h + 3] = vfloat<Width>(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+            }
+            return;
         }
 #endif
-        vfloat<Width> v;
-        for (int l = 0; l < Width; ++l) v[l] = p[offset[l]];
-        return v;
+        for (int f = 0; f < 8; ++f)
+            for (int l = 0; l < Width; ++l) out[f][l] = base[index[l] + f];
     }
 }
 

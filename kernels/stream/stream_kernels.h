@@ -1,10 +1,12 @@
 #pragma once
 // The stream filters' inner loops, one set per host instruction set (kernels/simd/isa.h),
 // built from one width-generic source (stream_kernels_impl.h) in translation units compiled
-// for that instruction set. Each processes Width lanes at a time: gather the ray fields of
-// Width slots, test them against one node or primitive broadcast across the lanes, compress
-// the passing slot ids. Every back end gives the same bits as the scalar one.
+// for that instruction set. Each processes Width lanes at a time: read the ray fields of
+// Width slots (one record half per slot, transposed into lanes), test them against one node or
+// primitive broadcast across the lanes, compress the passing slot ids. Every back end gives the
+// same bits as the scalar one.
 
+#include <boost/align/aligned_allocator.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -15,55 +17,54 @@
 
 namespace sfx {
 
-// The ray fields the box and triangle filters read, one array per field (structure of
-// arrays): the test's constants and t (the closest hit so far, or the ray's t_max; -1 for an
-// occluded shadow ray, which every later box and primitive test then misses). A group of
-// Width slots reads each field by plain loads and permutes when its ids lie in one window of
-// slots (kernels/simd/lanes.h, window_slots: 64 at 16 lanes, 16 at 8; stable partitions keep
-// ids in runs), by a gather otherwise.
-namespace traversal_field {  // the field arrays, in order
-constexpr int org = 0, inv_dir = 3, t = 6, kx = 7, ky = 8, kz = 9, sx = 10, sy = 11, count = 12;
+// The ray fields the box and triangle filters read, one 64-byte record (a cache line) per
+// slot: the box test's half (org, inv_dir, t: the closest hit so far, or the ray's t_max; -1
+// for an occluded shadow ray, which every later box and primitive test then misses), then the
+// triangle test's half (org again, kx, ky, kz, sx, sy). A group of Width slots scattered over
+// the buffer touches one line per ray, not one per field; it reads a half by Width 32-byte
+// loads and a transpose (kernels/simd/lanes.h, load_transposed).
+namespace traversal_field {  // float offsets within a slot's record
+constexpr int org = 0, inv_dir = 3, t = 6, box_half = 0;
+constexpr int tri_org = 8, kx = 11, ky = 12, kz = 13, sx = 14, sy = 15, triangle_half = 8;
+constexpr int record = 16;
 }  // namespace traversal_field
 
-// Room past the last slot of each field array: a window read loads up to 64 elements.
-constexpr uint32_t k_window_padding = 64;
-
-// What the kernels read: field f of slot i at data[f * stride + i]. A plain view, so the wide
-// translation units instantiate no out-of-line member of a library type.
+// What the kernels read: field f of slot i at data[i * traversal_field::record + f], data
+// 64-byte aligned. A plain view, so the wide translation units instantiate no out-of-line
+// member of a library type.
 struct TraversalView {
     const float* data;
-    uint32_t stride;
 };
 
 class TraversalRays {
   public:
     // Room for `slots` rays; every field zero.
-    void resize(uint32_t slots) {
-        m_stride = slots + k_window_padding;
-        m_data.assign(size_t(traversal_field::count) * m_stride, 0.f);
-    }
+    void resize(uint32_t slots) { m_data.assign(size_t(slots) * traversal_field::record, 0.f); }
     // Slot `slot` gets the test constants of `pre` and t.
     void set(uint32_t slot, const RayPrecomp& pre, float t) {
         namespace f = traversal_field;
+        float* r = record(slot);
         for (int a = 0; a < 3; ++a) {
-            at(f::org + a, slot) = pre.org[a];
-            at(f::inv_dir + a, slot) = pre.inv_dir[a];
+            r[f::org + a] = pre.org[a];
+            r[f::inv_dir + a] = pre.inv_dir[a];
+            r[f::tri_org + a] = pre.org[a];
         }
-        at(f::t, slot) = t;
+        r[f::t] = t;
+        r[7] = 0.f;
         const int32_t k[3] = {pre.kx, pre.ky, pre.kz};
-        for (int a = 0; a < 3; ++a) std::memcpy(&at(f::kx + a, slot), &k[a], sizeof(float));
-        at(f::sx, slot) = pre.sx;
-        at(f::sy, slot) = pre.sy;
+        std::memcpy(r + f::kx, k, sizeof k);
+        r[f::sx] = pre.sx;
+        r[f::sy] = pre.sy;
     }
-    float& t(uint32_t slot) { return at(traversal_field::t, slot); }
-    float t(uint32_t slot) const { return field(traversal_field::t)[slot]; }
-    const float* field(int f) const { return m_data.data() + size_t(f) * m_stride; }
-    TraversalView view() const { return {m_data.data(), m_stride}; }
+    float& t(uint32_t slot) { return record(slot)[traversal_field::t]; }
+    float t(uint32_t slot) const {
+        return m_data[size_t(slot) * traversal_field::record + traversal_field::t];
+    }
+    TraversalView view() const { return {m_data.data()}; }
 
   private:
-    float& at(int f, uint32_t slot) { return m_data[size_t(f) * m_stride + slot]; }
-    std::vector<float> m_data;
-    uint32_t m_stride = 0;
+    float* record(uint32_t slot) { return m_data.data() + size_t(slot) * traversal_field::record; }
+    std::vector<float, boost::alignment::aligned_allocator<float, 64>> m_data;
 };
 
 // Room every id, position and scratch buffer needs past its length: a group's compress

@@ -60,34 +60,30 @@ SFX_LANES_INLINE void for_each_group(uint32_t n, Group&& group) {
     }
 }
 
-// The ids of one group and how its fields are read: by window (plain loads and permutes)
-// when every id lies in [ids[g], ids[g] + window_slots), else by gather. Same bits either way.
+// One group's slot ids and its reads of their records' halves (stream_kernels.h).
 template <int Width>
 struct GroupReader {
-    static_assert(window_slots<Width>() <= int32_t(k_window_padding), "field arrays' padding");
     const float* data;
-    uint32_t stride;
     vint<Width> id;
-    int32_t lo;
-    vint<Width> offset;
-    bool window;
+    alignas(64) int32_t offset[Width];  // each lane's record, in floats from data
 
-    SFX_LANES_INLINE GroupReader(TraversalView rays, vint<Width> ids, int32_t first)
-        : data(rays.data), stride(rays.stride), id(ids), lo(first) {
-        window = in_window<Width>(id, lo);
-        offset = id - broadcast_int<Width>(lo);
+    SFX_LANES_INLINE GroupReader(TraversalView rays, vint<Width> ids) : data(rays.data), id(ids) {
+        const vint<Width> o = id * broadcast_int<Width>(traversal_field::record);
+        __builtin_memcpy(offset, &o, sizeof offset);
     }
-    SFX_LANES_INLINE vfloat<Width> read(int field) const {
-        const float* base = data + size_t(field) * stride;
-        return window ? gather_window<Width>(base, lo, offset) : gather<Width>(base, id);
-    }
-    SFX_LANES_INLINE vint<Width> read_int(int field) const {
-        const vfloat<Width> v = read(field);
-        vint<Width> r;
-        __builtin_memcpy(&r, &v, sizeof r);
-        return r;
+    // out[f] = field half + f of every lane's record.
+    SFX_LANES_INLINE void read_half(int half, vfloat<Width> out[8]) const {
+        load_transposed8<Width>(data + half, offset, out);
     }
 };
+
+// The lanes' bits as integers (kx, ky, kz are stored in float records).
+template <int Width>
+SFX_LANES_INLINE vint<Width> as_int(vfloat<Width> v) {
+    vint<Width> r;
+    __builtin_memcpy(&r, &v, sizeof r);
+    return r;
+}
 
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
 template <int Width>
@@ -97,13 +93,13 @@ SFX_LANES_INLINE void box_group(TraversalView rays, const Bounds3& box, int axis
                                 uint32_t& back, uint32_t& negatives) {
     namespace f = traversal_field;
     const uint32_t active = active_bits<Width>(left);
-    const GroupReader<Width> r(rays, load_ids<Width>(ids, active), int32_t(ids[0]));
-    vfloat<Width> org[3], inv_dir[3];
-    for (int a = 0; a < 3; ++a) {
-        org[a] = r.read(f::org + a);
-        inv_dir[a] = r.read(f::inv_dir + a);
-    }
-    const vfloat<Width> t_max = r.read(f::t);
+    const GroupReader<Width> r(rays, load_ids<Width>(ids, active));
+    vfloat<Width> field[8];
+    r.read_half(f::box_half, field);
+    const vfloat<Width> org[3] = {field[f::org], field[f::org + 1], field[f::org + 2]};
+    const vfloat<Width> inv_dir[3] = {field[f::inv_dir], field[f::inv_dir + 1],
+                                      field[f::inv_dir + 2]};
+    const vfloat<Width> t_max = field[f::t];
     vfloat<Width> t0;
     const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
     // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
@@ -138,11 +134,15 @@ uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1,
     uint32_t k = 0;
     for (uint32_t g = 0; g < n; g += Width) {
         const uint32_t active = active_bits<Width>(n - g);
-        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
-        const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
-        const ShearedTriangle<Width> s =
-            shear_triangle<Width>(org, r.read_int(f::kx), r.read_int(f::ky), r.read_int(f::kz),
-                                  r.read(f::sx), r.read(f::sy), p0, p1, p2);
+        const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active));
+        vfloat<Width> field[8];
+        r.read_half(f::triangle_half, field);
+        const int h = f::triangle_half;
+        const vfloat<Width> org[3] = {field[f::tri_org - h], field[f::tri_org + 1 - h],
+                                      field[f::tri_org + 2 - h]};
+        const ShearedTriangle<Width> s = shear_triangle<Width>(
+            org, as_int<Width>(field[f::kx - h]), as_int<Width>(field[f::ky - h]),
+            as_int<Width>(field[f::kz - h]), field[f::sx - h], field[f::sy - h], p0, p1, p2);
         const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
         k += compress_store<Width>(keep, lane_index<Width>() + broadcast_int<Width>(int32_t(g)),
                                    positions + k);  // positions has room past n
@@ -157,10 +157,15 @@ SFX_LANES_INLINE void leaf_group(TraversalView rays, const LeafPrimitive* triang
                                  uint32_t* positions, uint32_t stride, uint32_t* found) {
     namespace f = traversal_field;
     const uint32_t active = active_bits<Width>(left);
-    const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active), int32_t(ids[g]));
-    const vfloat<Width> org[3] = {r.read(f::org), r.read(f::org + 1), r.read(f::org + 2)};
-    const vint<Width> kx = r.read_int(f::kx), ky = r.read_int(f::ky), kz = r.read_int(f::kz);
-    const vfloat<Width> sx = r.read(f::sx), sy = r.read(f::sy);
+    const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active));
+    vfloat<Width> field[8];
+    r.read_half(f::triangle_half, field);
+    const int h = f::triangle_half;
+    const vfloat<Width> org[3] = {field[f::tri_org - h], field[f::tri_org + 1 - h],
+                                  field[f::tri_org + 2 - h]};
+    const vint<Width> kx = as_int<Width>(field[f::kx - h]), ky = as_int<Width>(field[f::ky - h]),
+                      kz = as_int<Width>(field[f::kz - h]);
+    const vfloat<Width> sx = field[f::sx - h], sy = field[f::sy - h];
     const vint<Width> position = lane_index<Width>() + broadcast_int<Width>(int32_t(g));
     for (uint32_t j = 0; j < count; ++j) {
         const LeafPrimitive& tri = triangles[j];

@@ -42,8 +42,9 @@ struct MicrobenchOptions {
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
 
-// The gather and compress rates by themselves: TSC ticks per lane of a 16-field gather of
-// `lanes` ids over `slots` records (contiguous or random slots), and of the compress partition.
+// The field-read and compress rates by themselves: TSC ticks per lane of the box kernel's read
+// of 7 fields for `lanes` ids over `slots` records (contiguous or random slots) with a box every
+// ray passes, and of the compress partition.
 struct KernelRate {
     const char* what;
     uint32_t slots, lanes;

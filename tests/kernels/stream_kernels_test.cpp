@@ -2,8 +2,8 @@
 // code, lane by lane, and partitions exactly as a stable partition: the slab test on the hard
 // cases (origins on slab planes with zero directions (0 * inf), infinite inverse directions,
 // signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
-// stage, and the compress. Streams of odd lengths exercise partial groups; shuffled and
-// increasing ids exercise both ways of reading a group's fields (gather and window).
+// stage, and the compress. Streams of odd lengths exercise partial groups (at 16 lanes, the
+// 8-lane tail), shuffled and increasing ids the records' transposed reads.
 
 #include "kernels/stream/stream_kernels.h"
 
@@ -40,9 +40,8 @@ std::vector<uint32_t> shuffled_ids(uint32_t n, uint32_t seed) {
 }
 
 // n distinct ids out of the first n, 2n, 3n or 4n slots (the test makes 4n rays), as the
-// tracer's streams hold them: shuffled (the kernels gather), increasing with gaps (a group
-// lies in one window or not: loads and permutes, or a gather), or increasing with a few
-// neighbours swapped (a group's first id is not its least).
+// tracer's streams hold them: shuffled, increasing with gaps (the runs stable partitions
+// leave), or increasing with a few neighbours swapped (a group's first id is not its least).
 std::vector<uint32_t> stream_ids(uint32_t n, uint32_t seed) {
     std::vector<uint32_t> ids(n + k_stream_padding, k_sentinel);
     std::vector<uint32_t> slots((1 + seed / 3 % 4) * n);
@@ -239,7 +238,7 @@ TEST_CASE("Compress partition of every back end is the stable partition", "[stre
     }
 }
 
-TEST_CASE("Lane type: masks as values, gather and compress at width 1 and 4", "[simd]") {
+TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "[simd]") {
     const vfloat<4> a = {1.f, -2.f, 3.f, -0.f};
     const vbool<4> negative = sign_bit<4>(a);
     CHECK(bits<4>(negative) == 0b1010u);
@@ -253,6 +252,14 @@ TEST_CASE("Lane type: masks as values, gather and compress at width 1 and 4", "[
     const float table[5] = {10.f, 11.f, 12.f, 13.f, 14.f};
     const vfloat<4> g = gather<4>(table, vint<4>{4, 0, 2, 2});
     CHECK((g[0] == 14.f && g[1] == 10.f && g[2] == 12.f && g[3] == 12.f));
+    float records[32];
+    for (int i = 0; i < 32; ++i) records[i] = float(i);
+    const int32_t starts[4] = {24, 0, 8, 8};
+    vfloat<4> fields[8];
+    load_transposed8<4>(records, starts, fields);
+    for (int f = 0; f < 8; ++f)
+        CHECK((fields[f][0] == float(24 + f) && fields[f][1] == float(f) &&
+               fields[f][2] == float(8 + f) && fields[f][3] == float(8 + f)));
     uint32_t out[4] = {};
     CHECK(compress_store<4>(0b1101u, vint<4>{5, 6, 7, 8}, out) == 3u);
     CHECK((out[0] == 5u && out[1] == 7u && out[2] == 8u));
