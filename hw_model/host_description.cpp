@@ -254,7 +254,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "ray_buffer:\n"
       << "  kib: " << c.ray_buffer.kib << "  # the L1D holds the ray buffers: "
       << (h.caches.empty() ? "assumed" : h.caches.front().source) << "\n"
-      << "  banks: 1  # no banks: the L1D serves the gathers (storage: l1d)\n"
+      << "  banks: 1  # no banks: the L1D serves the filters' loads (storage: l1d)\n"
       << "  line_words: " << c.ray_buffer.line_words << "  # the L1D line\n"
       << "  storage: l1d\n"
       << "partition:\n  kind: compress  # vpcompressd (AVX-512) or a permutation table (AVX2)\n"
