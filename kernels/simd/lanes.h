@@ -315,38 +315,89 @@ struct CompressTable8 {
 inline constexpr CompressTable8 k_compress_table8{};
 #endif
 
-// The paper's partition step: stores the lanes of `values` whose mask bit is set, in lane
-// order, at out[0 .. popcount); returns the popcount. Writes all Width elements of out (the
-// ones past the popcount are don't-care), so out needs Width elements of room.
+// The paper's partition step: the lanes of `values` whose mask bit is set, packed to the
+// front in lane order (the lanes past the popcount are don't-care).
 template <int Width>
-SFX_LANES_INLINE uint32_t compress_store(uint32_t mask_bits, vint<Width> values, uint32_t* out) {
+SFX_LANES_INLINE vint<Width> compress(uint32_t mask_bits, vint<Width> values) {
     if constexpr (Width == 1) {
-        *out = uint32_t(values);
-        return mask_bits & 1u;
+        return values;
     } else {
 #if defined(__AVX512F__)
-        if constexpr (Width == 16) {  // vpcompressd into a register, then one plain store
-            _mm512_storeu_si512(out,
-                                _mm512_maskz_compress_epi32(__mmask16(mask_bits), __m512i(values)));
-            return uint32_t(__builtin_popcount(mask_bits));
-        }
+        if constexpr (Width == 16)
+            return vint<Width>(_mm512_maskz_compress_epi32(__mmask16(mask_bits), __m512i(values)));
+#endif
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+        if constexpr (Width == 8)
+            return vint<Width>(_mm256_maskz_compress_epi32(__mmask8(mask_bits), __m256i(values)));
 #endif
 #if defined(__AVX2__)
-        if constexpr (Width == 8) {
+        if constexpr (Width == 8) {  // by permutation table
             const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
             const __m256i perm = _mm256_and_si256(
                 _mm256_srlv_epi32(_mm256_set1_epi32(int(k_compress_table8.packed[mask_bits & 255])),
                                   shifts),
                 _mm256_set1_epi32(7));
-            _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
-                                _mm256_permutevar8x32_epi32(__m256i(values), perm));
-            return uint32_t(__builtin_popcount(mask_bits & 255));
+            return vint<Width>(_mm256_permutevar8x32_epi32(__m256i(values), perm));
         }
 #endif
-        uint32_t k = 0;
+        vint<Width> packed = values;
+        int k = 0;
         for (int l = 0; l < Width; ++l)
-            if (mask_bits >> l & 1u) out[k++] = uint32_t(values[l]);
-        return k;
+            if (mask_bits >> l & 1u) packed[k++] = values[l];
+        return packed;
+    }
+}
+
+// The number of lanes whose mask bit is set (bits past Width ignored).
+template <int Width>
+SFX_LANES_INLINE uint32_t mask_count(uint32_t mask_bits) {
+    return uint32_t(__builtin_popcount(mask_bits & ((1u << Width) - 1u)));
+}
+
+// Stores compress(mask_bits, values) at out[0 .. popcount); returns the popcount. Writes all
+// Width elements of out (the ones past the popcount are don't-care), so out needs Width
+// elements of room.
+template <int Width>
+SFX_LANES_INLINE uint32_t compress_store(uint32_t mask_bits, vint<Width> values, uint32_t* out) {
+    const vint<Width> packed = compress<Width>(mask_bits, values);
+    __builtin_memcpy(out, &packed, sizeof packed);
+    return mask_count<Width>(mask_bits);
+}
+
+// compress_store that writes out[0 .. popcount) only, by a masked store: for the end of a
+// stream, where the elements past it belong to the streams around it.
+template <int Width>
+SFX_LANES_INLINE uint32_t compress_store_exact(uint32_t mask_bits, vint<Width> values,
+                                               uint32_t* out) {
+    const uint32_t count = mask_count<Width>(mask_bits);
+    if constexpr (Width == 1) {
+        if (count) *out = uint32_t(values);
+        return count;
+    } else {
+        const vint<Width> packed = compress<Width>(mask_bits, values);
+        [[maybe_unused]] const uint32_t first = (1u << count) - 1u;  // the lanes to store
+#if defined(__AVX512F__)
+        if constexpr (Width == 16) {
+            _mm512_mask_storeu_epi32(out, __mmask16(first), __m512i(packed));
+            return count;
+        }
+#endif
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+        if constexpr (Width == 8) {
+            _mm256_mask_storeu_epi32(out, __mmask8(first), __m256i(packed));
+            return count;
+        }
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) {
+            const __m256i store = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)),
+                                                     _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+            _mm256_maskstore_epi32(reinterpret_cast<int*>(out), store, __m256i(packed));
+            return count;
+        }
+#endif
+        for (uint32_t l = 0; l < count; ++l) out[l] = uint32_t(packed[l]);
+        return count;
     }
 }
 

@@ -39,11 +39,8 @@ SFX_LANES_INLINE vint<Width> load_ids(const uint32_t* ids, uint32_t active) {
 template <int Width>
 SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values, uint32_t* out,
                                           bool full_group) {
-    if (full_group) return compress_store<Width>(mask_bits, values, out);
-    uint32_t tmp[Width];
-    const uint32_t count = compress_store<Width>(mask_bits, values, tmp);
-    std::memcpy(out, tmp, count * sizeof(uint32_t));
-    return count;
+    return full_group ? compress_store<Width>(mask_bits, values, out)
+                      : compress_store_exact<Width>(mask_bits, values, out);
 }
 
 // Calls group(std::integral_constant<int, W>(), g) for each group of Width ids from g = 0 while

@@ -263,6 +263,9 @@ TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "
     uint32_t out[4] = {};
     CHECK(compress_store<4>(0b1101u, vint<4>{5, 6, 7, 8}, out) == 3u);
     CHECK((out[0] == 5u && out[1] == 7u && out[2] == 8u));
+    uint32_t exact[5] = {0, 0, 0, 0, 99};
+    CHECK(compress_store_exact<4>(0b1010u, vint<4>{5, 6, 7, 8}, exact) == 2u);
+    CHECK((exact[0] == 6u && exact[1] == 8u && exact[2] == 0u && exact[3] == 0u));
     // Width 1 is plain float and bool.
     static_assert(std::is_same_v<vfloat<1>, float> && std::is_same_v<vbool<1>, bool>);
     CHECK(sign_bit<1>(-0.f));
@@ -270,5 +273,7 @@ TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "
     CHECK(popcount<1>(true) == 1u);
     uint32_t one = 0;
     CHECK(compress_store<1>(1u, 42, &one) == 1u);
+    CHECK(one == 42u);
+    CHECK(compress_store_exact<1>(0u, 7, &one) == 0u);
     CHECK(one == 42u);
 }
