@@ -22,7 +22,7 @@ namespace sfx {
 // for an occluded shadow ray, which every later box and primitive test then misses), then the
 // triangle test's half (org again, kx, ky, kz, sx, sy). A group of Width slots scattered over
 // the buffer touches one line per ray, not one per field; it reads a half by Width 32-byte
-// loads and a transpose (kernels/simd/lanes.h, load_transposed).
+// loads and a transpose (kernels/simd/lanes.h, load_transposed8).
 namespace traversal_field {  // float offsets within a slot's record
 constexpr int org = 0, inv_dir = 3, t = 6, box_half = 0;
 constexpr int tri_org = 8, kx = 11, ky = 12, kz = 13, sx = 14, sy = 15, triangle_half = 8;
@@ -49,21 +49,21 @@ class TraversalRays {
             r[f::inv_dir + a] = pre.inv_dir[a];
             r[f::tri_org + a] = pre.org[a];
         }
-        r[f::t] = t;
-        r[7] = 0.f;
+        r[f::t] = t;  // the box half's last float stays the zero of resize()
         const int32_t k[3] = {pre.kx, pre.ky, pre.kz};
         std::memcpy(r + f::kx, k, sizeof k);
         r[f::sx] = pre.sx;
         r[f::sy] = pre.sy;
     }
     float& t(uint32_t slot) { return record(slot)[traversal_field::t]; }
-    float t(uint32_t slot) const {
-        return m_data[size_t(slot) * traversal_field::record + traversal_field::t];
-    }
+    float t(uint32_t slot) const { return record(slot)[traversal_field::t]; }
     TraversalView view() const { return {m_data.data()}; }
 
   private:
     float* record(uint32_t slot) { return m_data.data() + size_t(slot) * traversal_field::record; }
+    const float* record(uint32_t slot) const {
+        return m_data.data() + size_t(slot) * traversal_field::record;
+    }
     std::vector<float, boost::alignment::aligned_allocator<float, 64>> m_data;
 };
 

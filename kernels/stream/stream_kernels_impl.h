@@ -45,7 +45,7 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
 
 // Calls group(std::integral_constant<int, W>(), g) for each group of Width ids from g = 0 while
 // g < n. At 16 lanes a last group of at most 8 ids (a short stream, or a stream's tail) runs at
-// 8: half the gathers on short secondary streams; the lane math is the same at every width, so
+// 8: half the reads on short secondary streams; the lane math is the same at every width, so
 // are the results.
 template <int Width, class Group>
 SFX_LANES_INLINE void for_each_group(uint32_t n, Group&& group) {
@@ -56,6 +56,18 @@ SFX_LANES_INLINE void for_each_group(uint32_t n, Group&& group) {
         group(std::integral_constant<int, Width>(), g);
     }
 }
+
+// The ray fields of one group, as lanes: the box test's and the triangle test's.
+template <int Width>
+struct BoxLanes {
+    vfloat<Width> org[3], inv_dir[3], t;
+};
+template <int Width>
+struct TriangleLanes {
+    vfloat<Width> org[3];
+    vint<Width> kx, ky, kz;
+    vfloat<Width> sx, sy;
+};
 
 // One group's slot ids and its reads of their records' halves (stream_kernels.h).
 template <int Width>
@@ -68,40 +80,55 @@ struct GroupReader {
         const vint<Width> o = id * broadcast_int<Width>(traversal_field::record);
         __builtin_memcpy(offset, &o, sizeof offset);
     }
-    // out[f] = field half + f of every lane's record.
-    SFX_LANES_INLINE void read_half(int half, vfloat<Width> out[8]) const {
-        load_transposed8<Width>(data + half, offset, out);
+    // The box test's half of every lane's record.
+    SFX_LANES_INLINE BoxLanes<Width> read_box() const {
+        namespace f = traversal_field;
+        vfloat<Width> h[8];
+        load_transposed8<Width>(data + f::box_half, offset, h);
+        return {{h[f::org], h[f::org + 1], h[f::org + 2]},
+                {h[f::inv_dir], h[f::inv_dir + 1], h[f::inv_dir + 2]},
+                h[f::t]};
+    }
+    // The triangle test's half of every lane's record.
+    SFX_LANES_INLINE TriangleLanes<Width> read_triangle() const {
+        namespace f = traversal_field;
+        vfloat<Width> h[8];
+        load_transposed8<Width>(data + f::triangle_half, offset, h);
+        const int o = f::triangle_half;
+        return {{h[f::tri_org - o], h[f::tri_org + 1 - o], h[f::tri_org + 2 - o]},
+                as_int(h[f::kx - o]),
+                as_int(h[f::ky - o]),
+                as_int(h[f::kz - o]),
+                h[f::sx - o],
+                h[f::sy - o]};
+    }
+
+  private:
+    // The lanes' bits as integers (kx, ky, kz are stored in float records).
+    static SFX_LANES_INLINE vint<Width> as_int(vfloat<Width> v) {
+        vint<Width> r;
+        __builtin_memcpy(&r, &v, sizeof r);
+        return r;
     }
 };
-
-// The lanes' bits as integers (kx, ky, kz are stored in float records).
-template <int Width>
-SFX_LANES_INLINE vint<Width> as_int(vfloat<Width> v) {
-    vint<Width> r;
-    __builtin_memcpy(&r, &v, sizeof r);
-    return r;
-}
 
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
 template <int Width>
 SFX_LANES_INLINE void box_group(TraversalView rays, const Bounds3& box, int axis,
                                 const uint32_t* ids, uint32_t left, uint32_t* pass_out,
-                                uint32_t* fail_out, uint8_t* mask, uint32_t& front,
-                                uint32_t& back, uint32_t& negatives) {
-    namespace f = traversal_field;
+                                uint32_t* fail_out, uint8_t* mask, uint32_t& front, uint32_t& back,
+                                uint32_t& negatives) {
     const uint32_t active = active_bits<Width>(left);
     const GroupReader<Width> r(rays, load_ids<Width>(ids, active));
-    vfloat<Width> field[8];
-    r.read_half(f::box_half, field);
-    const vfloat<Width> org[3] = {field[f::org], field[f::org + 1], field[f::org + 2]};
-    const vfloat<Width> inv_dir[3] = {field[f::inv_dir], field[f::inv_dir + 1],
-                                      field[f::inv_dir + 2]};
-    const vfloat<Width> t_max = field[f::t];
+    const BoxLanes<Width> ray = r.read_box();
     vfloat<Width> t0;
-    const uint32_t pass = bits<Width>(slab_test<Width>(org, inv_dir, t_max, box, t0)) & active;
+    const uint32_t pass =
+        bits<Width>(slab_test<Width>(ray.org, ray.inv_dir, ray.t, box, t0)) & active;
     // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
     // flushes denormals, so a negative normal dir has a finite inverse).
-    const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
+    const vfloat<Width> inv = axis == 0   ? ray.inv_dir[0]
+                              : axis == 1 ? ray.inv_dir[1]
+                                          : ray.inv_dir[2];
     const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
     negatives += uint32_t(__builtin_popcount(
         bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
@@ -127,19 +154,13 @@ uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint
 template <int Width>
 uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1, const Vec3& p2,
                              const uint32_t* ids, uint32_t n, uint32_t* positions) {
-    namespace f = traversal_field;
     uint32_t k = 0;
     for (uint32_t g = 0; g < n; g += Width) {
         const uint32_t active = active_bits<Width>(n - g);
         const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active));
-        vfloat<Width> field[8];
-        r.read_half(f::triangle_half, field);
-        const int h = f::triangle_half;
-        const vfloat<Width> org[3] = {field[f::tri_org - h], field[f::tri_org + 1 - h],
-                                      field[f::tri_org + 2 - h]};
-        const ShearedTriangle<Width> s = shear_triangle<Width>(
-            org, as_int<Width>(field[f::kx - h]), as_int<Width>(field[f::ky - h]),
-            as_int<Width>(field[f::kz - h]), field[f::sx - h], field[f::sy - h], p0, p1, p2);
+        const TriangleLanes<Width> ray = r.read_triangle();
+        const ShearedTriangle<Width> s =
+            shear_triangle<Width>(ray.org, ray.kx, ray.ky, ray.kz, ray.sx, ray.sy, p0, p1, p2);
         const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
         k += compress_store<Width>(keep, lane_index<Width>() + broadcast_int<Width>(int32_t(g)),
                                    positions + k);  // positions has room past n
@@ -149,25 +170,17 @@ uint32_t triangle_candidates(TraversalView rays, const Vec3& p0, const Vec3& p1,
 
 // One group of leaf_candidates: the `left` ids from ids + g on.
 template <int Width>
-SFX_LANES_INLINE void leaf_group(TraversalView rays, const LeafPrimitive* triangles,
-                                 uint32_t count, const uint32_t* ids, uint32_t g, uint32_t left,
+SFX_LANES_INLINE void leaf_group(TraversalView rays, const LeafPrimitive* triangles, uint32_t count,
+                                 const uint32_t* ids, uint32_t g, uint32_t left,
                                  uint32_t* positions, uint32_t stride, uint32_t* found) {
-    namespace f = traversal_field;
     const uint32_t active = active_bits<Width>(left);
     const GroupReader<Width> r(rays, load_ids<Width>(ids + g, active));
-    vfloat<Width> field[8];
-    r.read_half(f::triangle_half, field);
-    const int h = f::triangle_half;
-    const vfloat<Width> org[3] = {field[f::tri_org - h], field[f::tri_org + 1 - h],
-                                  field[f::tri_org + 2 - h]};
-    const vint<Width> kx = as_int<Width>(field[f::kx - h]), ky = as_int<Width>(field[f::ky - h]),
-                      kz = as_int<Width>(field[f::kz - h]);
-    const vfloat<Width> sx = field[f::sx - h], sy = field[f::sy - h];
+    const TriangleLanes<Width> ray = r.read_triangle();
     const vint<Width> position = lane_index<Width>() + broadcast_int<Width>(int32_t(g));
     for (uint32_t j = 0; j < count; ++j) {
         const LeafPrimitive& tri = triangles[j];
-        const ShearedTriangle<Width> s =
-            shear_triangle<Width>(org, kx, ky, kz, sx, sy, tri.p0, tri.p1, tri.p2);
+        const ShearedTriangle<Width> s = shear_triangle<Width>(
+            ray.org, ray.kx, ray.ky, ray.kz, ray.sx, ray.sy, tri.p0, tri.p1, tri.p2);
         const uint32_t keep = ~bits<Width>(edges_reject<Width>(s)) & active;
         found[j] += compress_store<Width>(keep, position,
                                           positions + j * stride + found[j]);  // room past n
