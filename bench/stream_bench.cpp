@@ -209,6 +209,17 @@ int main(int argc, char** argv) {
         std::printf("  %s: stream / reference %.2fx (trace off), %.2fx (counting); image %s\n",
                     isa_name(isa), f_ref / f_st, f_ref / f_count,
                     same ? "bit-identical to the reference" : "DIFFERS from the reference");
+        // Where the time goes: one more frame with the stage clock (trace off).
+        RenderSettings clocked = settings;
+        clocked.stage_clock = true;
+        const RenderStats split = render_stream(scene, bvh, clocked).stats;
+        const double ticks =
+            double(split.stage_tsc[0] + split.stage_tsc[1] + split.stage_tsc[2]) / 100.0;
+        std::printf(
+            "  %s stage clock, one frame: traversal %.0f %%, intersection %.0f %%, shading and "
+            "the rest %.0f %%; %.0f TSC ticks per ray\n",
+            isa_name(isa), double(split.stage_tsc[0]) / ticks, double(split.stage_tsc[1]) / ticks,
+            double(split.stage_tsc[2]) / ticks, ticks * 100.0 / double(n));
     }
     return 0;
 }

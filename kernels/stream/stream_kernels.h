@@ -12,8 +12,10 @@
 #include <cstring>
 #include <vector>
 
+#include "kernels/bvh.h"
 #include "kernels/intersect.h"
 #include "kernels/simd/isa.h"
+#include "kernels/trace.h"
 
 namespace sfx {
 
@@ -58,6 +60,7 @@ class TraversalRays {
     float& t(uint32_t slot) { return record(slot)[traversal_field::t]; }
     float t(uint32_t slot) const { return record(slot)[traversal_field::t]; }
     TraversalView view() const { return {m_data.data()}; }
+    float* data() { return m_data.data(); }
 
   private:
     float* record(uint32_t slot) { return m_data.data() + size_t(slot) * traversal_field::record; }
@@ -73,6 +76,41 @@ constexpr uint32_t k_stream_padding = 16;
 
 // Triangles a leaf_candidates call takes at most (the default leaf size).
 constexpr uint32_t k_leaf_batch = 4;
+
+// How much of each op the traversal reports: nothing, counts (the op without its slots and
+// pass flags: TraceSink::counts_only), or the whole op.
+enum class TraceDetail : uint8_t { none, counts, lanes };
+constexpr int k_trace_details = 3;
+
+// One (node, stream length) of the traversal stack: the stream is the prefix of that length.
+struct TraversalStackEntry {
+    uint32_t node, length;
+};
+// A depth-first walk of a binary tree keeps at most one entry per level, plus the one popped.
+constexpr uint32_t k_traversal_stack_size = Bvh::k_max_depth + 2;
+
+// What one traversal (Fig. 3) of a stream works on. Plain pointers, so the wide translation
+// units instantiate no out-of-line member of a library type.
+struct TraversalJob {
+    const Bvh* bvh;  // its full primitive tests (intersect_leaf_primitive)
+    const BvhNode* nodes;
+    const LeafPrimitive* leaf;
+    uint32_t triangle_count;  // leaf[i].prim >= triangle_count: a sphere (Scene::is_sphere)
+    float* rays;              // TraversalRays' records: t is tightened as hits are found
+    const RayPrecomp* pre;    // per slot: the full primitive tests' constants
+    Hit* hit;                 // per slot: the closest hit so far
+    const uint8_t* any_hit;   // per slot: a shadow ray, done at its first hit
+    uint32_t* ids;            // the stream, n ids; every buffer has k_stream_padding of room
+    uint32_t n;
+    uint32_t entry;  // the node the stream enters at
+    uint32_t *scratch, *scratch2;
+    uint32_t* positions;  // k_leaf_batch * (n + k_stream_padding)
+    uint8_t* mask;
+    TraceSink* sink;  // null with TraceDetail::none
+    uint16_t generation;
+    OpStage box_stage, triangle_stage, sphere_stage;  // stage_of(their kinds)
+    uint64_t* leaf_tsc;                               // not null: adds the TSC ticks in leaves
+};
 
 struct StreamKernels {
     Isa isa;
@@ -103,6 +141,10 @@ struct StreamKernels {
     // Stable partition of ids[0, n) by mask[i] != 0, passing first, by compress; returns the
     // passing count; writes nothing past ids[n). `scratch` holds n + k_stream_padding ids.
     uint32_t (*partition)(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch);
+
+    // The whole traversal of Fig. 3 for job.ids[0, n) (stream_tracer.cpp says what it does),
+    // with the box filter and the leaves' float stage inlined; indexed by TraceDetail.
+    void (*traverse[k_trace_details])(const TraversalJob& job);
 };
 
 // The kernels for a resolved instruction set (never Isa::automatic; the CPU must support it).

@@ -35,7 +35,6 @@ struct RayBuffers {
     // Id lists and masks have k_stream_padding elements of room: compress writes whole vectors.
     std::vector<uint32_t> ids, next_ids, trav_ids, scratch, scratch2, positions;
     std::vector<uint8_t> mask;
-    std::vector<std::pair<uint32_t, uint32_t>> stack;  // (node, stream length)
 
     void ensure(uint32_t n) {
         if (n <= capacity) return;
@@ -81,29 +80,12 @@ uint32_t partition_and_vote(uint32_t* ids, uint32_t len, const uint8_t* mask, ui
     return passed;
 }
 
-// The box filter of Fig. 5 by the back end's kernel: passing ids first, failing ids after
-// them (the prefix [0, len) keeps its set of ids, so the streams on the stack stay valid).
+// How much of each op a trace policy reports (stream_filter.h).
 template <class Trace>
-uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& node,
-                    uint32_t node_index, uint16_t generation, TraversalView rays, uint32_t* ids,
-                    uint32_t len, RayBuffers& b, uint32_t& negative) {
-    uint32_t* scratch = b.scratch.data();
-    uint32_t passed;
-    if constexpr (Trace::k_lanes) {  // the op lists the slots in input order
-        uint32_t* failing = b.scratch2.data();
-        passed = kernels.box_filter(rays, node.bounds, node.axis, ids, len, scratch, failing,
-                                    b.mask.data(), negative);
-        trace.op(OpKind::box_test, generation, node_index, ids, len, b.mask.data(), passed);
-        std::copy(scratch, scratch + passed, ids);
-        std::copy(failing, failing + (len - passed), ids + passed);
-    } else {
-        passed = kernels.box_filter(rays, node.bounds, node.axis, ids, len, ids, scratch, nullptr,
-                                    negative);
-        // Always, even if none passed: the kernel's whole-vector stores wrote over ids.
-        std::copy(scratch, scratch + (len - passed), ids + passed);
-        trace.op(OpKind::box_test, generation, node_index, ids, len, nullptr, passed);
-    }
-    return passed;
+constexpr TraceDetail trace_detail() {
+    return !Trace::k_enabled ? TraceDetail::none
+           : Trace::k_lanes  ? TraceDetail::lanes
+                             : TraceDetail::counts;
 }
 
 // Fig. 3: test the stream against the node's box, filter, stop on empty; at a leaf intersect
@@ -111,97 +93,40 @@ uint32_t box_filter(const StreamKernels& kernels, Trace& trace, const BvhNode& n
 // rays tighten their t as they find hits; shadow rays leave the stream once occluded.
 // The front child is chosen by a majority of the passing rays' direction signs on the split
 // axis: independent of the order of the stream, and for one ray the reference's choice.
+// Every stream on the stack is a prefix of the traversal stream: filters move passing ids to
+// the front and only permute inside a prefix, so (node, length) names a stream.
 // `entry`: the node the stream enters at (the root, or a primary entry point whose subtree
-// holds every leaf the stream's rays can reach).
+// holds every leaf the stream's rays can reach). The loop is the back end's
+// (StreamKernels::traverse), so its box filter and leaf tests inline at the host's width.
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
               uint16_t generation, Trace& trace, uint32_t entry = 0,
               uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
-    const std::vector<BvhNode>& nodes = bvh.nodes();
-    const LeafPrimitive* leaf = bvh.leaf_primitives().data();
-    const Scene& scene = bvh.scene();
-    uint32_t* ids = b.trav_ids.data();
-    uint8_t* mask = b.mask.data();
-    uint32_t* positions = b.positions.data();
-    TraversalRays& rays = b.trav;
-    const RayPrecomp* pre = b.pre.data();
-    Hit* hit = b.hit.data();
-    const uint8_t* any_hit = b.any_hit.data();
-    auto& stack = b.stack;
-    stack.clear();
-    stack.push_back({entry, n});
-    // Every stream on the stack is a prefix of the traversal stream: filters move passing ids
-    // to the front and only permute inside a prefix, so (node, length) names a stream.
-    while (!stack.empty()) {
-        const auto [node_index, len] = stack.back();
-        stack.pop_back();
-        const BvhNode& node = nodes[node_index];
-        if (!node.is_leaf()) {  // the children arrive while this node's filter runs
-            __builtin_prefetch(&nodes[BvhNode::left(node_index)]);
-            __builtin_prefetch(&nodes[node.right()]);
-        } else {  // and a leaf's primitives (four by default: 160 bytes)
-            const char* first = reinterpret_cast<const char*>(&leaf[node.first]);
-            const char* last = reinterpret_cast<const char*>(&leaf[node.first + node.count]) - 1;
-            for (const char* p = first; p < last; p += 64) __builtin_prefetch(p);
-            __builtin_prefetch(last);
-        }
-        uint32_t negative = 0;
-        const uint32_t k = box_filter(kernels, trace, node, node_index, generation, rays.view(),
-                                      ids, len, b, negative);
-        if (k == 0) continue;
-        if (node.is_leaf()) {
-            const uint64_t leaf_start = leaf_tsc ? __rdtsc() : 0;
-            // Closest hit: later tests need t or less. Any hit: the ray is done, and with
-            // t = -1 every later box and primitive test misses it.
-            auto full_test = [&](uint32_t i, uint32_t id) {
-                float& t = rays.t(id);
-                if (!bvh.intersect_leaf_primitive(pre[id], i, t, hit[id])) return false;
-                t = any_hit[id] ? -1.f : hit[id].t;
-                return true;
-            };
-            const uint32_t end = node.first + node.count;
-            for (uint32_t i = node.first; i < end;) {
-                if (scene.is_sphere(leaf[i].prim)) {
-                    const uint32_t passed =
-                        evaluate(ids, k, mask, [&](uint32_t id) { return full_test(i, id); });
-                    trace.op(OpKind::sphere_test, generation, leaf[i].prim, ids, k, mask, passed);
-                    ++i;
-                    continue;
-                }
-                // A run of up to k_leaf_batch triangles: the float stage of the watertight test
-                // at the back end's width, each group's rays read once for all of them, rejects
-                // most lanes (it does not depend on t); the full tests run on the candidates it
-                // leaves, triangle by triangle in order.
-                uint32_t batch = 1;
-                while (batch < k_leaf_batch && i + batch < end &&
-                       !scene.is_sphere(leaf[i + batch].prim))
-                    ++batch;
-                uint32_t found[k_leaf_batch];
-                const uint32_t stride = k + k_stream_padding;
-                kernels.leaf_candidates(rays.view(), &leaf[i], batch, ids, k, positions, stride,
-                                        found);
-                for (uint32_t j = 0; j < batch; ++j, ++i) {
-                    const uint32_t* candidates = positions + j * stride;
-                    if constexpr (Trace::k_lanes) std::fill(mask, mask + k, uint8_t(0));
-                    uint32_t passed = 0;
-                    for (uint32_t c = 0; c < found[j]; ++c) {
-                        const uint32_t at = candidates[c];
-                        if (!full_test(i, ids[at])) continue;
-                        ++passed;
-                        if constexpr (Trace::k_lanes) mask[at] = 1;
-                    }
-                    trace.op(OpKind::triangle_test, generation, leaf[i].prim, ids, k, mask, passed);
-                }
-            }
-            if (leaf_tsc) *leaf_tsc += __rdtsc() - leaf_start;
-        } else {
-            const bool right_first = 2 * negative > k;
-            const uint32_t left = BvhNode::left(node_index), right = node.right();
-            stack.push_back({right_first ? left : right, k});  // back: popped last
-            stack.push_back({right_first ? right : left, k});
-        }
-    }
+    TraversalJob job;
+    job.bvh = &bvh;
+    job.nodes = bvh.nodes().data();
+    job.leaf = bvh.leaf_primitives().data();
+    job.triangle_count = uint32_t(bvh.scene().triangles.size());
+    job.rays = b.trav.data();
+    job.pre = b.pre.data();
+    job.hit = b.hit.data();
+    job.any_hit = b.any_hit.data();
+    job.ids = b.trav_ids.data();
+    job.n = n;
+    job.entry = entry;
+    job.scratch = b.scratch.data();
+    job.scratch2 = b.scratch2.data();
+    job.positions = b.positions.data();
+    job.mask = b.mask.data();
+    job.sink = nullptr;
+    if constexpr (Trace::k_enabled) job.sink = trace.sink;
+    job.generation = generation;
+    job.box_stage = stage_of(OpKind::box_test);
+    job.triangle_stage = stage_of(OpKind::triangle_test);
+    job.sphere_stage = stage_of(OpKind::sphere_test);
+    job.leaf_tsc = leaf_tsc;
+    kernels.traverse[int(trace_detail<Trace>())](job);
 }
 
 // Loads rays[ids[i]] for traversal; invalid rays (NaN/Inf, zero direction) stay out of the
