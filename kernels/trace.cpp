@@ -56,11 +56,13 @@ void CountingSink::op(const StreamOp& op) {
     ++s.ops;
     s.lanes += op.length;
     s.passed += op.pass_count;
-    for (size_t i = 0; i < m_widths.size(); ++i)
-        s.groups[i] += (op.length + m_widths[i] - 1) / m_widths[i];
-    uint32_t bucket = 0;
-    while (bucket + 1 < k_histogram_buckets && (op.length >> (bucket + 1)) != 0) ++bucket;
-    ++s.histogram[bucket];
+    // Most ops are shorter than a SIMD width (one ray, deep in the tree): no division for them.
+    for (size_t i = 0; i < m_widths.size(); ++i) {
+        const uint32_t w = m_widths[i];
+        s.groups[i] += op.length <= w ? 1u : (op.length + w - 1) / w;
+    }
+    const uint32_t log2_length = 31u - uint32_t(__builtin_clz(op.length));  // length > 0
+    ++s.histogram[std::min(log2_length, k_histogram_buckets - 1)];
     ++m_kind_ops[uint32_t(op.kind)];
     m_kind_lanes[uint32_t(op.kind)] += op.length;
     m_kind_lanes_by_generation[op.generation > 0][uint32_t(op.kind)] += op.length;

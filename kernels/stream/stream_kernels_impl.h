@@ -332,12 +332,64 @@ SFX_LANES_INLINE void box_stream(TraversalView view, const BvhNode& node, const 
     });
 }
 
+// What a node's test will need next arrives while the test runs: an interior node's
+// children, a leaf's primitives (four by default: 160 bytes).
+SFX_LANES_INLINE void prefetch_below(const TraversalJob& job, uint32_t node_index,
+                                     const BvhNode& node) {
+    if (!node.is_leaf()) {
+        __builtin_prefetch(&job.nodes[BvhNode::left(node_index)]);
+        __builtin_prefetch(&job.nodes[node.right()]);
+    } else {
+        const char* first = reinterpret_cast<const char*>(&job.leaf[node.first]);
+        const char* last = reinterpret_cast<const char*>(&job.leaf[node.first + node.count]) - 1;
+        for (const char* p = first; p < last; p += 64) __builtin_prefetch(p);
+        __builtin_prefetch(last);
+    }
+}
+
+// Fig. 3 from `root` for a stream of one ray (job.ids[0]): every op below has that one lane,
+// so the ray's box fields stay in registers and no stream is partitioned; the same ops in the
+// same order, and the same lane math as the wide filters, so the same bits. Most box ops of
+// secondary rays deep in the tree carry one ray (63 % of them on conference, 128 x 128, 4 spp).
+template <TraceDetail Detail>
+SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root) {
+    namespace f = traversal_field;
+    const float* record = job.rays + size_t(job.ids[0]) * f::record;
+    const float org[3] = {record[f::org], record[f::org + 1], record[f::org + 2]};
+    const float inv_dir[3] = {record[f::inv_dir], record[f::inv_dir + 1], record[f::inv_dir + 2]};
+    uint32_t stack[k_traversal_stack_size];
+    uint32_t depth = 0;
+    stack[depth++] = root;
+    while (depth != 0) {
+        const uint32_t node_index = stack[--depth];
+        const BvhNode& node = job.nodes[node_index];
+        prefetch_below(job, node_index, node);
+        float t0;  // t: the leaves below tighten it
+        const bool pass = slab_test<1>(org, inv_dir, record[f::t], node.bounds, t0);
+        if constexpr (Detail == TraceDetail::lanes) job.mask[0] = uint8_t(pass);
+        report<Detail>(job, OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask,
+                       pass);
+        if (!pass) continue;
+        if (node.is_leaf()) {
+            const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
+            traverse_leaf<1, Detail>(job, node, 1);
+            if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
+            continue;
+        }
+        // The front child by the ray's sign on the split axis, as box_group's vote.
+        const float inv = inv_dir[node.axis];
+        const bool right_first = inv < 0.f && inv != -INFINITY;
+        const uint32_t left = BvhNode::left(node_index), right = node.right();
+        stack[depth++] = right_first ? left : right;  // back: popped last
+        stack[depth++] = right_first ? right : left;
+    }
+}
+
 // Fig. 3 (stream_tracer.cpp's traverse says what and why), one instruction set's width.
 template <int Width, TraceDetail Detail>
 void traverse(const TraversalJob& job) {
     if (job.n == 0) return;
     const BvhNode* nodes = job.nodes;
-    const LeafPrimitive* leaf = job.leaf;
     uint32_t* ids = job.ids;
     const TraversalView view{job.rays};
     TraversalStackEntry stack[k_traversal_stack_size];
@@ -346,16 +398,12 @@ void traverse(const TraversalJob& job) {
     while (depth != 0) {
         const TraversalStackEntry top = stack[--depth];
         const uint32_t node_index = top.node, len = top.length;
-        const BvhNode& node = nodes[node_index];
-        if (!node.is_leaf()) {  // the children arrive while this node's filter runs
-            __builtin_prefetch(&nodes[BvhNode::left(node_index)]);
-            __builtin_prefetch(&nodes[node.right()]);
-        } else {  // and a leaf's primitives (four by default: 160 bytes)
-            const char* first = reinterpret_cast<const char*>(&leaf[node.first]);
-            const char* last = reinterpret_cast<const char*>(&leaf[node.first + node.count]) - 1;
-            for (const char* p = first; p < last; p += 64) __builtin_prefetch(p);
-            __builtin_prefetch(last);
+        if (len == 1) {
+            traverse_one<Detail>(job, node_index);
+            continue;
         }
+        const BvhNode& node = nodes[node_index];
+        prefetch_below(job, node_index, node);
         // The box filter (Fig. 5): passing ids first, failing ids after them (the prefix
         // [0, len) keeps its set of ids, so the streams on the stack stay valid).
         uint32_t front = 0, back = 0, negative = 0;
