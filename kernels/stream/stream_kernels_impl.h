@@ -289,7 +289,7 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
         uint32_t found[k_leaf_batch];
         const uint32_t stride = k + k_stream_padding;
         for (uint32_t j = 0; j < batch; ++j) found[j] = 0;
-        if (k == 1) {  // as box_stream
+        if (k == 1) {  // as traverse_one: no wide group's reads and transposes
             leaf_group<1>(view, &leaf[i], batch, ids, 0, 1, job.positions, stride, found);
         } else {
             for_each_group<Width>(k, [&](auto width, uint32_t g) {
@@ -313,18 +313,12 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
     }
 }
 
-// The box filter of ids[0, len) against node's box, as box_filter. Most ops of secondary rays
-// deep in the tree carry one ray (63 % of them on conference, 128 x 128, 4 spp): those run at
-// Width 1, without the reads and transposes of a wide group; the same lane math, so the same
-// bits.
+// The box filter of ids[0, len) against node's box, as box_filter.
 template <int Width>
 SFX_LANES_INLINE void box_stream(TraversalView view, const BvhNode& node, const uint32_t* ids,
                                  uint32_t len, uint32_t* pass_out, uint32_t* fail_out,
                                  uint8_t* mask, uint32_t& front, uint32_t& back,
                                  uint32_t& negative) {
-    if (len == 1)
-        return box_group<1>(view, node.bounds, node.axis, ids, 1, pass_out, fail_out, mask, front,
-                            back, negative);
     for_each_group<Width>(len, [&](auto width, uint32_t g) {
         box_group<decltype(width)::value>(view, node.bounds, node.axis, ids + g, len - g, pass_out,
                                           fail_out, mask ? mask + g : nullptr, front, back,
