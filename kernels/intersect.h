@@ -158,32 +158,24 @@ SFX_LANES_INLINE vbool<Width> edges_reject(const ShearedTriangle<Width>& s) {
     return mask_and<M>(nonzero, mask_and<M>(some_negative, some_positive));
 }
 
-// The decisions a hit candidate gets in double precision, from the input floats directly.
-// The cross product of the edges is exact whenever the coordinate differences are (exponents
-// within 29 bits of each other), so exactly collinear vertices give exactly zero.
-struct TrianglePlaneCheck {
-    bool degenerate = false;  // zero area: never hit
-    bool ahead = false;       // the ray meets the triangle's plane at t > 0
+// The plane normal (p1 - p0) x (p2 - p0) in double, from the input floats directly. The cross
+// product is exact whenever the coordinate differences are (exponents within 29 bits of each
+// other), so exactly collinear vertices give exactly zero.
+struct TriangleNormal {
+    double x, y, z;
+    bool zero() const { return x == 0.0 && y == 0.0 && z == 0.0; }
 };
 
-inline TrianglePlaneCheck check_triangle_plane(const Vec3& org, const Vec3& dir, const Vec3& p0,
-                                               const Vec3& p1, const Vec3& p2) {
+inline TriangleNormal triangle_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     const double e1x = double(p1.x) - double(p0.x), e1y = double(p1.y) - double(p0.y),
                  e1z = double(p1.z) - double(p0.z);
     const double e2x = double(p2.x) - double(p0.x), e2y = double(p2.y) - double(p0.y),
                  e2z = double(p2.z) - double(p0.z);
-    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
-    TrianglePlaneCheck c;
-    c.degenerate = nx == 0.0 && ny == 0.0 && nz == 0.0;
-    const double num = nx * (double(p0.x) - double(org.x)) + ny * (double(p0.y) - double(org.y)) +
-                       nz * (double(p0.z) - double(org.z));
-    const double den = nx * double(dir.x) + ny * double(dir.y) + nz * double(dir.z);
-    c.ahead = (num > 0.0 && den > 0.0) || (num < 0.0 && den < 0.0);
-    return c;
+    return {e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x};
 }
 
 inline bool triangle_is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
-    return check_triangle_plane(Vec3(0.f), Vec3(0.f), p0, p1, p2).degenerate;
+    return triangle_normal(p0, p1, p2).zero();
 }
 
 // Watertight ray/triangle test. On a hit with 0 < t <= t_max fills t, u, v and returns true.
@@ -218,12 +210,10 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     // plane equation in double: the scaled-barycentric t loses digits on slivers (0.4 % on a
     // 20 x 0.05 triangle), the plane's does not. Products of floats are exact in double, so
     // coplanar triangles report bit-equal t and their ties go to the lower id.
-    const double e1x = double(p1.x) - p0.x, e1y = double(p1.y) - p0.y, e1z = double(p1.z) - p0.z;
-    const double e2x = double(p2.x) - p0.x, e2y = double(p2.y) - p0.y, e2z = double(p2.z) - p0.z;
-    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
-    const double n_dot_d = nx * r.dir.x + ny * r.dir.y + nz * r.dir.z;
-    const double n_dot_a = nx * (double(p0.x) - r.org.x) + ny * (double(p0.y) - r.org.y) +
-                           nz * (double(p0.z) - r.org.z);
+    const TriangleNormal n = triangle_normal(p0, p1, p2);
+    const double n_dot_d = n.x * r.dir.x + n.y * r.dir.y + n.z * r.dir.z;
+    const double n_dot_a = n.x * (double(p0.x) - r.org.x) + n.y * (double(p0.y) - r.org.y) +
+                           n.z * (double(p0.z) - r.org.z);
     float t = n_dot_d != 0.0 ? float(n_dot_a / n_dot_d) : t_scaled / det;
     if (!(t > 0.f)) t = std::numeric_limits<float>::denorm_min();  // the sign test above rules
     // Range test on the final t only: a test on t * det would round differently and could
@@ -233,12 +223,11 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     const float min_z = std::min(az, std::min(bz, cz));
     const bool all_ahead = min_z > gamma_bound(4) * std::max(std::fabs(bz), std::fabs(cz)) &&
                            min_z > gamma_bound(4) * std::fabs(az);
-    if (all_ahead) {
-        if (triangle_is_degenerate(p0, p1, p2)) return false;
-    } else {
-        const TrianglePlaneCheck check = check_triangle_plane(r.org, r.dir, p0, p1, p2);
-        if (check.degenerate || !check.ahead) return false;
-    }
+    if (n.zero()) return false;  // degenerate
+    // Otherwise the origin's side of the plane, decided in double: the ray meets the plane at
+    // t > 0.
+    if (!all_ahead && !((n_dot_a > 0.0 && n_dot_d > 0.0) || (n_dot_a < 0.0 && n_dot_d < 0.0)))
+        return false;
     const float inv_det = 1.f / det;
     t_out = t;
     u_out = v * inv_det;  // weight of p1
