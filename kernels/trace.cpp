@@ -50,12 +50,51 @@ void CountingSink::end_pass(const TilePass& p) {
     m_generations += p.generations;
 }
 
+void TraceSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
+                             uint32_t passed) {
+    StreamOp o;
+    o.kind = kind;
+    o.stage = stage;
+    o.generation = generation;
+    o.length = 1;
+    for (uint32_t i = 0; i < count; ++i) {
+        o.pass_count = i < passed ? 1 : 0;
+        op(o);
+    }
+}
+
+CountingSink::StageCounts& CountingSink::add(OpKind kind, OpStage stage, uint16_t generation,
+                                             uint64_t ops, uint64_t lanes, uint64_t passed,
+                                             uint32_t first_length) {
+    StageCounts& s = m_stages[generation > 0][uint32_t(stage)];
+    s.ops += ops;
+    s.lanes += lanes;
+    s.passed += passed;
+    m_kind_ops[uint32_t(kind)] += ops;
+    m_kind_lanes[uint32_t(kind)] += lanes;
+    m_kind_lanes_by_generation[generation > 0][uint32_t(kind)] += lanes;
+    BounceCounts& b = m_bounce[std::min<uint32_t>(generation, k_bounce_slots - 1)];
+    if (kind == OpKind::box_test) {
+        b.box_ops += ops;
+        b.box_lanes += lanes;
+    } else if (kind == OpKind::triangle_test || kind == OpKind::sphere_test) {
+        b.prim_ops += ops;
+        b.prim_lanes += lanes;
+    }
+    // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
+    if ((kind == OpKind::box_test || kind == OpKind::raygrid_walk) &&
+        int32_t(generation) != m_traced_generation) {
+        m_rays += first_length;  // the generation's entry test: one lane per ray
+        b.rays += first_length;
+        m_rays_by_generation[generation > 0] += first_length;
+        m_traced_generation = generation;
+    }
+    return s;
+}
+
 void CountingSink::op(const StreamOp& op) {
     if (op.length == 0) return;
-    StageCounts& s = m_stages[op.generation > 0][uint32_t(op.stage)];
-    ++s.ops;
-    s.lanes += op.length;
-    s.passed += op.pass_count;
+    StageCounts& s = add(op.kind, op.stage, op.generation, 1, op.length, op.pass_count, op.length);
     // Most ops are shorter than a SIMD width (one ray, deep in the tree): no division for them.
     for (size_t i = 0; i < m_widths.size(); ++i) {
         const uint32_t w = m_widths[i];
@@ -63,25 +102,14 @@ void CountingSink::op(const StreamOp& op) {
     }
     const uint32_t log2_length = 31u - uint32_t(__builtin_clz(op.length));  // length > 0
     ++s.histogram[std::min(log2_length, k_histogram_buckets - 1)];
-    ++m_kind_ops[uint32_t(op.kind)];
-    m_kind_lanes[uint32_t(op.kind)] += op.length;
-    m_kind_lanes_by_generation[op.generation > 0][uint32_t(op.kind)] += op.length;
-    BounceCounts& b = m_bounce[std::min<uint32_t>(op.generation, k_bounce_slots - 1)];
-    if (op.kind == OpKind::box_test) {
-        ++b.box_ops;
-        b.box_lanes += op.length;
-    } else if (op.kind == OpKind::triangle_test || op.kind == OpKind::sphere_test) {
-        ++b.prim_ops;
-        b.prim_lanes += op.length;
-    }
-    // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
-    if ((op.kind == OpKind::box_test || op.kind == OpKind::raygrid_walk) &&
-        int32_t(op.generation) != m_traced_generation) {
-        m_rays += op.length;  // the generation's entry test: one lane per ray
-        b.rays += op.length;
-        m_rays_by_generation[op.generation > 0] += op.length;
-        m_traced_generation = op.generation;
-    }
+}
+
+void CountingSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
+                                uint32_t passed) {
+    if (count == 0) return;
+    StageCounts& s = add(kind, stage, generation, count, count, passed, 1);
+    for (uint64_t& g : s.groups) g += count;  // one group each at every width
+    s.histogram[0] += count;                  // length 1: bucket [1, 2)
 }
 
 CountingSink& CountingSink::operator+=(const CountingSink& o) {

@@ -211,6 +211,12 @@ class TraceSink {
     virtual void begin_frame(const TraceHeader&) {}
     virtual void begin_pass(const TilePass&) {}
     virtual void op(const StreamOp&) = 0;
+    // `count` ops of kind `kind` and one lane each, `passed` of which passed, in place of
+    // `count` op() calls: the stream tracer sends a one-ray subtree's ops this way to a sink
+    // that reads counts only (counts_only), which can add them at once. Their objects are left
+    // unsaid. The default calls op() for each.
+    virtual void one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
+                              uint32_t passed);
     virtual void end_pass(const TilePass&) {}
     virtual void end_frame() {}
     // True if the sink reads counts only: never an op's slots or pass flags, nor the frame
@@ -239,6 +245,8 @@ class CountingSink : public TraceSink {
     explicit CountingSink(std::vector<uint32_t> widths);
     void begin_pass(const TilePass&) override;
     void op(const StreamOp& op) override;
+    void one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
+                      uint32_t passed) override;
     void end_pass(const TilePass&) override;
     bool counts_only() const override { return true; }
 
@@ -285,6 +293,12 @@ class CountingSink : public TraceSink {
     uint64_t m_rays_by_generation[2] = {};
     BounceCounts m_bounce[k_bounce_slots];
     int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
+
+    // Adds `ops` ops of one kind with `lanes` lanes and `passed` passes in all, the first of
+    // them `first_length` lanes long; returns their stage's counts (groups and histogram are
+    // the caller's).
+    StageCounts& add(OpKind kind, OpStage stage, uint16_t generation, uint64_t ops, uint64_t lanes,
+                     uint64_t passed, uint32_t first_length);
 };
 
 // Writes the trace to a binary file (format in trace.cpp); memory stays one op at a time.

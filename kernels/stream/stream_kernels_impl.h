@@ -250,6 +250,39 @@ SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage
     }
 }
 
+// Reports each op to job.sink at the detail asked for.
+template <TraceDetail Detail>
+struct SinkReporter {
+    const TraversalJob& job;
+    SFX_LANES_INLINE void operator()(OpKind kind, OpStage stage, uint32_t object,
+                                     const uint32_t* ids, uint32_t n, const uint8_t* mask,
+                                     uint32_t passed) const {
+        report<Detail>(job, kind, stage, object, ids, n, mask, passed);
+    }
+};
+
+// Tallies the one-lane ops of a one-ray subtree per kind for a sink that reads counts only
+// (TraceDetail::counts), and sends them at once (TraceSink::one_lane_ops): one call per kind
+// instead of one per op.
+struct OneLaneTally {
+    const TraversalJob& job;
+    uint32_t count[3] = {0, 0, 0}, passed[3] = {0, 0, 0};  // box, triangle, sphere tests
+
+    SFX_LANES_INLINE void operator()(OpKind kind, OpStage, uint32_t, const uint32_t*, uint32_t,
+                                     const uint8_t*, uint32_t pass) {
+        const int k = kind == OpKind::box_test ? 0 : kind == OpKind::triangle_test ? 1 : 2;
+        ++count[k];
+        passed[k] += pass;
+    }
+    SFX_LANES_INLINE void send() const {
+        const OpKind kinds[3] = {OpKind::box_test, OpKind::triangle_test, OpKind::sphere_test};
+        const OpStage stages[3] = {job.box_stage, job.triangle_stage, job.sphere_stage};
+        for (int k = 0; k < 3; ++k)
+            if (count[k] != 0)
+                job.sink->one_lane_ops(kinds[k], stages[k], job.generation, count[k], passed[k]);
+    }
+};
+
 // Closest hit: later tests need t or less. Any hit: the ray is done, and with t = -1 every
 // later box and primitive test misses it.
 SFX_LANES_INLINE bool full_primitive_test(const TraversalJob& job, uint32_t i, uint32_t id) {
@@ -263,8 +296,9 @@ SFX_LANES_INLINE bool full_primitive_test(const TraversalJob& job, uint32_t i, u
 // time; runs of up to k_leaf_batch triangles by the float stage of the watertight test at
 // Width (each group's rays read once for all of them; it does not depend on t), which rejects
 // most lanes, then the full tests on the candidates it leaves, triangle by triangle in order.
-template <int Width, TraceDetail Detail>
-SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node, uint32_t k) {
+template <int Width, TraceDetail Detail, class Report>
+SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node, uint32_t k,
+                                    Report& report_op) {
     const LeafPrimitive* leaf = job.leaf;
     uint32_t* ids = job.ids;
     uint8_t* mask = job.mask;
@@ -278,8 +312,7 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
                 mask[j] = uint8_t(hit);
                 passed += hit;
             }
-            report<Detail>(job, OpKind::sphere_test, job.sphere_stage, leaf[i].prim, ids, k, mask,
-                           passed);
+            report_op(OpKind::sphere_test, job.sphere_stage, leaf[i].prim, ids, k, mask, passed);
             ++i;
             continue;
         }
@@ -307,8 +340,8 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
                 ++passed;
                 if constexpr (Detail == TraceDetail::lanes) mask[at] = 1;
             }
-            report<Detail>(job, OpKind::triangle_test, job.triangle_stage, leaf[i].prim, ids, k,
-                           mask, passed);
+            report_op(OpKind::triangle_test, job.triangle_stage, leaf[i].prim, ids, k, mask,
+                      passed);
         }
     }
 }
@@ -345,8 +378,8 @@ SFX_LANES_INLINE void prefetch_below(const TraversalJob& job, uint32_t node_inde
 // so the ray's box fields stay in registers and no stream is partitioned; the same ops in the
 // same order, and the same lane math as the wide filters, so the same bits. Most box ops of
 // secondary rays deep in the tree carry one ray (63 % of them on conference, 128 x 128, 4 spp).
-template <TraceDetail Detail>
-SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root) {
+template <TraceDetail Detail, class Report>
+SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Report& report_op) {
     namespace f = traversal_field;
     const float* record = job.rays + size_t(job.ids[0]) * f::record;
     const float org[3] = {record[f::org], record[f::org + 1], record[f::org + 2]};
@@ -361,12 +394,11 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root) {
         float t0;  // t: the leaves below tighten it
         const bool pass = slab_test<1>(org, inv_dir, record[f::t], node.bounds, t0);
         if constexpr (Detail == TraceDetail::lanes) job.mask[0] = uint8_t(pass);
-        report<Detail>(job, OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask,
-                       pass);
+        report_op(OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask, pass);
         if (!pass) continue;
         if (node.is_leaf()) {
             const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<1, Detail>(job, node, 1);
+            traverse_leaf<1, Detail>(job, node, 1, report_op);
             if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
             continue;
         }
@@ -386,6 +418,7 @@ void traverse(const TraversalJob& job) {
     const BvhNode* nodes = job.nodes;
     uint32_t* ids = job.ids;
     const TraversalView view{job.rays};
+    const SinkReporter<Detail> sink{job};
     TraversalStackEntry stack[k_traversal_stack_size];
     uint32_t depth = 0;
     stack[depth++] = {job.entry, job.n};
@@ -393,7 +426,13 @@ void traverse(const TraversalJob& job) {
         const TraversalStackEntry top = stack[--depth];
         const uint32_t node_index = top.node, len = top.length;
         if (len == 1) {
-            traverse_one<Detail>(job, node_index);
+            if constexpr (Detail == TraceDetail::counts) {
+                OneLaneTally tally{job};
+                traverse_one<Detail>(job, node_index, tally);
+                tally.send();
+            } else {
+                traverse_one<Detail>(job, node_index, sink);
+            }
             continue;
         }
         const BvhNode& node = nodes[node_index];
@@ -404,8 +443,7 @@ void traverse(const TraversalJob& job) {
         if constexpr (Detail == TraceDetail::lanes) {  // the op lists the slots in input order
             box_stream<Width>(view, node, ids, len, job.scratch, job.scratch2, job.mask, front,
                               back, negative);
-            report<Detail>(job, OpKind::box_test, job.box_stage, node_index, ids, len, job.mask,
-                           front);
+            sink(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
             __builtin_memcpy(ids, job.scratch, front * sizeof(uint32_t));
             __builtin_memcpy(ids + front, job.scratch2, back * sizeof(uint32_t));
         } else {
@@ -413,14 +451,13 @@ void traverse(const TraversalJob& job) {
                               negative);
             // Always, even if none passed: the whole-vector stores wrote over ids.
             __builtin_memcpy(ids + front, job.scratch, back * sizeof(uint32_t));
-            report<Detail>(job, OpKind::box_test, job.box_stage, node_index, ids, len, nullptr,
-                           front);
+            sink(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
         }
         const uint32_t k = front;
         if (k == 0) continue;
         if (node.is_leaf()) {
             const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<Width, Detail>(job, node, k);
+            traverse_leaf<Width, Detail>(job, node, k, sink);
             if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
         } else {
             // The front child by a majority of the passing rays' direction signs.

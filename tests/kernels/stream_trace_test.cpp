@@ -179,6 +179,64 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     CHECK(sink.rays() == 45);
 }
 
+TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add", "[stream]") {
+    // `batched` takes the sink's own one_lane_ops; `single` the base class's, which calls op()
+    // once per op. A generation's first op is among the batched ones (its entry test).
+    CountingSink batched({1, 8, 16}), single({1, 8, 16});
+    auto both = [&](OpKind kind, uint16_t generation, uint32_t count, uint32_t passed) {
+        batched.one_lane_ops(kind, stage_of(kind), generation, count, passed);
+        single.TraceSink::one_lane_ops(kind, stage_of(kind), generation, count, passed);
+    };
+    auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
+        StreamOp o;
+        o.kind = kind;
+        o.stage = stage_of(kind);
+        o.generation = generation;
+        o.length = len;
+        o.pass_count = pass;
+        batched.op(o);
+        single.op(o);
+    };
+    for (CountingSink* s : {&batched, &single}) s->begin_pass({});
+    both(OpKind::box_test, 0, 7, 4);
+    op(OpKind::box_test, 0, 30, 12);
+    both(OpKind::triangle_test, 0, 5, 2);
+    both(OpKind::sphere_test, 0, 0, 0);
+    op(OpKind::box_test, 1, 9, 9);
+    both(OpKind::box_test, 1, 11, 0);
+    both(OpKind::box_test, 2, 3, 3);
+    both(OpKind::sphere_test, 4, 6, 1);
+    for (CountingSink* s : {&batched, &single}) s->end_pass({});
+
+    CHECK(batched.rays() == 1 + 9 + 1);  // each generation's first box test: its lanes
+    CHECK(batched.rays() == single.rays());
+    for (const bool secondary : {false, true}) {
+        CHECK(batched.rays(secondary) == single.rays(secondary));
+        for (uint32_t st = 0; st < k_op_stage_count; ++st) {
+            const auto& a = batched.stage(secondary, OpStage(st));
+            const auto& b = single.stage(secondary, OpStage(st));
+            CHECK(a.ops == b.ops);
+            CHECK(a.lanes == b.lanes);
+            CHECK(a.passed == b.passed);
+            CHECK(a.groups == b.groups);
+            CHECK(a.histogram == b.histogram);
+        }
+    }
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        CHECK(batched.kind_ops(OpKind(k)) == single.kind_ops(OpKind(k)));
+        CHECK(batched.kind_lanes(OpKind(k), true) == single.kind_lanes(OpKind(k), true));
+        CHECK(batched.kind_lanes(OpKind(k), false) == single.kind_lanes(OpKind(k), false));
+    }
+    CHECK(batched.kind_ops(OpKind::box_test) == 7 + 1 + 1 + 11 + 3);
+    for (uint32_t g = 0; g < 5; ++g) {
+        CHECK(batched.bounce(g).rays == single.bounce(g).rays);
+        CHECK(batched.bounce(g).box_ops == single.bounce(g).box_ops);
+        CHECK(batched.bounce(g).box_lanes == single.bounce(g).box_lanes);
+        CHECK(batched.bounce(g).prim_ops == single.bounce(g).prim_ops);
+        CHECK(batched.bounce(g).prim_lanes == single.bounce(g).prim_lanes);
+    }
+}
+
 TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[stream]") {
     const Scene s = cluster_scene(false);
     const Bvh bvh(s);
