@@ -155,6 +155,7 @@ struct StreamTracer::Impl {
     CameraFrame camera;
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
+    std::vector<uint32_t> material_next;  // per material: where its next ray goes in the sort
     RayBuffers b;
     // Hit-point reordering (RenderSettings::reorder): the simplified hierarchy and its buffers.
     std::unique_ptr<HitPointReorder> reorder;
@@ -185,7 +186,8 @@ struct StreamTracer::Impl {
           settings(r),
           kernels(stream_kernels(resolve_isa(r.isa))),
           camera(s.camera, r.width, r.height),
-          material_rays(s.materials.size(), 0) {
+          material_rays(s.materials.size(), 0),
+          material_next(s.materials.size(), 0) {
         if (r.reorder == RayReorder::hit_point)
             reorder = std::make_unique<HitPointReorder>(h, r.reorder_lod_ppm);
         if (r.batching == RayBatching::raygrid && !h.nodes().empty()) {
@@ -564,16 +566,36 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             next_ids[pushed++] = id;
             ++(shadow ? stats.shadow_rays : stats.extension_rays);
         };
+        // The material filters below leave the stream stably sorted by material, in
+        // `present` order. Without a trace of lanes nothing needs their masks, so one counting
+        // sort does it here and each filter's op carries only its counts.
+        if constexpr (!Trace::k_lanes) {
+            if (present.size() > 1) {
+                uint32_t start = 0;
+                for (const uint32_t m : present) {
+                    material_next[m] = start;
+                    start += material_rays[m];
+                }
+                for (uint32_t i = 0; i < len; ++i)
+                    scratch[material_next[surf[s[i]].material]++] = s[i];
+                std::copy(scratch, scratch + len, s);
+            }
+        }
         // One sub-stack per material (a shader instance: its constants are uniform over the
         // lanes), for the materials this generation hit; the last one is what is left.
         for (size_t j = 0; j < present.size(); ++j) {
             const uint32_t mat = present[j];
             const MaterialKind kind = scene.materials[mat].kind;
-            const uint32_t g =
-                j + 1 == present.size()
-                    ? len
-                    : run_filter(OpKind::material_filter, mat, s, len,
-                                 [&](uint32_t id) { return surf[id].material == mat; });
+            uint32_t g = len;
+            if (j + 1 < present.size()) {
+                if constexpr (Trace::k_lanes) {
+                    g = run_filter(OpKind::material_filter, mat, s, len,
+                                   [&](uint32_t id) { return surf[id].material == mat; });
+                } else {
+                    g = material_rays[mat];
+                    trace.op(OpKind::material_filter, generation, mat, s, len, nullptr, g);
+                }
+            }
             switch (kind) {
                 case MaterialKind::lambertian: {
                     const bool ambient = !is_black(scene.ambient);
