@@ -199,6 +199,8 @@ void leaf_candidates(TraversalView rays, const LeafPrimitive* triangles, uint32_
                      const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
                      uint32_t* found) {
     for (uint32_t j = 0; j < count; ++j) found[j] = 0;
+    if (n == 1)  // one ray (most leaf ops of secondary rays): no wide group's reads and transposes
+        return leaf_group<1>(rays, triangles, count, ids, 0, 1, positions, stride, found);
     for_each_group<Width>(n, [&](auto width, uint32_t g) {
         leaf_group<decltype(width)::value>(rays, triangles, count, ids, g, n - g, positions, stride,
                                            found);
@@ -321,15 +323,7 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
             ++batch;
         uint32_t found[k_leaf_batch];
         const uint32_t stride = k + k_stream_padding;
-        for (uint32_t j = 0; j < batch; ++j) found[j] = 0;
-        if (k == 1) {  // as traverse_one: no wide group's reads and transposes
-            leaf_group<1>(view, &leaf[i], batch, ids, 0, 1, job.positions, stride, found);
-        } else {
-            for_each_group<Width>(k, [&](auto width, uint32_t g) {
-                leaf_group<decltype(width)::value>(view, &leaf[i], batch, ids, g, k - g,
-                                                   job.positions, stride, found);
-            });
-        }
+        leaf_candidates<Width>(view, &leaf[i], batch, ids, k, job.positions, stride, found);
         for (uint32_t j = 0; j < batch; ++j, ++i) {
             const uint32_t* candidates = job.positions + j * stride;
             if constexpr (Detail == TraceDetail::lanes) __builtin_memset(mask, 0, k);
@@ -344,19 +338,6 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
                       passed);
         }
     }
-}
-
-// The box filter of ids[0, len) against node's box, as box_filter.
-template <int Width>
-SFX_LANES_INLINE void box_stream(TraversalView view, const BvhNode& node, const uint32_t* ids,
-                                 uint32_t len, uint32_t* pass_out, uint32_t* fail_out,
-                                 uint8_t* mask, uint32_t& front, uint32_t& back,
-                                 uint32_t& negative) {
-    for_each_group<Width>(len, [&](auto width, uint32_t g) {
-        box_group<decltype(width)::value>(view, node.bounds, node.axis, ids + g, len - g, pass_out,
-                                          fail_out, mask ? mask + g : nullptr, front, back,
-                                          negative);
-    });
 }
 
 // What a node's test will need next arrives while the test runs: an interior node's
@@ -439,16 +420,18 @@ void traverse(const TraversalJob& job) {
         prefetch_below(job, node_index, node);
         // The box filter (Fig. 5): passing ids first, failing ids after them (the prefix
         // [0, len) keeps its set of ids, so the streams on the stack stay valid).
-        uint32_t front = 0, back = 0, negative = 0;
+        uint32_t negative = 0, front, back;
         if constexpr (Detail == TraceDetail::lanes) {  // the op lists the slots in input order
-            box_stream<Width>(view, node, ids, len, job.scratch, job.scratch2, job.mask, front,
-                              back, negative);
+            front = box_filter<Width>(view, node.bounds, node.axis, ids, len, job.scratch,
+                                      job.scratch2, job.mask, negative);
+            back = len - front;
             sink(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
             __builtin_memcpy(ids, job.scratch, front * sizeof(uint32_t));
             __builtin_memcpy(ids + front, job.scratch2, back * sizeof(uint32_t));
         } else {
-            box_stream<Width>(view, node, ids, len, ids, job.scratch, nullptr, front, back,
-                              negative);
+            front = box_filter<Width>(view, node.bounds, node.axis, ids, len, ids, job.scratch,
+                                      nullptr, negative);
+            back = len - front;
             // Always, even if none passed: the whole-vector stores wrote over ids.
             __builtin_memcpy(ids + front, job.scratch, back * sizeof(uint32_t));
             sink(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
