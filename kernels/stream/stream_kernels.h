@@ -143,7 +143,8 @@ struct StreamKernels {
     uint32_t (*partition)(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch);
 
     // The whole traversal of Fig. 3 for job.ids[0, n) (stream_tracer.cpp says what it does),
-    // with the box filter and the leaves' float stage inlined; indexed by TraceDetail.
+    // calling the box filter and the leaves' float stage directly, not through this table;
+    // indexed by TraceDetail.
     void (*traverse[k_trace_details])(const TraversalJob& job);
 };
 

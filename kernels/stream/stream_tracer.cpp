@@ -97,7 +97,8 @@ constexpr TraceDetail trace_detail() {
 // the front and only permute inside a prefix, so (node, length) names a stream.
 // `entry`: the node the stream enters at (the root, or a primary entry point whose subtree
 // holds every leaf the stream's rays can reach). The loop is the back end's
-// (StreamKernels::traverse), so its box filter and leaf tests inline at the host's width.
+// (StreamKernels::traverse), so its box filter and leaf tests run at the host's width without a
+// table call.
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
               uint16_t generation, Trace& trace, uint32_t entry = 0,
