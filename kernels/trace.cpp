@@ -52,11 +52,7 @@ void CountingSink::end_pass(const TilePass& p) {
 
 void TraceSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
                              uint32_t passed) {
-    StreamOp o;
-    o.kind = kind;
-    o.stage = stage;
-    o.generation = generation;
-    o.length = 1;
+    StreamOp o{kind, stage, generation, k_no_object, 1};
     for (uint32_t i = 0; i < count; ++i) {
         o.pass_count = i < passed ? 1 : 0;
         op(o);

@@ -122,6 +122,8 @@ inline bool is_option_kind(OpKind kind) {
 constexpr uint32_t k_no_object = 0xffffffffu;
 
 // One stream operation. `slots` and `passed` are views valid only during the sink call.
+// Built by aggregate initialization in field order, so an emitter names every field it sets in
+// one expression (and the kernels' copies stay inline).
 struct StreamOp {
     OpKind kind = OpKind::box_test;
     OpStage stage = OpStage::traversal;

@@ -42,16 +42,7 @@ struct SinkTraceOf {
     void op(OpKind kind, uint16_t generation, uint32_t object, const uint32_t* ids, uint32_t n,
             const uint8_t* mask, uint32_t passed) {
         if constexpr (!Lanes) ids = nullptr, mask = nullptr;
-        StreamOp o;
-        o.kind = kind;
-        o.stage = stage_of(kind);
-        o.generation = generation;
-        o.object = object;
-        o.length = n;
-        o.pass_count = passed;
-        o.slots = ids;
-        o.passed = mask;
-        sink->op(o);
+        sink->op(StreamOp{kind, stage_of(kind), generation, object, n, passed, ids, mask});
     }
 };
 using SinkTrace = SinkTraceOf<true>;

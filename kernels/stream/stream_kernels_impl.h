@@ -237,18 +237,8 @@ SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage
                              const uint32_t* ids, uint32_t n, const uint8_t* mask,
                              uint32_t passed) {
     if constexpr (Detail != TraceDetail::none) {
-        StreamOp o;
-        o.kind = kind;
-        o.stage = stage;
-        o.generation = job.generation;
-        o.object = object;
-        o.length = n;
-        o.pass_count = passed;
-        if constexpr (Detail == TraceDetail::lanes) {
-            o.slots = ids;
-            o.passed = mask;
-        }
-        job.sink->op(o);
+        if constexpr (Detail != TraceDetail::lanes) ids = nullptr, mask = nullptr;
+        job.sink->op(StreamOp{kind, stage, job.generation, object, n, passed, ids, mask});
     }
 }
 

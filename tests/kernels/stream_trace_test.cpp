@@ -141,16 +141,8 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     std::vector<uint8_t> passed(40, 1);
     for (uint32_t i = 0; i < 40; ++i) slots[i] = i;
     auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
-        StreamOp o;
-        o.kind = kind;
-        o.stage = stage_of(kind);
-        o.generation = generation;
-        o.object = 1;
-        o.length = len;
-        o.pass_count = pass;
-        o.slots = slots.data();
-        o.passed = passed.data();
-        sink.op(o);
+        sink.op(StreamOp{kind, stage_of(kind), generation, 1, len, pass, slots.data(),
+                         passed.data()});
     };
     sink.begin_pass({});
     op(OpKind::box_test, 1, 5, 3);
@@ -188,12 +180,7 @@ TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add
         single.TraceSink::one_lane_ops(kind, stage_of(kind), generation, count, passed);
     };
     auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
-        StreamOp o;
-        o.kind = kind;
-        o.stage = stage_of(kind);
-        o.generation = generation;
-        o.length = len;
-        o.pass_count = pass;
+        const StreamOp o{kind, stage_of(kind), generation, k_no_object, len, pass};
         batched.op(o);
         single.op(o);
     };
