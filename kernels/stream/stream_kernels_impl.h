@@ -150,10 +150,12 @@ uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint
                     uint32_t n, uint32_t* pass_out, uint32_t* fail_out, uint8_t* mask,
                     uint32_t& negative) {
     uint32_t front = 0, back = 0, negatives = 0;
-    for_each_group<Width>(n, [&](auto width, uint32_t g) {
-        box_group<decltype(width)::value>(rays, box, axis, ids + g, n - g, pass_out, fail_out,
-                                          mask ? mask + g : nullptr, front, back, negatives);
-    });
+    // Forced: GCC otherwise keeps the 8-lane group out of line (primary rays +10 % on AVX2).
+    for_each_group<Width>(
+        n, [&](auto width, uint32_t g) __attribute__((always_inline)) {
+            box_group<decltype(width)::value>(rays, box, axis, ids + g, n - g, pass_out, fail_out,
+                                              mask ? mask + g : nullptr, front, back, negatives);
+        });
     negative += negatives;
     return front;
 }
