@@ -130,6 +130,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"per_lane", k.per_lane_cycles},
                                            {"per_pass", k.per_pass_cycles},
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
+                                           {"one_lane", k.one_lane_cycles},
                                            {"fit_median_error", cal.fit_errors[i].first},
                                            {"fit_worst_error", cal.fit_errors[i].second}};
                 }
@@ -139,6 +140,15 @@ void add_calibrate_command(CLI::App& app) {
                                             {"lanes", m.lanes},
                                             {"passed", m.passed},
                                             {"cycles", m.cycles}});
+                j["one_lane_fit_median_error"] = cal.one_lane_fit_error.first;
+                j["one_lane_fit_worst_error"] = cal.one_lane_fit_error.second;
+                for (const OneRaySample& s : cal.one_ray_samples) {
+                    nlohmann::json ops;
+                    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                        if (s.ops[k]) ops[to_string(OpKind(k))] = s.ops[k];
+                    j["one_ray_samples"].push_back(
+                        {{"rays", s.rays}, {"ops", ops}, {"cycles", s.cycles}});
+                }
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
                                           {"slots", r.slots},
@@ -151,15 +161,21 @@ void add_calibrate_command(CLI::App& app) {
             std::printf("host: %s, TSC %.1f MHz, %zu cache levels%s\n", cal.host.isa.c_str(),
                         cal.host.tsc_mhz, cal.host.caches.size(),
                         pinned ? ", pinned" : ", NOT pinned");
-            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s\n", "op kind", "per_op", "per_group",
-                        "per_lane", "per_pass", "beyondL1", "fit med", "fit max");
+            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s %9s\n", "op kind", "per_op", "per_group",
+                        "per_lane", "per_pass", "beyondL1", "fit med", "fit max", "one_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
-                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%%\n", k.op.c_str(),
-                            k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
+                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f\n",
+                            k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
                             k.per_pass_cycles, k.beyond_l1_per_lane_cycles,
-                            100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second);
+                            100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
+                            k.one_lane_cycles);
             }
+            std::printf(
+                "one-lane costs: %zu batches of one-ray traversals, fit error median "
+                "%.1f%%, worst %.1f%%\n",
+                cal.one_ray_samples.size(), 100 * cal.one_lane_fit_error.first,
+                100 * cal.one_lane_fit_error.second);
             std::printf("\n%-30s %6s %6s %9s %12s\n", "kernel", "slots", "lanes", "slots are",
                         "cycles/lane");
             for (const KernelRate& r : cal.rates)

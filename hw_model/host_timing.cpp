@@ -8,6 +8,7 @@ namespace sfx {
 
 double host_op_cycles(const OpCostConfig& c, uint32_t width, uint32_t lanes, uint32_t passed,
                       double beyond_l1) {
+    if (lanes == 1 && c.one_lane_cycles > 0) return c.one_lane_cycles;
     const double groups = double((lanes + width - 1) / width);
     return c.per_op_cycles + c.per_group_cycles * groups + c.per_lane_cycles * lanes +
            c.per_pass_cycles * passed + c.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
@@ -118,6 +119,52 @@ std::vector<double> solve(std::vector<std::vector<double>> a, std::vector<double
     return x;
 }
 
+// Least squares on relative error of rows[s] . x = cycles[s] over the active columns, every
+// coefficient non-negative: the most negative one is dropped and the rest refitted.
+template <size_t Terms>
+std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, Terms>>& rows,
+                                          const std::vector<double>& cycles,
+                                          std::array<bool, Terms> active) {
+    std::array<double, Terms> x{};
+    for (size_t round = 0; round < Terms; ++round) {
+        std::vector<size_t> cols;
+        for (size_t t = 0; t < Terms; ++t)
+            if (active[t]) cols.push_back(t);
+        const size_t m = cols.size();
+        std::vector<std::vector<double>> ata(m, std::vector<double>(m, 0.0));
+        std::vector<double> atb(m, 0.0);
+        for (size_t s = 0; s < rows.size(); ++s) {
+            // Relative error; below k_resolution cycles the clock's steps dominate a sample.
+            const double w = 1.0 / std::max(cycles[s], k_resolution);
+            for (size_t i = 0; i < m; ++i) {
+                atb[i] += rows[s][cols[i]] * w * cycles[s] * w;
+                for (size_t j = 0; j < m; ++j)
+                    ata[i][j] += rows[s][cols[i]] * w * rows[s][cols[j]] * w;
+            }
+        }
+        const std::vector<double> sol = solve(ata, atb);
+        x.fill(0.0);
+        int most_negative = -1;
+        for (size_t i = 0; i < m; ++i) {
+            x[cols[i]] = sol[i];
+            if (sol[i] < 0 && (most_negative < 0 || sol[i] < x[size_t(most_negative)]))
+                most_negative = int(cols[i]);
+        }
+        if (most_negative < 0) break;
+        active[size_t(most_negative)] = false;
+        x[size_t(most_negative)] = 0.0;
+    }
+    for (double& v : x) v = std::max(v, 0.0);
+    return x;
+}
+
+// The one-lane kinds' counts of a sample, as a row of the fit.
+std::array<double, k_op_kind_count> one_lane_row(const OneLaneSample& s) {
+    std::array<double, k_op_kind_count> row{};
+    for (size_t k = 0; k < k_op_kind_count; ++k) row[k] = double(s.ops[k]);
+    return row;
+}
+
 }  // namespace
 
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
@@ -127,44 +174,44 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     active.fill(true);
     // A column that never varies apart from the constant carries no information.
     bool any_beyond = false, any_passed = false;
+    std::vector<std::array<double, k_terms>> rows;
+    std::vector<double> cycles;
     for (const OpCostSample& s : samples) {
         any_beyond |= s.beyond_l1 > 0;
         any_passed |= s.passed > 0;
+        rows.push_back(terms(s, width));
+        cycles.push_back(s.cycles);
     }
     active[4] = any_beyond;
     active[3] = any_passed;
-    std::array<double, k_terms> x{};
-    for (int round = 0; round < k_terms; ++round) {
-        std::vector<int> cols;
-        for (int t = 0; t < k_terms; ++t)
-            if (active[t]) cols.push_back(t);
-        const size_t m = cols.size();
-        std::vector<std::vector<double>> ata(m, std::vector<double>(m, 0.0));
-        std::vector<double> atb(m, 0.0);
-        for (const OpCostSample& s : samples) {
-            const auto row = terms(s, width);
-            // Relative error; below k_resolution cycles the clock's steps dominate a sample.
-            const double w = 1.0 / std::max(s.cycles, k_resolution);
-            for (size_t i = 0; i < m; ++i) {
-                atb[i] += row[size_t(cols[i])] * w * s.cycles * w;
-                for (size_t j = 0; j < m; ++j)
-                    ata[i][j] += row[size_t(cols[i])] * w * row[size_t(cols[j])] * w;
-            }
-        }
-        const std::vector<double> sol = solve(ata, atb);
-        x.fill(0.0);
-        int most_negative = -1;
-        for (size_t i = 0; i < m; ++i) {
-            x[size_t(cols[i])] = sol[i];
-            if (sol[i] < 0 && (most_negative < 0 || sol[i] < x[size_t(most_negative)]))
-                most_negative = cols[i];
-        }
-        if (most_negative < 0) break;
-        active[size_t(most_negative)] = false;
-        x[size_t(most_negative)] = 0.0;
+    return from_coefficients(op, fit_nonnegative(rows, cycles, active));
+}
+
+std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLaneSample>& samples) {
+    if (samples.empty()) throw std::invalid_argument("no one-ray traversal samples");
+    std::array<bool, k_op_kind_count> active{};
+    std::vector<std::array<double, k_op_kind_count>> rows;
+    std::vector<double> cycles;
+    for (const OneLaneSample& s : samples) {
+        for (size_t k = 0; k < k_op_kind_count; ++k) active[k] = active[k] || s.ops[k] > 0;
+        rows.push_back(one_lane_row(s));
+        cycles.push_back(s.cycles);
     }
-    for (double& v : x) v = std::max(v, 0.0);
-    return from_coefficients(op, x);
+    return fit_nonnegative(rows, cycles, active);
+}
+
+std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
+                                             const std::vector<OneLaneSample>& samples) {
+    std::vector<double> e;
+    for (const OneLaneSample& s : samples) {
+        const std::array<double, k_op_kind_count> row = one_lane_row(s);
+        double predicted = 0.0;
+        for (size_t k = 0; k < k_op_kind_count; ++k) predicted += row[k] * cycles[k];
+        e.push_back(std::abs(predicted - s.cycles) / std::max(s.cycles, k_resolution));
+    }
+    if (e.empty()) return {0.0, 0.0};
+    std::sort(e.begin(), e.end());
+    return {e[e.size() / 2], e.back()};
 }
 
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,

@@ -30,7 +30,7 @@ struct HostTimingResult {
 };
 
 // An op's cost from its profile, without scene data: n lanes, p passing, a fraction
-// `beyond_l1` of the ray buffer outside the L1D.
+// `beyond_l1` of the ray buffer outside the L1D (one lane: one_lane_cycles when measured).
 double host_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
                       double beyond_l1);
 
@@ -77,5 +77,21 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
 // measured, a measurement under 100 cycles counting as 100 (the clock's steps).
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples);
+
+// One-ray traversals timed together (kernels/stream/stream_microbench.h): how many one-lane ops
+// of each kind they made, and the cycles they took.
+struct OneLaneSample {
+    std::array<uint64_t, k_op_kind_count> ops{};
+    double cycles = 0.0;
+};
+
+// The one-lane cost of every kind the samples make (OpCostConfig::one_lane_cycles; 0 for the
+// rest): least squares on relative error, non-negative as in fit_op_cost. Throws
+// std::invalid_argument on no samples.
+std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLaneSample>& samples);
+
+// That fit's (median, worst) relative error on its own samples.
+std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
+                                             const std::vector<OneLaneSample>& samples);
 
 }  // namespace sfx

@@ -231,7 +231,11 @@ struct DatapathConfig {
 // by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
 // streams, never on frames. An op of n lanes in g = ceil(n / simd.width) groups, p passing,
 // whose ray buffer is a fraction f beyond the L1D costs
-//   per_op + per_group * g + per_lane * n + per_pass * p + beyond_l1_per_lane * f * n cycles.
+//   per_op + per_group * g + per_lane * n + per_pass * p + beyond_l1_per_lane * f * n cycles,
+// except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
+// stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
+// partition), so its box, triangle and sphere tests cost one_lane_cycles each, fitted on
+// one-ray traversals of the same synthetic scene.
 // Empty (every preset): the machine model prices ops from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
@@ -240,6 +244,7 @@ struct OpCostConfig {
     double per_lane_cycles = 0.0;
     double per_pass_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
+    double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
 
     template <class V>
     void visit(V& v) {
@@ -255,6 +260,10 @@ struct OpCostConfig {
         v.param("beyond_l1_per_lane_cycles", beyond_l1_per_lane_cycles, "cycles",
                 "extra cost per lane when the ray buffer is wholly beyond the L1D (scaled by "
                 "the fraction beyond)",
+                0.0, 1e9);
+        v.param("one_lane_cycles", one_lane_cycles, "cycles",
+                "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "
+                "formula above applies)",
                 0.0, 1e9);
     }
 };

@@ -37,9 +37,16 @@ HostCalibration calibrate_host(Isa isa, uint32_t repeats,
     for (const MicrobenchSample& s : c.samples)
         by_kind[s.kind].push_back(
             {s.lanes, s.passed, beyond_l1_fraction(s.slots, slot_bytes, l1d), s.cycles});
+    // One-lane ops run in the one-ray loop, not the filters above: their own fit.
+    c.one_ray_samples = run_one_ray_microbenchmarks(resolved, repeats);
+    std::vector<OneLaneSample> one_lane;
+    for (const OneRaySample& s : c.one_ray_samples) one_lane.push_back({s.ops, s.cycles});
+    const std::array<double, k_op_kind_count> one_lane_cycles = fit_one_lane_cycles(one_lane);
+    c.one_lane_fit_error = one_lane_fit_error(one_lane_cycles, one_lane);
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
+        c.op_costs.back().one_lane_cycles = one_lane_cycles[size_t(kind)];
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size();
     }
@@ -47,7 +54,9 @@ HostCalibration calibrate_host(Isa isa, uint32_t repeats,
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
          << "256/1024/4096 slots of " << slot_bytes << " bytes, median of " << repeats
-         << "; kernels/stream/stream_microbench.h), least squares on relative error; no frame";
+         << "; kernels/stream/stream_microbench.h), least squares on relative error; one-lane "
+         << "costs from " << c.one_ray_samples.size()
+         << " batches of 1-32 one-ray traversals of the same scene; no frame";
     c.yaml = host_hw_yaml(c.host, c.op_costs, note.str());
     return c;
 }

@@ -26,6 +26,10 @@ struct HostCalibration {
     std::vector<KernelRate> rates;  // field read and compress by themselves (reported, not fitted)
     // Per fitted kind: the fit's (median, worst) relative error on its own samples.
     std::vector<std::pair<double, double>> fit_errors;
+    // One-ray traversals, and the one-lane costs' fit error on them (OpCostConfig::
+    // one_lane_cycles of the box, triangle and sphere tests).
+    std::vector<OneRaySample> one_ray_samples;
+    std::pair<double, double> one_lane_fit_error{};
     std::string yaml;  // host.hw.yaml
 };
 

@@ -7,6 +7,19 @@ namespace sfx {
 const StreamKernels& stream_kernels_avx2();    // stream_kernels_avx2.cpp
 const StreamKernels& stream_kernels_avx512();  // stream_kernels_avx512.cpp
 
+TraversalJob traversal_job(const Bvh& bvh) {
+    TraversalJob job{};
+    job.bvh = &bvh;
+    job.nodes = bvh.nodes().data();
+    job.leaf = bvh.leaf_primitives().data();
+    job.triangle_count = uint32_t(bvh.scene().triangles.size());
+    job.entry = 0;
+    job.box_stage = stage_of(OpKind::box_test);
+    job.triangle_stage = stage_of(OpKind::triangle_test);
+    job.sphere_stage = stage_of(OpKind::sphere_test);
+    return job;
+}
+
 const StreamKernels& stream_kernels(Isa isa) {
     static const StreamKernels scalar = scalar_kernels::make_kernels<1>(Isa::scalar);
     switch (isa) {

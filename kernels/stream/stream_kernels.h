@@ -151,4 +151,9 @@ struct StreamKernels {
 // The kernels for a resolved instruction set (never Isa::automatic; the CPU must support it).
 const StreamKernels& stream_kernels(Isa isa);
 
+// A job's fields that come from the BVH (nodes, leaf primitives, the triangle count, the
+// stages of the test kinds), entering at the root; the caller sets the buffers, the stream and
+// the trace.
+TraversalJob traversal_job(const Bvh& bvh);
+
 }  // namespace sfx

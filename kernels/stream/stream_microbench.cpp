@@ -26,8 +26,10 @@ uint32_t stream_slot_bytes() {
 
 namespace {
 
-// A floor (Lambertian), a glossy panel, a glass sphere and a light over them.
-Scene synthetic_scene() {
+// A floor (Lambertian), a glossy panel, a glass sphere and a light over them. `dense`: the
+// floor cut into 16 x 16 quads with 16 small glass spheres on it, for one-ray traversals deep
+// enough and with enough sphere tests to tell the kinds' costs apart.
+Scene synthetic_scene(bool dense = false) {
     Scene s;
     s.name = "microbench";
     Material floor, panel, glass, light;
@@ -39,13 +41,21 @@ Scene synthetic_scene() {
     s.materials = {floor, panel, glass, light};
     SceneBuilder b(s);
     b.begin_object();
-    shapes::quad(b, Vec3(-4, 0, -4), Vec3(8, 0, 0), Vec3(0, 0, 8), 0);
+    const uint32_t floor_cuts = dense ? 16 : 1;
+    const float cell = 8.f / float(floor_cuts);
+    for (uint32_t i = 0; i < floor_cuts; ++i)
+        for (uint32_t j = 0; j < floor_cuts; ++j)
+            shapes::quad(b, Vec3(-4 + cell * float(i), 0, -4 + cell * float(j)), Vec3(cell, 0, 0),
+                         Vec3(0, 0, cell), 0);
     b.begin_object();
     shapes::quad(b, Vec3(-3, 0, -3), Vec3(3, 0, 0), Vec3(0, 3, 0), 1);
     b.begin_object();
     shapes::quad(b, Vec3(-1, 4, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), 3);
     b.begin_object();
     b.add_sphere(Vec3(1.5f, 1.f, 0.5f), 1.f, 2);
+    if (dense)
+        for (int i = 0; i < 16; ++i)
+            b.add_sphere(Vec3(-3.5f + 0.5f * float(i), 0.2f, 2.5f - 0.4f * float(i % 4)), 0.2f, 2);
     s.camera.eye = Vec3(0, 2, 8);
     s.camera.look_at = Vec3(0, 1, 0);
     s.finalize(b.light_groups());
@@ -350,6 +360,69 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         }
         if (progress) progress(++done, uint32_t(kinds.size()));
     }
+    return out;
+}
+
+std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats, uint64_t seed) {
+    const Scene scene = synthetic_scene(true);
+    const Bvh bvh(scene);
+    const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
+    std::mt19937 rng{uint32_t(seed)};
+    const double overhead = tsc_overhead();
+    constexpr uint32_t k_slots = 256;
+    Buffers b = make_buffers(scene, bvh, k_slots, rng);
+    TraversalJob job = traversal_job(bvh);
+    job.rays = b.trav.data();
+    job.pre = b.pre.data();
+    job.hit = b.hit.data();
+    job.any_hit = b.any_hit.data();
+    job.n = 1;
+    job.scratch = b.scratch.data();
+    job.scratch2 = b.scratch2.data();
+    job.positions = b.positions.data();
+    job.mask = b.mask.data();
+    std::vector<uint32_t> order(k_slots);
+    std::iota(order.begin(), order.end(), 0u);
+    std::vector<OneRaySample> out;
+    for (uint32_t rays : {1u, 2u, 4u, 8u, 16u, 32u})
+        for (uint32_t batch = 0; batch < 8; ++batch) {
+            std::shuffle(order.begin(), order.end(), rng);
+            std::copy(order.begin(), order.begin() + rays, b.ids.begin());
+            // Each traversal starts from no hit and the ray's full t, as after load_rays.
+            auto reset = [&] {
+                for (uint32_t i = 0; i < rays; ++i) {
+                    const uint32_t id = b.ids[i];
+                    b.trav.set(id, b.pre[id], b.ray[id].t_max);
+                    b.hit[id] = Hit{};
+                }
+            };
+            auto run = [&](TraceDetail detail) {
+                for (uint32_t i = 0; i < rays; ++i) {
+                    job.ids = b.ids.data() + i;  // a one-ray stream: only ids[0] is read
+                    kernels.traverse[int(detail)](job);
+                }
+            };
+            OneRaySample sample;
+            sample.rays = rays;
+            CountingSink counts({1});
+            counts.begin_pass(TilePass{});
+            job.sink = &counts;
+            reset();
+            run(TraceDetail::counts);
+            counts.end_pass(TilePass{});
+            for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                sample.ops[k] = counts.kind_ops(OpKind(k));
+            job.sink = nullptr;
+            std::vector<double> times;
+            for (uint32_t rep = 0; rep < repeats; ++rep) {
+                reset();
+                const uint64_t start = __rdtsc();
+                run(TraceDetail::none);
+                times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+            }
+            sample.cycles = median(times);
+            out.push_back(sample);
+        }
     return out;
 }
 

@@ -8,6 +8,7 @@
 // the median of several repetitions. `sfx calibrate --describe-host` fits the host's per-op
 // costs to these samples (hw_model/host_timing.h), never to frames.
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -41,6 +42,20 @@ struct MicrobenchOptions {
 // total)` is called after each kind.
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
+
+// One-ray traversals: StreamKernels::traverse (trace off) of `rays` one-ray streams from the
+// root, one after another, in the synthetic scene with its floor cut into 16 x 16 quads and 16
+// small spheres on it (so a traversal tests as many boxes as a secondary ray's one-ray subtree
+// does, and spheres often enough to fit their cost). Every op of
+// a one-ray stream has one lane and runs in the one-ray loop (traverse_one), whatever the width.
+struct OneRaySample {
+    uint32_t rays = 0;
+    std::array<uint64_t, k_op_kind_count> ops{};  // per kind, counted by the same traversals
+    double cycles = 0.0;                          // TSC ticks, median over repetitions
+};
+// Batches of 1 to 32 random rays (several batches of each size).
+std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats = 9,
+                                                      uint64_t seed = 1);
 
 // The field-read and compress rates by themselves: TSC ticks per lane of the box kernel's read
 // of 7 fields for `lanes` ids over `slots` records (contiguous or random slots) with a box every

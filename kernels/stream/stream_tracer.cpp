@@ -104,11 +104,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
               uint16_t generation, Trace& trace, uint32_t entry = 0,
               uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
-    TraversalJob job;
-    job.bvh = &bvh;
-    job.nodes = bvh.nodes().data();
-    job.leaf = bvh.leaf_primitives().data();
-    job.triangle_count = uint32_t(bvh.scene().triangles.size());
+    TraversalJob job = traversal_job(bvh);
     job.rays = b.trav.data();
     job.pre = b.pre.data();
     job.hit = b.hit.data();
@@ -123,9 +119,6 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     job.sink = nullptr;
     if constexpr (Trace::k_enabled) job.sink = trace.sink;
     job.generation = generation;
-    job.box_stage = stage_of(OpKind::box_test);
-    job.triangle_stage = stage_of(OpKind::triangle_test);
-    job.sphere_stage = stage_of(OpKind::sphere_test);
     job.leaf_tsc = leaf_tsc;
     kernels.traverse[int(trace_detail<Trace>())](job);
 }

@@ -44,6 +44,14 @@ TEST_CASE("An op's host cost is the formula of its kind", "[host_timing]") {
     CHECK(beyond_l1_fraction(256, 64, 32) == 0.0);   // 16 KiB in 32 KiB
     CHECK(beyond_l1_fraction(1024, 64, 32) == 0.5);  // 64 KiB
     CHECK(beyond_l1_fraction(0, 64, 32) == 0.0);
+
+    // A one-lane op runs in the one-ray loop: its own measured cost, when there is one.
+    OpCostConfig one = c;
+    CHECK(host_op_cycles(one, 16, 1, 1, 0.5) == Approx(10 + 4 + 0.5 + 2 + 4));
+    one.one_lane_cycles = 7;
+    CHECK(host_op_cycles(one, 16, 1, 1, 0.5) == Approx(7));
+    CHECK(host_op_cycles(one, 16, 1, 0, 0.0) == Approx(7));
+    CHECK(host_op_cycles(one, 16, 2, 1, 0.0) == Approx(10 + 4 + 1 + 2));
 }
 
 TEST_CASE("The fit recovers costs from exact samples and never goes negative", "[host_timing]") {
@@ -69,6 +77,34 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
                      f.beyond_l1_per_lane_cycles})
         CHECK(v >= 0.0);
     CHECK_THROWS_AS(fit_op_cost("box_test", 16, {}), std::invalid_argument);
+}
+
+TEST_CASE("The one-lane fit recovers each kind's cost from traversals that mix them",
+          "[host_timing]") {
+    auto sample = [](uint64_t boxes, uint64_t triangles, uint64_t spheres, double cycles) {
+        OneLaneSample s;
+        s.ops[size_t(OpKind::box_test)] = boxes;
+        s.ops[size_t(OpKind::triangle_test)] = triangles;
+        s.ops[size_t(OpKind::sphere_test)] = spheres;
+        s.cycles = cycles;
+        return s;
+    };
+    std::vector<OneLaneSample> samples;
+    for (uint64_t b : {7u, 23u, 130u})
+        for (uint64_t t : {0u, 2u, 12u})
+            for (uint64_t s : {0u, 1u, 5u})
+                samples.push_back(sample(b, t, s, 30.0 * b + 90.0 * t + 40.0 * s));
+    const auto fit = fit_one_lane_cycles(samples);
+    CHECK(fit[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::triangle_test)] == Approx(90).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::sphere_test)] == Approx(40).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::camera)] == 0.0);  // never made: no cost
+    CHECK(one_lane_fit_error(fit, samples).second < 1e-9);
+    // A wrong cost shows in the error: 10 % off on the boxes.
+    auto off = fit;
+    off[size_t(OpKind::box_test)] *= 1.1;
+    CHECK(one_lane_fit_error(off, samples).second > 0.05);
+    CHECK_THROWS_AS(fit_one_lane_cycles({}), std::invalid_argument);
 }
 
 TEST_CASE("Host timing charges ops by kind and scene data by the level that holds it",
@@ -112,8 +148,9 @@ TEST_CASE("Host timing charges ops by kind and scene data by the level that hold
 }
 
 TEST_CASE("host.hw.yaml reads back with its host knobs", "[host_timing]") {
-    const std::string yaml =
-        host_hw_yaml(small_host(), {cost("box_test", 1, 2, 3, 4, 5)}, "test samples");
+    OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
+    box.one_lane_cycles = 6;
+    const std::string yaml = host_hw_yaml(small_host(), {box}, "test samples");
     const HwConfig c = parse_hw_config(yaml, "host.hw.yaml");
     CHECK(c.ray_buffer.storage == "l1d");
     CHECK(c.ray_buffer.kib == 32);
@@ -126,6 +163,12 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host_timing]") {
     CHECK(c.scene_memory.dram_latency_ns == Approx(81));
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
+    CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
+    // A host file written before one-lane costs were measured: the formula for every op.
+    CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
+                          "old.hw.yaml")
+              .op_costs[0]
+              .one_lane_cycles == 0.0);
     // The presets carry no op costs, so the store gains no columns from them.
     CHECK(HwConfig().op_costs.empty());
 

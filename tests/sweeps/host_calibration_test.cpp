@@ -25,9 +25,27 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         by_kind[s.kind].push_back(
             {s.lanes, s.passed,
              beyond_l1_fraction(s.slots, stream_slot_bytes(), host.caches.front().kib), s.cycles});
+    // One-ray traversals: only the traversal's kinds, each made, and their fitted cost.
+    const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, 3);
+    std::vector<OneLaneSample> one_lane;
+    std::map<OpKind, uint64_t> made;
+    for (const OneRaySample& s : one_ray) {
+        CHECK(s.cycles > 0);
+        one_lane.push_back({s.ops, s.cycles});
+        for (uint32_t k = 0; k < k_op_kind_count; ++k)
+            if (s.ops[k]) made[OpKind(k)] += s.ops[k];
+    }
+    CHECK(made.size() == 3);
+    CHECK(made[OpKind::box_test] > 10 * one_ray.size());  // deep enough to be a loop
+    CHECK(made[OpKind::triangle_test] > 0);
+    CHECK(made[OpKind::sphere_test] > 0);
+    const auto one_lane_cycles = fit_one_lane_cycles(one_lane);
+    CHECK(one_lane_cycles[size_t(OpKind::box_test)] > 0);
     std::vector<OpCostConfig> costs;
-    for (const auto& [kind, samples] : by_kind)
+    for (const auto& [kind, samples] : by_kind) {
         costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
+        costs.back().one_lane_cycles = one_lane_cycles[size_t(kind)];
+    }
     const HwConfig config = parse_hw_config(host_hw_yaml(host, costs, "test"), "host.hw.yaml");
 
     const Scene scene = load_scene("cornell");
