@@ -59,9 +59,11 @@ constexpr float k_slab_t_max_scale = 1.f + 1.f / 65536.f;
 // passes iff its ray enters the box; t0 is the entry distance of passing lanes.
 // The near and far planes are chosen by the sign of the direction (-0 counts as negative), so
 // no swap is needed. The only NaN source, 0 * inf, means the origin lies on a slab plane and the
-// ray runs inside that plane: the plane then bounds nothing (the box is closed, so it is kept).
-// No early exit per axis: t0 only grows and t1 only shrinks (NaN distances are replaced before
-// they are compared), so "t0 > t1 after some axis" equals "t0 > t1 after the last axis".
+// ray runs inside that plane: the plane then bounds nothing (the box is closed, so it is kept),
+// which the compares give by themselves: a NaN distance fails both, so t0 and t1 keep their
+// values, as if it were -inf (near) or +inf (far).
+// No early exit per axis: t0 only grows and t1 only shrinks, so "t0 > t1 after some axis"
+// equals "t0 > t1 after the last axis".
 template <int Width>
 SFX_LANES_INLINE vbool<Width> slab_test(const vfloat<Width> org[3], const vfloat<Width> inv_dir[3],
                                         vfloat<Width> t_max, const Bounds3& b, vfloat<Width>& t0) {
@@ -71,10 +73,9 @@ SFX_LANES_INLINE vbool<Width> slab_test(const vfloat<Width> org[3], const vfloat
     for (int a = 0; a < 3; ++a) {
         const vbool<Width> negative = sign_bit<Width>(inv_dir[a]);
         const vfloat<Width> lo = broadcast<Width>(b.lo[a]), hi = broadcast<Width>(b.hi[a]);
-        vfloat<Width> t_near = (select(negative, hi, lo) - org[a]) * inv_dir[a];
-        vfloat<Width> t_far = (select(negative, lo, hi) - org[a]) * inv_dir[a];
-        t_near = select(is_nan<Width>(t_near), -inf, t_near);
-        t_far = select(is_nan<Width>(t_far), inf, t_far * k_slab_far_scale);
+        const vfloat<Width> t_near = (select(negative, hi, lo) - org[a]) * inv_dir[a];
+        const vfloat<Width> t_far =
+            (select(negative, lo, hi) - org[a]) * inv_dir[a] * k_slab_far_scale;
         t0 = select(t_near > t0, t_near, t0);
         t1 = select(t_far < t1, t_far, t1);
     }
