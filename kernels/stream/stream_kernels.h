@@ -156,4 +156,20 @@ const StreamKernels& stream_kernels(Isa isa);
 // the trace.
 TraversalJob traversal_job(const Bvh& bvh);
 
+// traversal_job with the per-slot fields and scratch lists of `b` (the tracer's and the
+// microbenchmarks' buffers name them alike); the caller sets the stream and the trace.
+template <class Buffers>
+TraversalJob traversal_job(const Bvh& bvh, Buffers& b) {
+    TraversalJob job = traversal_job(bvh);
+    job.rays = b.trav.data();
+    job.pre = b.pre.data();
+    job.hit = b.hit.data();
+    job.any_hit = b.any_hit.data();
+    job.scratch = b.scratch.data();
+    job.scratch2 = b.scratch2.data();
+    job.positions = b.positions.data();
+    job.mask = b.mask.data();
+    return job;
+}
+
 }  // namespace sfx

@@ -371,16 +371,8 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats,
     const double overhead = tsc_overhead();
     constexpr uint32_t k_slots = 256;
     Buffers b = make_buffers(scene, bvh, k_slots, rng);
-    TraversalJob job = traversal_job(bvh);
-    job.rays = b.trav.data();
-    job.pre = b.pre.data();
-    job.hit = b.hit.data();
-    job.any_hit = b.any_hit.data();
+    TraversalJob job = traversal_job(bvh, b);
     job.n = 1;
-    job.scratch = b.scratch.data();
-    job.scratch2 = b.scratch2.data();
-    job.positions = b.positions.data();
-    job.mask = b.mask.data();
     std::vector<uint32_t> order(k_slots);
     std::iota(order.begin(), order.end(), 0u);
     std::vector<OneRaySample> out;

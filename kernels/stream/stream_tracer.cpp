@@ -104,18 +104,10 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
               uint16_t generation, Trace& trace, uint32_t entry = 0,
               uint64_t* leaf_tsc = nullptr) {
     if (n == 0) return;
-    TraversalJob job = traversal_job(bvh);
-    job.rays = b.trav.data();
-    job.pre = b.pre.data();
-    job.hit = b.hit.data();
-    job.any_hit = b.any_hit.data();
+    TraversalJob job = traversal_job(bvh, b);
     job.ids = b.trav_ids.data();
     job.n = n;
     job.entry = entry;
-    job.scratch = b.scratch.data();
-    job.scratch2 = b.scratch2.data();
-    job.positions = b.positions.data();
-    job.mask = b.mask.data();
     job.sink = nullptr;
     if constexpr (Trace::k_enabled) job.sink = trace.sink;
     job.generation = generation;
