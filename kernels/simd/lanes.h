@@ -2,16 +2,16 @@
 // Width-generic SIMD lanes, written once (after Embree's vfloat<N> / vbool<N>):
 //   vfloat<Width>, vint<Width>, vbool<Width>
 // are `float`, `int32_t`, `bool` for Width 1 and GCC vector types (element-wise IEEE
-// operations; a comparison gives 0 / -1 per lane) for Width 8 and 16, so the reference
+// operations; a comparison gives 0 / -1 per lane) for Width 4, 8 and 16, so the reference
 // tracer's one-ray code and the stream kernels share every line of ray math.
 //
 // Masks are values: any, none, popcount, bits, select. Gather and compress-store are
-// operations of the type. Under __AVX512F__ (Width 16) and __AVX2__ (Width 8) they use the
-// instructions (vpgatherdd/vgatherdps, vpcompressd, a permutation table); otherwise a portable
-// loop with the same results.
+// operations of the type. Under __AVX512F__ (Width 16) and __AVX2__ (Width 8, and Width 4: the
+// AVX2 kernels' short groups) they use the instructions (vpgatherdd/vgatherdps, vpcompressd, a
+// permutation table); otherwise a portable loop with the same results.
 //
 // One rule keeps one binary safe on every machine (see kernels/simd/isa.h): each Width is
-// used only in translation units compiled for its instruction set (16: AVX-512, 8: AVX2,
+// used only in translation units compiled for its instruction set (16: AVX-512, 8 and 4: AVX2,
 // 1: the default flags), and every function here is always inlined, so no out-of-line copy
 // built with wider instructions can be picked by the linker for a narrower caller.
 // Bit-identity: only IEEE add/sub/mul/div/compare/select; no FMA (-ffp-contract=off), no
@@ -60,6 +60,7 @@ SFX_LANES_INLINE vfloat<Width> broadcast(float x) {
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) return vfloat<Width>(_mm256_set1_ps(x));
+        if constexpr (Width == 4) return vfloat<Width>(_mm_set1_ps(x));
 #endif
         vfloat<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = x;
@@ -76,6 +77,7 @@ SFX_LANES_INLINE vint<Width> broadcast_int(int32_t x) {
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) return vint<Width>(_mm256_set1_epi32(x));
+        if constexpr (Width == 4) return vint<Width>(_mm_set1_epi32(x));
 #endif
         vint<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = x;
@@ -96,6 +98,7 @@ SFX_LANES_INLINE vint<Width> lane_index() {
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) return vint<Width>(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        if constexpr (Width == 4) return vint<Width>(_mm_setr_epi32(0, 1, 2, 3));
 #endif
         vint<Width> v;
         for (int l = 0; l < Width; ++l) v[l] = l;
@@ -161,6 +164,7 @@ SFX_LANES_INLINE uint32_t bits(vbool<Width> m) {
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) return uint32_t(_mm256_movemask_ps(__m256(m)));
+        if constexpr (Width == 4) return uint32_t(_mm_movemask_ps(__m128(m)));
 #endif
         uint32_t r = 0;
         for (int l = 0; l < Width; ++l) r |= uint32_t(m[l] & 1) << l;
@@ -229,7 +233,7 @@ SFX_LANES_INLINE vfloat<Width> gather(const float* base, vint<Width> index) {
 // so a lane touches one cache line where eight gathers would touch it eight times; the same
 // bits as gathers. At 16 lanes: 256-bit halves of lanes l and l + 4 share a register, 4x4
 // transposes within 128-bit blocks, then one block shuffle per field; at 8 lanes: 128-bit
-// halves of lanes l and l + 4, two 4x4 transposes.
+// halves of lanes l and l + 4, two 4x4 transposes; at 4 lanes: two 4x4 transposes.
 template <int Width>
 SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
                                        vfloat<Width> out[8]) {
@@ -292,6 +296,18 @@ SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
             }
             return;
         }
+        if constexpr (Width == 4) {
+            for (int h = 0; h < 8; h += 4) {
+                __m128 r0 = _mm_load_ps(base + index[0] + h), r1 = _mm_load_ps(base + index[1] + h);
+                __m128 r2 = _mm_load_ps(base + index[2] + h), r3 = _mm_load_ps(base + index[3] + h);
+                _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+                out[h] = vfloat<Width>(r0);
+                out[h + 1] = vfloat<Width>(r1);
+                out[h + 2] = vfloat<Width>(r2);
+                out[h + 3] = vfloat<Width>(r3);
+            }
+            return;
+        }
 #endif
         for (int f = 0; f < 8; ++f)
             for (int l = 0; l < Width; ++l) out[f][l] = base[index[l] + f];
@@ -338,6 +354,14 @@ SFX_LANES_INLINE vint<Width> compress(uint32_t mask_bits, vint<Width> values) {
                                   shifts),
                 _mm256_set1_epi32(7));
             return vint<Width>(_mm256_permutevar8x32_epi32(__m256i(values), perm));
+        }
+        if constexpr (Width == 4) {  // the 8-lane table's entries for masks below 16
+            const __m128i perm = _mm_and_si128(
+                _mm_srlv_epi32(_mm_set1_epi32(int(k_compress_table8.packed[mask_bits & 15])),
+                               _mm_setr_epi32(0, 4, 8, 12)),
+                _mm_set1_epi32(3));
+            return vint<Width>(
+                _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(__m128i(values)), perm)));
         }
 #endif
         vint<Width> packed = values;
@@ -393,6 +417,12 @@ SFX_LANES_INLINE uint32_t compress_store_exact(uint32_t mask_bits, vint<Width> v
             const __m256i store = _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)),
                                                      _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
             _mm256_maskstore_epi32(reinterpret_cast<int*>(out), store, __m256i(packed));
+            return count;
+        }
+        if constexpr (Width == 4) {
+            const __m128i store =
+                _mm_cmpgt_epi32(_mm_set1_epi32(int(count)), _mm_setr_epi32(0, 1, 2, 3));
+            _mm_maskstore_epi32(reinterpret_cast<int*>(out), store, __m128i(packed));
             return count;
         }
 #endif

@@ -46,14 +46,14 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
 }
 
 // Calls group(std::integral_constant<int, W>(), g) for each group of Width ids from g = 0 while
-// g < n. At 16 lanes a last group of at most 8 ids (a short stream, or a stream's tail) runs at
-// 8: half the reads on short secondary streams; the lane math is the same at every width, so
-// are the results.
+// g < n. A last group of at most half the width (a short stream, or a stream's tail) runs at
+// half the width (16 -> 8, 8 -> 4): half the reads and lane work on short secondary streams;
+// the lane math is the same at every width, so are the results.
 template <int Width, class Group>
 SFX_LANES_INLINE void for_each_group(uint32_t n, Group&& group) {
     for (uint32_t g = 0; g < n; g += Width) {
-        if constexpr (Width == 16) {
-            if (n - g <= 8) return group(std::integral_constant<int, 8>(), g);
+        if constexpr (Width == 16 || Width == 8) {
+            if (n - g <= Width / 2) return group(std::integral_constant<int, Width / 2>(), g);
         }
         group(std::integral_constant<int, Width>(), g);
     }
