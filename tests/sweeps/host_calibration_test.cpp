@@ -29,12 +29,17 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, 3);
     std::vector<OneLaneSample> one_lane;
     std::map<OpKind, uint64_t> made;
+    double one_ray_cycles = 0;
     for (const OneRaySample& s : one_ray) {
-        CHECK(s.cycles > 0);
+        // A batch of one ray that misses the root costs about what reading the TSC does, so
+        // its cycles can be 0 (after the overhead); the batches together cannot.
+        CHECK(s.cycles >= 0);
+        one_ray_cycles += s.cycles;
         one_lane.push_back({s.ops, s.cycles});
         for (uint32_t k = 0; k < k_op_kind_count; ++k)
             if (s.ops[k]) made[OpKind(k)] += s.ops[k];
     }
+    CHECK(one_ray_cycles > 0);
     CHECK(made.size() == 3);
     CHECK(made[OpKind::box_test] > 10 * one_ray.size());  // deep enough to be a loop
     CHECK(made[OpKind::triangle_test] > 0);
