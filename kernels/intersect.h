@@ -236,37 +236,55 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     return true;
 }
 
-// Ray/sphere test over (0, t_max]; returns the nearest root in range.
+// Ray/sphere test over (0, t_max] for Width rays against one sphere, written once for the
+// reference tracer (Width 1) and the stream's sphere filter: a lane hits iff a root lies in
+// range; t is then the nearest such root.
 // An origin within rounding error of the surface (a spawned ray) is treated as on it: the root
 // near 0 is the surface being left and is dropped, so a ray leaving outwards misses and a ray
 // leaving inwards hits the far side, whichever side of the surface the origin rounded to.
-inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, float& t_out) {
-    const Vec3 f = r.org - s.center;
-    const float a = dot(r.dir, r.dir);
-    const float b_half = -dot(f, r.dir);  // -b/2
+// Lanes that have already missed are computed on (their NaNs are masked off); a group none of
+// whose lanes has a real discriminant stops there.
+template <int Width>
+SFX_LANES_INLINE vbool<Width> sphere_test(const vfloat<Width> org[3], const vfloat<Width> dir[3],
+                                          vfloat<Width> t_max, const Sphere& s, vfloat<Width>& t) {
+    using M = vbool<Width>;
+    const vfloat<Width> zero = broadcast<Width>(0.f), inf = broadcast<Width>(INFINITY);
+    const vfloat<Width> fx = org[0] - broadcast<Width>(s.center.x),
+                        fy = org[1] - broadcast<Width>(s.center.y),
+                        fz = org[2] - broadcast<Width>(s.center.z);
+    const vfloat<Width> a = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+    const vfloat<Width> b_half = -(fx * dir[0] + fy * dir[1] + fz * dir[2]);  // -b/2
     // Discriminant from the distance of the ray's closest approach (Haines et al. eq. 7.5).
-    const Vec3 l = f + r.dir * (b_half / a);
-    const float r2 = s.radius * s.radius;
-    const float disc = a * (r2 - dot(l, l));
-    if (!(disc >= 0.f)) return false;
-    const float q = b_half + std::copysign(std::sqrt(disc), b_half);
-    if (q == 0.f) return false;  // tangent at the origin
-    const float f2 = dot(f, f);
-    const float c = f2 - r2;  // |f|^2 - r^2: the origin's side of the surface
-    const bool on_surface = std::fabs(c) <= gamma_bound(8) * (f2 + r2);
+    const vfloat<Width> along = b_half / a;
+    const vfloat<Width> lx = fx + dir[0] * along, ly = fy + dir[1] * along,
+                        lz = fz + dir[2] * along;
+    const vfloat<Width> r2 = broadcast<Width>(s.radius * s.radius);
+    const vfloat<Width> disc = a * (r2 - (lx * lx + ly * ly + lz * lz));
+    M hit = disc >= zero;
+    if (none<Width>(hit)) return hit;
+    const vfloat<Width> q = b_half + copy_sign<Width>(square_root<Width>(disc), b_half);
+    hit = mask_and<M>(hit, q != zero);  // q = 0: tangent at the origin
+    const vfloat<Width> f2 = fx * fx + fy * fy + fz * fz;
+    const vfloat<Width> c = f2 - r2;  // |f|^2 - r^2: the origin's side of the surface
+    const M on_surface = magnitude<Width>(c) <= broadcast<Width>(gamma_bound(8)) * (f2 + r2);
     // Stable pair of roots: c / q is the one near 0 when the origin is near the surface.
-    const float t_near_origin = c / q, t_other = q / a;
-    float t0 = on_surface ? INFINITY : t_near_origin, t1 = t_other;
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > 0.f && t0 <= t_max) {
-        t_out = t0;
-        return true;
-    }
-    if (t1 > 0.f && t1 <= t_max && std::isfinite(t1)) {
-        t_out = t1;
-        return true;
-    }
-    return false;
+    const vfloat<Width> t_near_origin = c / q, t_other = q / a;
+    const vfloat<Width> t_first = select(on_surface, inf, t_near_origin);
+    const M swap = t_first > t_other;
+    const vfloat<Width> t0 = select(swap, t_other, t_first), t1 = select(swap, t_first, t_other);
+    const M first = mask_and<M>(t0 > zero, t0 <= t_max);
+    const M second = mask_and<M>(mask_and<M>(t1 > zero, t1 <= t_max), magnitude<Width>(t1) < inf);
+    t = select(first, t0, t1);
+    return mask_and<M>(hit, mask_or<M>(first, second));
+}
+
+// The sphere test for one ray; on a hit fills t_out.
+inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, float& t_out) {
+    const float org[3] = {r.org.x, r.org.y, r.org.z}, dir[3] = {r.dir.x, r.dir.y, r.dir.z};
+    float t;
+    if (!sphere_test<1>(org, dir, t_max, s, t)) return false;
+    t_out = t;
+    return true;
 }
 
 inline uint32_t float_bits(float f) {

@@ -14,7 +14,7 @@
 // used only in translation units compiled for its instruction set (16: AVX-512, 8 and 4: AVX2,
 // 1: the default flags), and every function here is always inlined, so no out-of-line copy
 // built with wider instructions can be picked by the linker for a narrower caller.
-// Bit-identity: only IEEE add/sub/mul/div/compare/select; no FMA (-ffp-contract=off), no
+// Bit-identity: only IEEE add/sub/mul/div/sqrt/compare/select; no FMA (-ffp-contract=off), no
 // approximate reciprocals.
 
 #include <cstdint>
@@ -150,6 +150,55 @@ SFX_LANES_INLINE vbool<Width> sign_bit(vfloat<Width> x) {
 template <int Width>
 SFX_LANES_INLINE vbool<Width> is_nan(vfloat<Width> x) {
     return x != x;
+}
+
+// |x| per lane (std::fabs: the sign bit cleared).
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> magnitude(vfloat<Width> x) {
+    if constexpr (Width == 1) {
+        return __builtin_fabsf(x);
+    } else {
+        vint<Width> bits;
+        __builtin_memcpy(&bits, &x, sizeof bits);
+        bits &= 0x7fffffff;
+        __builtin_memcpy(&x, &bits, sizeof bits);
+        return x;
+    }
+}
+
+// |x| with the sign bit of s per lane (std::copysign).
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> copy_sign(vfloat<Width> x, vfloat<Width> s) {
+    if constexpr (Width == 1) {
+        return __builtin_copysignf(x, s);
+    } else {
+        vint<Width> xb, sb;
+        __builtin_memcpy(&xb, &x, sizeof xb);
+        __builtin_memcpy(&sb, &s, sizeof sb);
+        xb = (xb & 0x7fffffff) | (sb & int32_t(0x80000000u));
+        __builtin_memcpy(&x, &xb, sizeof xb);
+        return x;
+    }
+}
+
+// The correctly rounded square root per lane (IEEE, as std::sqrt; NaN for x < 0).
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> square_root(vfloat<Width> x) {
+    if constexpr (Width == 1) {
+        return __builtin_sqrtf(x);
+    } else {
+#if defined(__AVX512F__)
+        // maskz: GCC 12 warns of _mm512_sqrt_ps's undefined pass-through register.
+        if constexpr (Width == 16)
+            return vfloat<Width>(_mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(x)));
+#endif
+#if defined(__AVX2__)
+        if constexpr (Width == 8) return vfloat<Width>(_mm256_sqrt_ps(__m256(x)));
+        if constexpr (Width == 4) return vfloat<Width>(_mm_sqrt_ps(__m128(x)));
+#endif
+        for (int l = 0; l < Width; ++l) x[l] = __builtin_sqrtf(x[l]);
+        return x;
+    }
 }
 
 // Bit l set iff lane l of the mask is true.

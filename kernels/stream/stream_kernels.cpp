@@ -13,6 +13,7 @@ TraversalJob traversal_job(const Bvh& bvh) {
     job.nodes = bvh.nodes().data();
     job.leaf = bvh.leaf_primitives().data();
     job.triangle_count = uint32_t(bvh.scene().triangles.size());
+    job.spheres = bvh.scene().spheres.data();
     job.entry = 0;
     job.box_stage = stage_of(OpKind::box_test);
     job.triangle_stage = stage_of(OpKind::triangle_test);

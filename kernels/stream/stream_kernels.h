@@ -96,6 +96,7 @@ struct TraversalJob {
     const BvhNode* nodes;
     const LeafPrimitive* leaf;
     uint32_t triangle_count;  // leaf[i].prim >= triangle_count: a sphere (Scene::is_sphere)
+    const Sphere* spheres;    // Scene::spheres: sphere prim is spheres[prim - triangle_count]
     float* rays;              // TraversalRays' records: t is tightened as hits are found
     const RayPrecomp* pre;    // per slot: the full primitive tests' constants
     Hit* hit;                 // per slot: the closest hit so far
@@ -137,6 +138,12 @@ struct StreamKernels {
     void (*leaf_candidates)(TraversalView rays, const LeafPrimitive* triangles, uint32_t count,
                             const uint32_t* ids, uint32_t n, uint32_t* positions, uint32_t stride,
                             uint32_t* found);
+
+    // The sphere test of ids[0, n) against `sphere` over (0, the slots' t]: mask[i] = hit
+    // (0/1), and t[i] = its distance where it hits; pre holds the slots' directions. Both
+    // buffers have k_stream_padding of room past n. Returns the hit count.
+    uint32_t (*sphere_filter)(TraversalView rays, const RayPrecomp* pre, const Sphere& sphere,
+                              const uint32_t* ids, uint32_t n, uint8_t* mask, float* t);
 
     // Stable partition of ids[0, n) by mask[i] != 0, passing first, by compress; returns the
     // passing count; writes nothing past ids[n). `scratch` holds n + k_stream_padding ids.

@@ -286,8 +286,78 @@ SFX_LANES_INLINE bool full_primitive_test(const TraversalJob& job, uint32_t i, u
     return true;
 }
 
-// The primitives of a leaf against its stream ids[0, k): spheres by the full test one ray at a
-// time; runs of up to k_leaf_batch triangles by the float stage of the watertight test at
+// The sphere test of one group: the `left` ids from ids on (all of them if left >= Width) at
+// Width. Returns the lanes that hit; lane_t[l] is lane l's t where it hits.
+template <int Width>
+SFX_LANES_INLINE uint32_t sphere_lanes(TraversalView rays, const RayPrecomp* pre,
+                                       const Sphere& sphere, const uint32_t* ids, uint32_t left,
+                                       float* lane_t) {
+    const uint32_t active = active_bits<Width>(left);
+    const GroupReader<Width> r(rays, ids, active);
+    const BoxLanes<Width> ray = r.read_box();  // org and t; the direction is RayPrecomp's
+    alignas(64) float d[3][Width];
+    for (int l = 0; l < Width; ++l) {
+        const Vec3& dir = pre[ids[uint32_t(l) < left ? l : 0]].dir;
+        d[0][l] = dir.x, d[1][l] = dir.y, d[2][l] = dir.z;
+    }
+    vfloat<Width> dir[3];
+    for (int a = 0; a < 3; ++a) __builtin_memcpy(&dir[a], d[a], sizeof dir[a]);
+    vfloat<Width> t{};  // no lane hits: sphere_test may return before setting it
+    const uint32_t hits = bits<Width>(sphere_test<Width>(ray.org, dir, ray.t, sphere, t)) & active;
+    __builtin_memcpy(lane_t, &t, sizeof t);
+    return hits;
+}
+
+template <int Width>
+uint32_t sphere_filter(TraversalView rays, const RayPrecomp* pre, const Sphere& sphere,
+                       const uint32_t* ids, uint32_t n, uint8_t* mask, float* t) {
+    uint32_t passed = 0;
+    for_each_group<Width>(n, [&](auto width, uint32_t g) {
+        constexpr int W = decltype(width)::value;
+        alignas(64) float lane_t[W];
+        const uint32_t hits = sphere_lanes<W>(rays, pre, sphere, ids + g, n - g, lane_t);
+        store_mask_bytes<W>(hits, mask + g);
+        for (uint32_t h = hits; h != 0; h &= h - 1)
+            t[g + __builtin_ctz(h)] = lane_t[__builtin_ctz(h)];
+        passed += uint32_t(__builtin_popcount(hits));
+    });
+    return passed;
+}
+
+// A leaf's sphere `prim` against job.ids[0, k) by sphere_lanes: a lane that hits closer than
+// its ray's hit so far takes the hit, as full_primitive_test does. Under TraceDetail::lanes,
+// job.mask[0, k) gets the lanes that took it. Returns their count.
+template <int Width, TraceDetail Detail>
+SFX_LANES_INLINE uint32_t sphere_leaf(const TraversalJob& job, uint32_t prim, uint32_t k) {
+    namespace f = traversal_field;
+    const Sphere& sphere = job.spheres[prim - job.triangle_count];
+    uint32_t passed = 0;
+    for_each_group<Width>(k, [&](auto width, uint32_t g) {
+        constexpr int W = decltype(width)::value;
+        const uint32_t* ids = job.ids + g;
+        alignas(64) float lane_t[W];
+        uint32_t took = 0;
+        for (uint32_t h =
+                 sphere_lanes<W>(TraversalView{job.rays}, job.pre, sphere, ids, k - g, lane_t);
+             h != 0; h &= h - 1) {
+            const int l = __builtin_ctz(h);
+            const uint32_t id = ids[l];
+            Hit& best = job.hit[id];
+            if (!closer(lane_t[l], prim, best)) continue;
+            best.t = lane_t[l];
+            best.u = best.v = 0.f;
+            best.prim = prim;
+            job.rays[size_t(id) * f::record + f::t] = job.any_hit[id] ? -1.f : best.t;
+            took |= 1u << l;
+        }
+        if constexpr (Detail == TraceDetail::lanes) store_mask_bytes<W>(took, job.mask + g);
+        passed += uint32_t(__builtin_popcount(took));
+    });
+    return passed;
+}
+
+// The primitives of a leaf against its stream ids[0, k): spheres by sphere_leaf at Width;
+// runs of up to k_leaf_batch triangles by the float stage of the watertight test at
 // Width (each group's rays read once for all of them; it does not depend on t), which rejects
 // most lanes, then the full tests on the candidates it leaves, triangle by triangle in order.
 template <int Width, TraceDetail Detail, class Report>
@@ -300,12 +370,7 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
     const uint32_t end = node.first + node.count;
     for (uint32_t i = node.first; i < end;) {
         if (leaf[i].prim >= job.triangle_count) {
-            uint32_t passed = 0;
-            for (uint32_t j = 0; j < k; ++j) {
-                const bool hit = full_primitive_test(job, i, ids[j]);
-                mask[j] = uint8_t(hit);
-                passed += hit;
-            }
+            const uint32_t passed = sphere_leaf<Width, Detail>(job, leaf[i].prim, k);
             report_op(OpKind::sphere_test, job.sphere_stage, leaf[i].prim, ids, k, mask, passed);
             ++i;
             continue;
@@ -452,6 +517,7 @@ StreamKernels make_kernels(Isa isa) {
     k.box_filter = &box_filter<Width>;
     k.triangle_candidates = &triangle_candidates<Width>;
     k.leaf_candidates = &leaf_candidates<Width>;
+    k.sphere_filter = &sphere_filter<Width>;
     k.partition = &partition<Width>;
     k.traverse[int(TraceDetail::none)] = &traverse<Width, TraceDetail::none>;
     k.traverse[int(TraceDetail::counts)] = &traverse<Width, TraceDetail::counts>;

@@ -2,8 +2,9 @@
 // code, lane by lane, and partitions exactly as a stable partition: the slab test on the hard
 // cases (origins on slab planes with zero directions (0 * inf), infinite inverse directions,
 // signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
-// stage, and the compress. Streams of odd lengths exercise partial groups (at 16 lanes, the
-// 8-lane tail), shuffled and increasing ids the records' transposed reads.
+// stage, the sphere filter (origins on the surface, tangents), and the compress. Streams of odd
+// lengths exercise partial groups (at 16 lanes, the 8-lane tail), shuffled and increasing ids the
+// records' transposed reads.
 
 #include "kernels/stream/stream_kernels.h"
 
@@ -12,6 +13,7 @@
 #include <numeric>
 #include <vector>
 
+#include "kernels/intersect.h"
 #include "kernels/rng.h"
 #include "kernels/simd/lanes.h"
 
@@ -213,6 +215,91 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
     }
     CHECK(total_hits > 0);
     CHECK(total_candidates < lanes);  // the filter rejects something
+}
+
+TEST_CASE("Sphere filter of every back end equals intersect_sphere per lane, hard cases included",
+          "[stream][simd]") {
+    // Origins on the surface (spawned rays leaving it inwards and outwards), inside, outside;
+    // rays through the centre, tangent, grazing, away; zero direction components; t_max of
+    // -1, 0, below and beyond the roots, infinity; spheres of radius 0, tiny and huge.
+    const std::vector<float> coords{0.f, -0.f, 1.f, -1.f, 2.f, 0.5f};
+    const std::vector<float> radii{1.f, 0.5f, 0.f, 1e-3f, 1e4f, 3.f};
+    const std::vector<float> t_maxes{INFINITY, 1.f, -1.f, 0.f, 0.5f, 3.f, 1e-7f, 100.f};
+    for (const Isa isa : supported_isas()) {
+        const StreamKernels& kernels = stream_kernels(isa);
+        INFO("back end " << isa_name(isa));
+        uint64_t lanes = 0, hits = 0, mismatches = 0, t_mismatches = 0, on_surface = 0;
+        for (uint32_t i = 0; i < 1500; ++i) {
+            Sphere sphere;
+            for (int a = 0; a < 3; ++a) sphere.center[a] = pick(i, 10 + a, coords);
+            sphere.radius = radii[random_bits(17, i, 0, 0, 1) % radii.size()];
+            const uint32_t n = 1 + i % 41;
+            std::vector<RayPrecomp> pre;
+            std::vector<float> t_max;
+            for (uint32_t l = 0; l < 4 * n; ++l) {
+                const uint32_t k = i * 256 + l;
+                Ray ray;
+                for (int a = 0; a < 3; ++a) {
+                    ray.org[a] = pick(k, 30 + a, coords) * 2.f;
+                    ray.dir[a] = pick(k, 40 + a, coords);
+                }
+                // A point on the surface along a random direction, maybe nudged off it.
+                Vec3 out = Vec3(pick(k, 50, coords), pick(k, 51, coords), pick(k, 52, coords));
+                if (out == Vec3(0.f)) out.z = 1.f;
+                const Vec3 surface = sphere.center + normalize(out) * sphere.radius;
+                switch (k % 6) {
+                    case 0:  // on the surface, leaving outwards or inwards
+                        ray.org = surface;
+                        ray.dir = (k / 6 % 2 ? out : -out) + ray.dir * 0.25f;
+                        ++on_surface;
+                        break;
+                    case 1:  // just off the surface (a spawned ray)
+                        ray.org =
+                            offset_ray_origin(surface, normalize(out) * (k / 6 % 2 ? 1.f : -1.f));
+                        ++on_surface;
+                        break;
+                    case 2:  // through the centre
+                        ray.dir = sphere.center - ray.org;
+                        break;
+                    case 3: {  // tangent: at right angles to the radius through `surface`
+                        const Vec3 side = cross(out, Vec3(0.3f, 1.f, 0.1f));
+                        ray.org = surface - side * 2.f;
+                        ray.dir = side;
+                        break;
+                    }
+                    default:
+                        break;
+                }
+                if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
+                pre.push_back(RayPrecomp(ray));
+                t_max.push_back(t_maxes[random_bits(17, k, 0, 0, 50) % t_maxes.size()]);
+            }
+            TraversalRays rays;
+            rays.resize(4 * n);
+            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], t_max[l]);
+            const std::vector<uint32_t> ids = stream_ids(n, i);
+            std::vector<uint8_t> mask(n + k_stream_padding, 7);
+            std::vector<float> t(n + k_stream_padding, -7.f);
+            const uint32_t passed = kernels.sphere_filter(rays.view(), pre.data(), sphere,
+                                                          ids.data(), n, mask.data(), t.data());
+            uint32_t want_passed = 0;
+            for (uint32_t l = 0; l < n; ++l) {
+                float want_t = 0.f;
+                const bool want = intersect_sphere(pre[ids[l]], sphere, t_max[ids[l]], want_t);
+                ++lanes;
+                hits += want;
+                want_passed += want;
+                mismatches += mask[l] != uint8_t(want);
+                t_mismatches += want && float_bits(t[l]) != float_bits(want_t);
+            }
+            mismatches += passed != want_passed;
+        }
+        CHECK(hits > lanes / 10);
+        CHECK(hits < lanes - lanes / 10);
+        CHECK(on_surface > lanes / 4);
+        CHECK(mismatches == 0);
+        CHECK(t_mismatches == 0);
+    }
 }
 
 TEST_CASE("Compress partition of every back end is the stable partition", "[stream][simd]") {
