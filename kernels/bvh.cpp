@@ -6,6 +6,18 @@
 
 namespace sfx {
 
+struct Bvh::BuildInput {
+    const std::vector<Bounds3>& prim_bounds;
+    const std::vector<Vec3>& centroids;
+    const BvhBuildOptions& options;
+    // Scratch of one node's SAH evaluation, reused by every node: per axis, each bin's bounds
+    // and primitive count (axis-major); per split, the right side's area and count.
+    std::vector<Bounds3> bin_bounds;
+    std::vector<uint32_t> bin_counts;
+    std::vector<float> right_area;
+    std::vector<uint32_t> right_count;
+};
+
 Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : m_scene(&scene) {
     if (options.max_leaf_size == 0 || options.max_leaf_size > 0xffff || options.bins < 2)
         throw std::invalid_argument("bvh: max_leaf_size must be in 1..65535 and bins >= 2");
@@ -23,7 +35,15 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : m_scene(&scene) {
         m_nodes.emplace_back();  // an empty leaf with empty bounds: every ray misses
         return;
     }
-    build(0, n, prim_bounds, centroids, options, 0);
+    const size_t bins = options.bins;
+    BuildInput in{prim_bounds,
+                  centroids,
+                  options,
+                  std::vector<Bounds3>(3 * bins),
+                  std::vector<uint32_t>(3 * bins),
+                  std::vector<float>(bins),
+                  std::vector<uint32_t>(bins)};
+    build(0, n, in, 0);
     m_leaf.resize(n);
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t prim = m_prim_ids[i];
@@ -36,9 +56,10 @@ Bvh::Bvh(const Scene& scene, const BvhBuildOptions& options) : m_scene(&scene) {
     }
 }
 
-uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& prim_bounds,
-                    const std::vector<Vec3>& centroids, const BvhBuildOptions& options,
-                    uint32_t depth) {
+uint32_t Bvh::build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth) {
+    const std::vector<Bounds3>& prim_bounds = in.prim_bounds;
+    const std::vector<Vec3>& centroids = in.centroids;
+    const BvhBuildOptions& options = in.options;
     const uint32_t index = uint32_t(m_nodes.size());
     m_nodes.emplace_back();
     Bounds3 bounds, centroid_bounds;
@@ -61,24 +82,36 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& pr
     float best_cost = INFINITY;
     int best_axis = -1;
     uint32_t best_split = 0;
-    std::vector<Bounds3> bin_bounds(bins);
-    std::vector<uint32_t> bin_counts(bins);
-    std::vector<float> right_area(bins);
-    std::vector<uint32_t> right_count(bins);
+    std::vector<float>& right_area = in.right_area;
+    std::vector<uint32_t>& right_count = in.right_count;
     auto bin_of = [&](const Vec3& c, int axis) {
         const float rel = (c[axis] - centroid_bounds.lo[axis]) / extent[axis];
         return std::min(bins - 1, uint32_t(std::max(0.f, rel * float(bins))));
     };
-    for (int axis = 0; axis < 3; ++axis) {
-        if (!(extent[axis] > 0.f)) continue;
-        std::fill(bin_bounds.begin(), bin_bounds.end(), Bounds3{});
-        std::fill(bin_counts.begin(), bin_counts.end(), 0u);
-        for (uint32_t i = begin; i < end; ++i) {
-            const uint32_t p = m_prim_ids[i];
-            const uint32_t b = bin_of(centroids[p], axis);
-            bin_bounds[b].extend(prim_bounds[p]);
-            ++bin_counts[b];
+    // One pass over the primitives bins them on every axis that has an extent.
+    bool binned[3];
+    for (int axis = 0; axis < 3; ++axis) binned[axis] = extent[axis] > 0.f;
+    std::fill(in.bin_bounds.begin(), in.bin_bounds.end(), Bounds3{});
+    std::fill(in.bin_counts.begin(), in.bin_counts.end(), 0u);
+    // bin_of on the three axes at once: the same division and rounding per lane.
+    typedef float Float4 __attribute__((vector_size(16)));
+    const Float4 lo = {centroid_bounds.lo.x, centroid_bounds.lo.y, centroid_bounds.lo.z, 0.f};
+    const Float4 scale = {extent.x, extent.y, extent.z, 1.f};
+    for (uint32_t i = begin; i < end; ++i) {
+        const uint32_t p = m_prim_ids[i];
+        const Vec3& c = centroids[p];
+        const Float4 rel = (Float4{c.x, c.y, c.z, 0.f} - lo) / scale * float(bins);
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!binned[axis]) continue;
+            const uint32_t b = axis * bins + std::min(bins - 1, uint32_t(std::max(0.f, rel[axis])));
+            in.bin_bounds[b].extend(prim_bounds[p]);
+            ++in.bin_counts[b];
         }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!binned[axis]) continue;
+        const Bounds3* bin_bounds = &in.bin_bounds[axis * size_t(bins)];
+        const uint32_t* bin_counts = &in.bin_counts[axis * size_t(bins)];
         Bounds3 acc;
         uint32_t acc_count = 0;
         for (uint32_t b = bins - 1; b > 0; --b) {
@@ -131,8 +164,8 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& pr
                              return ca < cb || (ca == cb && a < b);
                          });
     }
-    const uint32_t left = build(begin, mid, prim_bounds, centroids, options, depth + 1);
-    const uint32_t right = build(mid, end, prim_bounds, centroids, options, depth + 1);
+    const uint32_t left = build(begin, mid, in, depth + 1);
+    const uint32_t right = build(mid, end, in, depth + 1);
     if (left != BvhNode::left(index)) throw std::logic_error("bvh: left child must follow its parent");
     m_nodes[index].first = right;
     m_nodes[index].count = 0;

@@ -88,14 +88,13 @@ public:
     bool intersect_leaf_primitive(const RayPrecomp& r, uint32_t i, float t_max, Hit& hit) const;
 
 private:
-    uint32_t build(uint32_t begin, uint32_t end, const std::vector<Bounds3>& prim_bounds,
-                   const std::vector<Vec3>& centroids, const BvhBuildOptions& options,
-                   uint32_t depth);
+  struct BuildInput;  // bvh.cpp: the primitives' bounds and centroids, the bins' scratch
+  uint32_t build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth);
 
-    const Scene* m_scene = nullptr;
-    std::vector<BvhNode> m_nodes;
-    std::vector<uint32_t> m_prim_ids;
-    std::vector<LeafPrimitive> m_leaf;
+  const Scene* m_scene = nullptr;
+  std::vector<BvhNode> m_nodes;
+  std::vector<uint32_t> m_prim_ids;
+  std::vector<LeafPrimitive> m_leaf;
 };
 
 // Front child first: the child on the side the direction comes from.
