@@ -266,7 +266,8 @@ SFX_LANES_INLINE vbool<Width> sphere_test(const vfloat<Width> org[3], const vflo
     hit = mask_and<M>(hit, q != zero);  // q = 0: tangent at the origin
     const vfloat<Width> f2 = fx * fx + fy * fy + fz * fz;
     const vfloat<Width> c = f2 - r2;  // |f|^2 - r^2: the origin's side of the surface
-    const M on_surface = magnitude<Width>(c) <= broadcast<Width>(gamma_bound(8)) * (f2 + r2);
+    constexpr float surface_bound = gamma_bound(8);  // a constant: no call in the wide kernels
+    const M on_surface = magnitude<Width>(c) <= broadcast<Width>(surface_bound) * (f2 + r2);
     // Stable pair of roots: c / q is the one near 0 when the origin is near the surface.
     const vfloat<Width> t_near_origin = c / q, t_other = q / a;
     const vfloat<Width> t_first = select(on_surface, inf, t_near_origin);

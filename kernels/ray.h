@@ -32,8 +32,10 @@ struct Hit {
     bool valid() const { return prim != k_no_hit; }
 };
 
-// Closest hit with deterministic ties: equal t goes to the lower primitive id.
-inline bool closer(float t, uint32_t prim, const Hit& best) {
+// Closest hit with deterministic ties: equal t goes to the lower primitive id. Always inlined:
+// the wide stream kernels call it (kernels/simd/lanes.h says why nothing shared may be emitted
+// out of line there).
+inline __attribute__((always_inline)) bool closer(float t, uint32_t prim, const Hit& best) {
     return t < best.t || (t == best.t && prim < best.prim);
 }
 

@@ -38,6 +38,20 @@ struct TraversalView {
     const float* data;
 };
 
+// A primitive test's hit at t, taken if it is closer than the ray's hit so far (closer()): the
+// hit record gets it (u, v = 0: a sphere's), the ray's t tightens to it, or to -1 for an
+// any-hit ray (done). The sphere filter's step after the kernel, in the tracer and its
+// microbenchmark.
+SFX_LANES_INLINE bool take_closer_hit(float t, uint32_t prim, Hit& best, float& ray_t,
+                                      bool any_hit) {
+    if (!closer(t, prim, best)) return false;
+    best.t = t;
+    best.u = best.v = 0.f;
+    best.prim = prim;
+    ray_t = any_hit ? -1.f : t;
+    return true;
+}
+
 class TraversalRays {
   public:
     // Room for `slots` rays; every field zero.

@@ -325,8 +325,8 @@ uint32_t sphere_filter(TraversalView rays, const RayPrecomp* pre, const Sphere& 
 }
 
 // A leaf's sphere `prim` against job.ids[0, k) by sphere_lanes: a lane that hits closer than
-// its ray's hit so far takes the hit, as full_primitive_test does. Under TraceDetail::lanes,
-// job.mask[0, k) gets the lanes that took it. Returns their count.
+// its ray's hit so far takes the hit (take_closer_hit), as full_primitive_test does. Under
+// TraceDetail::lanes, job.mask[0, k) gets the lanes that took it. Returns their count.
 template <int Width, TraceDetail Detail>
 SFX_LANES_INLINE uint32_t sphere_leaf(const TraversalJob& job, uint32_t prim, uint32_t k) {
     namespace f = traversal_field;
@@ -342,13 +342,9 @@ SFX_LANES_INLINE uint32_t sphere_leaf(const TraversalJob& job, uint32_t prim, ui
              h != 0; h &= h - 1) {
             const int l = __builtin_ctz(h);
             const uint32_t id = ids[l];
-            Hit& best = job.hit[id];
-            if (!closer(lane_t[l], prim, best)) continue;
-            best.t = lane_t[l];
-            best.u = best.v = 0.f;
-            best.prim = prim;
-            job.rays[size_t(id) * f::record + f::t] = job.any_hit[id] ? -1.f : best.t;
-            took |= 1u << l;
+            if (take_closer_hit(lane_t[l], prim, job.hit[id],
+                                job.rays[size_t(id) * f::record + f::t], job.any_hit[id]))
+                took |= 1u << l;
         }
         if constexpr (Detail == TraceDetail::lanes) store_mask_bytes<W>(took, job.mask + g);
         passed += uint32_t(__builtin_popcount(took));

@@ -71,6 +71,7 @@ struct Buffers {
     std::vector<uint8_t> any_hit, mask;
     std::vector<SurfaceHit> surf;
     std::vector<uint32_t> ids, scratch, scratch2, positions;
+    std::vector<float> sphere_t;  // the sphere filter's distances
 };
 
 // Random rays from above the scene toward random points of it: a mix of hits on every
@@ -93,6 +94,7 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     b.scratch.resize(padded);
     b.scratch2.resize(padded);
     b.positions.resize(padded);
+    b.sphere_t.resize(padded);
     b.mask.resize(padded);
     for (uint32_t i = 0; i < slots; ++i) {
         Ray r;
@@ -252,14 +254,17 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 break;
                             }
                             case OpKind::sphere_test: {
+                                // The tracer's sphere filter: the kernel's hits, then each one
+                                // taken if closer.
                                 const uint32_t prim = scene.triangle_count();
-                                passed = evaluate(ids, n, mask, [&](uint32_t id) {
-                                    float& t = b.trav.t(id);
-                                    if (!bvh.intersect_primitive(b.pre[id], prim, t, b.hit[id]))
-                                        return false;
-                                    t = b.any_hit[id] ? -1.f : b.hit[id].t;
-                                    return true;
-                                });
+                                float* t = b.sphere_t.data();
+                                kernels.sphere_filter(b.trav.view(), b.pre.data(),
+                                                      scene.sphere(prim), ids, n, mask, t);
+                                passed = 0;
+                                for (uint32_t j = 0; j < n; ++j)
+                                    passed += mask[j] &&
+                                              take_closer_hit(t[j], prim, b.hit[ids[j]],
+                                                              b.trav.t(ids[j]), b.any_hit[ids[j]]);
                                 break;
                             }
                             case OpKind::shadow_filter:
