@@ -308,7 +308,9 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
     Vec3 out;
     for (int a = 0; a < 3; ++a) {
         const int of = int(k_int_scale * n[a]);
-        const float pi = bits_float(uint32_t(int32_t(float_bits(p[a])) + (p[a] < 0.f ? -of : of)));
+        // In uint32_t: the same bits as the int sum, without its overflow at p = -0 (whose
+        // result the float branch below replaces).
+        const float pi = bits_float(float_bits(p[a]) + uint32_t(p[a] < 0.f ? -of : of));
         out[a] = std::fabs(p[a]) < k_origin ? p[a] + k_float_scale * n[a] : pi;
     }
     return out;
