@@ -57,6 +57,14 @@ std::vector<uint32_t> stream_ids(uint32_t n, uint32_t seed) {
     return ids;
 }
 
+// The traversal's SoA ray records of the test's rays, in their order.
+TraversalRays traversal_rays(const std::vector<RayPrecomp>& pre, const std::vector<float>& t_max) {
+    TraversalRays rays;
+    rays.resize(uint32_t(pre.size()));
+    for (uint32_t l = 0; l < pre.size(); ++l) rays.set(l, pre[l], t_max[l]);
+    return rays;
+}
+
 }  // namespace
 
 TEST_CASE("Box filter of every back end equals intersect_box per lane, hard cases included",
@@ -95,9 +103,7 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
                 pre.push_back(RayPrecomp(ray));
                 t_max.push_back(t_maxes[random_bits(11, k, 0, 0, 50) % t_maxes.size()]);
             }
-            TraversalRays rays;
-            rays.resize(4 * n);
-            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], t_max[l]);
+            const TraversalRays rays = traversal_rays(pre, t_max);
             const int axis = int(i % 5 % 3);
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
@@ -167,9 +173,8 @@ TEST_CASE("Triangle filter of every back end keeps every hit and equals the scal
                 if (ray.dir == Vec3(0.f)) ray.dir.x = 1.f;
                 pre.push_back(RayPrecomp(ray));
             }
-            TraversalRays rays;
-            rays.resize(4 * n);
-            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], INFINITY);
+            const TraversalRays rays =
+                traversal_rays(pre, std::vector<float>(pre.size(), INFINITY));
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> got(n + k_stream_padding), want(n + k_stream_padding);
             const uint32_t c = kernels.triangle_candidates(rays.view(), p[0], p[1], p[2],
@@ -275,9 +280,7 @@ TEST_CASE("Sphere filter of every back end equals intersect_sphere per lane, har
                 pre.push_back(RayPrecomp(ray));
                 t_max.push_back(t_maxes[random_bits(17, k, 0, 0, 50) % t_maxes.size()]);
             }
-            TraversalRays rays;
-            rays.resize(4 * n);
-            for (uint32_t l = 0; l < 4 * n; ++l) rays.set(l, pre[l], t_max[l]);
+            const TraversalRays rays = traversal_rays(pre, t_max);
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint8_t> mask(n + k_stream_padding, 7);
             std::vector<float> t(n + k_stream_padding, -7.f);
