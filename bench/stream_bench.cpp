@@ -91,18 +91,25 @@ int main(int argc, char** argv) {
     uint32_t w = 512, h = 512;
     int repeat = 5;
     Isa only = Isa::automatic;
+    std::string part;  // empty: every part
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--res" && i + 1 < argc) {
             if (std::sscanf(argv[++i], "%ux%u", &w, &h) != 2) return 2;
         } else if (a == "--isa" && i + 1 < argc) {
             only = parse_isa(argv[++i]);
+        } else if (a == "--only" && i + 1 < argc) {
+            part = argv[++i];
+            if (part != "primary" && part != "diffuse" && part != "frames") {
+                std::fprintf(stderr, "sfx_bench_stream: --only takes primary, diffuse or frames\n");
+                return 2;
+            }
         } else if (a == "--repeat" && i + 1 < argc) {
             repeat = std::max(1, std::atoi(argv[++i]));
         } else if (a == "-h" || a == "--help") {
             std::printf(
                 "usage: sfx_bench_stream [SCENE] [--res WxH] [--repeat N] [--isa "
-                "auto|avx512|avx2|scalar]\n");
+                "auto|avx512|avx2|scalar] [--only primary|diffuse|frames]\n");
             return 0;
         } else {
             scene_name = a;
@@ -126,6 +133,7 @@ int main(int argc, char** argv) {
     for (const auto& [label, rays] :
          {std::pair<const char*, const std::vector<Ray>*>{"primary rays", &primary},
           {"diffuse-bounce rays", &diffuse}}) {
+        if (!part.empty() && std::strncmp(label, part.c_str(), part.size()) != 0) continue;
         std::printf("\n%s (%zu)\n", label, rays->size());
         std::vector<Hit> ref(rays->size()), st, em(rays->size());
         const double t_embree = median_seconds(repeat, [&] {
@@ -179,6 +187,7 @@ int main(int argc, char** argv) {
             counts.stage(false, OpStage::intersection).average_length());
     }
 
+    if (!part.empty() && part != "frames") return 0;
     // Whole frames: path tracing with all generations, shading included.
     RenderSettings settings;
     settings.width = w / 2;

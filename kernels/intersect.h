@@ -54,6 +54,22 @@ constexpr float k_slab_far_scale = 1.f + 2.f * gamma_bound(3);
 // face, equal-t ties). Culling such a box would make the closest hit depend on traversal order.
 constexpr float k_slab_t_max_scale = 1.f + 1.f / 65536.f;
 
+// The origin of a slab test whose lanes share it (a pinhole camera's primary rays) and whose
+// box is given relative to it: the caller subtracts the origin from the planes once per box,
+// not once per lane; the same subtraction, so the same bits.
+struct BoxRelativeToOrigin {};
+
+// Box planes on axis a (one per lane) relative to the lanes' origins.
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> minus_origin(vfloat<Width> plane, const vfloat<Width> (&org)[3],
+                                            int a) {
+    return plane - org[a];
+}
+template <int Width>
+SFX_LANES_INLINE vfloat<Width> minus_origin(vfloat<Width> plane, BoxRelativeToOrigin, int) {
+    return plane;
+}
+
 // Slab test over [0, t_max] for Width rays against one box, written once for the reference
 // tracer (Width 1) and the stream filters (kernels/stream/stream_kernels_impl.h). A lane
 // passes iff its ray enters the box; t0 is the entry distance of passing lanes.
@@ -64,8 +80,9 @@ constexpr float k_slab_t_max_scale = 1.f + 1.f / 65536.f;
 // values, as if it were -inf (near) or +inf (far).
 // No early exit per axis: t0 only grows and t1 only shrinks, so "t0 > t1 after some axis"
 // equals "t0 > t1 after the last axis".
-template <int Width>
-SFX_LANES_INLINE vbool<Width> slab_test(const vfloat<Width> org[3], const vfloat<Width> inv_dir[3],
+// `org`: each lane's origin (vfloat<Width>[3]), or BoxRelativeToOrigin.
+template <int Width, class Origin>
+SFX_LANES_INLINE vbool<Width> slab_test(const Origin& org, const vfloat<Width> inv_dir[3],
                                         vfloat<Width> t_max, const Bounds3& b, vfloat<Width>& t0) {
     const vfloat<Width> inf = broadcast<Width>(INFINITY);
     t0 = broadcast<Width>(0.f);
@@ -73,9 +90,10 @@ SFX_LANES_INLINE vbool<Width> slab_test(const vfloat<Width> org[3], const vfloat
     for (int a = 0; a < 3; ++a) {
         const vbool<Width> negative = sign_bit<Width>(inv_dir[a]);
         const vfloat<Width> lo = broadcast<Width>(b.lo[a]), hi = broadcast<Width>(b.hi[a]);
-        const vfloat<Width> t_near = (select(negative, hi, lo) - org[a]) * inv_dir[a];
+        const vfloat<Width> t_near =
+            minus_origin<Width>(select(negative, hi, lo), org, a) * inv_dir[a];
         const vfloat<Width> t_far =
-            (select(negative, lo, hi) - org[a]) * inv_dir[a] * k_slab_far_scale;
+            minus_origin<Width>(select(negative, lo, hi), org, a) * inv_dir[a] * k_slab_far_scale;
         t0 = select(t_near > t0, t_near, t0);
         t1 = select(t_far < t1, t_far, t1);
     }

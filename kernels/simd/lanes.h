@@ -277,19 +277,28 @@ SFX_LANES_INLINE vfloat<Width> gather(const float* base, vint<Width> index) {
         return v;
     }
 }
-// Eight consecutive floats per lane, as eight vectors: lane l of out[f] = base[index[l] + f].
-// Each lane's eight floats (32-byte aligned) come by one load and a transpose makes them lanes,
-// so a lane touches one cache line where eight gathers would touch it eight times; the same
-// bits as gathers. At 16 lanes: 256-bit halves of lanes l and l + 4 share a register, 4x4
-// transposes within 128-bit blocks, then one block shuffle per field; at 8 lanes: 128-bit
-// halves of lanes l and l + 4, two 4x4 transposes; at 4 lanes: two 4x4 transposes.
-template <int Width>
-SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
-                                       vfloat<Width> out[8]) {
+// Fields (8 or 4) consecutive floats per lane, as Fields vectors: lane l of out[f] =
+// base[index[l] + f]. Each lane's floats (aligned to their size) come by one load and a
+// transpose makes them lanes, so a lane touches one cache line where Fields gathers would touch
+// it Fields times; the same bits as gathers. At 16 lanes: 256-bit halves of lanes l and l + 4
+// share a register, 4x4 transposes within 128-bit blocks, then one block shuffle per field (4
+// fields read the 8 and keep half: that form is not yet measured on an AVX-512 host); at 8
+// lanes: 128-bit quarters of lanes l and l + 4, one 4x4 transpose per 4 fields; at 4 lanes:
+// one 4x4 transpose per 4 fields.
+template <int Width, int Fields = 8>
+SFX_LANES_INLINE void load_transposed(const float* base, const int32_t* index,
+                                      vfloat<Width> out[Fields]) {
+    static_assert(Fields == 4 || Fields == 8, "load_transposed: 4 or 8 fields");
     if constexpr (Width == 1) {
-        for (int f = 0; f < 8; ++f) out[f] = base[index[0] + f];
+        for (int f = 0; f < Fields; ++f) out[f] = base[index[0] + f];
     } else {
 #if defined(__AVX512F__)
+        if constexpr (Width == 16 && Fields == 4) {
+            vfloat<Width> all[8];
+            load_transposed<Width, 8>(base, index, all);
+            for (int f = 0; f < 4; ++f) out[f] = all[f];
+            return;
+        }
         if constexpr (Width == 16) {
             auto row = [&](int a, int b) {  // a's 256 bits, then b's
                 const vfloat<8> low = vfloat<8>(_mm256_load_ps(base + index[a]));
@@ -329,7 +338,7 @@ SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
 #endif
 #if defined(__AVX2__)
         if constexpr (Width == 8) {
-            for (int h = 0; h < 8; h += 4) {
+            for (int h = 0; h < Fields; h += 4) {
                 auto row = [&](int a, int b) {
                     return _mm256_insertf128_ps(
                         _mm256_castps128_ps256(_mm_load_ps(base + index[a] + h)),
@@ -346,7 +355,7 @@ SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
             return;
         }
         if constexpr (Width == 4) {
-            for (int h = 0; h < 8; h += 4) {
+            for (int h = 0; h < Fields; h += 4) {
                 __m128 r0 = _mm_load_ps(base + index[0] + h), r1 = _mm_load_ps(base + index[1] + h);
                 __m128 r2 = _mm_load_ps(base + index[2] + h), r3 = _mm_load_ps(base + index[3] + h);
                 _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
@@ -358,7 +367,7 @@ SFX_LANES_INLINE void load_transposed8(const float* base, const int32_t* index,
             return;
         }
 #endif
-        for (int f = 0; f < 8; ++f)
+        for (int f = 0; f < Fields; ++f)
             for (int l = 0; l < Width; ++l) out[f][l] = base[index[l] + f];
     }
 }

@@ -21,6 +21,16 @@ TraversalJob traversal_job(const Bvh& bvh) {
     return job;
 }
 
+const float* shared_origin(const float* rays, const uint32_t* ids, uint32_t n) {
+    namespace f = traversal_field;
+    if (n == 0) return nullptr;
+    const float* first = rays + size_t(ids[0]) * f::record + f::org;
+    for (uint32_t i = 1; i < n; ++i)
+        if (std::memcmp(rays + size_t(ids[i]) * f::record + f::org, first, 3 * sizeof(float)))
+            return nullptr;
+    return first;
+}
+
 const StreamKernels& stream_kernels(Isa isa) {
     static const StreamKernels scalar = scalar_kernels::make_kernels<1>(Isa::scalar);
     switch (isa) {

@@ -20,13 +20,14 @@
 namespace sfx {
 
 // The ray fields the box and triangle filters read, one 64-byte record (a cache line) per
-// slot: the box test's half (org, inv_dir, t: the closest hit so far, or the ray's t_max; -1
-// for an occluded shadow ray, which every later box and primitive test then misses), then the
+// slot: the box test's half (inv_dir, t: the closest hit so far, or the ray's t_max; -1 for an
+// occluded shadow ray, which every later box and primitive test then misses; org), then the
 // triangle test's half (org again, kx, ky, kz, sx, sy). A group of Width slots scattered over
 // the buffer touches one line per ray, not one per field; it reads a half by Width 32-byte
-// loads and a transpose (kernels/simd/lanes.h, load_transposed8).
+// loads and a transpose (kernels/simd/lanes.h, load_transposed). A stream whose rays share
+// their origin (TraversalView::shared_origin) reads only the box half's first quarter.
 namespace traversal_field {  // float offsets within a slot's record
-constexpr int org = 0, inv_dir = 3, t = 6, box_half = 0;
+constexpr int inv_dir = 0, t = 3, org = 4, box_half = 0;
 constexpr int tri_org = 8, kx = 11, ky = 12, kz = 13, sx = 14, sy = 15, triangle_half = 8;
 constexpr int record = 16;
 }  // namespace traversal_field
@@ -36,6 +37,9 @@ constexpr int record = 16;
 // member of a library type.
 struct TraversalView {
     const float* data;
+    // Not null: every slot the kernel is given has this origin (x, y, z), so the box filter
+    // reads only inv_dir and t.
+    const float* shared_origin = nullptr;
 };
 
 // A primitive test's hit at t, taken if it is closer than the ray's hit so far (closer()): the
@@ -112,6 +116,7 @@ struct TraversalJob {
     uint32_t triangle_count;  // leaf[i].prim >= triangle_count: a sphere (Scene::is_sphere)
     const Sphere* spheres;    // Scene::spheres: sphere prim is spheres[prim - triangle_count]
     float* rays;              // TraversalRays' records: t is tightened as hits are found
+    const float* shared_origin;  // TraversalView::shared_origin of the stream (shared_origin())
     const RayPrecomp* pre;    // per slot: the full primitive tests' constants
     Hit* hit;                 // per slot: the closest hit so far
     const uint8_t* any_hit;   // per slot: a shadow ray, done at its first hit
@@ -168,6 +173,10 @@ struct StreamKernels {
     // indexed by TraceDetail.
     void (*traverse[k_trace_details])(const TraversalJob& job);
 };
+
+// The origin (x, y, z in the first slot's record) that every slot of ids[0, n) has, bit for
+// bit (a pinhole camera's primary stream), or null.
+const float* shared_origin(const float* rays, const uint32_t* ids, uint32_t n);
 
 // The kernels for a resolved instruction set (never Isa::automatic; the CPU must support it).
 const StreamKernels& stream_kernels(Isa isa);

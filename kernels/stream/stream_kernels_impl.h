@@ -91,16 +91,24 @@ struct GroupReader {
     SFX_LANES_INLINE BoxLanes<Width> read_box() const {
         namespace f = traversal_field;
         vfloat<Width> h[8];
-        load_transposed8<Width>(data + f::box_half, offset, h);
+        load_transposed<Width>(data + f::box_half, offset, h);
         return {{h[f::org], h[f::org + 1], h[f::org + 2]},
                 {h[f::inv_dir], h[f::inv_dir + 1], h[f::inv_dir + 2]},
                 h[f::t]};
+    }
+    // The box half's first quarter (inv_dir and t), for lanes that share their origin.
+    SFX_LANES_INLINE BoxLanes<Width> read_box_directions() const {
+        namespace f = traversal_field;
+        static_assert(f::inv_dir == 0 && f::t == 3, "inv_dir and t lead the box half");
+        vfloat<Width> h[4];
+        load_transposed<Width, 4>(data + f::box_half, offset, h);
+        return {{}, {h[f::inv_dir], h[f::inv_dir + 1], h[f::inv_dir + 2]}, h[f::t]};
     }
     // The triangle test's half of every lane's record.
     SFX_LANES_INLINE TriangleLanes<Width> read_triangle() const {
         namespace f = traversal_field;
         vfloat<Width> h[8];
-        load_transposed8<Width>(data + f::triangle_half, offset, h);
+        load_transposed<Width>(data + f::triangle_half, offset, h);
         const int o = f::triangle_half;
         return {{h[f::tri_org - o], h[f::tri_org + 1 - o], h[f::tri_org + 2 - o]},
                 as_int(h[f::kx - o]),
@@ -120,17 +128,25 @@ struct GroupReader {
 };
 
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
-template <int Width>
+// Shared: the lanes share their origin, and `box` is relative to it.
+template <int Width, bool Shared>
 SFX_LANES_INLINE void box_group(TraversalView rays, const Bounds3& box, int axis,
                                 const uint32_t* ids, uint32_t left, uint32_t* pass_out,
                                 uint32_t* fail_out, uint8_t* mask, uint32_t& front, uint32_t& back,
                                 uint32_t& negatives) {
     const uint32_t active = active_bits<Width>(left);
     const GroupReader<Width> r(rays, ids, active);
-    const BoxLanes<Width> ray = r.read_box();
     vfloat<Width> t0;
-    const uint32_t pass =
-        bits<Width>(slab_test<Width>(ray.org, ray.inv_dir, ray.t, box, t0)) & active;
+    uint32_t pass;
+    BoxLanes<Width> ray;
+    if constexpr (Shared) {
+        ray = r.read_box_directions();
+        pass = bits<Width>(slab_test<Width>(BoxRelativeToOrigin(), ray.inv_dir, ray.t, box, t0)) &
+               active;
+    } else {
+        ray = r.read_box();
+        pass = bits<Width>(slab_test<Width>(ray.org, ray.inv_dir, ray.t, box, t0)) & active;
+    }
     // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
     // flushes denormals, so a negative normal dir has a finite inverse).
     const vfloat<Width> inv = axis == 0   ? ray.inv_dir[0]
@@ -151,11 +167,26 @@ uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint
                     uint32_t& negative) {
     uint32_t front = 0, back = 0, negatives = 0;
     // Forced: GCC otherwise keeps the 8-lane group out of line (primary rays +10 % on AVX2).
-    for_each_group<Width>(
-        n, [&](auto width, uint32_t g) __attribute__((always_inline)) {
-            box_group<decltype(width)::value>(rays, box, axis, ids + g, n - g, pass_out, fail_out,
-                                              mask ? mask + g : nullptr, front, back, negatives);
-        });
+    auto groups = [&](auto shared, const Bounds3& b) __attribute__((always_inline)) {
+        for_each_group<Width>(
+            n, [&](auto width, uint32_t g) __attribute__((always_inline)) {
+                box_group<decltype(width)::value, decltype(shared)::value>(
+                    rays, b, axis, ids + g, n - g, pass_out, fail_out, mask ? mask + g : nullptr,
+                    front, back, negatives);
+            });
+    };
+    // The box as a local: the groups' whole-vector stores could alias `box` as far as the
+    // compiler knows, so it would load the planes again for every group.
+    Bounds3 local = box;
+    if (rays.shared_origin) {
+        for (int a = 0; a < 3; ++a) {
+            local.lo[a] = box.lo[a] - rays.shared_origin[a];
+            local.hi[a] = box.hi[a] - rays.shared_origin[a];
+        }
+        groups(std::true_type(), local);
+    } else {
+        groups(std::false_type(), box);
+    }
     negative += negatives;
     return front;
 }
@@ -451,7 +482,7 @@ void traverse(const TraversalJob& job) {
     if (job.n == 0) return;
     const BvhNode* nodes = job.nodes;
     uint32_t* ids = job.ids;
-    const TraversalView view{job.rays};
+    const TraversalView view{job.rays, job.shared_origin};
     const SinkReporter<Detail> sink{job};
     TraversalStackEntry stack[k_traversal_stack_size];
     uint32_t depth = 0;

@@ -107,6 +107,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     TraversalJob job = traversal_job(bvh, b);
     job.ids = b.trav_ids.data();
     job.n = n;
+    job.shared_origin = shared_origin(job.rays, job.ids, n);
     job.entry = entry;
     job.sink = nullptr;
     if constexpr (Trace::k_enabled) job.sink = trace.sink;

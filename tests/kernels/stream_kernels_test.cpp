@@ -1,10 +1,10 @@
 // Every stream-kernel back end the machine has (scalar always) decides exactly as the one-ray
 // code, lane by lane, and partitions exactly as a stable partition: the slab test on the hard
 // cases (origins on slab planes with zero directions (0 * inf), infinite inverse directions,
-// signed zeros, flat and empty boxes, t_max of -1, 0 and infinity), the triangle filter's float
-// stage, the sphere filter (origins on the surface, tangents), and the compress. Streams of odd
-// lengths exercise partial groups (at 16 lanes, the 8-lane tail), shuffled and increasing ids the
-// records' transposed reads.
+// signed zeros, flat and empty boxes, t_max of -1, 0 and infinity; each lane's own origin or
+// one the stream shares), the triangle filter's float stage, the sphere filter (origins on the
+// surface, tangents), and the compress. Streams of odd lengths exercise partial groups (at 16
+// lanes, the 8-lane tail), shuffled and increasing ids the records' transposed reads.
 
 #include "kernels/stream/stream_kernels.h"
 
@@ -78,6 +78,7 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
         CHECK(kernels.isa == isa);
         CHECK(kernels.width == isa_width(isa));
         uint64_t lanes = 0, hits = 0, mismatches = 0, order_errors = 0, negative_errors = 0;
+        uint32_t shared_streams = 0;
         for (uint32_t i = 0; i < 2000; ++i) {
             Bounds3 box;
             for (int a = 0; a < 3; ++a) {
@@ -95,7 +96,9 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
                 const uint32_t k = i * 256 + l;
                 Ray ray;
                 for (int a = 0; a < 3; ++a) {
-                    ray.org[a] = pick(k, 30 + a, coords);
+                    // Every fourth stream's rays share one origin (the box filter's
+                    // shared-origin form), on slab planes as often as the others.
+                    ray.org[a] = pick(i % 4 == 3 ? i * 256 : k, 30 + a, coords);
                     ray.dir[a] = pick(k, 40 + a, dirs);
                 }
                 if (k % 2 == 0 && !box.empty()) ray.dir = box.center() - ray.org;  // aim at it
@@ -108,10 +111,13 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             const std::vector<uint32_t> ids = stream_ids(n, i);
             std::vector<uint32_t> pass(n + k_stream_padding), fail(n + k_stream_padding);
             std::vector<uint8_t> mask(n + k_stream_padding, 7);
+            TraversalView view = rays.view();
+            view.shared_origin = shared_origin(view.data, ids.data(), n);
+            shared_streams += view.shared_origin != nullptr;
+            if (i % 4 == 3) CHECK(view.shared_origin != nullptr);
             uint32_t negative = 0;
-            const uint32_t passed =
-                kernels.box_filter(rays.view(), box, axis, ids.data(), n, pass.data(), fail.data(),
-                                   mask.data(), negative);
+            const uint32_t passed = kernels.box_filter(view, box, axis, ids.data(), n, pass.data(),
+                                                       fail.data(), mask.data(), negative);
             std::vector<uint32_t> want_pass, want_fail;
             uint32_t want_negative = 0;
             for (uint32_t l = 0; l < n; ++l) {
@@ -131,7 +137,7 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
             std::vector<uint32_t> in_place = ids;
             uint32_t negative2 = 0;
             const uint32_t passed2 =
-                kernels.box_filter(rays.view(), box, axis, in_place.data(), n, in_place.data(),
+                kernels.box_filter(view, box, axis, in_place.data(), n, in_place.data(),
                                    fail.data(), nullptr, negative2);
             order_errors += !tail_intact(in_place, n);
             order_errors += passed2 != passed ||
@@ -143,6 +149,9 @@ TEST_CASE("Box filter of every back end equals intersect_box per lane, hard case
         CHECK(mismatches == 0);
         CHECK(order_errors == 0);
         CHECK(negative_errors == 0);
+        // The shared-origin streams, and those of one ray; no stream of differing origins.
+        CHECK(shared_streams >= 500);
+        CHECK(shared_streams < 700);
     }
 }
 
@@ -349,7 +358,7 @@ TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "
     for (int i = 0; i < 32; ++i) records[i] = float(i);
     const int32_t starts[4] = {24, 0, 8, 8};
     vfloat<4> fields[8];
-    load_transposed8<4>(records, starts, fields);
+    load_transposed<4>(records, starts, fields);
     for (int f = 0; f < 8; ++f)
         CHECK((fields[f][0] == float(24 + f) && fields[f][1] == float(f) &&
                fields[f][2] == float(8 + f) && fields[f][3] == float(8 + f)));
