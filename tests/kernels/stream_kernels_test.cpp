@@ -354,7 +354,7 @@ TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "
     const float table[5] = {10.f, 11.f, 12.f, 13.f, 14.f};
     const vfloat<4> g = gather<4>(table, vint<4>{4, 0, 2, 2});
     CHECK((g[0] == 14.f && g[1] == 10.f && g[2] == 12.f && g[3] == 12.f));
-    float records[32];
+    alignas(32) float records[32];
     for (int i = 0; i < 32; ++i) records[i] = float(i);
     const int32_t starts[4] = {24, 0, 8, 8};
     vfloat<4> fields[8];
@@ -362,6 +362,12 @@ TEST_CASE("Lane type: masks as values, gathers and compress at width 1 and 4", "
     for (int f = 0; f < 8; ++f)
         CHECK((fields[f][0] == float(24 + f) && fields[f][1] == float(f) &&
                fields[f][2] == float(8 + f) && fields[f][3] == float(8 + f)));
+    vfloat<4> quarter[4];  // the first four fields only (a shared-origin stream's box read)
+    const int32_t quarter_starts[4] = {4, 28, 16, 0};
+    load_transposed<4, 4>(records, quarter_starts, quarter);
+    for (int f = 0; f < 4; ++f)
+        CHECK((quarter[f][0] == float(4 + f) && quarter[f][1] == float(28 + f) &&
+               quarter[f][2] == float(16 + f) && quarter[f][3] == float(f)));
     uint32_t out[4] = {};
     CHECK(compress_store<4>(0b1101u, vint<4>{5, 6, 7, 8}, out) == 3u);
     CHECK((out[0] == 5u && out[1] == 7u && out[2] == 8u));
