@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "base/huge_pages.h"
 #include "kernels/intersect.h"
 #include "kernels/ray.h"
 #include "workloads/scene.h"
@@ -26,6 +27,11 @@ struct alignas(32) BvhNode {
     uint32_t right() const { return first; }
 };
 static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");
+
+// The tree's arrays: read at random by every traversal, so in huge pages where the kernel
+// gives them (base/huge_pages.h).
+using BvhNodes = std::vector<BvhNode, HugePageAllocator<BvhNode>>;
+using LeafPrimitives = std::vector<LeafPrimitive, HugePageAllocator<LeafPrimitive>>;
 
 struct BvhBuildOptions {
     uint32_t max_leaf_size = 4;
@@ -64,10 +70,10 @@ public:
     Bvh() = default;
     Bvh(const Scene& scene, const BvhBuildOptions& options = {});
 
-    const std::vector<BvhNode>& nodes() const { return m_nodes; }
+    const BvhNodes& nodes() const { return m_nodes; }
     const std::vector<uint32_t>& prim_ids() const { return m_prim_ids; }
     // prim_ids' primitives with their vertices, in the same order (LeafPrimitive).
-    const std::vector<LeafPrimitive>& leaf_primitives() const { return m_leaf; }
+    const LeafPrimitives& leaf_primitives() const { return m_leaf; }
     const Scene& scene() const { return *m_scene; }
     BvhStats stats() const;
 
@@ -92,9 +98,9 @@ private:
   uint32_t build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth);
 
   const Scene* m_scene = nullptr;
-  std::vector<BvhNode> m_nodes;
+  BvhNodes m_nodes;
   std::vector<uint32_t> m_prim_ids;
-  std::vector<LeafPrimitive> m_leaf;
+  LeafPrimitives m_leaf;
 };
 
 // Front child first: the child on the side the direction comes from.

@@ -84,9 +84,8 @@ struct Candidate {
 };
 
 template <class Test>
-bool descend(const std::vector<BvhNode>& nodes, const FrustumProxy& f, uint32_t index,
-             uint32_t depth, Test& test, std::vector<Candidate>* queue, uint32_t& leaf,
-             uint32_t& leaf_depth) {
+bool descend(const BvhNodes& nodes, const FrustumProxy& f, uint32_t index, uint32_t depth,
+             Test& test, std::vector<Candidate>* queue, uint32_t& leaf, uint32_t& leaf_depth) {
     const BvhNode& node = nodes[index];
     if (node.is_leaf()) {
         leaf = index;
@@ -113,7 +112,7 @@ bool descend(const std::vector<BvhNode>& nodes, const FrustumProxy& f, uint32_t 
 
 template <class Test>
 EntryPoint find_entry_point(const Bvh& bvh, const FrustumProxy& frustum, Test&& test) {
-    const std::vector<BvhNode>& nodes = bvh.nodes();
+    const BvhNodes& nodes = bvh.nodes();
     if (frustum.empty || nodes.empty()) return {};
     const bool root = frustum.overlaps(nodes[0].bounds);
     test(0u, root);

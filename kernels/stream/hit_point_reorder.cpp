@@ -21,7 +21,7 @@ uint64_t morton6(uint32_t x, uint32_t y, uint32_t z) {
 }  // namespace
 
 HitPointReorder::HitPointReorder(const Bvh& bvh, uint32_t ppm) {
-    const std::vector<BvhNode>& nodes = bvh.nodes();
+    const BvhNodes& nodes = bvh.nodes();
     m_proxy.assign(nodes.size(), 0);
     if (nodes.empty()) return;
     m_bounds = nodes[0].bounds;

@@ -6,7 +6,7 @@
 namespace sfx {
 
 RayGrid::RayGrid(const Bvh& bvh, uint32_t cell_prims) {
-    const std::vector<BvhNode>& nodes = bvh.nodes();
+    const BvhNodes& nodes = bvh.nodes();
     m_cell.assign(nodes.size(), k_no_cell);
     if (nodes.empty()) return;
     // Primitives under each node; children come after their parent (depth-first build).

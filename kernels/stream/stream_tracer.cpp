@@ -193,7 +193,7 @@ struct StreamTracer::Impl {
     template <class Trace>
     void grid_walk(const uint32_t* ids, uint32_t n, uint16_t generation, Trace& trace) {
         GridBuffers& g = gb;
-        const std::vector<BvhNode>& nodes = bvh.nodes();
+        const BvhNodes& nodes = bvh.nodes();
         TraversalRays& rays = b.trav;
         for (uint32_t i = 0; i < n; ++i) {
             g.ids[i] = ids[i];
@@ -346,7 +346,7 @@ struct StreamTracer::Impl {
             r.mask.resize(b.capacity);
             r.ones.assign(b.capacity, 1);
         }
-        const std::vector<BvhNode>& nodes = bvh.nodes();
+        const BvhNodes& nodes = bvh.nodes();
         uint32_t m = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint32_t id = ids[i];

@@ -248,7 +248,7 @@ TEST_CASE("RayGrid: the cut's cells hold every primitive once, none more than as
           "[stream][seeds]") {
     const Scene s = test::box_scene(test::Variant::lights);
     const Bvh bvh(s);
-    const std::vector<BvhNode>& nodes = bvh.nodes();
+    const BvhNodes& nodes = bvh.nodes();
     for (uint32_t cell_prims : {1u, 4u, 16u, 1000000u}) {
         const RayGrid grid(bvh, cell_prims);
         INFO("cell_prims " << cell_prims);
