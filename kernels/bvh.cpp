@@ -174,14 +174,17 @@ uint32_t Bvh::build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth
 }
 
 namespace {
-// The primitive test behind both entry points: `vertices` is the triangle's, or null for a
-// sphere.
+// The primitive test behind every entry point: `vertices` is the triangle's, or null for a
+// sphere; `normal`, if not null, the triangle's triangle_normal.
 bool test_primitive(const Scene& s, const RayPrecomp& r, uint32_t prim, const Vec3* p0,
-                    const Vec3* p1, const Vec3* p2, float t_max, Hit& hit) {
+                    const Vec3* p1, const Vec3* p2, const TriangleNormal* normal, float t_max,
+                    Hit& hit) {
     float t, u = 0.f, v = 0.f;
     if (s.is_sphere(prim)) {
         if (!intersect_sphere(r, s.sphere(prim), t_max, t)) return false;
-    } else if (!intersect_triangle(r, *p0, *p1, *p2, t_max, t, u, v)) {
+    } else if (!intersect_triangle(r, *p0, *p1, *p2,
+                                   normal ? *normal : triangle_normal(*p0, *p1, *p2), t_max, t, u,
+                                   v)) {
         return false;
     }
     if (!closer(t, prim, hit)) return false;
@@ -195,15 +198,22 @@ bool test_primitive(const Scene& s, const RayPrecomp& r, uint32_t prim, const Ve
 
 bool Bvh::intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const {
     const Scene& s = *m_scene;
-    if (s.is_sphere(prim)) return test_primitive(s, r, prim, nullptr, nullptr, nullptr, t_max, hit);
+    if (s.is_sphere(prim))
+        return test_primitive(s, r, prim, nullptr, nullptr, nullptr, nullptr, t_max, hit);
     const Triangle& tri = s.triangles[prim];
     return test_primitive(s, r, prim, &s.positions[tri.v0], &s.positions[tri.v1],
-                          &s.positions[tri.v2], t_max, hit);
+                          &s.positions[tri.v2], nullptr, t_max, hit);
 }
 
 bool Bvh::intersect_leaf_primitive(const RayPrecomp& r, uint32_t i, float t_max, Hit& hit) const {
     const LeafPrimitive& l = m_leaf[i];
-    return test_primitive(*m_scene, r, l.prim, &l.p0, &l.p1, &l.p2, t_max, hit);
+    return test_primitive(*m_scene, r, l.prim, &l.p0, &l.p1, &l.p2, nullptr, t_max, hit);
+}
+
+bool Bvh::intersect_leaf_triangle(const RayPrecomp& r, uint32_t i, const TriangleNormal& normal,
+                                  float t_max, Hit& hit) const {
+    const LeafPrimitive& l = m_leaf[i];
+    return test_primitive(*m_scene, r, l.prim, &l.p0, &l.p1, &l.p2, &normal, t_max, hit);
 }
 
 template <class Counts>

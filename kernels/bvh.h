@@ -92,15 +92,19 @@ public:
     bool intersect_primitive(const RayPrecomp& r, uint32_t prim, float t_max, Hit& hit) const;
     // The same test of the primitive at position i of prim_ids, from leaf_primitives().
     bool intersect_leaf_primitive(const RayPrecomp& r, uint32_t i, float t_max, Hit& hit) const;
+    // The same test of a triangle at position i, given its triangle_normal (a caller testing
+    // many rays against one triangle computes it once).
+    bool intersect_leaf_triangle(const RayPrecomp& r, uint32_t i, const TriangleNormal& normal,
+                                 float t_max, Hit& hit) const;
 
-private:
-  struct BuildInput;  // bvh.cpp: the primitives' bounds and centroids, the bins' scratch
-  uint32_t build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth);
+  private:
+    struct BuildInput;  // bvh.cpp: the primitives' bounds and centroids, the bins' scratch
+    uint32_t build(uint32_t begin, uint32_t end, BuildInput& in, uint32_t depth);
 
-  const Scene* m_scene = nullptr;
-  BvhNodes m_nodes;
-  std::vector<uint32_t> m_prim_ids;
-  LeafPrimitives m_leaf;
+    const Scene* m_scene = nullptr;
+    BvhNodes m_nodes;
+    std::vector<uint32_t> m_prim_ids;
+    LeafPrimitives m_leaf;
 };
 
 // Front child first: the child on the side the direction comes from.

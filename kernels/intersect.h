@@ -185,7 +185,7 @@ struct TriangleNormal {
     bool zero() const { return x == 0.0 && y == 0.0 && z == 0.0; }
 };
 
-inline TriangleNormal triangle_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+SFX_LANES_INLINE TriangleNormal triangle_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     const double e1x = double(p1.x) - double(p0.x), e1y = double(p1.y) - double(p0.y),
                  e1z = double(p1.z) - double(p0.z);
     const double e2x = double(p2.x) - double(p0.x), e2y = double(p2.y) - double(p0.y),
@@ -208,8 +208,11 @@ inline bool triangle_is_degenerate(const Vec3& p0, const Vec3& p1, const Vec3& p
 // - Degenerate (zero-area) triangles never hit. In sheared ray space collinear vertices are no
 //   longer exactly collinear, so the determinant alone does not catch them.
 // Both double-precision checks run only for candidates that passed every float test.
+// `n`: triangle_normal(p0, p1, p2), computed once by a caller that tests many rays against the
+// triangle (the stream's candidates of a leaf op).
 inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                               float t_max, float& t_out, float& u_out, float& v_out) {
+                               const TriangleNormal& n, float t_max, float& t_out, float& u_out,
+                               float& v_out) {
     const float org[3] = {r.org.x, r.org.y, r.org.z};
     const ShearedTriangle<1> s = shear_triangle<1>(org, r.kx, r.ky, r.kz, r.sx, r.sy, p0, p1, p2);
     const float ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
@@ -229,7 +232,6 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     // plane equation in double: the scaled-barycentric t loses digits on slivers (0.4 % on a
     // 20 x 0.05 triangle), the plane's does not. Products of floats are exact in double, so
     // coplanar triangles report bit-equal t and their ties go to the lower id.
-    const TriangleNormal n = triangle_normal(p0, p1, p2);
     const double n_dot_d = n.x * r.dir.x + n.y * r.dir.y + n.z * r.dir.z;
     const double n_dot_a = n.x * (double(p0.x) - r.org.x) + n.y * (double(p0.y) - r.org.y) +
                            n.z * (double(p0.z) - r.org.z);
@@ -252,6 +254,12 @@ inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& 
     u_out = v * inv_det;  // weight of p1
     v_out = w * inv_det;  // weight of p2
     return true;
+}
+
+inline bool intersect_triangle(const RayPrecomp& r, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                               float t_max, float& t_out, float& u_out, float& v_out) {
+    return intersect_triangle(r, p0, p1, p2, triangle_normal(p0, p1, p2), t_max, t_out, u_out,
+                              v_out);
 }
 
 // Ray/sphere test over (0, t_max] for Width rays against one sphere, written once for the

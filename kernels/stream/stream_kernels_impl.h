@@ -308,11 +308,13 @@ struct OneLaneTally {
     }
 };
 
+// The full test of the triangle at leaf position i (its triangle_normal given) for slot id.
 // Closest hit: later tests need t or less. Any hit: the ray is done, and with t = -1 every
 // later box and primitive test misses it.
-SFX_LANES_INLINE bool full_primitive_test(const TraversalJob& job, uint32_t i, uint32_t id) {
+SFX_LANES_INLINE bool full_triangle_test(const TraversalJob& job, uint32_t i,
+                                         const TriangleNormal& normal, uint32_t id) {
     float& t = job.rays[size_t(id) * traversal_field::record + traversal_field::t];
-    if (!job.bvh->intersect_leaf_primitive(job.pre[id], i, t, job.hit[id])) return false;
+    if (!job.bvh->intersect_leaf_triangle(job.pre[id], i, normal, t, job.hit[id])) return false;
     t = job.any_hit[id] ? -1.f : job.hit[id].t;
     return true;
 }
@@ -356,7 +358,7 @@ uint32_t sphere_filter(TraversalView rays, const RayPrecomp* pre, const Sphere& 
 }
 
 // A leaf's sphere `prim` against job.ids[0, k) by sphere_lanes: a lane that hits closer than
-// its ray's hit so far takes the hit (take_closer_hit), as full_primitive_test does. Under
+// its ray's hit so far takes the hit (take_closer_hit), as full_triangle_test does. Under
 // TraceDetail::lanes, job.mask[0, k) gets the lanes that took it. Returns their count.
 template <int Width, TraceDetail Detail>
 SFX_LANES_INLINE uint32_t sphere_leaf(const TraversalJob& job, uint32_t prim, uint32_t k) {
@@ -412,9 +414,13 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
             const uint32_t* candidates = job.positions + j * stride;
             if constexpr (Detail == TraceDetail::lanes) __builtin_memset(mask, 0, k);
             uint32_t passed = 0;
+            // Once for the op's candidates (the full test's plane, in double).
+            const TriangleNormal normal = found[j] != 0
+                                              ? triangle_normal(leaf[i].p0, leaf[i].p1, leaf[i].p2)
+                                              : TriangleNormal{};
             for (uint32_t c = 0; c < found[j]; ++c) {
                 const uint32_t at = candidates[c];
-                if (!full_primitive_test(job, i, ids[at])) continue;
+                if (!full_triangle_test(job, i, normal, ids[at])) continue;
                 ++passed;
                 if constexpr (Detail == TraceDetail::lanes) mask[at] = 1;
             }
