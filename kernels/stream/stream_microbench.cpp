@@ -169,6 +169,10 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     std::vector<Buffers> buffers;
     for (uint32_t slots : options.buffer_slots)
         buffers.push_back(make_buffers(scene, bvh, slots, rng));
+    // The triangle test's floor triangle (primitive 0) at its leaf position, as the tracer's
+    // leaves test it.
+    const uint32_t floor_leaf = uint32_t(
+        std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), 0u) - bvh.prim_ids().begin());
 
     for (OpKind kind : kinds) {
         for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
@@ -236,17 +240,22 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 break;
                             }
                             case OpKind::triangle_test: {
-                                const uint32_t prim = 0;  // a floor triangle: about half the rays
-                                const Triangle& tri = scene.triangles[prim];
+                                // A floor triangle: about half the rays. The tracer's leaf
+                                // test: the float stage, then the full test of each candidate
+                                // with the plane normal computed once for the op.
+                                const LeafPrimitive& tri = bvh.leaf_primitives()[floor_leaf];
                                 uint32_t* positions = b.positions.data();
                                 const uint32_t candidates = kernels.triangle_candidates(
-                                    b.trav.view(), scene.positions[tri.v0], scene.positions[tri.v1],
-                                    scene.positions[tri.v2], ids, n, positions);
+                                    b.trav.view(), tri.p0, tri.p1, tri.p2, ids, n, positions);
+                                const TriangleNormal normal =
+                                    candidates != 0 ? triangle_normal(tri.p0, tri.p1, tri.p2)
+                                                    : TriangleNormal{};
                                 passed = 0;
                                 for (uint32_t j = 0; j < candidates; ++j) {
                                     const uint32_t id = ids[positions[j]];
                                     float& t = b.trav.t(id);
-                                    if (!bvh.intersect_primitive(b.pre[id], prim, t, b.hit[id]))
+                                    if (!bvh.intersect_leaf_triangle(b.pre[id], floor_leaf, normal,
+                                                                     t, b.hit[id]))
                                         continue;
                                     t = b.any_hit[id] ? -1.f : b.hit[id].t;
                                     ++passed;
