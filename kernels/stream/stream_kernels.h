@@ -110,7 +110,7 @@ constexpr uint32_t k_traversal_stack_size = Bvh::k_max_depth + 2;
 // What one traversal (Fig. 3) of a stream works on. Plain pointers, so the wide translation
 // units instantiate no out-of-line member of a library type.
 struct TraversalJob {
-    const Bvh* bvh;  // its full primitive tests (intersect_leaf_primitive)
+    const Bvh* bvh;  // its full triangle tests (intersect_leaf_triangle)
     const BvhNode* nodes;
     const LeafPrimitive* leaf;
     uint32_t triangle_count;  // leaf[i].prim >= triangle_count: a sphere (Scene::is_sphere)

@@ -175,15 +175,13 @@ uint32_t box_filter(TraversalView rays, const Bounds3& box, int axis, const uint
                     front, back, negatives);
             });
     };
-    // The box as a local: the groups' whole-vector stores could alias `box` as far as the
-    // compiler knows, so it would load the planes again for every group.
-    Bounds3 local = box;
     if (rays.shared_origin) {
+        Bounds3 relative;  // the planes less the shared origin: once per box, not per lane
         for (int a = 0; a < 3; ++a) {
-            local.lo[a] = box.lo[a] - rays.shared_origin[a];
-            local.hi[a] = box.hi[a] - rays.shared_origin[a];
+            relative.lo[a] = box.lo[a] - rays.shared_origin[a];
+            relative.hi[a] = box.hi[a] - rays.shared_origin[a];
         }
-        groups(std::true_type(), local);
+        groups(std::true_type(), relative);
     } else {
         groups(std::false_type(), box);
     }
