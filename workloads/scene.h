@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "base/huge_pages.h"
 #include "base/vec.h"
 
 namespace sfx {
@@ -88,8 +89,9 @@ uint64_t scene_hash(const Scene& scene);
 
 struct Scene {
     std::string name;
-    std::vector<Vec3> positions;
-    std::vector<Triangle> triangles;
+    // Huge pages (base/huge_pages.h): shading reads a hit's triangle and vertices at random.
+    std::vector<Vec3, HugePageAllocator<Vec3>> positions;
+    std::vector<Triangle, HugePageAllocator<Triangle>> triangles;
     std::vector<Sphere> spheres;
     std::vector<Material> materials;
     std::vector<AreaLight> lights;  // built by finalize() from emissive primitives
