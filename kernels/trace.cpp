@@ -59,6 +59,12 @@ void TraceSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, ui
     }
 }
 
+namespace {
+uint32_t bounce_slot(uint32_t generation) {
+    return std::min(generation, CountingSink::k_bounce_slots - 1);
+}
+}  // namespace
+
 CountingSink::StageCounts& CountingSink::add(OpKind kind, OpStage stage, uint16_t generation,
                                              uint64_t ops, uint64_t lanes, uint64_t passed,
                                              uint32_t first_length) {
@@ -66,38 +72,28 @@ CountingSink::StageCounts& CountingSink::add(OpKind kind, OpStage stage, uint16_
     s.ops += ops;
     s.lanes += lanes;
     s.passed += passed;
-    m_kind_ops[uint32_t(kind)] += ops;
-    m_kind_lanes[uint32_t(kind)] += lanes;
-    m_kind_lanes_by_generation[generation > 0][uint32_t(kind)] += lanes;
-    BounceCounts& b = m_bounce[std::min<uint32_t>(generation, k_bounce_slots - 1)];
-    if (kind == OpKind::box_test) {
-        b.box_ops += ops;
-        b.box_lanes += lanes;
-    } else if (kind == OpKind::triangle_test || kind == OpKind::sphere_test) {
-        b.prim_ops += ops;
-        b.prim_lanes += lanes;
-    }
+    const uint32_t slot = bounce_slot(generation);
+    KindTally& k = m_kinds[slot][uint32_t(kind)];
+    k.ops += ops;
+    k.lanes += lanes;
     // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
     if ((kind == OpKind::box_test || kind == OpKind::raygrid_walk) &&
         int32_t(generation) != m_traced_generation) {
-        m_rays += first_length;  // the generation's entry test: one lane per ray
-        b.rays += first_length;
-        m_rays_by_generation[generation > 0] += first_length;
+        m_rays[slot] += first_length;  // the generation's entry test: one lane per ray
         m_traced_generation = generation;
     }
     return s;
 }
 
 void CountingSink::op(const StreamOp& op) {
-    if (op.length == 0) return;
-    StageCounts& s = add(op.kind, op.stage, op.generation, 1, op.length, op.pass_count, op.length);
-    // Most ops are shorter than a SIMD width (one ray, deep in the tree): no division for them.
-    for (size_t i = 0; i < m_widths.size(); ++i) {
-        const uint32_t w = m_widths[i];
-        s.groups[i] += op.length <= w ? 1u : (op.length + w - 1) / w;
-    }
-    const uint32_t log2_length = 31u - uint32_t(__builtin_clz(op.length));  // length > 0
-    ++s.histogram[std::min(log2_length, k_histogram_buckets - 1)];
+    const uint32_t length = op.length;
+    if (length == 0) return;
+    StageCounts& s = add(op.kind, op.stage, op.generation, 1, length, op.pass_count, length);
+    uint64_t* groups = s.groups.data();
+    const uint32_t* widths = m_widths.data();
+    for (size_t i = 0, n = m_widths.size(); i < n; ++i)
+        groups[i] += (length - 1) / widths[i] + 1;         // ceil(length / width): length > 0
+    ++s.histogram[31u - uint32_t(__builtin_clz(length))];  // length > 0: bucket below 32
 }
 
 void CountingSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
@@ -106,6 +102,48 @@ void CountingSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation,
     StageCounts& s = add(kind, stage, generation, count, count, passed, 1);
     for (uint64_t& g : s.groups) g += count;  // one group each at every width
     s.histogram[0] += count;                  // length 1: bucket [1, 2)
+}
+
+uint64_t CountingSink::kind_ops(OpKind k) const {
+    uint64_t sum = 0;
+    for (const auto& slot : m_kinds) sum += slot[uint32_t(k)].ops;
+    return sum;
+}
+
+uint64_t CountingSink::kind_lanes(OpKind k) const {
+    return kind_lanes(k, false) + kind_lanes(k, true);
+}
+
+uint64_t CountingSink::kind_lanes(OpKind k, bool secondary) const {
+    if (!secondary) return m_kinds[0][uint32_t(k)].lanes;  // slot 0 is generation 0 alone
+    uint64_t sum = 0;
+    for (uint32_t slot = 1; slot < k_bounce_slots; ++slot) sum += m_kinds[slot][uint32_t(k)].lanes;
+    return sum;
+}
+
+uint64_t CountingSink::rays() const {
+    return rays(false) + rays(true);
+}
+
+uint64_t CountingSink::rays(bool secondary) const {
+    if (!secondary) return m_rays[0];
+    uint64_t sum = 0;
+    for (uint32_t slot = 1; slot < k_bounce_slots; ++slot) sum += m_rays[slot];
+    return sum;
+}
+
+CountingSink::BounceCounts CountingSink::bounce(uint32_t generation) const {
+    const uint32_t slot = bounce_slot(generation);
+    const auto& k = m_kinds[slot];
+    const auto box = uint32_t(OpKind::box_test), triangle = uint32_t(OpKind::triangle_test),
+               sphere = uint32_t(OpKind::sphere_test);
+    BounceCounts b;
+    b.rays = m_rays[slot];
+    b.box_ops = k[box].ops;
+    b.box_lanes = k[box].lanes;
+    b.prim_ops = k[triangle].ops + k[sphere].ops;
+    b.prim_lanes = k[triangle].lanes + k[sphere].lanes;
+    return b;
 }
 
 CountingSink& CountingSink::operator+=(const CountingSink& o) {
@@ -120,23 +158,15 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
             for (size_t i = 0; i < a.groups.size(); ++i) a.groups[i] += b.groups[i];
             for (size_t i = 0; i < a.histogram.size(); ++i) a.histogram[i] += b.histogram[i];
         }
-    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
-        m_kind_ops[k] += o.m_kind_ops[k];
-        m_kind_lanes[k] += o.m_kind_lanes[k];
-        for (int g = 0; g < 2; ++g)
-            m_kind_lanes_by_generation[g][k] += o.m_kind_lanes_by_generation[g][k];
+    for (uint32_t slot = 0; slot < k_bounce_slots; ++slot) {
+        for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+            m_kinds[slot][k].ops += o.m_kinds[slot][k].ops;
+            m_kinds[slot][k].lanes += o.m_kinds[slot][k].lanes;
+        }
+        m_rays[slot] += o.m_rays[slot];
     }
     m_passes += o.m_passes;
     m_generations += o.m_generations;
-    m_rays += o.m_rays;
-    for (int g = 0; g < 2; ++g) m_rays_by_generation[g] += o.m_rays_by_generation[g];
-    for (uint32_t g = 0; g < k_bounce_slots; ++g) {
-        m_bounce[g].rays += o.m_bounce[g].rays;
-        m_bounce[g].box_ops += o.m_bounce[g].box_ops;
-        m_bounce[g].box_lanes += o.m_bounce[g].box_lanes;
-        m_bounce[g].prim_ops += o.m_bounce[g].prim_ops;
-        m_bounce[g].prim_lanes += o.m_bounce[g].prim_lanes;
-    }
     return *this;
 }
 

@@ -257,18 +257,16 @@ class CountingSink : public TraceSink {
     const StageCounts& stage(bool secondary, OpStage s) const {
         return m_stages[secondary][uint32_t(s)];
     }
-    uint64_t kind_ops(OpKind k) const { return m_kind_ops[uint32_t(k)]; }
-    uint64_t kind_lanes(OpKind k) const { return m_kind_lanes[uint32_t(k)]; }
+    uint64_t kind_ops(OpKind k) const;
+    uint64_t kind_lanes(OpKind k) const;
     // Lanes of one kind in primary (generation 0) or secondary streams.
-    uint64_t kind_lanes(OpKind k, bool secondary) const {
-        return m_kind_lanes_by_generation[secondary][uint32_t(k)];
-    }
+    uint64_t kind_lanes(OpKind k, bool secondary) const;
     uint64_t passes() const { return m_passes; }
     uint64_t generations() const { return m_generations; }
     // Rays traced: the lanes of each generation's first box test (its entry node: the root, or
     // a primary entry point).
-    uint64_t rays() const { return m_rays; }
-    uint64_t rays(bool secondary) const { return m_rays_by_generation[secondary]; }
+    uint64_t rays() const;
+    uint64_t rays(bool secondary) const;
     // Per generation (bounce; the last slot holds every later one): rays traced, box tests
     // (ops, lanes: rays per visited node, seeds/000 Tables 2 and 4) and primitive tests (each op
     // of a leaf carries the rays that reached it: rays per visited leaf).
@@ -279,21 +277,22 @@ class CountingSink : public TraceSink {
         double box_tests_per_ray() const { return rays ? double(box_lanes) / rays : 0.0; }
     };
     static constexpr uint32_t k_bounce_slots = 5;
-    const BounceCounts& bounce(uint32_t generation) const {
-        return m_bounce[generation < k_bounce_slots ? generation : k_bounce_slots - 1];
-    }
+    BounceCounts bounce(uint32_t generation) const;
 
     CountingSink& operator+=(const CountingSink& o);
 
   private:
     std::vector<uint32_t> m_widths;
     StageCounts m_stages[2][k_op_stage_count];
-    uint64_t m_kind_ops[k_op_kind_count] = {};
-    uint64_t m_kind_lanes[k_op_kind_count] = {};
-    uint64_t m_kind_lanes_by_generation[2][k_op_kind_count] = {};
-    uint64_t m_passes = 0, m_generations = 0, m_rays = 0;
-    uint64_t m_rays_by_generation[2] = {};
-    BounceCounts m_bounce[k_bounce_slots];
+    // Ops and lanes per generation slot (as bounce()'s) and kind: every per-kind and per-bounce
+    // figure is a sum of these, so an op adds to one of them only (the sink is on the path
+    // tracer's hot path: hundreds of thousands of ops a frame).
+    struct KindTally {
+        uint64_t ops = 0, lanes = 0;
+    };
+    KindTally m_kinds[k_bounce_slots][k_op_kind_count];
+    uint64_t m_rays[k_bounce_slots] = {};  // per generation slot
+    uint64_t m_passes = 0, m_generations = 0;
     int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
 
     // Adds `ops` ops of one kind with `lanes` lanes and `passed` passes in all, the first of

@@ -150,6 +150,7 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     op(OpKind::box_test, 1, 17, 2);
     op(OpKind::triangle_test, 0, 3, 1);
     op(OpKind::box_test, 0, 40, 40);
+    op(OpKind::sphere_test, 6, 4, 1);
     sink.end_pass({});
     const auto& t = sink.stage(true, OpStage::traversal);
     CHECK(t.ops == 3);
@@ -169,6 +170,24 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     CHECK(sink.kind_ops(OpKind::box_test) == 4);
     // Each generation's first box test is its entry test, one lane per ray: 5 + 40.
     CHECK(sink.rays() == 45);
+    CHECK(sink.rays(false) == 40);
+    CHECK(sink.rays(true) == 5);
+    CHECK(sink.kind_lanes(OpKind::box_test) == 78);
+    CHECK(sink.kind_lanes(OpKind::box_test, false) == 40);
+    CHECK(sink.kind_lanes(OpKind::box_test, true) == 38);
+    CHECK(sink.kind_ops(OpKind::sphere_test) == 1);
+    // Per bounce: generation 0, 1, and the last slot for generation 6.
+    CHECK(sink.bounce(0).rays == 40);
+    CHECK(sink.bounce(0).box_lanes == 40);
+    CHECK(sink.bounce(0).prim_ops == 1);
+    CHECK(sink.bounce(0).prim_lanes == 3);
+    CHECK(sink.bounce(1).rays == 5);
+    CHECK(sink.bounce(1).box_ops == 3);
+    CHECK(sink.bounce(1).box_lanes == 38);
+    CHECK(sink.bounce(1).prim_ops == 0);
+    CHECK(sink.bounce(6).prim_ops == 1);  // a sphere test counts as a primitive test
+    CHECK(sink.bounce(6).prim_lanes == 4);
+    CHECK(sink.bounce(CountingSink::k_bounce_slots - 1).prim_lanes == 4);
 }
 
 TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add", "[stream]") {
