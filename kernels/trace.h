@@ -214,9 +214,10 @@ class TraceSink {
     virtual void begin_pass(const TilePass&) {}
     virtual void op(const StreamOp&) = 0;
     // `count` ops of kind `kind` and one lane each, `passed` of which passed, in place of
-    // `count` op() calls: the stream tracer sends a one-ray subtree's ops this way to a sink
-    // that reads counts only (counts_only), which can add them at once. Their objects are left
-    // unsaid. The default calls op() for each.
+    // `count` op() calls: the stream tracer sends the ops of a traversal's one-ray subtrees
+    // this way, at the traversal's end, to a sink that reads counts only (counts_only), which
+    // can add them at once. Their objects and their places in the op order are left unsaid.
+    // The default calls op() for each.
     virtual void one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
                               uint32_t passed);
     virtual void end_pass(const TilePass&) {}

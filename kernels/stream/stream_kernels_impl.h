@@ -284,9 +284,12 @@ struct SinkReporter {
     }
 };
 
-// Tallies the one-lane ops of a one-ray subtree per kind for a sink that reads counts only
-// (TraceDetail::counts), and sends them at once (TraceSink::one_lane_ops): one call per kind
-// instead of one per op.
+// Tallies the one-lane ops of a traversal's one-ray subtrees per kind for a sink that reads
+// counts only (TraceDetail::counts), and sends them at the traversal's end
+// (TraceSink::one_lane_ops): one call per kind instead of one per op. A counting sink adds them
+// up, so their place among the traversal's other ops changes nothing but the rays it counts
+// from a generation's first box test, and the tally holds a traversal's first op only when
+// the traversal is of one ray, when it holds all of them.
 struct OneLaneTally {
     const TraversalJob& job;
     uint32_t count[3] = {0, 0, 0}, passed[3] = {0, 0, 0};  // box, triangle, sphere tests
@@ -488,6 +491,7 @@ void traverse(const TraversalJob& job) {
     uint32_t* ids = job.ids;
     const TraversalView view{job.rays, job.shared_origin};
     const SinkReporter<Detail> sink{job};
+    OneLaneTally tally{job};  // TraceDetail::counts: every one-ray subtree's ops, sent at the end
     TraversalStackEntry stack[k_traversal_stack_size];
     uint32_t depth = 0;
     stack[depth++] = {job.entry, job.n};
@@ -496,9 +500,7 @@ void traverse(const TraversalJob& job) {
         const uint32_t node_index = top.node, len = top.length;
         if (len == 1) {
             if constexpr (Detail == TraceDetail::counts) {
-                OneLaneTally tally{job};
                 traverse_one<Detail>(job, node_index, tally);
-                tally.send();
             } else {
                 traverse_one<Detail>(job, node_index, sink);
             }
@@ -538,6 +540,7 @@ void traverse(const TraversalJob& job) {
             stack[depth++] = {right_first ? right : left, k};
         }
     }
+    if constexpr (Detail == TraceDetail::counts) tally.send();
 }
 
 template <int Width>
