@@ -286,10 +286,10 @@ struct SinkReporter {
 
 // Tallies the one-lane ops of a traversal's one-ray subtrees per kind for a sink that reads
 // counts only (TraceDetail::counts), and sends them at the traversal's end
-// (TraceSink::one_lane_ops): one call per kind instead of one per op. A counting sink adds them
-// up, so their place among the traversal's other ops changes nothing but the rays it counts
-// from a generation's first box test, and the tally holds a traversal's first op only when
-// the traversal is of one ray, when it holds all of them.
+// (TraceSink::one_lane_ops): one call per kind instead of one per op. A counting sink only adds
+// them up. The one count that depends on order, a generation's rays (its first box test's
+// lanes), stays the same: a traversal's first op is a wide one unless the traversal has one
+// ray, and then the tally holds all of its ops.
 struct OneLaneTally {
     const TraversalJob& job;
     uint32_t count[3] = {0, 0, 0}, passed[3] = {0, 0, 0};  // box, triangle, sphere tests
