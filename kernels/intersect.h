@@ -380,6 +380,19 @@ struct SurfaceHit {
     uint32_t material = 0;
 };
 
+// Prefetches of what surface_at(scene, ray, hit) reads for hit.prim: its triangle record, then
+// (once that has arrived) its vertices. A sphere's record is small and read by few rays.
+inline void prefetch_surface_triangle(const Scene& scene, uint32_t prim) {
+    if (!scene.is_sphere(prim)) __builtin_prefetch(&scene.triangles[prim]);
+}
+inline void prefetch_surface_vertices(const Scene& scene, uint32_t prim) {
+    if (scene.is_sphere(prim)) return;
+    const Triangle& tri = scene.triangles[prim];
+    __builtin_prefetch(&scene.positions[tri.v0]);
+    __builtin_prefetch(&scene.positions[tri.v1]);
+    __builtin_prefetch(&scene.positions[tri.v2]);
+}
+
 inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit) {
     SurfaceHit s;
     Vec3 n;

@@ -529,9 +529,16 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             });
         s += misses;
         len -= misses;
+        // The hits' surfaces, for the emission filter and the stack below: the scene's arrays
+        // are read at random, so each hit's triangle is fetched 16 rays ahead and its vertices
+        // 8 ahead (the stream is known in advance, unlike one ray at a time).
+        for (uint32_t i = 0; i < len; ++i) {
+            if (i + 16 < len) prefetch_surface_triangle(scene, hit[s[i + 16]].prim);
+            if (i + 8 < len) prefetch_surface_vertices(scene, hit[s[i + 8]].prim);
+            b.surf[s[i]] = surface_at(scene, rays[s[i]], hit[s[i]]);
+        }
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
-            b.surf[id] = surface_at(scene, rays[id], hit[id]);
-            const Material& m = scene.materials[b.surf[id].material];
+            const Material& m = scene.materials[surf[id].material];
             if (!m.emissive()) return false;
             shade_emission(path[id], m);
             return true;
