@@ -50,11 +50,12 @@ void CountingSink::end_pass(const TilePass& p) {
     m_generations += p.generations;
 }
 
-void TraceSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
-                             uint32_t passed) {
-    StreamOp o{kind, stage, generation, k_no_object, 1};
-    for (uint32_t i = 0; i < count; ++i) {
-        o.pass_count = i < passed ? 1 : 0;
+void TraceSink::ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
+                              uint32_t count, uint32_t passed) {
+    StreamOp o{kind, stage, generation, k_no_object, length};
+    for (uint32_t i = 0; i < count; ++i) {  // the passes fill the ops in turn
+        o.pass_count = std::min(passed, length);
+        passed -= o.pass_count;
         op(o);
     }
 }
@@ -65,43 +66,33 @@ uint32_t bounce_slot(uint32_t generation) {
 }
 }  // namespace
 
-CountingSink::StageCounts& CountingSink::add(OpKind kind, OpStage stage, uint16_t generation,
-                                             uint64_t ops, uint64_t lanes, uint64_t passed,
-                                             uint32_t first_length) {
+void CountingSink::op(const StreamOp& op) {
+    CountingSink::ops_of_length(op.kind, op.stage, op.generation, op.length, 1, op.pass_count);
+}
+
+void CountingSink::ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
+                                 uint32_t count, uint32_t passed) {
+    if (count == 0 || length == 0) return;
+    const uint64_t lanes = uint64_t(count) * length;
     StageCounts& s = m_stages[generation > 0][uint32_t(stage)];
-    s.ops += ops;
+    s.ops += count;
     s.lanes += lanes;
     s.passed += passed;
+    uint64_t* groups = s.groups.data();
+    const uint32_t* widths = m_widths.data();
+    for (size_t i = 0, n = m_widths.size(); i < n; ++i)
+        groups[i] += uint64_t(count) * ((length - 1) / widths[i] + 1);  // ceil(length / width)
+    s.histogram[31u - uint32_t(__builtin_clz(length))] += count;        // length > 0: below 32
     const uint32_t slot = bounce_slot(generation);
     KindTally& k = m_kinds[slot][uint32_t(kind)];
-    k.ops += ops;
+    k.ops += count;
     k.lanes += lanes;
     // A batched generation (RayGrid) enters with the cell walk at the root, before any box test.
     if ((kind == OpKind::box_test || kind == OpKind::raygrid_walk) &&
         int32_t(generation) != m_traced_generation) {
-        m_rays[slot] += first_length;  // the generation's entry test: one lane per ray
+        m_rays[slot] += length;  // the generation's entry test: one lane per ray
         m_traced_generation = generation;
     }
-    return s;
-}
-
-void CountingSink::op(const StreamOp& op) {
-    const uint32_t length = op.length;
-    if (length == 0) return;
-    StageCounts& s = add(op.kind, op.stage, op.generation, 1, length, op.pass_count, length);
-    uint64_t* groups = s.groups.data();
-    const uint32_t* widths = m_widths.data();
-    for (size_t i = 0, n = m_widths.size(); i < n; ++i)
-        groups[i] += (length - 1) / widths[i] + 1;         // ceil(length / width): length > 0
-    ++s.histogram[31u - uint32_t(__builtin_clz(length))];  // length > 0: bucket below 32
-}
-
-void CountingSink::one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
-                                uint32_t passed) {
-    if (count == 0) return;
-    StageCounts& s = add(kind, stage, generation, count, count, passed, 1);
-    for (uint64_t& g : s.groups) g += count;  // one group each at every width
-    s.histogram[0] += count;                  // length 1: bucket [1, 2)
 }
 
 uint64_t CountingSink::kind_ops(OpKind k) const {

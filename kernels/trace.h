@@ -213,13 +213,14 @@ class TraceSink {
     virtual void begin_frame(const TraceHeader&) {}
     virtual void begin_pass(const TilePass&) {}
     virtual void op(const StreamOp&) = 0;
-    // `count` ops of kind `kind` and one lane each, `passed` of which passed, in place of
-    // `count` op() calls: the stream tracer sends the ops of a traversal's one-ray subtrees
-    // this way, at the traversal's end, to a sink that reads counts only (counts_only), which
-    // can add them at once. Their objects and their places in the op order are left unsaid.
+    // `count` ops of kind `kind` and `length` lanes each (length > 0), with `passed` passing
+    // lanes among them, in place of `count` op() calls: the stream tracer sends a traversal's
+    // ops this way, at the traversal's end, to a sink that reads counts only (counts_only),
+    // which can add them at once. Their objects, their places in the op order and how the passes
+    // split among them are left unsaid; the traversal's first op still comes first, by op().
     // The default calls op() for each.
-    virtual void one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
-                              uint32_t passed);
+    virtual void ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
+                               uint32_t count, uint32_t passed);
     virtual void end_pass(const TilePass&) {}
     virtual void end_frame() {}
     // True if the sink reads counts only: never an op's slots or pass flags, nor the frame
@@ -248,8 +249,8 @@ class CountingSink : public TraceSink {
     explicit CountingSink(std::vector<uint32_t> widths);
     void begin_pass(const TilePass&) override;
     void op(const StreamOp& op) override;
-    void one_lane_ops(OpKind kind, OpStage stage, uint16_t generation, uint32_t count,
-                      uint32_t passed) override;
+    void ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
+                       uint32_t count, uint32_t passed) override;
     void end_pass(const TilePass&) override;
     bool counts_only() const override { return true; }
 
@@ -295,12 +296,6 @@ class CountingSink : public TraceSink {
     uint64_t m_rays[k_bounce_slots] = {};  // per generation slot
     uint64_t m_passes = 0, m_generations = 0;
     int32_t m_traced_generation = -1;  // the last generation of this pass whose rays were counted
-
-    // Adds `ops` ops of one kind with `lanes` lanes and `passed` passes in all, the first of
-    // them `first_length` lanes long; returns their stage's counts (groups and histogram are
-    // the caller's).
-    StageCounts& add(OpKind kind, OpStage stage, uint16_t generation, uint64_t ops, uint64_t lanes,
-                     uint64_t passed, uint32_t first_length);
 };
 
 // Writes the trace to a binary file (format in trace.cpp); memory stays one op at a time.

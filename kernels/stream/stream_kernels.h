@@ -92,6 +92,12 @@ class TraversalRays {
 // writes whole vectors.
 constexpr uint32_t k_stream_padding = 16;
 
+// The size of TraversalJob::op_tally for streams of up to n rays: an op count and a pass count
+// per kind (box, triangle and sphere tests) and length (0 to n).
+constexpr size_t op_tally_size(uint32_t n) {
+    return 2 * 3 * (size_t(n) + 1);
+}
+
 // Triangles a leaf_candidates call takes at most (the default leaf size).
 constexpr uint32_t k_leaf_batch = 4;
 
@@ -127,6 +133,9 @@ struct TraversalJob {
     uint32_t* positions;  // k_leaf_batch * (n + k_stream_padding)
     uint8_t* mask;
     TraceSink* sink;  // null with TraceDetail::none
+    // TraceDetail::counts: op_tally_size(n) zeros, where the traversal tallies its ops by kind
+    // and length until it sends them (TraceSink::ops_of_length); zeros again after.
+    uint32_t* op_tally;
     uint16_t generation;
     OpStage box_stage, triangle_stage, sphere_stage;  // stage_of(their kinds)
     uint64_t* leaf_tsc;                               // not null: adds the TSC ticks in leaves
@@ -199,6 +208,7 @@ TraversalJob traversal_job(const Bvh& bvh, Buffers& b) {
     job.scratch2 = b.scratch2.data();
     job.positions = b.positions.data();
     job.mask = b.mask.data();
+    job.op_tally = b.op_tally.data();
     return job;
 }
 

@@ -284,28 +284,45 @@ struct SinkReporter {
     }
 };
 
-// Tallies the one-lane ops of a traversal's one-ray subtrees per kind for a sink that reads
-// counts only (TraceDetail::counts), and sends them at the traversal's end
-// (TraceSink::one_lane_ops): one call per kind instead of one per op. A counting sink only adds
-// them up. The one count that depends on order, a generation's rays (its first box test's
-// lanes), stays the same: a traversal's first op is a wide one unless the traversal has one
-// ray, and then the tally holds all of its ops.
-struct OneLaneTally {
+// Tallies a traversal's ops by kind and length for a sink that reads counts only
+// (TraceDetail::counts) and sends them at the traversal's end (TraceSink::ops_of_length): one
+// call per kind and length instead of one per op (a path-traced frame has hundreds of thousands
+// of ops, and few lengths). The first op goes to the sink at once: a counting sink counts a
+// generation's rays from its first box test's lanes, the one count that depends on order.
+struct OpTally {
     const TraversalJob& job;
-    uint32_t count[3] = {0, 0, 0}, passed[3] = {0, 0, 0};  // box, triangle, sphere tests
+    bool first = true;
+    uint32_t longest[3] = {0, 0, 0};  // per kind: the longest op tallied
 
-    SFX_LANES_INLINE void operator()(OpKind kind, OpStage, uint32_t, const uint32_t*, uint32_t,
-                                     const uint8_t*, uint32_t pass) {
+    // job.op_tally: op counts [kind][length], then pass counts [kind][length].
+    SFX_LANES_INLINE uint32_t* ops(int k) const { return job.op_tally + size_t(k) * (job.n + 1); }
+    SFX_LANES_INLINE uint32_t* passes(int k) const { return ops(k) + 3 * (size_t(job.n) + 1); }
+
+    SFX_LANES_INLINE void operator()(OpKind kind, OpStage stage, uint32_t object, const uint32_t*,
+                                     uint32_t n, const uint8_t*, uint32_t pass) {
+        if (first) {
+            first = false;
+            job.sink->op(StreamOp{kind, stage, job.generation, object, n, pass, nullptr, nullptr});
+            return;
+        }
         const int k = kind == OpKind::box_test ? 0 : kind == OpKind::triangle_test ? 1 : 2;
-        ++count[k];
-        passed[k] += pass;
+        ++ops(k)[n];
+        passes(k)[n] += pass;
+        longest[k] = n > longest[k] ? n : longest[k];
     }
+    // Sends the tallies and zeros them.
     SFX_LANES_INLINE void send() const {
         const OpKind kinds[3] = {OpKind::box_test, OpKind::triangle_test, OpKind::sphere_test};
         const OpStage stages[3] = {job.box_stage, job.triangle_stage, job.sphere_stage};
-        for (int k = 0; k < 3; ++k)
-            if (count[k] != 0)
-                job.sink->one_lane_ops(kinds[k], stages[k], job.generation, count[k], passed[k]);
+        for (int k = 0; k < 3; ++k) {
+            uint32_t *count = ops(k), *passed = passes(k);
+            for (uint32_t n = 1; n <= longest[k]; ++n) {
+                if (count[n] == 0) continue;
+                job.sink->ops_of_length(kinds[k], stages[k], job.generation, n, count[n],
+                                        passed[n]);
+                count[n] = passed[n] = 0;
+            }
+        }
     }
 };
 
@@ -490,8 +507,8 @@ void traverse(const TraversalJob& job) {
     const BvhNode* nodes = job.nodes;
     uint32_t* ids = job.ids;
     const TraversalView view{job.rays, job.shared_origin};
-    const SinkReporter<Detail> sink{job};
-    OneLaneTally tally{job};  // TraceDetail::counts: every one-ray subtree's ops, sent at the end
+    // Where the ops go: to job.sink one by one, or (TraceDetail::counts) tallied, sent at the end.
+    std::conditional_t<Detail == TraceDetail::counts, OpTally, SinkReporter<Detail>> report{job};
     TraversalStackEntry stack[k_traversal_stack_size];
     uint32_t depth = 0;
     stack[depth++] = {job.entry, job.n};
@@ -499,11 +516,7 @@ void traverse(const TraversalJob& job) {
         const TraversalStackEntry top = stack[--depth];
         const uint32_t node_index = top.node, len = top.length;
         if (len == 1) {
-            if constexpr (Detail == TraceDetail::counts) {
-                traverse_one<Detail>(job, node_index, tally);
-            } else {
-                traverse_one<Detail>(job, node_index, sink);
-            }
+            traverse_one<Detail>(job, node_index, report);
             continue;
         }
         const BvhNode& node = nodes[node_index];
@@ -515,7 +528,7 @@ void traverse(const TraversalJob& job) {
             front = box_filter<Width>(view, node.bounds, node.axis, ids, len, job.scratch,
                                       job.scratch2, job.mask, negative);
             back = len - front;
-            sink(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
+            report(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
             __builtin_memcpy(ids, job.scratch, front * sizeof(uint32_t));
             __builtin_memcpy(ids + front, job.scratch2, back * sizeof(uint32_t));
         } else {
@@ -524,13 +537,13 @@ void traverse(const TraversalJob& job) {
             back = len - front;
             // Always, even if none passed: the whole-vector stores wrote over ids.
             __builtin_memcpy(ids + front, job.scratch, back * sizeof(uint32_t));
-            sink(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
+            report(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
         }
         const uint32_t k = front;
         if (k == 0) continue;
         if (node.is_leaf()) {
             const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<Width, Detail>(job, node, k, sink);
+            traverse_leaf<Width, Detail>(job, node, k, report);
             if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
         } else {
             // The front child by a majority of the passing rays' direction signs.
@@ -540,7 +553,7 @@ void traverse(const TraversalJob& job) {
             stack[depth++] = {right_first ? right : left, k};
         }
     }
-    if constexpr (Detail == TraceDetail::counts) tally.send();
+    if constexpr (Detail == TraceDetail::counts) report.send();
 }
 
 template <int Width>

@@ -72,6 +72,7 @@ struct Buffers {
     std::vector<SurfaceHit> surf;
     std::vector<uint32_t> ids, scratch, scratch2, positions;
     std::vector<float> sphere_t;  // the sphere filter's distances
+    std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
 };
 
 // Random rays from above the scene toward random points of it: a mix of hits on every
@@ -96,6 +97,7 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     b.positions.resize(padded);
     b.sphere_t.resize(padded);
     b.mask.resize(padded);
+    b.op_tally.assign(op_tally_size(slots), 0);
     for (uint32_t i = 0; i < slots; ++i) {
         Ray r;
         r.org = Vec3(3 * u(rng), 5.f + u(rng), 6.f + u(rng));

@@ -35,6 +35,7 @@ struct RayBuffers {
     // Id lists and masks have k_stream_padding elements of room: compress writes whole vectors.
     std::vector<uint32_t> ids, next_ids, trav_ids, scratch, scratch2, positions;
     std::vector<uint8_t> mask;
+    std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
 
     void ensure(uint32_t n) {
         if (n <= capacity) return;
@@ -57,6 +58,7 @@ struct RayBuffers {
         scratch2.resize(padded);
         positions.resize(size_t(k_leaf_batch) * padded);
         mask.resize(padded);
+        op_tally.assign(op_tally_size(n), 0);
     }
 };
 

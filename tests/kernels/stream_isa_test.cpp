@@ -181,7 +181,8 @@ TEST_CASE("A one-ray stream visits the BVH as a stream of two copies of that ray
                 leaf_ops += a.kind != OpKind::box_test;
             }
             ops_checked += one.ops.size();
-            // The counts-only path reports the same ops, batched per kind (one_lane_ops).
+            // The counts-only path reports the same ops, tallied by kind and length
+            // (ops_of_length).
             CountingSink counts({1});
             stream_intersect(bvh, {r}, one_hit, &counts, isa);
             uint64_t boxes = 0;

@@ -190,13 +190,14 @@ TEST_CASE("Counting sink: utilization = sum len / (N * sum ceil(len / N)) per st
     CHECK(sink.bounce(CountingSink::k_bounce_slots - 1).prim_lanes == 4);
 }
 
-TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add", "[stream]") {
-    // `batched` takes the sink's own one_lane_ops; `single` the base class's, which calls op()
+TEST_CASE("Counting sink: ops_of_length adds what as many op() calls add", "[stream]") {
+    // `batched` takes the sink's own ops_of_length; `single` the base class's, which calls op()
     // once per op. A generation's first op is among the batched ones (its entry test).
-    CountingSink batched({1, 8, 16}), single({1, 8, 16});
-    auto both = [&](OpKind kind, uint16_t generation, uint32_t count, uint32_t passed) {
-        batched.one_lane_ops(kind, stage_of(kind), generation, count, passed);
-        single.TraceSink::one_lane_ops(kind, stage_of(kind), generation, count, passed);
+    CountingSink batched({1, 8, 12, 16}), single({1, 8, 12, 16});
+    auto both = [&](OpKind kind, uint16_t generation, uint32_t length, uint32_t count,
+                    uint32_t passed) {
+        batched.ops_of_length(kind, stage_of(kind), generation, length, count, passed);
+        single.TraceSink::ops_of_length(kind, stage_of(kind), generation, length, count, passed);
     };
     auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
         const StreamOp o{kind, stage_of(kind), generation, k_no_object, len, pass};
@@ -204,17 +205,19 @@ TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add
         single.op(o);
     };
     for (CountingSink* s : {&batched, &single}) s->begin_pass({});
-    both(OpKind::box_test, 0, 7, 4);
+    both(OpKind::box_test, 0, 1, 7, 4);
     op(OpKind::box_test, 0, 30, 12);
-    both(OpKind::triangle_test, 0, 5, 2);
-    both(OpKind::sphere_test, 0, 0, 0);
+    both(OpKind::box_test, 0, 13, 3, 20);  // lengths 13 and 30 differ in groups and buckets
+    both(OpKind::triangle_test, 0, 1, 5, 2);
+    both(OpKind::triangle_test, 0, 17, 2, 3);
+    both(OpKind::sphere_test, 0, 1, 0, 0);
     op(OpKind::box_test, 1, 9, 9);
-    both(OpKind::box_test, 1, 11, 0);
-    both(OpKind::box_test, 2, 3, 3);
-    both(OpKind::sphere_test, 4, 6, 1);
+    both(OpKind::box_test, 1, 1, 11, 0);
+    both(OpKind::box_test, 2, 5, 3, 15);
+    both(OpKind::sphere_test, 4, 64, 6, 1);
     for (CountingSink* s : {&batched, &single}) s->end_pass({});
 
-    CHECK(batched.rays() == 1 + 9 + 1);  // each generation's first box test: its lanes
+    CHECK(batched.rays() == 1 + 9 + 5);  // each generation's first box test: its lanes
     CHECK(batched.rays() == single.rays());
     for (const bool secondary : {false, true}) {
         CHECK(batched.rays(secondary) == single.rays(secondary));
@@ -233,7 +236,7 @@ TEST_CASE("Counting sink: one_lane_ops adds what as many one-lane op() calls add
         CHECK(batched.kind_lanes(OpKind(k), true) == single.kind_lanes(OpKind(k), true));
         CHECK(batched.kind_lanes(OpKind(k), false) == single.kind_lanes(OpKind(k), false));
     }
-    CHECK(batched.kind_ops(OpKind::box_test) == 7 + 1 + 1 + 11 + 3);
+    CHECK(batched.kind_ops(OpKind::box_test) == 7 + 1 + 3 + 1 + 11 + 3);
     for (uint32_t g = 0; g < 5; ++g) {
         CHECK(batched.bounce(g).rays == single.bounce(g).rays);
         CHECK(batched.bounce(g).box_ops == single.bounce(g).box_ops);
