@@ -45,6 +45,24 @@ SFX_LANES_INLINE uint32_t compress_append(uint32_t mask_bits, vint<Width> values
                       : compress_store_exact<Width>(mask_bits, values, out);
 }
 
+// Copies n ids between two buffers inline: a filter's failing ids, most often a few (a library
+// memcpy call per op costs more than the copy). Never writes past out[n): ids past a stream
+// belong to the streams around it.
+SFX_LANES_INLINE void copy_ids(uint32_t* out, const uint32_t* in, uint32_t n) {
+    if (n >= 8) {
+        for (uint32_t i = 0; i + 8 <= n; i += 8) __builtin_memcpy(out + i, in + i, 32);
+        __builtin_memcpy(out + n - 8, in + n - 8, 32);  // the tail, overlapping
+    } else if (n >= 4) {
+        __builtin_memcpy(out, in, 16);
+        __builtin_memcpy(out + n - 4, in + n - 4, 16);
+    } else if (n >= 2) {
+        __builtin_memcpy(out, in, 8);
+        __builtin_memcpy(out + n - 2, in + n - 2, 8);
+    } else if (n == 1) {
+        out[0] = in[0];
+    }
+}
+
 // Calls group(std::integral_constant<int, W>(), g) for each group of Width ids from g = 0 while
 // g < n. A last group of at most half the width (a short stream, or a stream's tail) runs at
 // half the width (16 -> 8, 8 -> 4): half the reads and lane work on short secondary streams;
@@ -258,7 +276,7 @@ uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scr
         partition_group<decltype(width)::value>(ids, g, n - g, mask, scratch, front, back);
     });
     // Always: the whole-vector stores overwrote ids[0, n) past the passing prefix.
-    if (back != 0) std::memcpy(ids + front, scratch, back * sizeof(uint32_t));
+    copy_ids(ids + front, scratch, back);
     return front;
 }
 
@@ -529,14 +547,14 @@ void traverse(const TraversalJob& job) {
                                       job.scratch2, job.mask, negative);
             back = len - front;
             report(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
-            __builtin_memcpy(ids, job.scratch, front * sizeof(uint32_t));
-            __builtin_memcpy(ids + front, job.scratch2, back * sizeof(uint32_t));
+            copy_ids(ids, job.scratch, front);
+            copy_ids(ids + front, job.scratch2, back);
         } else {
             front = box_filter<Width>(view, node.bounds, node.axis, ids, len, ids, job.scratch,
                                       nullptr, negative);
             back = len - front;
             // Always, even if none passed: the whole-vector stores wrote over ids.
-            __builtin_memcpy(ids + front, job.scratch, back * sizeof(uint32_t));
+            copy_ids(ids + front, job.scratch, back);
             report(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
         }
         const uint32_t k = front;
