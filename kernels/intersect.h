@@ -38,7 +38,7 @@ struct RayPrecomp {
         if (dir[kz] < 0.f) std::swap(kx, ky);  // keep the winding of the triangle test
         sx = dir[kx] / dir[kz];
         sy = dir[ky] / dir[kz];
-        sz = 1.f / dir[kz];
+        sz = inv_dir[kz];  // 1.f / dir[kz], computed above
     }
 };
 
