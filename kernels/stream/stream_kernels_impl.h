@@ -518,6 +518,79 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
     }
 }
 
+// Fig. 3 from `root` for a stream of two to four rays (job.ids[0, len)) when the trace takes no
+// lanes (TraceDetail::none or counts). Short streams are most wide box ops (two or three rays in
+// 46 % of them on conference, 128 x 128, 4 spp), and there the stream loop's reads, transposes
+// and compresses cost more than the test. Here the rays' box fields are read into four lanes
+// once, and each stream on the stack is a mask of those lanes instead of a partitioned prefix
+// of ids: a stable partition keeps the passing ids in order, so a mask's lanes are the same
+// stream in the same order, and the ops, their order and the lane math are the stream loop's.
+// job.ids[0, len) is left as it was. t is read again after every leaf and one-ray subtree.
+template <int Width, TraceDetail Detail, class Report>
+SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint32_t len,
+                                   Report& report_op) {
+    static_assert(Detail != TraceDetail::lanes, "a lanes trace lists each op's slots");
+    constexpr int W = 4;
+    namespace f = traversal_field;
+    uint32_t lane_ids[W];
+    for (uint32_t l = 0; l < uint32_t(W); ++l) lane_ids[l] = job.ids[l < len ? l : 0];
+    // The ids of a leaf's stream or a one-ray subtree's ray, for the same code as the stream loop.
+    alignas(64) uint32_t stream[W + k_stream_padding];
+    TraversalJob sub = job;
+    sub.ids = stream;
+    BoxLanes<W> ray =
+        GroupReader<W>(TraversalView{job.rays}, lane_ids, active_bits<W>(len)).read_box();
+    auto read_t = [&] {
+        alignas(16) float t[W];
+        for (int l = 0; l < W; ++l) t[l] = job.rays[size_t(lane_ids[l]) * f::record + f::t];
+        __builtin_memcpy(&ray.t, t, sizeof t);
+    };
+    const vfloat<W> zero = broadcast<W>(0.f), minus_inf = broadcast<W>(-INFINITY);
+    struct Entry {
+        uint32_t node, lanes;
+    };
+    Entry stack[k_traversal_stack_size];
+    uint32_t depth = 0;
+    stack[depth++] = {root, active_bits<W>(len)};
+    while (depth != 0) {
+        const Entry top = stack[--depth];
+        const uint32_t n = uint32_t(__builtin_popcount(top.lanes));
+        if (n == 1) {
+            stream[0] = lane_ids[__builtin_ctz(top.lanes)];
+            traverse_one<Detail>(sub, top.node, report_op);
+            read_t();
+            continue;
+        }
+        const BvhNode& node = job.nodes[top.node];
+        prefetch_below(job, top.node, node);
+        vfloat<W> t0;
+        const uint32_t pass =
+            bits<W>(slab_test<W>(ray.org, ray.inv_dir, ray.t, node.bounds, t0)) & top.lanes;
+        const uint32_t k = uint32_t(__builtin_popcount(pass));
+        report_op(OpKind::box_test, job.box_stage, top.node, nullptr, n, nullptr, k);
+        if (k == 0) continue;
+        if (node.is_leaf()) {
+            uint32_t m = 0;
+            for (uint32_t b = pass; b != 0; b &= b - 1) stream[m++] = lane_ids[__builtin_ctz(b)];
+            const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
+            traverse_leaf<Width, Detail>(sub, node, k, report_op);
+            if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
+            read_t();
+            continue;
+        }
+        // The front child by a majority of the passing rays' direction signs, as box_group's.
+        const vfloat<W> inv = node.axis == 0   ? ray.inv_dir[0]
+                              : node.axis == 1 ? ray.inv_dir[1]
+                                               : ray.inv_dir[2];
+        const uint32_t negative = uint32_t(
+            __builtin_popcount(bits<W>(mask_and<vbool<W>>(inv < zero, inv != minus_inf)) & pass));
+        const bool right_first = 2 * negative > k;
+        const uint32_t left = BvhNode::left(top.node), right = node.right();
+        stack[depth++] = {right_first ? left : right, pass};  // back: popped last
+        stack[depth++] = {right_first ? right : left, pass};
+    }
+}
+
 // Fig. 3 (stream_tracer.cpp's traverse says what and why), one instruction set's width.
 template <int Width, TraceDetail Detail>
 void traverse(const TraversalJob& job) {
@@ -536,6 +609,12 @@ void traverse(const TraversalJob& job) {
         if (len == 1) {
             traverse_one<Detail>(job, node_index, report);
             continue;
+        }
+        if constexpr (Width >= 8 && Detail != TraceDetail::lanes) {
+            if (len <= 4) {
+                traverse_few<Width, Detail>(job, node_index, len, report);
+                continue;
+            }
         }
         const BvhNode& node = nodes[node_index];
         prefetch_below(job, node_index, node);
