@@ -11,21 +11,30 @@
 #include "kernels/simd/isa.h"
 #include "kernels/stream/stream_tracer.h"
 #include "kernels/trace.h"
+#include "tests/kernels/count_checks.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
+
+namespace {
+// 32 x 24, 2 spp, one thread: small enough for every scene and back end.
+RenderSettings small_frame(const Scene& scene) {
+    RenderSettings settings;
+    settings.width = 32;
+    settings.height = 24;
+    settings.spp = 2;
+    settings.max_depth = scene.max_depth;
+    settings.threads = 1;
+    return settings;
+}
+}  // namespace
 
 TEST_CASE("Every shipped scene: stream image equals the reference image bit for bit",
           "[stream][scenes]") {
     for (const std::string& name : builtin_scene_names()) {
         const Scene scene = load_scene(name);
         const Bvh bvh(scene);
-        RenderSettings settings;
-        settings.width = 32;
-        settings.height = 24;
-        settings.spp = 2;
-        settings.max_depth = scene.max_depth;
-        settings.threads = 1;
+        RenderSettings settings = small_frame(scene);
         const RenderResult ref = render_reference(scene, bvh, settings);
         for (uint32_t tile : {1u, 8u, 32u, 64u})
             for (uint32_t threads : {1u, 2u}) {
@@ -60,12 +69,7 @@ TEST_CASE("Every shipped scene: the counts-only traversal counts what the full t
     for (const std::string& name : builtin_scene_names()) {
         const Scene scene = load_scene(name);
         const Bvh bvh(scene);
-        RenderSettings settings;
-        settings.width = 32;
-        settings.height = 24;
-        settings.spp = 2;
-        settings.max_depth = scene.max_depth;
-        settings.threads = 1;
+        RenderSettings settings = small_frame(scene);
         settings.tile = 32;
         for (const Isa isa : supported_isas()) {
             INFO(name << " back end " << isa_name(isa));
@@ -75,26 +79,7 @@ TEST_CASE("Every shipped scene: the counts-only traversal counts what the full t
             REQUIRE(counts.counts_only());
             render_stream(scene, bvh, settings, &counts);
             render_stream(scene, bvh, settings, &full);
-            CHECK(counts.rays() == full.rays());
-            for (const bool secondary : {false, true})
-                for (uint32_t st = 0; st < k_op_stage_count; ++st) {
-                    const auto& a = counts.stage(secondary, OpStage(st));
-                    const auto& b = full.stage(secondary, OpStage(st));
-                    CHECK(a.ops == b.ops);
-                    CHECK(a.lanes == b.lanes);
-                    CHECK(a.passed == b.passed);
-                    CHECK(a.groups == b.groups);
-                    CHECK(a.histogram == b.histogram);
-                }
-            for (uint32_t k = 0; k < k_op_kind_count; ++k) {
-                CHECK(counts.kind_ops(OpKind(k)) == full.kind_ops(OpKind(k)));
-                CHECK(counts.kind_lanes(OpKind(k)) == full.kind_lanes(OpKind(k)));
-            }
-            for (uint32_t g = 0; g < CountingSink::k_bounce_slots; ++g) {
-                CHECK(counts.bounce(g).rays == full.bounce(g).rays);
-                CHECK(counts.bounce(g).box_lanes == full.bounce(g).box_lanes);
-                CHECK(counts.bounce(g).prim_lanes == full.bounce(g).prim_lanes);
-            }
+            test::check_same_counts(counts, full);
         }
     }
 }

@@ -9,11 +9,12 @@
 #include <fstream>
 #include <iterator>
 
+#include "base/input_error.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/stream/stream_tracer.h"
+#include "tests/kernels/count_checks.h"
 #include "tests/temp_dir.h"
-#include "base/input_error.h"
 
 using namespace sfx;
 
@@ -218,32 +219,8 @@ TEST_CASE("Counting sink: ops_of_length adds what as many op() calls add", "[str
     for (CountingSink* s : {&batched, &single}) s->end_pass({});
 
     CHECK(batched.rays() == 1 + 9 + 5);  // each generation's first box test: its lanes
-    CHECK(batched.rays() == single.rays());
-    for (const bool secondary : {false, true}) {
-        CHECK(batched.rays(secondary) == single.rays(secondary));
-        for (uint32_t st = 0; st < k_op_stage_count; ++st) {
-            const auto& a = batched.stage(secondary, OpStage(st));
-            const auto& b = single.stage(secondary, OpStage(st));
-            CHECK(a.ops == b.ops);
-            CHECK(a.lanes == b.lanes);
-            CHECK(a.passed == b.passed);
-            CHECK(a.groups == b.groups);
-            CHECK(a.histogram == b.histogram);
-        }
-    }
-    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
-        CHECK(batched.kind_ops(OpKind(k)) == single.kind_ops(OpKind(k)));
-        CHECK(batched.kind_lanes(OpKind(k), true) == single.kind_lanes(OpKind(k), true));
-        CHECK(batched.kind_lanes(OpKind(k), false) == single.kind_lanes(OpKind(k), false));
-    }
     CHECK(batched.kind_ops(OpKind::box_test) == 7 + 1 + 3 + 1 + 11 + 3);
-    for (uint32_t g = 0; g < 5; ++g) {
-        CHECK(batched.bounce(g).rays == single.bounce(g).rays);
-        CHECK(batched.bounce(g).box_ops == single.bounce(g).box_ops);
-        CHECK(batched.bounce(g).box_lanes == single.bounce(g).box_lanes);
-        CHECK(batched.bounce(g).prim_ops == single.bounce(g).prim_ops);
-        CHECK(batched.bounce(g).prim_lanes == single.bounce(g).prim_lanes);
-    }
+    test::check_same_counts(batched, single);
 }
 
 TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[stream]") {
@@ -341,24 +318,10 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CHECK(h.spp == 2);
     CHECK(replayed.passes() == direct.passes());
     CHECK(replayed.generations() == direct.generations());
-    for (bool secondary : {false, true})
-        for (OpStage st : {OpStage::traversal, OpStage::intersection, OpStage::shading}) {
-            const auto& x = replayed.stage(secondary, st);
-            const auto& y = direct.stage(secondary, st);
-            CHECK(x.ops == y.ops);
-            CHECK(x.lanes == y.lanes);
-            CHECK(x.passed == y.passed);
-            CHECK(x.groups == y.groups);
-            CHECK(x.histogram == y.histogram);
-        }
     // The direct counts took the tracer's lane-free path (CountingSink::counts_only); the file
     // was written with every slot and pass flag: the same ops either way.
     CHECK(direct.counts_only());
-    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
-        CHECK(replayed.kind_ops(OpKind(k)) == direct.kind_ops(OpKind(k)));
-        CHECK(replayed.kind_lanes(OpKind(k)) == direct.kind_lanes(OpKind(k)));
-    }
-    CHECK(replayed.rays() == direct.rays());
+    test::check_same_counts(replayed, direct);
     std::remove(p1.c_str());
     std::remove(p2.c_str());
     // A truncated file is an error, not a silent partial trace.
