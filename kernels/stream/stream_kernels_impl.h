@@ -145,6 +145,18 @@ struct GroupReader {
     }
 };
 
+// How many of the `lanes` point down the split axis, for the front-child vote: dir < 0 is
+// inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp flushes denormals, so a negative
+// normal dir has a finite inverse).
+template <int Width>
+SFX_LANES_INLINE uint32_t negative_lanes(const vfloat<Width> (&inv_dir)[3], int axis,
+                                         uint32_t lanes) {
+    const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
+    const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
+    return uint32_t(__builtin_popcount(
+        bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & lanes));
+}
+
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
 // Shared: the lanes share their origin, and `box` is relative to it.
 template <int Width, bool Shared>
@@ -165,14 +177,7 @@ SFX_LANES_INLINE void box_group(TraversalView rays, const Bounds3& box, int axis
         ray = r.read_box();
         pass = bits<Width>(slab_test<Width>(ray.org, ray.inv_dir, ray.t, box, t0)) & active;
     }
-    // dir < 0 on the split axis: inv_dir < 0, except inv_dir = -inf (dir = -0; RayPrecomp
-    // flushes denormals, so a negative normal dir has a finite inverse).
-    const vfloat<Width> inv = axis == 0   ? ray.inv_dir[0]
-                              : axis == 1 ? ray.inv_dir[1]
-                                          : ray.inv_dir[2];
-    const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
-    negatives += uint32_t(__builtin_popcount(
-        bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & pass));
+    negatives += negative_lanes<Width>(ray.inv_dir, axis, pass);
     if (mask) store_mask_bytes<Width>(pass, mask);
     const bool full = left >= uint32_t(Width);
     front += compress_append<Width>(pass, r.id, pass_out + front, full);
@@ -466,6 +471,15 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
     }
 }
 
+// traverse_leaf, its TSC ticks added to job.leaf_tsc when the caller asks for the stage clock.
+template <int Width, TraceDetail Detail, class Report>
+SFX_LANES_INLINE void timed_leaf(const TraversalJob& job, const BvhNode& node, uint32_t k,
+                                 Report& report_op) {
+    const uint64_t start = job.leaf_tsc ? __rdtsc() : 0;
+    traverse_leaf<Width, Detail>(job, node, k, report_op);
+    if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - start;
+}
+
 // What a node's test will need next arrives while the test runs: an interior node's
 // children, a leaf's primitives (four by default: 160 bytes).
 SFX_LANES_INLINE void prefetch_below(const TraversalJob& job, uint32_t node_index,
@@ -504,9 +518,7 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
         report_op(OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask, pass);
         if (!pass) continue;
         if (node.is_leaf()) {
-            const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<1, Detail>(job, node, 1, report_op);
-            if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
+            timed_leaf<1, Detail>(job, node, 1, report_op);
             continue;
         }
         // The front child by the ray's sign on the split axis, as box_group's vote.
@@ -545,7 +557,6 @@ SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint3
         for (int l = 0; l < W; ++l) t[l] = job.rays[size_t(lane_ids[l]) * f::record + f::t];
         __builtin_memcpy(&ray.t, t, sizeof t);
     };
-    const vfloat<W> zero = broadcast<W>(0.f), minus_inf = broadcast<W>(-INFINITY);
     struct Entry {
         uint32_t node, lanes;
     };
@@ -572,19 +583,12 @@ SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint3
         if (node.is_leaf()) {
             uint32_t m = 0;
             for (uint32_t b = pass; b != 0; b &= b - 1) stream[m++] = lane_ids[__builtin_ctz(b)];
-            const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<Width, Detail>(sub, node, k, report_op);
-            if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
+            timed_leaf<Width, Detail>(sub, node, k, report_op);
             read_t();
             continue;
         }
         // The front child by a majority of the passing rays' direction signs, as box_group's.
-        const vfloat<W> inv = node.axis == 0   ? ray.inv_dir[0]
-                              : node.axis == 1 ? ray.inv_dir[1]
-                                               : ray.inv_dir[2];
-        const uint32_t negative = uint32_t(
-            __builtin_popcount(bits<W>(mask_and<vbool<W>>(inv < zero, inv != minus_inf)) & pass));
-        const bool right_first = 2 * negative > k;
+        const bool right_first = 2 * negative_lanes<W>(ray.inv_dir, node.axis, pass) > k;
         const uint32_t left = BvhNode::left(top.node), right = node.right();
         stack[depth++] = {right_first ? left : right, pass};  // back: popped last
         stack[depth++] = {right_first ? right : left, pass};
@@ -639,9 +643,7 @@ void traverse(const TraversalJob& job) {
         const uint32_t k = front;
         if (k == 0) continue;
         if (node.is_leaf()) {
-            const uint64_t leaf_start = job.leaf_tsc ? __rdtsc() : 0;
-            traverse_leaf<Width, Detail>(job, node, k, report);
-            if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - leaf_start;
+            timed_leaf<Width, Detail>(job, node, k, report);
         } else {
             // The front child by a majority of the passing rays' direction signs.
             const bool right_first = 2 * negative > k;
