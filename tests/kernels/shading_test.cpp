@@ -205,3 +205,24 @@ TEST_CASE("Area light sampling: the sampling pdf equals the evaluated pdf", "[sh
     CHECK(per_prim[1] / double(n) == Approx(0.25).margin(0.01));
     CHECK(per_prim[2] / double(n) == Approx(0.5).margin(0.01));
 }
+
+TEST_CASE("Random numbers: a path's key draws the hash of (seed, pixel, sample, bounce, dim)",
+          "[shading]") {
+    // The definition, hashed in three rounds as rng.h states it; PathKey keeps the first two.
+    auto spec = [](uint64_t seed, uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t dim) {
+        uint64_t h = mix64(seed ^ 0x9e3779b97f4a7c15ull);
+        h = mix64(h ^ ((uint64_t(pixel) << 32) | sample));
+        h = mix64(h ^ ((uint64_t(bounce) << 32) | dim));
+        return float(uint32_t(h >> 32) >> 8) * (1.0f / 16777216.0f);
+    };
+    for (const uint64_t seed : {0ull, 1ull, 0xfedcba9876543210ull})
+        for (const uint32_t pixel : {0u, 7u, 65535u})
+            for (const uint32_t sample : {0u, 3u})
+                for (uint32_t bounce = 0; bounce < 3; ++bounce)
+                    for (uint32_t d = 0; d < uint32_t(RngDim::count); ++d) {
+                        const float u = PathKey(seed, pixel, sample).uniform(bounce, RngDim(d));
+                        CHECK(u == spec(seed, pixel, sample, bounce, d));
+                        CHECK(u == random_float(seed, pixel, sample, bounce, RngDim(d)));
+                    }
+    CHECK(PathKey().uniform(2, RngDim::light_u) == spec(0, 0, 0, 2, uint32_t(RngDim::light_u)));
+}
