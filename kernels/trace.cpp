@@ -101,15 +101,24 @@ uint64_t CountingSink::kind_ops(OpKind k) const {
     return sum;
 }
 
+namespace {
+// Slot 0 (generation 0 alone) for primary streams, the sum of the later slots for secondary.
+template <class PerSlot>
+uint64_t primary_or_secondary(bool secondary, uint32_t slots, PerSlot per_slot) {
+    if (!secondary) return per_slot(0u);
+    uint64_t sum = 0;
+    for (uint32_t slot = 1; slot < slots; ++slot) sum += per_slot(slot);
+    return sum;
+}
+}  // namespace
+
 uint64_t CountingSink::kind_lanes(OpKind k) const {
     return kind_lanes(k, false) + kind_lanes(k, true);
 }
 
 uint64_t CountingSink::kind_lanes(OpKind k, bool secondary) const {
-    if (!secondary) return m_kinds[0][uint32_t(k)].lanes;  // slot 0 is generation 0 alone
-    uint64_t sum = 0;
-    for (uint32_t slot = 1; slot < k_bounce_slots; ++slot) sum += m_kinds[slot][uint32_t(k)].lanes;
-    return sum;
+    return primary_or_secondary(secondary, k_bounce_slots,
+                                [&](uint32_t slot) { return m_kinds[slot][uint32_t(k)].lanes; });
 }
 
 uint64_t CountingSink::rays() const {
@@ -117,10 +126,8 @@ uint64_t CountingSink::rays() const {
 }
 
 uint64_t CountingSink::rays(bool secondary) const {
-    if (!secondary) return m_rays[0];
-    uint64_t sum = 0;
-    for (uint32_t slot = 1; slot < k_bounce_slots; ++slot) sum += m_rays[slot];
-    return sum;
+    return primary_or_secondary(secondary, k_bounce_slots,
+                                [&](uint32_t slot) { return m_rays[slot]; });
 }
 
 CountingSink::BounceCounts CountingSink::bounce(uint32_t generation) const {
