@@ -521,9 +521,8 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
             timed_leaf<1, Detail>(job, node, 1, report_op);
             continue;
         }
-        // The front child by the ray's sign on the split axis, as box_group's vote.
-        const float inv = inv_dir[node.axis];
-        const bool right_first = inv < 0.f && inv != -INFINITY;
+        // The front child by the ray's sign on the split axis: box_group's vote of one lane.
+        const bool right_first = negative_lanes<1>(inv_dir, node.axis, 1u) == 1;
         const uint32_t left = BvhNode::left(node_index), right = node.right();
         stack[depth++] = right_first ? left : right;  // back: popped last
         stack[depth++] = right_first ? right : left;
