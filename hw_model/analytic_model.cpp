@@ -168,13 +168,26 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
 FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                             const TraceProfile& profile, const TraceProfile* footprint) {
     const RayRecordLayout layout(shape.features);
-    const OpCostTable costs(layout, c.datapath);
+    const OpCostTable costs(layout, c);
+    costs.check_measured(shape.needed_kinds(), c.name);
+    // A CPU core (storage l1d): the lanes' loads, stores and compress-stores are inside the
+    // measured op costs, and so is an L1D hit on scene data.
+    const bool l1d = c.ray_buffer.storage == "l1d";
+    const double scene_hidden =
+        l1d && !c.scene_memory.caches.empty()
+            ? double(ns_to_cycles(c.scene_memory.caches.front().hit_latency_ns, c.clock.core_mhz))
+            : 0.0;
     const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
     std::vector<double> global_misses;  // per cache level, for the action counts
-    const double fetch_cycles = expected_fetch_cycles(
-        c.scene_memory, c.clock.core_mhz, footprint ? *footprint : profile, &global_misses);
+    const double fetch_cycles = std::max(
+        0.0, expected_fetch_cycles(c.scene_memory, c.clock.core_mhz,
+                                   footprint ? *footprint : profile, &global_misses) -
+                 scene_hidden);
+    const uint32_t slot_bytes = c.ray_buffer.slot_bytes ? c.ray_buffer.slot_bytes : layout.bytes();
+    const double beyond_l1 =
+        l1d ? beyond_l1_fraction(std::max(1u, shape.slots()), slot_bytes, c.ray_buffer.kib) : 0.0;
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank =
@@ -206,7 +219,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const double units = double(std::max(1u, c.simd.units));
     const double agu_rate = double(c.agu.count) * c.agu.addresses_per_cycle;
     const double occupancy = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
-    const bool programmable = c.datapath.issue == "programmable";
     for (const auto& [key, bucket] : profile.buckets()) {
         const auto& [secondary, kind, length] = key;
         if (length == 0) continue;
@@ -217,8 +229,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const uint64_t groups = (uint64_t(length) + n - 1) / n;
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
         const double gathers = double(p.gather_words.size());
-        const double busy =
-            programmable ? double(p.compute_instructions) : double(c.datapath.initiation_interval);
         // The cycle model's pipeline in closed form. Groups spread over the units; each round
         // of them costs the slowest of execution, the access side's issue, and the shared
         // address units and interconnect. An op that partitions holds the next op back: the
@@ -228,8 +238,18 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         double align = 0.0, conflict = 0.0, accesses = 0.0, round_sum = 0.0, addr_sum = 0.0,
                ic_sum = 0.0;
         double first_fetch = 0.0, scatter_addresses = 0.0, access_sum = 0.0, word_sum = 0.0;
+        double busy_sum = 0.0;  // the op's issue cycles, all groups
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
+            const double busy = p.issue_cycles(c.datapath, length, lanes,
+                                               uint32_t(std::lround(pass_rate * lanes)), g == 0,
+                                               beyond_l1);
+            busy_sum += busy;
+            if (l1d) {
+                // A CPU core: nothing besides the measured cost; the groups run back to back.
+                round_sum += busy;
+                continue;
+            }
             const RayBufferModel::Contiguous ids = buffer.access_contiguous(g * n, lanes);
             // Scatters of the passing lanes share the address units, interconnect and banks.
             const double scattering = std::round(pass_rate * lanes);
@@ -261,14 +281,18 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         }
         const double per_round = round_sum / double(groups);
         const double exec = rounds * per_round;
-        const double tail = std::max(0.0, double(p.latency_cycles) - busy) + 1.0;
+        const double busy = busy_sum / double(groups);  // the mean group's
+        const double tail =
+            l1d ? 0.0 : std::max(0.0, p.result_cycles(c.datapath, busy) - busy) + 1.0;
         double compare = 0.0, moves = 0.0, moved_ids = 0.0;
-        if (p.partitions) {
+        if (p.partitions && c.partition.kind == "compress") {
+            moved_ids = expected_moved_ids(length, pass_rate);  // written by the groups
+        } else if (p.partitions) {
             compare = std::ceil(double(length) / (double(n) * c.partition.comparators_per_lane));
             moved_ids = expected_moved_ids(length, pass_rate);
             moves = std::ceil(moved_ids / n);
         }
-        const double bubble = p.partitions ? first_fetch + tail + compare + moves : 0.0;
+        const double bubble = p.partitions && !l1d ? first_fetch + tail + compare + moves : 0.0;
         // Scene data is requested at dispatch (or prefetch_depth ops earlier): what the first
         // fetch and the earlier ops do not cover shows.
         const double memory_stall =
@@ -309,6 +333,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         stalls.interconnect += fetch_excess * ic_sum / excess_parts;
         stalls.partition += ops * units * (compare + moves);
         stalls.scene_memory += ops * units * memory_stall;
+        t.stages[secondary][uint32_t(stage_of(kind))].scene_memory_cycles +=
+            uint64_t(std::llround(ops * units * memory_stall));
         stalls.pipeline_fill += ops * units * (p.partitions ? first_fetch + tail : 0.0);
         stalls.unit_idle += ops * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
         StageTiming& stage = t.stages[secondary][uint32_t(stage_of(kind))];

@@ -29,6 +29,14 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_costs(costs),
       m_map(map),
       m_core(core_index),
+      m_l1d(config.ray_buffer.storage == "l1d"),
+      m_slot_bytes(config.ray_buffer.slot_bytes ? config.ray_buffer.slot_bytes : record_words * 4),
+      // Measured op costs were timed with their scene data in the L1D: only the latency of a
+      // farther level is the model's to add.
+      m_scene_hidden(m_l1d && !config.scene_memory.caches.empty()
+                         ? ns_to_cycles(config.scene_memory.caches.front().hit_latency_ns,
+                                        config.clock.core_mhz)
+                         : 0),
       m_layout(config.ray_buffer, record_words, slot_capacity),
       m_banks{BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer)),
               BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer))},
@@ -41,6 +49,7 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
                                            1e-9))),
       m_scene_memory(std::move(scene_memory)),
       m_unit_free(config.simd.units, 0),
+      m_unit_carry(config.simd.units, 0.0),
       m_unit_stage(config.simd.units, 0) {}
 
 const OpProfile& CoreModel::profile(uint32_t op) const {
@@ -58,6 +67,9 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_partition_free = std::max(m_partition_free, now);
     m_timing = FrameTiming();
     m_timing.passes = 1;
+    m_beyond_l1 =
+        m_l1d ? beyond_l1_fraction(pass->pass().slot_count, m_slot_bytes, m_config.ray_buffer.kib)
+              : 0.0;
 }
 
 void CoreModel::dispatch_op(uint32_t index) {
@@ -102,8 +114,9 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
         m_scene_ready[index] = 0;
         return;
     }
-    m_scene_ready[index] =
+    const uint64_t ready =
         m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
+    m_scene_ready[index] = std::max(now, ready - std::min(ready, m_scene_hidden));
 }
 
 uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,
@@ -167,6 +180,11 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     act.busy_cycles[size_t(HwUnit::agu)] += ceil_cycle(double(gathered) / m_agu.per_cycle());
     act.busy_cycles[size_t(HwUnit::interconnect)] +=
         ceil_cycle(double(gathered) / m_interconnect.per_cycle());
+    if (m_l1d) {
+        // A CPU core: the lanes' loads are part of the op's measured cost, issued with it.
+        t.data_ready = now;
+        return now;
+    }
     if (gathers == 0) {
         t.data_ready = ids_done;
         return ids_done;
@@ -205,12 +223,17 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     if (p.scene_bytes && op.object != k_no_object) e.start = std::max(e.start, m_scene_ready[t.op]);
     charge_idle(m_unit_free[unit], e.start, t, stage);
 
-    const bool programmable = m_config.datapath.issue == "programmable";
-    const uint64_t busy =
-        programmable ? p.compute_instructions : m_config.datapath.initiation_interval;
+    uint32_t passed = 0;
+    if (p.measured)
+        for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
+    // Fractional measured cycles: the unit carries the remainder to its next group.
+    const double exact = m_unit_carry[unit] + p.issue_cycles(m_config.datapath, op.length, t.lanes,
+                                                             passed, t.first == 0, m_beyond_l1);
+    const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact)));
+    m_unit_carry[unit] = exact - double(busy);
     e.issue_end = e.start + busy;
     const uint64_t result =
-        e.start + (programmable ? std::max<uint64_t>(busy, p.latency_cycles) : p.latency_cycles);
+        e.start + ceil_cycle(p.result_cycles(m_config.datapath, double(busy)));
     stage.busy_cycles += busy;
     m_unit_free[unit] = e.issue_end;
     // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
@@ -222,6 +245,12 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     act.busy_cycles[size_t(HwUnit::scratchpad)] += 1;
     m_unit_stage[unit] = uint8_t((op.generation > 0) * k_op_stage_count + uint32_t(op.stage));
 
+    if (m_l1d) {
+        // A CPU core: the mask stays in a register; stores and compress-stores are in the
+        // measured cost.
+        e.completion = result;
+        return finish_group(t, e);
+    }
     // The mask goes through the scratchpad to the partition unit.
     e.completion = m_scratchpad.serve(result, 1.0) + 1;
     // Conditional scatters of the passing lanes: into the current buffer, or the next
@@ -250,6 +279,10 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
             act.busy_cycles[size_t(HwUnit::ray_buffer)] += words;
         }
     }
+    return finish_group(t, e);
+}
+
+CoreModel::Executed CoreModel::finish_group(const GroupToken& t, Executed e) {
     m_op_completion[t.op] = std::max(m_op_completion[t.op], e.completion);
     if (--m_groups_left[t.op] == 0) {
         e.op_done = true;
@@ -282,6 +315,7 @@ void CoreModel::charge_idle(uint64_t from, uint64_t start, const GroupToken& t,
     const uint64_t data_or_idle = std::max(released, t.data_ready);
     const uint64_t scene = ready > data_or_idle ? std::min(rest, ready - data_or_idle) : 0;
     s.scene_memory += scene;
+    stage.scene_memory_cycles += scene;
     rest -= scene;
     // 4. The fetch's excess over an ideal fetch, by cause; what remains is its ideal latency.
     const uint64_t excess = t.alignment + t.conflict + t.address + t.interconnect;

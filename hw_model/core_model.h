@@ -88,6 +88,8 @@ class CoreModel {
     // Books the interconnect for `words` words ready at `ready`; returns the cycle the last
     // has crossed, and adds the cycles spent waiting for it beyond an idle interconnect.
     uint64_t cross(uint64_t ready, uint64_t words, uint64_t& wait_cycles);
+    // Records a group's completion; the op's last group marks it done.
+    Executed finish_group(const GroupToken& token, Executed e);
     void charge_idle(uint64_t idle_from, uint64_t start, const GroupToken& token,
                      StageTiming& stage);
 
@@ -95,6 +97,10 @@ class CoreModel {
     OpCostTable m_costs;
     SceneDataMap m_map;
     uint32_t m_core;
+    bool m_l1d;               // a CPU core: ray buffers behind its L1D, measured op costs
+    uint32_t m_slot_bytes;    // bytes of one ray slot (the L1D's share of a pass)
+    uint64_t m_scene_hidden;  // scene-data latency already inside measured costs (L1D hit)
+    double m_beyond_l1 = 0.0; // the current pass's share of slots beyond an l1d buffer
     RayBufferModel m_layout;
     BankSchedule m_banks[2];  // the current generation's buffer and the next one's
     CapacityServer m_agu, m_interconnect, m_scratchpad;
@@ -107,6 +113,7 @@ class CoreModel {
     std::vector<uint32_t> m_groups_left;    // per op
     std::vector<uint64_t> m_op_completion;  // per op: latest group completion so far
     std::vector<uint64_t> m_unit_free;      // per SIMD unit
+    std::vector<double> m_unit_carry;       // per SIMD unit: fractional issue cycles owed
     std::vector<uint8_t> m_unit_stage;  // per SIMD unit: [secondary * 3 + stage] of its last group
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass

@@ -220,6 +220,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     c.ray_buffer.kib = l1d;
     c.ray_buffer.banks = 1;
     c.ray_buffer.storage = "l1d";
+    c.ray_buffer.slot_bytes = h.slot_bytes;
     c.ray_buffer.line_words = (h.caches.empty() ? 64 : h.caches.front().line_bytes) / 4;
     c.partition.kind = "compress";
     c.scene_memory.caches.clear();
@@ -245,12 +246,13 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
     std::ostringstream y;
     y << "# The host CPU as a hardware configuration, written by `sfx calibrate --describe-host`.\n"
       << "# One core running the native stream tracer (kernels/stream) single-threaded; timed by\n"
-      << "# the host timing (hw_model/host_timing.h), not by the machine model of the paper.\n"
+      << "# the same machine model as the paper's machine (hw_model/core_model.h): one SIMD unit,\n"
+      << "# ray buffers behind the L1D, partition by compress, measured per-op costs.\n"
       << "version: 1\nname: host\nclock:\n"
       << "  core_mhz: " << fmt(h.tsc_mhz, 3)
       << "  # measured: TSC ticks over 0.2 s of the steady clock\n"
       << "  interconnect_mhz: " << fmt(h.tsc_mhz, 3)
-      << "  # one clock (unused by the host timing)\n"
+      << "  # one clock (unused: storage l1d has no interconnect)\n"
       << "simd:\n  width: " << h.simd_width << "  # cpuid: " << h.isa << "\n"
       << "  units: 1  # the native tracer runs its filters on one core's vector unit\n"
       << "cores:\n  count: 1  # measured single-threaded, one pinned thread\n"
@@ -260,6 +262,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  banks: 1  # no banks: the L1D serves the filters' loads (storage: l1d)\n"
       << "  line_words: " << c.ray_buffer.line_words << "  # the L1D line\n"
       << "  storage: l1d\n"
+      << "  slot_bytes: " << h.slot_bytes << "  # the native tracer's ray slot (kernels/stream)\n"
       << "partition:\n  kind: compress  # vpcompressd (AVX-512) or a permutation table (AVX2)\n"
       << "scene_memory:\n  caches:\n";
     for (size_t i = 0; i < c.scene_memory.caches.size(); ++i) {
@@ -273,7 +276,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
     y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2)
       << "  # measured: pointer chase over 256 MiB\n"
       << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
-      << "  # assumed (unused by the host timing)\n";
+      << "  # assumed: not measured; DRAM lines queue for it\n";
     y << "# Fitted: " << fit_note << "\n";
     if (op_costs.empty()) {
         y << "op_costs: []\n";

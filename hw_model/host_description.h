@@ -4,6 +4,7 @@
 // reports, its time-stamp-counter clock and measured load latencies. `sfx calibrate
 // --describe-host` writes it as host.hw.yaml, every value with where it came from; the fitted
 // per-op costs (HwConfig::op_costs) are added by the calibration (sweeps/host_calibration.h).
+// It is timed by the same machine model as every other configuration (hw_model/core_model.h).
 
 #include <cstdint>
 #include <string>
@@ -42,6 +43,7 @@ struct HostDescription {
     double tsc_mhz = 0.0;
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
+    uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
 };
 
 // Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).

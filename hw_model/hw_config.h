@@ -67,9 +67,13 @@ struct RayBufferConfig {
     uint32_t access_latency_cycles = 2;  // G&R 3.3: "Data access requires two cycles,
     bool pipelined = true;               //  but the operations are pipelined"
     std::string layout = "soa";          // G&R Fig. 5: one array per field (org_x, org_y, ...)
-    // G&R 3.3: dedicated banked SRAM. "l1d": a CPU core's ray buffers live in its L1 data
-    // cache (no banks); only the host timing (hw_model/host_timing.h) reads such a machine.
+    // G&R 3.3: dedicated banked SRAM. "l1d": a CPU core's ray buffers live in memory and its
+    // L1 data cache (kib: the L1D's size) holds what fits; the lanes' loads and stores are
+    // priced inside the measured op costs (op_costs), so an l1d machine needs them.
     std::string storage = "banks";
+    // 0: a slot is the ray record of the scene's features (hw_model/op_costs.h). l1d: the
+    // bytes one ray slot of the native tracer occupies (what the L1D must hold per ray).
+    uint32_t slot_bytes = 0;
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
@@ -87,8 +91,12 @@ struct RayBufferConfig {
                  "ray records: soa puts a field of consecutive slots in consecutive banks; aos "
                  "puts slot * record words + field word in bank (that word mod banks)");
         v.choice("storage", storage, {"banks", "l1d"},
-                 "banks: dedicated banked buffers (the machine model); l1d: the buffers live in a "
-                 "CPU core's L1 data cache (kib = its size; timed by the host timing only)");
+                 "banks: dedicated banked buffers; l1d: the buffers live in memory behind a CPU "
+                 "core's L1 data cache (kib = its size; loads priced by the measured op_costs)");
+        v.param("slot_bytes", slot_bytes, "bytes",
+                "bytes of one ray slot (0: the scene's ray record); sets the share of a pass's "
+                "slots beyond an l1d buffer",
+                0u, 1u << 16);
     }
 };
 
@@ -126,16 +134,17 @@ struct ScratchpadConfig {
 };
 
 struct PartitionConfig {
-    // G&R 3.3: "SIMD comparator units", in place. "compress": a CPU's compress instruction
-    // (vpcompressd) writes the passing ids, then the failing ones (kernels/stream).
+    // G&R 3.3: "SIMD comparator units", in place. "compress": the SIMD unit itself writes each
+    // group's passing ids, then its failing ones, as it executes the group (vpcompressd, or a
+    // permutation table on AVX2: kernels/stream); no partition pass follows the op.
     std::string kind = "in_place_compare";
     uint32_t comparators_per_lane = 1;      // G&R 3.3: SIMD comparators, i.e. one per lane
 
     template <class V>
     void visit(V& v) {
         v.choice("kind", kind, {"in_place_compare", "compress"},
-                 "partition algorithm (in_place_compare: SIMD comparators, in place; compress: a "
-                 "CPU's compress instruction, timed by the host timing only)");
+                 "partition algorithm (in_place_compare: SIMD comparators after the op, in "
+                 "place; compress: two compress-stores per group on the SIMD unit, no pass after)");
         v.param("comparators_per_lane", comparators_per_lane, "comparators/lane",
                 "mask lanes compared per cycle, per SIMD lane", 1u, 64u);
     }
@@ -227,7 +236,8 @@ struct DatapathConfig {
     }
 };
 
-// A CPU core's measured cost of one kind of stream operation (hw_model/host_timing.h), fitted
+// A CPU core's measured cost of one kind of stream operation (priced by OpProfile in
+// hw_model/op_costs.h, the one place an op is priced), fitted
 // by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
 // streams, never on frames. An op of n lanes in g = ceil(n / simd.width) groups, p passing,
 // whose ray buffer is a fraction f beyond the L1D costs
@@ -236,7 +246,7 @@ struct DatapathConfig {
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each, fitted on
 // one-ray traversals of the same synthetic scene.
-// Empty (every preset): the machine model prices ops from instruction counts instead.
+// Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
     double per_op_cycles = 0.0;
@@ -316,9 +326,10 @@ HwConfig parse_hw_config(const std::string& yaml_text, const std::string& file_n
 using HwLineMap = std::map<std::string, int>;
 void check_hw_config(const HwConfig& config, const std::string& file_name,
                      const HwLineMap& lines = {});
-// The machine model times dedicated banked buffers and the comparator partition unit; a host
-// description (ray_buffer.storage: l1d, partition.kind: compress, op_costs) is timed only by
-// the host timing (sfx calibrate --check). Throws an InputError naming the configuration.
+// What the machine model can time: ray buffers in an L1D (storage l1d) only with measured op
+// costs, which already hold the lanes' loads and stores; measured op costs only with l1d
+// storage (with banks they would count the gathers twice). Throws an InputError naming the
+// configuration and key.
 void check_machine_model_config(const HwConfig& config);
 
 // The fully resolved configuration as YAML: load(dump(c)) == c.

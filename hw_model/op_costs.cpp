@@ -1,5 +1,9 @@
 #include "hw_model/op_costs.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "base/input_error.h"
 #include "workloads/ray_layout.h"
 
 namespace sfx {
@@ -112,6 +116,51 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // add, compare, select); queues hold ray ids, as the paper allows (Sec. 3.2.3).
     set(OpKind::raygrid_walk, {"origin", "inverse_direction", "t_max"}, {"t_max"}, 47, 13, 32);
     set(OpKind::raygrid_enqueue, {"t_max"}, {}, 6, 4, 0);
+}
+
+OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
+    : OpCostTable(layout, config.datapath) {
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        OpProfile& p = m_profiles[k];
+        // Compress: the unit stores the group's passing ids, then its failing ones.
+        if (p.partitions && config.partition.kind == "compress") p.compute_instructions += 2;
+        for (const OpCostConfig& c : config.op_costs)
+            if (c.op == k_op_kinds[k].name) {
+                p.measured = true;
+                p.cost = c;
+            }
+    }
+}
+
+void OpCostTable::check_measured(const std::array<bool, k_op_kind_count>& needed,
+                                 const std::string& config_name) const {
+    bool any = false;
+    for (const OpProfile& p : m_profiles) any |= p.measured;
+    if (!any) return;
+    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        if (needed[k] && !m_profiles[k].measured)
+            throw InputError(config_name, 0, "op_costs",
+                             std::string("no measured cost for ") + k_op_kinds[k].name +
+                                 ", which this workload runs (fit it with sfx calibrate "
+                                 "--describe-host)");
+}
+
+double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_t lanes,
+                               uint32_t passed, bool first, double beyond_l1) const {
+    if (!measured)
+        return d.issue == "programmable" ? double(compute_instructions)
+                                         : double(d.initiation_interval);
+    // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
+    if (length == 1 && cost.one_lane_cycles > 0) return cost.one_lane_cycles;
+    return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
+           cost.per_lane_cycles * lanes + cost.per_pass_cycles * passed +
+           cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
+}
+
+double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
+    if (measured) return issue;
+    return d.issue == "programmable" ? std::max(issue, double(latency_cycles))
+                                     : double(latency_cycles);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {

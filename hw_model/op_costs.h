@@ -2,9 +2,9 @@
 // What each kind of stream operation asks of the hardware: which ray-record words it gathers
 // for every lane, which it scatters for the lanes that pass, how many SIMD compute instructions
 // it issues per lane group, which datapath latency it pays, what scene data it fetches, and
-// whether its mask partitions the stream. Counting lives here; costing (cycles) lives in the
-// models that read this table, so the analytic and cycle-level models cannot disagree about
-// the work, only about its price.
+// whether its mask partitions the stream; or, on a CPU core, what the op's kind was measured to
+// cost (HwConfig::op_costs). This is the one place a lane group's issue cycles are priced
+// (OpProfile::issue_cycles); the models decide when a group issues and what it waits for.
 
 #include <array>
 #include <cstdint>
@@ -42,12 +42,34 @@ struct OpProfile {
     uint32_t scene_bytes = 0;             // scene data fetched once per op (broadcast operand)
     bool partitions = false;              // the mask partitions the stream in place (op table)
     bool pushes_rays = false;             // passing lanes write the next generation (op table)
+    // A CPU core's fitted cost of this kind (HwConfig::op_costs): it replaces the instruction
+    // count and chain, and holds the lanes' loads, stores and compress-stores.
+    bool measured = false;
+    OpCostConfig cost;
+
+    // Cycles a SIMD unit spends issuing one group of `lanes` lanes, `passed` of them passing,
+    // of an op of `length` lanes (`first`: the op's first group, which carries a measured
+    // per-op cost), with a share `beyond_l1` of the pass's ray slots outside an l1d buffer.
+    // Fractional for measured costs (the caller carries the remainder); instruction-priced
+    // groups cost compute_instructions (programmable) or the initiation interval (pipelined).
+    double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t lanes,
+                        uint32_t passed, bool first, double beyond_l1) const;
+    // Cycles from a group's first issue to its mask: the measured cost (its loads and chain are
+    // inside it) or the datapath's dependent chain.
+    double result_cycles(const DatapathConfig& datapath, double issue) const;
 };
 
 // One profile per OpKind for a scene's layout and a configuration's datapath.
 class OpCostTable {
   public:
     OpCostTable(const RayRecordLayout& layout, const DatapathConfig& datapath);
+    // With the configuration's partition (compress adds its two compress-stores per group to
+    // the instruction count) and measured op costs.
+    OpCostTable(const RayRecordLayout& layout, const HwConfig& config);
+    // A kind the workload can emit (`needed`) without a measured cost on a configuration that
+    // has measured costs: throws InputError naming the configuration and the kind.
+    void check_measured(const std::array<bool, k_op_kind_count>& needed,
+                        const std::string& config_name) const;
     const OpProfile& operator[](OpKind kind) const { return m_profiles[size_t(kind)]; }
 
   private:

@@ -104,6 +104,7 @@ struct StageTiming {
     uint64_t groups = 0;       // lane groups issued: sum of ceil(len / width)
     uint64_t busy_cycles = 0;  // unit-cycles issuing work (no stalls)
     uint64_t stall_cycles = 0;
+    uint64_t scene_memory_cycles = 0;  // of the stalls, waiting for scene data
 
     template <class A, class B, class F>
     static void visit(A& a, B& b, F&& f) {
@@ -116,6 +117,9 @@ struct StageTiming {
           b.busy_cycles);
         f(CounterInfo("stall_cycles", "cycles", "unit-cycles stalled"), a.stall_cycles,
           b.stall_cycles);
+        f(CounterInfo("scene_memory_cycles", "cycles",
+                      "unit-cycles stalled waiting for scene data (part of stall_cycles)"),
+          a.scene_memory_cycles, b.scene_memory_cycles);
     }
     StageTiming& operator+=(const StageTiming& o);
 };

@@ -59,6 +59,10 @@ uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length) {
 PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint32_t length,
                              uint32_t moved_ids) {
     PartitionCost p;
+    p.moved_ids = moved_ids;
+    // Compress: the SIMD unit wrote each group's ids as it executed it (OpCostTable counts
+    // those instructions); nothing is left for a partition pass.
+    if (config.kind == "compress") return p;
     const uint64_t per_cycle = uint64_t(width) * config.comparators_per_lane;
     p.compare_cycles = (uint64_t(length) + per_cycle - 1) / per_cycle;
     p.moved_ids = moved_ids;
@@ -69,6 +73,11 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint
 PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, const uint8_t* passed,
                              uint32_t length) {
     return partition_cost(config, width, length, stable_partition_moves(passed, length));
+}
+
+double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib) {
+    const double bytes = double(slots) * slot_bytes;
+    return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(l1d_kib) * 1024.0 / bytes);
 }
 
 }  // namespace sfx

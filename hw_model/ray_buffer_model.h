@@ -106,4 +106,8 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint
                              uint32_t moved_ids);
 uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 
+// Ray buffers in a CPU core's L1D (storage l1d): the share of `slots` slots of `slot_bytes`
+// that an L1D of `l1d_kib` cannot hold; a random lane misses it with that probability.
+double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
+
 }  // namespace sfx

@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "hw_model/op_costs.h"
+#include "hw_model/ray_buffer_model.h"
 #include "kernels/stream/stream_tracer.h"
+#include "sweeps/point_group.h"
 
 namespace sfx {
 
@@ -26,6 +28,7 @@ HostCalibration calibrate_host(Isa isa, uint32_t repeats,
     HostCalibration c;
     const Isa resolved = resolve_isa(isa);
     c.host = describe_host(isa_width(resolved), describe_isa(resolved));
+    c.host.slot_bytes = stream_slot_bytes();
     MicrobenchOptions options;
     options.isa = resolved;
     options.repeats = repeats;
@@ -74,21 +77,19 @@ SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, Rende
                                        const HwConfig& host, uint32_t repeats) {
     settings.threads = 1;
     SiliconMeasurement m;
-    {  // The prediction, from the trace of the same render.
+    {  // The prediction: the machine model at full fidelity on the trace of the same render,
+       // through the path sfx simulate takes.
         settings.stage_clock = false;
-        SceneDataMap map;
-        map.nodes = bvh.nodes().size();
-        map.triangles = scene.triangles.size();
-        map.spheres = scene.spheres.size();
-        const OpCostTable profiles(RayRecordLayout(scene.features()), host.datapath);
-        HostTiming timing(host, map, profiles, stream_slot_bytes());
-        render_stream(scene, bvh, settings, &timing);
-        const HostTimingResult& r = timing.result();
-        for (int s = 0; s < 3; ++s) {
-            m.predicted_stage[size_t(s)] = r.stage_cycles[size_t(s)];
-            m.predicted_memory[size_t(s)] = r.scene_memory_cycles[size_t(s)];
-        }
-        m.predicted_frame = r.frame_cycles();
+        const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full);
+        m.prediction = r.predictions.front();
+        const FrameTiming& t = m.prediction.timing;
+        for (int s = 0; s < 3; ++s)
+            for (int secondary = 0; secondary < 2; ++secondary) {
+                const StageTiming& st = t.stages[secondary][s];
+                m.predicted_stage[size_t(s)] += double(st.busy_cycles + st.stall_cycles);
+                m.predicted_memory[size_t(s)] += double(st.scene_memory_cycles);
+            }
+        m.predicted_frame = double(t.cycles);
     }
     // The measurement: unclocked and stage-clocked renders alternate, so drift in the machine's
     // load touches both alike. The TSC counts while the thread is descheduled too, and on a

@@ -1,8 +1,9 @@
 #pragma once
 // The host CPU as a hardware configuration, validated on silicon: describe the host and fit its
 // per-op costs on microbenchmarks of the native filters (never on frames), then, for a held-out
-// workload, predict the native stream tracer's single-thread cycles from the trace of the same
-// render (hw_model/host_timing.h) and measure them (TSC, trace off, one pinned thread).
+// workload, predict the native stream tracer's single-thread cycles with the machine model on
+// the trace of the same render (run_point_group at full fidelity, as sfx simulate) and measure
+// them (TSC, trace off, one pinned thread).
 
 #include <array>
 #include <cstdint>
@@ -11,7 +12,8 @@
 #include <vector>
 
 #include "hw_model/host_description.h"
-#include "hw_model/host_timing.h"
+#include "hw_model/op_cost_fit.h"
+#include "hw_model/prediction.h"
 #include "kernels/bvh.h"
 #include "kernels/render.h"
 #include "kernels/stream/stream_microbench.h"
@@ -42,6 +44,7 @@ HostCalibration calibrate_host(Isa isa, uint32_t repeats,
 bool pin_to_current_cpu();
 
 struct SiliconMeasurement {
+    Prediction prediction;                     // the machine model's, whole
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses
     double predicted_frame = 0.0;

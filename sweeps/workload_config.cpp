@@ -155,7 +155,9 @@ uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwCo
     const uint64_t bytes_per_ray = ray_record_bytes(features);
     uint64_t smallest = UINT64_MAX;
     for (const HwConfig& c : configs)
-        smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
+        if (c.ray_buffer.storage == "banks")  // l1d: the buffers live in memory, any size
+            smallest = std::min<uint64_t>(smallest, uint64_t(c.ray_buffer.kib) * 1024);
+    if (smallest == UINT64_MAX) return 64;  // the tracer's default tile
     return uint32_t(std::sqrt(double(smallest / bytes_per_ray)));
 }
 
@@ -163,7 +165,7 @@ void check_tile_fits(uint32_t tile, const FeatureSet& features,
                      const std::vector<HwConfig>& configs, const std::string& key) {
     const uint64_t need = uint64_t(tile) * tile * ray_record_bytes(features);
     for (const HwConfig& c : configs)
-        if (need > uint64_t(c.ray_buffer.kib) * 1024)
+        if (c.ray_buffer.storage == "banks" && need > uint64_t(c.ray_buffer.kib) * 1024)
             throw InputError("command line", 0, key,
                              "a " + std::to_string(tile) + "x" + std::to_string(tile) +
                                  " stream needs " + std::to_string((need + 1023) / 1024) +

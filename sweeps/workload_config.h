@@ -111,10 +111,11 @@ struct WorkloadColumn {
 std::vector<WorkloadColumn> workload_columns(const WorkloadConfig& w);
 
 // The largest tile whose stream fits every configuration's ray buffer: tile^2 * bytes per ray
-// <= buffer bytes.
+// <= buffer bytes. A CPU core's buffers (storage l1d) live in memory and fit any tile; with
+// only those, 64.
 uint32_t largest_fitting_tile(const FeatureSet& features, const std::vector<HwConfig>& configs);
-// Checks a tile against every configuration; throws InputError(key) if one cannot hold the
-// stream.
+// Checks a tile against every configuration with banked buffers; throws InputError(key) if one
+// cannot hold the stream.
 void check_tile_fits(uint32_t tile, const FeatureSet& features,
                      const std::vector<HwConfig>& configs, const std::string& key);
 

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <map>
 
+#include "hw_model/ray_buffer_model.h"
 #include "kernels/bvh.h"
 #include "workloads/scene_loader.h"
 
@@ -14,7 +15,8 @@ using namespace sfx;
 TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame", "[host]") {
     // A quick fit: few points, one repetition (scripts/silicon-check fits properly).
     const Isa isa = resolve_isa(Isa::automatic);
-    const HostDescription host = describe_host(isa_width(isa), describe_isa(isa));
+    HostDescription host = describe_host(isa_width(isa), describe_isa(isa));
+    host.slot_bytes = stream_slot_bytes();
     MicrobenchOptions o;
     o.isa = isa;
     o.buffer_slots = {64, 256};

@@ -1,71 +1,29 @@
-#include "hw_model/host_timing.h"
+#include "hw_model/op_cost_fit.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "hw_model/op_costs.h"
+
 namespace sfx {
 
-double host_op_cycles(const OpCostConfig& c, uint32_t width, uint32_t lanes, uint32_t passed,
-                      double beyond_l1) {
-    if (lanes == 1 && c.one_lane_cycles > 0) return c.one_lane_cycles;
-    const double groups = double((lanes + width - 1) / width);
-    return c.per_op_cycles + c.per_group_cycles * groups + c.per_lane_cycles * lanes +
-           c.per_pass_cycles * passed + c.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
-}
-
-double beyond_l1_fraction(uint32_t slots, uint32_t record_bytes, uint32_t l1d_kib) {
-    const double bytes = double(slots) * record_bytes;
-    return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(l1d_kib) * 1024.0 / bytes);
-}
-
-HostTiming::HostTiming(const HwConfig& config, const SceneDataMap& scene,
-                       const OpCostTable& profiles, uint32_t record_bytes)
-    : m_config(config), m_scene(scene), m_profiles(profiles), m_record_bytes(record_bytes) {
-    for (const OpCostConfig& c : m_config.op_costs)
-        for (uint32_t k = 0; k < k_op_kind_count; ++k)
-            if (c.op == k_op_kinds[k].name) m_costs[k] = &c;
-    const std::vector<CacheLevelConfig>& levels = m_config.scene_memory.caches;
-    const double l1_ns = levels.empty() ? 0.0 : levels.front().hit_latency_ns;
-    const double mhz = m_config.clock.core_mhz;
-    for (const CacheLevelConfig& l : levels) {
-        m_caches.emplace_back(l);
-        m_extra_cycles.push_back((l.hit_latency_ns - l1_ns) * mhz / 1000.0);
+double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes,
+                          uint32_t passed, double beyond_l1) {
+    OpProfile p;
+    p.measured = true;
+    p.cost = cost;
+    const DatapathConfig datapath;  // unused by measured costs
+    double cycles = 0.0;
+    // The passing lanes go to the first groups (the sum is linear in them: any split prices
+    // the same).
+    for (uint32_t first = 0, left = passed; first < lanes; first += width) {
+        const uint32_t n = std::min(width, lanes - first);
+        const uint32_t pass = std::min(n, left);
+        left -= pass;
+        cycles += p.issue_cycles(datapath, lanes, n, pass, first == 0, beyond_l1);
     }
-    m_extra_cycles.push_back((m_config.scene_memory.dram_latency_ns - l1_ns) * mhz / 1000.0);
-}
-
-void HostTiming::begin_pass(const TilePass& pass) {
-    m_beyond_l1 = beyond_l1_fraction(pass.slot_count, m_record_bytes, m_config.ray_buffer.kib);
-    ++m_result.passes;
-}
-
-void HostTiming::op(const StreamOp& op) {
-    const OpCostConfig* cost = m_costs[size_t(op.kind)];
-    if (!cost)
-        throw std::invalid_argument(std::string("the host configuration has no op_costs entry "
-                                                "for ") +
-                                    to_string(op.kind) + " (run sfx calibrate --describe-host)");
-    double cycles =
-        host_op_cycles(*cost, m_config.simd.width, op.length, op.pass_count, m_beyond_l1);
-    const uint32_t bytes = m_profiles[op.kind].scene_bytes;
-    double memory = 0.0;
-    if (bytes && op.object != k_no_object && !m_caches.empty()) {
-        const uint64_t address = m_scene.address(op.kind, op.object);
-        const uint32_t line = m_caches.front().config().line_bytes;
-        double worst = 0.0;  // the op waits for its slowest line
-        for (uint64_t a = address / line * line; a < address + bytes; a += line) {
-            size_t level = 0;
-            while (level < m_caches.size() && !m_caches[level].access(a)) ++level;
-            worst = std::max(worst, m_extra_cycles[level]);
-        }
-        memory = worst;
-    }
-    const size_t stage = size_t(op.stage);
-    m_result.stage_cycles[stage] += cycles + memory;
-    m_result.scene_memory_cycles[stage] += memory;
-    m_result.kind_cycles[size_t(op.kind)] += cycles + memory;
-    ++m_result.ops;
+    return cycles;
 }
 
 namespace {
@@ -219,7 +177,7 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
     std::vector<double> e;
     for (const OpCostSample& s : samples)
         e.push_back(
-            std::abs(host_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) - s.cycles) /
+            std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) - s.cycles) /
             std::max(s.cycles, k_resolution));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());

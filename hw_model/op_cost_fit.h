@@ -1,0 +1,56 @@
+#pragma once
+// A CPU core's per-op costs (HwConfig::op_costs) fitted on microbenchmarks of the native filters
+// (kernels/stream/stream_microbench.h), never on frames. The costs are priced where every op is
+// priced, OpProfile::issue_cycles (hw_model/op_costs.h); the fit's error is measured through it.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hw_model/hw_config.h"
+#include "kernels/trace.h"
+
+namespace sfx {
+
+// An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
+// `beyond_l1` of the ray slots outside the L1D; one lane: one_lane_cycles when measured).
+double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes,
+                          uint32_t passed, double beyond_l1);
+
+// One microbenchmark run of an op kind: what the cost formula sees, and the cycles measured.
+struct OpCostSample {
+    uint32_t lanes = 0, passed = 0;
+    double beyond_l1 = 0.0;
+    double cycles = 0.0;  // per op
+};
+
+// Fits an op kind's cost profile to its samples: least squares on relative error, every
+// coefficient non-negative (a negative one is dropped and the rest refitted). Throws
+// std::invalid_argument on no samples.
+OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
+                         const std::vector<OpCostSample>& samples);
+
+// The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
+// measured, a measurement under 100 cycles counting as 100 (the clock's steps).
+std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
+                                    const std::vector<OpCostSample>& samples);
+
+// One-ray traversals timed together (kernels/stream/stream_microbench.h): how many one-lane ops
+// of each kind they made, and the cycles they took.
+struct OneLaneSample {
+    std::array<uint64_t, k_op_kind_count> ops{};
+    double cycles = 0.0;
+};
+
+// The one-lane cost of every kind the samples make (OpCostConfig::one_lane_cycles; 0 for the
+// rest): least squares on relative error, non-negative as in fit_op_cost. Throws
+// std::invalid_argument on no samples.
+std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLaneSample>& samples);
+
+// That fit's (median, worst) relative error on its own samples.
+std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
+                                             const std::vector<OneLaneSample>& samples);
+
+}  // namespace sfx

@@ -1,0 +1,278 @@
+// The host CPU as a configuration of the machine model: measured op costs priced where every op
+// is priced (OpProfile), their fit, scene-data latency through the host's caches, and the host
+// configuration's knobs (storage l1d, slot_bytes, partition by compress, op_costs).
+
+#include "hw_model/op_cost_fit.h"
+
+#include <catch2/catch.hpp>
+
+#include "hw_model/host_description.h"
+#include "hw_model/op_costs.h"
+#include "hw_model/ray_buffer_model.h"
+#include "hw_model/systemc/systemc_timing.h"
+#include "base/input_error.h"
+
+using namespace sfx;
+
+namespace {
+
+OpCostConfig cost(const char* op, double per_op, double group, double lane, double pass,
+                  double beyond) {
+    OpCostConfig c;
+    c.op = op;
+    c.per_op_cycles = per_op;
+    c.per_group_cycles = group;
+    c.per_lane_cycles = lane;
+    c.per_pass_cycles = pass;
+    c.beyond_l1_per_lane_cycles = beyond;
+    return c;
+}
+
+HostDescription small_host() {
+    HostDescription h;
+    h.simd_width = 16;
+    h.isa = "avx512 (16 lanes)";
+    h.tsc_mhz = 1000.0;  // 1 cycle per ns
+    h.caches = {{1, "data", 32, 64, 8, false, "test"}, {2, "unified", 256, 64, 8, false, "test"}};
+    h.latency_ns = {1.0, 5.0, 81.0};
+    h.slot_bytes = 64;
+    return h;
+}
+
+// A host configuration with a cost for every op kind: `costs` as given, the rest free.
+HwConfig host_with(std::vector<OpCostConfig> costs) {
+    for (const OpKindInfo& k : k_op_kinds) {
+        bool given = false;
+        for (const OpCostConfig& c : costs) given |= c.op == k.name;
+        if (!given) costs.push_back(cost(k.name, 0, 0, 0, 0, 0));
+    }
+    return host_hw_config(small_host(), costs);
+}
+
+WorkloadShape shape() {
+    WorkloadShape s;
+    s.features.triangles = true;
+    s.features.lambertian = true;
+    s.features.light_count = 1;
+    s.triangles = 100;
+    s.bvh_nodes = 64;
+    s.tile = 8;
+    return s;
+}
+
+// One box test of `lanes` lanes (all passing) on node `node`, per pass, in passes of `slots`
+// ray slots, timed by the machine model.
+FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes,
+                       uint32_t slots = 64, uint32_t node = 3) {
+    SystemcTiming timing({config}, shape());
+    std::vector<uint32_t> ids(lanes);
+    for (uint32_t i = 0; i < lanes; ++i) ids[i] = i;
+    std::vector<uint8_t> passed(lanes, 1);
+    for (uint32_t p = 0; p < passes; ++p) {
+        TilePass pass;
+        pass.slot_count = slots;
+        timing.begin_pass(pass);
+        StreamOp box;
+        box.kind = OpKind::box_test;
+        box.stage = OpStage::traversal;
+        box.object = node;
+        box.length = lanes;
+        box.pass_count = lanes;
+        box.slots = ids.data();
+        box.passed = passed.data();
+        timing.op(box);
+        timing.end_pass(pass);
+    }
+    return timing.timing(0);
+}
+
+}  // namespace
+
+TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]") {
+    const OpCostConfig c = cost("box_test", 10, 4, 0.5, 2, 8);
+    // 40 lanes: 3 groups of 16; 10 pass; half the buffer beyond the L1D.
+    CHECK(measured_op_cycles(c, 16, 40, 10, 0.5) == Approx(10 + 12 + 20 + 20 + 160));
+    CHECK(measured_op_cycles(c, 8, 40, 10, 0.0) == Approx(10 + 20 + 20 + 20));
+    // The machine model prices a group where the fit does: the first carries the per-op cost.
+    OpProfile p;
+    p.measured = true;
+    p.cost = c;
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 16, 3, true, 0.0) == Approx(10 + 4 + 8 + 6));
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 8, 0, false, 0.5) == Approx(4 + 4 + 32));
+    CHECK(p.result_cycles(DatapathConfig{}, 12.5) == 12.5);
+    CHECK(beyond_l1_fraction(256, 64, 32) == 0.0);   // 16 KiB in 32 KiB
+    CHECK(beyond_l1_fraction(1024, 64, 32) == 0.5);  // 64 KiB
+    CHECK(beyond_l1_fraction(0, 64, 32) == 0.0);
+
+    // A one-lane op runs in the one-ray loop: its own measured cost, when there is one.
+    OpCostConfig one = c;
+    CHECK(measured_op_cycles(one, 16, 1, 1, 0.5) == Approx(10 + 4 + 0.5 + 2 + 4));
+    one.one_lane_cycles = 7;
+    CHECK(measured_op_cycles(one, 16, 1, 1, 0.5) == Approx(7));
+    CHECK(measured_op_cycles(one, 16, 1, 0, 0.0) == Approx(7));
+    CHECK(measured_op_cycles(one, 16, 2, 1, 0.0) == Approx(10 + 4 + 1 + 2));
+}
+
+TEST_CASE("The fit recovers costs from exact samples and never goes negative", "[host]") {
+    const OpCostConfig truth = cost("triangle_test", 30, 12, 0, 40, 3);
+    std::vector<OpCostSample> samples;
+    for (uint32_t lanes : {1u, 7u, 16u, 33u, 100u, 512u, 4096u})
+        for (double beyond : {0.0, 0.75})
+            for (uint32_t passed : {0u, lanes / 3})
+                samples.push_back(
+                    {lanes, passed, beyond, measured_op_cycles(truth, 16, lanes, passed, beyond)});
+    const OpCostConfig fit = fit_op_cost("triangle_test", 16, samples);
+    CHECK(fit.per_op_cycles == Approx(30).epsilon(1e-6));
+    CHECK(fit.per_group_cycles == Approx(12).epsilon(1e-6));
+    CHECK(fit.per_lane_cycles == Approx(0).margin(1e-6));
+    CHECK(fit.per_pass_cycles == Approx(40).epsilon(1e-6));
+    CHECK(fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
+    CHECK(fit_error(fit, 16, samples).second < 1e-9);
+
+    // Cycles that fall with length cannot be fitted by non-negative costs: the fit clamps.
+    std::vector<OpCostSample> falling = {{1, 0, 0, 100}, {16, 0, 0, 50}, {256, 0, 0, 10}};
+    const OpCostConfig f = fit_op_cost("miss_filter", 16, falling);
+    for (double v : {f.per_op_cycles, f.per_group_cycles, f.per_lane_cycles, f.per_pass_cycles,
+                     f.beyond_l1_per_lane_cycles})
+        CHECK(v >= 0.0);
+    CHECK_THROWS_AS(fit_op_cost("box_test", 16, {}), std::invalid_argument);
+}
+
+TEST_CASE("The one-lane fit recovers each kind's cost from traversals that mix them",
+          "[host]") {
+    auto sample = [](uint64_t boxes, uint64_t triangles, uint64_t spheres, double cycles) {
+        OneLaneSample s;
+        s.ops[size_t(OpKind::box_test)] = boxes;
+        s.ops[size_t(OpKind::triangle_test)] = triangles;
+        s.ops[size_t(OpKind::sphere_test)] = spheres;
+        s.cycles = cycles;
+        return s;
+    };
+    std::vector<OneLaneSample> samples;
+    for (uint64_t b : {7u, 23u, 130u})
+        for (uint64_t t : {0u, 2u, 12u})
+            for (uint64_t s : {0u, 1u, 5u})
+                samples.push_back(sample(b, t, s, 30.0 * b + 90.0 * t + 40.0 * s));
+    const auto fit = fit_one_lane_cycles(samples);
+    CHECK(fit[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::triangle_test)] == Approx(90).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::sphere_test)] == Approx(40).epsilon(1e-6));
+    CHECK(fit[size_t(OpKind::camera)] == 0.0);  // never made: no cost
+    CHECK(one_lane_fit_error(fit, samples).second < 1e-9);
+    // A wrong cost shows in the error: 10 % off on the boxes.
+    auto off = fit;
+    off[size_t(OpKind::box_test)] *= 1.1;
+    CHECK(one_lane_fit_error(off, samples).second > 0.05);
+    CHECK_THROWS_AS(fit_one_lane_cycles({}), std::invalid_argument);
+}
+
+TEST_CASE("The machine model times a host: measured costs, scene data beyond the L1D",
+          "[host][systemc]") {
+    const HwConfig host = host_with({cost("box_test", 10, 4, 0, 0, 8)});
+    // One box test of 20 lanes (groups of 16 and 4) on node 3, first touched: the line comes
+    // from DRAM (81 ns at 1 GHz, then 64 bytes at 25.6 B/cycle: ready at cycle 84), less the
+    // L1D hit the measured cost already holds (1): the unit waits 83 cycles, then issues
+    // 10 + 4 and 4 cycles. A second pass finds the node in the L1D: 18 cycles.
+    const FrameTiming one = time_boxes(host, 1, 20);
+    CHECK(one.cycles == 83 + 18);
+    CHECK(one.stalls.scene_memory == 83);
+    CHECK(one.stages[0][size_t(OpStage::traversal)].scene_memory_cycles == 83);
+    CHECK(one.stages[0][size_t(OpStage::traversal)].busy_cycles == 18);
+    const FrameTiming two = time_boxes(host, 2, 20);
+    CHECK(two.cycles == 83 + 18 + 18);
+    CHECK(two.stalls.scene_memory == 83);
+    // Compress partitions inside the groups: no partition pass, no partition stall.
+    CHECK(two.stalls.partition == 0);
+    CHECK(two.actions.busy_cycles[size_t(HwUnit::partition)] == 0);
+
+    // 4096 slots of 64 bytes (256 KiB) behind a 32 KiB L1D: 7/8 of the lanes beyond it, at 8
+    // cycles each: 20 * 7/8 * 8 = 140 more issue cycles.
+    CHECK(time_boxes(host, 1, 20, 4096).cycles == 83 + 18 + 140);
+
+    // A one-ray stream costs its one-lane cost.
+    HwConfig one_lane = host;
+    for (OpCostConfig& c : one_lane.op_costs)
+        if (c.op == "box_test") c.one_lane_cycles = 7;
+    CHECK(time_boxes(one_lane, 2, 1).cycles == 83 + 7 + 7);
+}
+
+TEST_CASE("Each host knob moves the prediction the way it should", "[host][systemc]") {
+    const HwConfig base = host_with({cost("box_test", 10, 4, 1, 0, 8)});
+    const uint64_t cycles = time_boxes(base, 3, 40, 4096).cycles;
+    auto with = [&](auto change) {
+        HwConfig c = base;
+        change(c);
+        return time_boxes(c, 3, 40, 4096).cycles;
+    };
+    CHECK(with([](HwConfig& c) { c.scene_memory.dram_latency_ns = 200; }) > cycles);
+    CHECK(with([](HwConfig& c) { c.ray_buffer.kib = 128; }) < cycles);       // a bigger L1D
+    CHECK(with([](HwConfig& c) { c.ray_buffer.slot_bytes = 128; }) > cycles);  // fatter slots
+    CHECK(with([](HwConfig& c) { c.op_costs[0].per_lane_cycles = 2; }) > cycles);
+    CHECK(with([](HwConfig& c) { c.simd.width = 8; }) > cycles);  // more groups
+    CHECK(with([](HwConfig& c) { c.scene_memory.caches[0].hit_latency_ns = 3; }) < cycles);
+}
+
+TEST_CASE("A host needs a measured cost for every kind its workload runs", "[host]") {
+    HwConfig host = host_hw_config(small_host(), {cost("box_test", 1, 1, 1, 0, 0)});
+    CHECK_THROWS_WITH(SystemcTiming({host}, shape()), Catch::Contains("op_costs") &&
+                                                          Catch::Contains("no measured cost"));
+    CHECK_THROWS_WITH(check_machine_model_config(host_hw_config(small_host(), {})),
+                      Catch::Contains("needs measured op costs"));
+    HwConfig banked;  // gr08 with measured costs: the gathers would be priced twice
+    banked.op_costs = {cost("box_test", 1, 1, 1, 0, 0)};
+    CHECK_THROWS_WITH(check_machine_model_config(banked), Catch::Contains("storage l1d"));
+    CHECK_NOTHROW(check_machine_model_config(host_with({})));
+}
+
+TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
+    OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
+    box.one_lane_cycles = 6;
+    const std::string yaml = host_hw_yaml(small_host(), {box}, "test samples");
+    const HwConfig c = parse_hw_config(yaml, "host.hw.yaml");
+    CHECK(c.ray_buffer.storage == "l1d");
+    CHECK(c.ray_buffer.kib == 32);
+    CHECK(c.partition.kind == "compress");
+    CHECK(c.simd.width == 16);
+    CHECK(c.simd.units == 1);
+    CHECK(c.clock.core_mhz == Approx(1000));
+    REQUIRE(c.scene_memory.caches.size() == 2);
+    CHECK(c.scene_memory.caches[1].hit_latency_ns == Approx(5));
+    CHECK(c.scene_memory.dram_latency_ns == Approx(81));
+    REQUIRE(c.op_costs.size() == 1);
+    CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
+    CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
+    // A host file written before one-lane costs were measured: the formula for every op.
+    CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
+                          "old.hw.yaml")
+              .op_costs[0]
+              .one_lane_cycles == 0.0);
+    // The presets carry no op costs, so the store gains no columns from them.
+    CHECK(HwConfig().op_costs.empty());
+
+    try {
+        parse_hw_config("version: 1\nop_costs:\n  - {op: box_tset}\n", "bad.hw.yaml");
+        FAIL("no error for an unknown op kind");
+    } catch (const InputError& e) {
+        CHECK_THAT(e.what(), Catch::Contains("bad.hw.yaml:3") && Catch::Contains("op_costs[0].op"));
+    }
+    CHECK_THROWS_AS(parse_hw_config("version: 1\nop_costs:\n  - {op: camera}\n  - {op: camera}\n",
+                                    "bad.hw.yaml"),
+                    InputError);
+    CHECK_THROWS_AS(parse_hw_config("version: 1\nray_buffer: {storage: dram}\n", "bad.hw.yaml"),
+                    InputError);
+}
+
+TEST_CASE("The host's caches and clock are read from the CPU", "[host]") {
+    const std::vector<HostCacheLevel> caches = read_host_caches();
+    REQUIRE(!caches.empty());  // sysfs or cpuid: every x86-64 CPU sfx runs on says something
+    CHECK(caches.front().level == 1);
+    CHECK(caches.front().type == "data");
+    for (const HostCacheLevel& l : caches) {
+        CHECK(l.kib > 0);
+        CHECK(l.line_bytes >= 32);
+        CHECK(l.ways >= 1);
+    }
+    const double mhz = measure_tsc_mhz(0.02);
+    CHECK(mhz > 100.0);
+    CHECK(mhz < 10000.0);
+}
