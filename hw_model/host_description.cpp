@@ -236,6 +236,9 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.push_back(cl);
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
+    // The native tracer prefetches a node's children while it tests the node (prefetch_below
+    // in kernels/stream/stream_kernels_impl.h): depth first, the next op's node.
+    c.scene_memory.prefetch_depth = 1;
     c.op_costs = op_costs;
     return c;
 }
@@ -276,7 +279,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
     y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2)
       << "  # measured: pointer chase over 256 MiB\n"
       << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
-      << "  # assumed: not measured; DRAM lines queue for it\n";
+      << "  # assumed: not measured; DRAM lines queue for it\n"
+      << "  prefetch_depth: 1  # the native tracer prefetches a node's children as it tests the node\n"
+      << "                     # (prefetch_below, kernels/stream): depth first, the next op's node\n";
     y << "# Fitted: " << fit_note << "\n";
     if (op_costs.empty()) {
         y << "op_costs: []\n";

@@ -88,6 +88,20 @@ class TraversalRays {
     std::vector<float, boost::alignment::aligned_allocator<float, 64>> m_data;
 };
 
+// A ray set up for its generation's traversal (the tracer's load_rays, one ray): its any-hit
+// flag (a shadow ray stops at any hit), no hit yet, the full tests' constants and the
+// filters' fields. False for a ray that is not traced (ray_is_valid). The calibration's
+// microbenchmarks time this with the op that made the ray (kernels/stream/stream_microbench.h).
+inline bool set_up_ray(const Ray& r, bool shadow, uint32_t slot, uint8_t& any_hit, Hit& hit,
+                       RayPrecomp& pre, TraversalRays& trav) {
+    any_hit = shadow;
+    hit = Hit{};
+    if (!ray_is_valid(r)) return false;
+    pre = RayPrecomp(r);
+    trav.set(slot, pre, r.t_max);
+    return true;
+}
+
 // Room every id, position and scratch buffer needs past its length: a group's compress
 // writes whole vectors.
 constexpr uint32_t k_stream_padding = 16;

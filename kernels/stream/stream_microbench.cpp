@@ -73,6 +73,12 @@ struct Buffers {
     std::vector<uint32_t> ids, scratch, scratch2, positions;
     std::vector<float> sphere_t;  // the sphere filter's distances
     std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
+    // Where a made ray is set up for the next generation's traversal (set_up_ray): arrays of
+    // their own, so a repeated call finds its inputs as they were.
+    std::vector<uint8_t> next_any_hit;
+    std::vector<Hit> next_hit;
+    std::vector<RayPrecomp> next_pre;
+    TraversalRays next_trav;
 };
 
 // Random rays from above the scene toward random points of it: a mix of hits on every
@@ -86,7 +92,11 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     Ray unit;
     unit.dir = {0.f, 0.f, 1.f};
     b.trav.resize(slots);
+    b.next_trav.resize(slots);
     b.pre.resize(slots, RayPrecomp(unit));
+    b.next_pre.resize(slots, RayPrecomp(unit));
+    b.next_hit.resize(slots);
+    b.next_any_hit.resize(slots);
     b.hit.resize(slots);
     b.any_hit.resize(slots);
     b.surf.resize(slots);
@@ -213,6 +223,14 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     auto run_filter = [&](auto&& test) {
                         return filter(kernels, trace, kind, 1, mat, ids, n, mask, scratch, test);
                     };
+                    // A made ray is set up for the next generation's traversal (the tracer's
+                    // load_rays) by the op that made it, as the op table writes the whole ray
+                    // (inverse direction included) with that op.
+                    auto set_up = [&](uint32_t id, bool shadow) {
+                        set_up_ray(b.next[id], shadow, id, b.next_any_hit[id], b.next_hit[id],
+                                   b.next_pre[id], b.next_trav);
+                        return true;
+                    };
                     // Short streams run several times in the timed region: the TSC ticks in
                     // steps of tens of cycles here. Repeats test the same ids again, as
                     // traversal tests one stream against node after node.
@@ -226,6 +244,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                     p = PathState{};
                                     p.key = {1, slot, 0};
                                     b.next[slot] = camera.generate(p.key);
+                                    set_up(slot, false);
                                     mask[i] = 1;
                                 }
                                 passed = n;
@@ -331,7 +350,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 passed = run_filter([&](uint32_t id) {
                                     if (!b.hit[id].valid()) return false;
                                     return lambertian_direct(b.path[id], scene, scene.materials[0],
-                                                             b.surf[id], b.next[id]);
+                                                             b.surf[id], b.next[id]) &&
+                                           set_up(id, true);
                                 });
                                 break;
                             case OpKind::lambertian_indirect:
@@ -339,21 +359,24 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                     if (!b.hit[id].valid()) return false;
                                     return lambertian_indirect(b.path[id], scene,
                                                                scene.materials[0], b.surf[id],
-                                                               b.next[id]);
+                                                               b.next[id]) &&
+                                           set_up(id, false);
                                 });
                                 break;
                             case OpKind::dielectric:
                                 passed = run_filter([&](uint32_t id) {
                                     if (!b.hit[id].valid()) return false;
                                     return dielectric_scatter(b.path[id], scene.materials[2],
-                                                              b.surf[id], b.ray[id], b.next[id]);
+                                                              b.surf[id], b.ray[id], b.next[id]) &&
+                                           set_up(id, false);
                                 });
                                 break;
                             case OpKind::glossy:
                                 passed = run_filter([&](uint32_t id) {
                                     if (!b.hit[id].valid()) return false;
                                     return glossy_scatter(b.path[id], scene.materials[1],
-                                                          b.surf[id], b.ray[id], b.next[id]);
+                                                          b.surf[id], b.ray[id], b.next[id]) &&
+                                           set_up(id, false);
                                 });
                                 break;
                             // Not microbenchmarked (the host's seed-kernel ops); no default, so

@@ -5,8 +5,11 @@
 // run with the trace off on streams of a chosen length whose ids are scattered at random over a
 // ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
 // glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
-// the median of several repetitions. `sfx calibrate --describe-host` fits the host's per-op
-// costs to these samples (hw_model/host_timing.h), never to frames.
+// the median of several repetitions. An op is timed with all the per-ray work the tracer does for
+// it: the emission filter computes the hits' surfaces (surface_at), and the camera and every
+// shader that makes a ray set it up for the next generation's traversal (set_up_ray, the
+// tracer's load_rays). `sfx calibrate --describe-host` fits the host's per-op costs to these
+// samples (hw_model/op_cost_fit.h), never to frames.
 
 #include <array>
 #include <cstdint>

@@ -124,12 +124,9 @@ uint32_t load_rays(RayBuffers& b, const Ray* rays, uint32_t n) {
     uint32_t m = 0;
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t id = b.ids[i];
-        const Ray& r = rays[id];
-        b.hit[id] = Hit{};
-        if (!ray_is_valid(r)) continue;
-        b.pre[id] = RayPrecomp(r);
-        b.trav.set(id, b.pre[id], r.t_max);
-        b.trav_ids[m++] = id;
+        if (set_up_ray(rays[id], b.path[id].kind == RayKind::shadow, id, b.any_hit[id], b.hit[id],
+                       b.pre[id], b.trav))
+            b.trav_ids[m++] = id;
     }
     return m;
 }
@@ -484,7 +481,6 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
         if (reorder) reorder_stream(ids, n, rays, generation, trace);
-        for (uint32_t i = 0; i < n; ++i) b.any_hit[ids[i]] = path[ids[i]].kind == RayKind::shadow;
         const uint32_t traversal_rays = load_rays(b, rays, n);
         uint32_t entry = 0;
         if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
