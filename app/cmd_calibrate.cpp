@@ -1,8 +1,9 @@
 // sfx calibrate: the host CPU as a hardware configuration, validated on silicon.
 //   --describe-host: describe the host (cpuid, caches, TSC, load latencies), microbenchmark the
 //     native filters on synthetic streams, fit the per-op costs, write host.hw.yaml.
-//   --check HOST.hw.yaml: for held-out workloads, the host timing's prediction from the trace
-//     against the native tracer's measured cycles (TSC, one pinned thread, trace off).
+//   --check HOST.hw.yaml[,...]: for held-out workloads, the machine model's prediction from the
+//     trace against the native tracer's measured cycles (TSC, one pinned thread, trace off);
+//     one host file per back end (its SIMD width), all measured in turn per cell.
 
 #include <cstdio>
 #include <fstream>
@@ -78,7 +79,8 @@ void add_calibrate_command(CLI::App& app) {
     c->add_option("-o,--output", o->output, "the host configuration written by --describe-host")
         ->capture_default_str();
     c->add_option("--check", o->check,
-                  "HOST.hw.yaml: predict and measure the native tracer's cycles per workload");
+                  "HOST.hw.yaml[,MORE.hw.yaml]: predict and measure the native tracer's cycles "
+                  "per workload, each file on the back end of its SIMD width");
     c->add_option("--isa", o->isa, "auto, avx512, avx2 or scalar: the back end measured")
         ->capture_default_str();
     c->add_option("--microbench-repeats", o->repeats, "repetitions per microbenchmark point")
@@ -185,44 +187,71 @@ void add_calibrate_command(CLI::App& app) {
             return;
         }
 
-        const HwConfig host = load_hw_config(o->check);
-        if (host.op_costs.empty())
-            throw InputError(
-                o->check, 0, "op_costs",
-                "no fitted per-op costs (write it with sfx calibrate --describe-host)");
+        // One host file per back end: each is measured with the back end of its SIMD width.
+        std::vector<HwConfig> hosts;
+        std::vector<Isa> host_isas;
+        for (const std::string& path : split(o->check)) {
+            hosts.push_back(load_hw_config(path));
+            const HwConfig& host = hosts.back();
+            if (host.op_costs.empty())
+                throw InputError(
+                    path, 0, "op_costs",
+                    "no fitted per-op costs (write it with sfx calibrate --describe-host)");
+            Isa by_width = Isa::automatic;
+            for (const Isa candidate : {Isa::scalar, Isa::avx2, Isa::avx512})
+                if (isa_width(candidate) == host.simd.width) by_width = candidate;
+            if (by_width == Isa::automatic || !isa_supported(by_width))
+                throw InputError(path, 0, "simd.width",
+                                 std::to_string(host.simd.width) +
+                                     " lanes: no stream back end of that width runs on this CPU");
+            if (parse_isa(o->isa) != Isa::automatic && isa != by_width)
+                throw InputError("command line", 0, "--isa",
+                                 std::string(isa_name(isa)) + " does not match " + path +
+                                     " (simd.width " + std::to_string(host.simd.width) + ")");
+            host_isas.push_back(by_width);
+        }
         std::vector<uint32_t> tiles;
         for (const std::string& t : split(o->tiles))
             tiles.push_back(parse_count(t, "--tiles", 1, 4096));
         std::vector<std::pair<uint32_t, uint32_t>> resolutions;
         for (const std::string& r : split(o->res)) resolutions.push_back(parse_res(r));
         const std::vector<std::string> scenes = split(o->scenes);
-        Progress progress("calibrate --check", scenes.size() * tiles.size() * resolutions.size(),
-                          "workloads");
+        Progress progress("calibrate --check", scenes.size() * resolutions.size(),
+                          "(scene, resolution) cells");
         nlohmann::json rows = nlohmann::json::array();
         for (const std::string& name : scenes) {
             progress.set_label(name + ": loading");
             const Scene scene = load_scene(name);
             const Bvh bvh(scene);
-            for (const auto& [w, h] : resolutions)
-                for (uint32_t tile : tiles) {
-                    progress.set_label(name + " " + std::to_string(w) + "x" + std::to_string(h) +
-                                       " tile " + std::to_string(tile));
-                    RenderSettings s;
-                    s.width = w;
-                    s.height = h;
-                    s.spp = o->spp;
-                    s.tile = tile;
-                    s.max_depth = scene.max_depth;
-                    s.isa = isa;
-                    const SiliconMeasurement m =
-                        predict_and_measure(scene, bvh, s, host, o->repeat);
+            for (const auto& [w, h] : resolutions) {
+                progress.set_label(name + " " + std::to_string(w) + "x" + std::to_string(h));
+                // Every tile on every back end of the cell, measured in turn.
+                std::vector<SiliconVariant> variants;
+                for (size_t k = 0; k < hosts.size(); ++k)
+                    for (uint32_t tile : tiles) {
+                        SiliconVariant v;
+                        v.settings.width = w;
+                        v.settings.height = h;
+                        v.settings.spp = o->spp;
+                        v.settings.tile = tile;
+                        v.settings.max_depth = scene.max_depth;
+                        v.settings.isa = host_isas[k];
+                        v.host = &hosts[k];
+                        variants.push_back(v);
+                    }
+                const std::vector<SiliconMeasurement> measured =
+                    predict_and_measure(scene, bvh, variants, o->repeat);
+                for (size_t i = 0; i < variants.size(); ++i) {
+                    const SiliconMeasurement& m = measured[i];
+                    const RenderSettings& st = variants[i].settings;
                     nlohmann::json row;
                     row["scene"] = name;
                     row["width"] = w;
                     row["height"] = h;
-                    row["tile"] = tile;
+                    row["tile"] = st.tile;
                     row["spp"] = o->spp;
-                    row["isa"] = isa_name(isa);
+                    row["isa"] = isa_name(st.isa);
+                    row["simd_width"] = isa_width(st.isa);
                     row["pinned"] = pinned;
                     row["predicted.frame_cycles"] = m.predicted_frame;
                     row["measured.frame_cycles"] = m.measured_frame;
@@ -230,24 +259,29 @@ void add_calibrate_command(CLI::App& app) {
                     row["stage_clock_overhead"] = m.stage_clock_overhead;
                     row["measured.interrupted_renders"] = m.interrupted;
                     row["measured.frame_tsc"] = m.measured_frame_tsc;
-                    for (int st = 0; st < 3; ++st) {
-                        row[std::string("predicted.") + k_stage_names[st] + "_cycles"] =
-                            m.predicted_stage[size_t(st)];
-                        row[std::string("predicted.") + k_stage_names[st] + "_memory_cycles"] =
-                            m.predicted_memory[size_t(st)];
-                        row[std::string("measured.") + k_stage_names[st] + "_cycles"] =
-                            m.measured_stage[size_t(st)];
+                    for (int sg = 0; sg < 3; ++sg) {
+                        row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =
+                            m.predicted_stage[size_t(sg)];
+                        row[std::string("predicted.") + k_stage_names[sg] + "_memory_cycles"] =
+                            m.predicted_memory[size_t(sg)];
+                        row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
+                            m.measured_stage[size_t(sg)];
                     }
+                    // The machine model's stall causes, as sfx simulate reports them.
+                    for (const Stat& stat : m.prediction.stats())
+                        if (stat.name.rfind("stall_cycles.", 0) == 0)
+                            row["predicted." + stat.name] = stat.value;
                     rows.push_back(row);
-                    progress.advance();
-                    if (!o->json) {
+                    if (!o->json)
                         progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) +
-                                     " tile " + std::to_string(tile) + ": predicted " +
+                                     " tile " + std::to_string(st.tile) + " " +
+                                     isa_name(st.isa) + ": predicted " +
                                      std::to_string(m.predicted_frame / 1e6) +
                                      " Mcycles, measured " +
                                      std::to_string(m.measured_frame / 1e6));
-                    }
                 }
+                progress.advance();
+            }
         }
         progress.finish();
         std::cout << rows.dump(o->json ? 2 : -1) << "\n";

@@ -81,6 +81,8 @@ void add_scene_info_command(CLI::App& app) {
             j["bvh.build_seconds"] = build_seconds;
             j["load_seconds"] = load_seconds;
             j["isa"] = isa_name(best_isa());
+            j["isas"] = nlohmann::json::array();  // every back end this CPU runs
+            for (const Isa i : supported_isas()) j["isas"].push_back(isa_name(i));
             j["memory.geometry_bytes"] = geometry;
             j["memory.bvh_bytes"] = st.bytes;
             j["memory.total_bytes"] = geometry + st.bytes;

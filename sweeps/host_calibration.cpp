@@ -73,69 +73,98 @@ bool pin_to_current_cpu() {
     return sched_setaffinity(0, sizeof set, &set) == 0;
 }
 
-SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
-                                       const HwConfig& host, uint32_t repeats) {
-    settings.threads = 1;
-    SiliconMeasurement m;
-    {  // The prediction: the machine model at full fidelity on the trace of the same render,
-       // through the path sfx simulate takes.
-        settings.stage_clock = false;
-        const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full);
-        m.prediction = r.predictions.front();
-        const FrameTiming& t = m.prediction.timing;
-        for (int s = 0; s < 3; ++s)
-            for (int secondary = 0; secondary < 2; ++secondary) {
-                const StageTiming& st = t.stages[secondary][s];
-                m.predicted_stage[size_t(s)] += double(st.busy_cycles + st.stall_cycles);
-                m.predicted_memory[size_t(s)] += double(st.scene_memory_cycles);
-            }
-        m.predicted_frame = double(t.cycles);
+namespace {
+
+// The machine model's prediction of one workload, through the path sfx simulate takes.
+void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
+             SiliconMeasurement& m) {
+    settings.stage_clock = false;
+    const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full);
+    m.prediction = r.predictions.front();
+    const FrameTiming& t = m.prediction.timing;
+    for (int s = 0; s < 3; ++s)
+        for (int secondary = 0; secondary < 2; ++secondary) {
+            const StageTiming& st = t.stages[secondary][s];
+            m.predicted_stage[size_t(s)] += double(st.busy_cycles + st.stall_cycles);
+            m.predicted_memory[size_t(s)] += double(st.scene_memory_cycles);
+        }
+    m.predicted_frame = double(t.cycles);
+}
+
+// One render, trace off, with or without the stage clock: (cycles, TSC ticks). The TSC counts
+// while the thread is descheduled too, and on a shared machine that is often most of a
+// render's wall time; so a render's cycles are its process CPU time at the TSC rate (what the
+// TSC would count were the core ours alone), and a render whose TSC ticks exceed that by more
+// than 3 % is counted as interrupted.
+std::pair<double, double> timed_render(const Scene& scene, const Bvh& bvh, RenderSettings settings,
+                                       bool clock, double mhz, RenderResult& result,
+                                       uint32_t& interrupted) {
+    settings.stage_clock = clock;
+    timespec c0, c1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    const uint64_t start = read_tsc();
+    result = render_stream(scene, bvh, settings);
+    const double ticks = double(read_tsc() - start);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    const double cpu_us = (c1.tv_sec - c0.tv_sec) * 1e6 + (c1.tv_nsec - c0.tv_nsec) * 1e-3;
+    if (ticks > 1.03 * cpu_us * mhz + 2000.0) ++interrupted;
+    return {cpu_us * mhz, ticks};
+}
+
+}  // namespace
+
+std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bvh& bvh,
+                                                    const std::vector<SiliconVariant>& variants,
+                                                    uint32_t repeats) {
+    const size_t n = variants.size();
+    std::vector<SiliconMeasurement> out(n);
+    std::vector<RenderSettings> settings(n);
+    for (size_t v = 0; v < n; ++v) {
+        settings[v] = variants[v].settings;
+        settings[v].threads = 1;
+        predict(scene, bvh, settings[v], *variants[v].host, out[v]);
     }
-    // The measurement: unclocked and stage-clocked renders alternate, so drift in the machine's
-    // load touches both alike. The TSC counts while the thread is descheduled too, and on a
-    // shared machine that is often most of a render's wall time; so a render's cycles are its
-    // process CPU time at the TSC rate (what the TSC would count were the core ours alone), and
-    // a render whose TSC ticks exceed that by more than 3 % is counted as interrupted.
+    // The measurement: rounds in which every variant renders once unclocked and once with the
+    // stage clock, in turn, so the machine's drift touches every variant and both kinds alike.
     // Stages: the TSC split of the least interrupted stage-clocked render (ticks closest to its
     // CPU time: a neighbour's time lands in whichever stage it interrupts), as fractions of the
     // frame's cycles.
-    std::array<double, 3> fractions{};
-    double least_interrupted = 1e300;
-    std::vector<double> clocked_totals, tsc_samples;
-    const double mhz = host.clock.core_mhz;
-    auto timed = [&](bool clock, RenderResult& result) {
-        settings.stage_clock = clock;
-        timespec c0, c1;
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-        const uint64_t start = read_tsc();
-        result = render_stream(scene, bvh, settings);
-        const double ticks = double(read_tsc() - start);
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-        const double cpu_us = (c1.tv_sec - c0.tv_sec) * 1e6 + (c1.tv_nsec - c0.tv_nsec) * 1e-3;
-        if (ticks > 1.03 * cpu_us * mhz + 2000.0) ++m.interrupted;
-        return std::make_pair(cpu_us * mhz, ticks);
-    };
+    std::vector<std::array<double, 3>> fractions(n);
+    std::vector<double> least_interrupted(n, 1e300);
+    std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
     RenderResult r;
-    timed(false, r);  // warm: caches, page faults, the tracer's buffers
-    for (uint32_t i = 0; i < repeats; ++i) {
-        const auto [cycles, ticks] = timed(false, r);
-        m.frame_samples.push_back(cycles);
-        tsc_samples.push_back(ticks);
-        const auto [clocked, clocked_ticks] = timed(true, r);
-        double total = 0.0;
-        for (int s = 0; s < 3; ++s) total += double(r.stats.stage_tsc[s]);
-        if (total > 0 && clocked_ticks / clocked < least_interrupted) {
-            least_interrupted = clocked_ticks / clocked;
-            for (int s = 0; s < 3; ++s) fractions[size_t(s)] = double(r.stats.stage_tsc[s]) / total;
+    for (size_t v = 0; v < n; ++v)  // warm: caches, page faults, the tracer's buffers
+        timed_render(scene, bvh, settings[v], false, variants[v].host->clock.core_mhz, r,
+                     out[v].interrupted);
+    for (size_t v = 0; v < n; ++v) out[v].interrupted = 0;
+    for (uint32_t i = 0; i < repeats; ++i)
+        for (size_t v = 0; v < n; ++v) {
+            SiliconMeasurement& m = out[v];
+            const double mhz = variants[v].host->clock.core_mhz;
+            const auto [cycles, ticks] =
+                timed_render(scene, bvh, settings[v], false, mhz, r, m.interrupted);
+            m.frame_samples.push_back(cycles);
+            tsc_samples[v].push_back(ticks);
+            const auto [clocked, clocked_ticks] =
+                timed_render(scene, bvh, settings[v], true, mhz, r, m.interrupted);
+            double total = 0.0;
+            for (int s = 0; s < 3; ++s) total += double(r.stats.stage_tsc[s]);
+            if (total > 0 && clocked_ticks / clocked < least_interrupted[v]) {
+                least_interrupted[v] = clocked_ticks / clocked;
+                for (int s = 0; s < 3; ++s)
+                    fractions[v][size_t(s)] = double(r.stats.stage_tsc[s]) / total;
+            }
+            clocked_totals[v].push_back(clocked);
         }
-        clocked_totals.push_back(clocked);
+    for (size_t v = 0; v < n; ++v) {
+        SiliconMeasurement& m = out[v];
+        m.measured_frame = median(m.frame_samples);
+        m.measured_frame_tsc = median(tsc_samples[v]);
+        for (int s = 0; s < 3; ++s)
+            m.measured_stage[size_t(s)] = fractions[v][size_t(s)] * m.measured_frame;
+        m.stage_clock_overhead = median(clocked_totals[v]) / m.measured_frame - 1.0;
     }
-    m.measured_frame = median(m.frame_samples);
-    m.measured_frame_tsc = median(tsc_samples);
-    for (int s = 0; s < 3; ++s)
-        m.measured_stage[size_t(s)] = fractions[size_t(s)] * m.measured_frame;
-    m.stage_clock_overhead = median(clocked_totals) / m.measured_frame - 1.0;
-    return m;
+    return out;
 }
 
 }  // namespace sfx

@@ -58,10 +58,20 @@ struct SiliconMeasurement {
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
 };
 
-// One workload: `settings` are forced to one thread and `isa`. The host config must carry
-// op_costs for every kind the scene uses. Renders once with the trace on (the prediction),
-// `repeats` times with the trace and stage clock off, and `repeats` times with the stage clock.
-SiliconMeasurement predict_and_measure(const Scene& scene, const Bvh& bvh, RenderSettings settings,
-                                       const HwConfig& host, uint32_t repeats);
+// One workload of a silicon check: its render settings and the host configuration (whose SIMD
+// width is the back end's, settings.isa) that predicts it.
+struct SiliconVariant {
+    RenderSettings settings;
+    const HwConfig* host = nullptr;
+};
+
+// The variants of one scene and resolution (tiles, back ends), each forced to one thread; every
+// host config must carry op_costs for every kind the scene uses. Each is predicted by the
+// machine model on the trace of its own render; then `repeats` rounds render every variant in
+// turn (trace off), once plain and once with the stage clock, so that the drift of a shared
+// machine touches all of them alike.
+std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bvh& bvh,
+                                                    const std::vector<SiliconVariant>& variants,
+                                                    uint32_t repeats);
 
 }  // namespace sfx

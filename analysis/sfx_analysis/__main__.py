@@ -84,14 +84,16 @@ def _silicon(args) -> int:
         header = f.read()
     plot = os.path.join(os.path.dirname(os.path.abspath(args.output)), args.plot)
     silicon.scatter_plot(df, plot)
-    s = silicon.write_page(df, args.output, args.plot, header)
+    silicon.write_page(df, args.output, args.plot, header)
     print(silicon.table_text(df))
     print()
     print(silicon.stage_table_text(df))
     print()
     print(silicon.ranking_text(df))
     print()
-    print(silicon.summary_text(s))
+    print(silicon.width_ranking_text(df))
+    print()
+    print(silicon.all_summaries_text(df))
     print(f"silicon check: {os.path.abspath(args.output)}, {plot}")
     return 0
 

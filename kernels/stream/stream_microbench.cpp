@@ -197,10 +197,13 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::vector<double> times;
                 uint32_t passed = 0;
                 for (uint32_t rep = 0; rep < options.repeats; ++rep) {
-                    // A fresh random stream; the whole buffer touched in random order first, so
-                    // the L1D holds what a pass over this buffer leaves in it.
+                    // A fresh random stream: n slots of the buffer in increasing order, as the
+                    // tracer's streams are (the camera's, and every stable partition of one);
+                    // the whole buffer touched in random order first, so the L1D holds what a
+                    // pass over this buffer leaves in it.
                     std::shuffle(order.begin(), order.end(), rng);
                     std::copy(order.begin(), order.begin() + n, b.ids.begin());
+                    std::sort(b.ids.begin(), b.ids.begin() + n);
                     std::copy(b.saved_path.begin(), b.saved_path.end(), b.path.begin());
                     b.trav = b.saved_trav;
                     // Intersection tests start from no hit, as after the tracer's load_rays;

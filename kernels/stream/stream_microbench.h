@@ -2,8 +2,8 @@
 // Microbenchmarks of the stream tracer's native filters on synthetic streams: each op kind's
 // filter (the box kernel, the triangle test's SIMD float stage and its exact stage, the sphere
 // test, the camera and every shading filter of Fig. 4 with the same per-ray steps of path.h)
-// run with the trace off on streams of a chosen length whose ids are scattered at random over a
-// ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
+// run with the trace off on streams of a chosen length whose ids are a random subset, in
+// increasing order (as the tracer's stable partitions keep them), of a ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
 // glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
 // the median of several repetitions. An op is timed with all the per-ray work the tracer does for
 // it: the emission filter computes the hits' surfaces (surface_at), and the camera and every

@@ -63,7 +63,10 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     s.tile = 8;
     s.max_depth = scene.max_depth;
     s.isa = isa;
-    const SiliconMeasurement m = predict_and_measure(scene, bvh, s, config, 1);
+    const std::vector<SiliconMeasurement> cell = predict_and_measure(scene, bvh, {{s, &config}}, 1);
+    REQUIRE(cell.size() == 1);
+    const SiliconMeasurement& m = cell.front();
+    CHECK(m.prediction.config.ray_buffer.storage == "l1d");  // the machine model's prediction
     CHECK(m.frame_samples.size() == 1);
     CHECK(m.measured_frame > 0);
     CHECK(m.predicted_frame > 0);
