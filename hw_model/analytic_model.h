@@ -8,7 +8,9 @@
 // scaled by how sparse the stream is in its buffer), partition moves (an i.i.d. mask with the
 // measured pass rate), and scene-data latency (per cache level, a miss rate from the working
 // sets of a pass and of the frame against the level's capacity). Its error is measured
-// against the cycle-level model, never assumed (tests/hw_model, sfx accuracy).
+// against the cycle-level model, never assumed (tests/hw_model, sfx accuracy). Not in the
+// closed form: the op window across ops (cores.op_window > 1), which only the cycle-level
+// model's dispatcher has; a calibration on sampled passes (--calibration) carries its effect.
 
 #include <cstdint>
 #include <map>

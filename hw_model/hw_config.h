@@ -48,6 +48,11 @@ struct SimdConfig {
 
 struct CoreConfig {
     uint32_t count = 1;  // G&R 3.3 simulates one core; 5.2 proposes replicating it
+    // G&R 3.3: the simulator is "similar to the SimpleScalar tool set" [5]; sim-outorder's
+    // default register update unit holds 16 instructions (Burger & Austin 1997, -ruu:size 16),
+    // fewer than one box-test group's (34, op_costs.cpp): no later op enters the window while
+    // a partition is pending, so ops issue in order.
+    uint32_t op_window = 1;
 
     template <class V>
     void visit(V& v) {
@@ -55,6 +60,11 @@ struct CoreConfig {
                 "homogeneous cores, each with its own ray buffers, SIMD units and L1; tiles are "
                 "scheduled across them; lower scene caches and DRAM bandwidth are shared",
                 1u, 256u);
+        v.param("op_window", op_window, "partitions",
+                "out-of-order window across ops: an op is released once the op whose partition "
+                "produced its stream is done, while fewer than this many partitions are pending "
+                "(1: in order, every op waits for every earlier partition)",
+                1u, 64u);
     }
 };
 

@@ -3,6 +3,7 @@
 // group replays the same pass (trace once, time many). Memory: one pass, never a frame.
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "hw_model/ray_buffer_model.h"
@@ -19,6 +20,8 @@ public:
         m_moved.clear();
         m_slots.clear();
         m_passed.clear();
+        m_producer.clear();
+        m_streams.clear();
     }
     void op(const StreamOp& op) override {
         StreamOp copy = op;
@@ -29,12 +32,22 @@ public:
         m_slots.insert(m_slots.end(), op.slots, op.slots + op.length);
         m_passed.insert(m_passed.end(), op.passed, op.passed + op.length);
         m_moved.push_back(stable_partition_moves(op.passed, op.length));
+        // The op whose partition produced this stream: the latest one whose passing ids, in
+        // order, are this op's ids (a child's stream is its parent's passing prefix).
+        const auto producer = m_streams.find(stream_key(op.slots, op.passed, op.length, false));
+        m_producer.push_back(producer == m_streams.end() ? -1 : int32_t(producer->second));
+        if (op_info(op.kind).partitions && op.length > 0)  // an empty op is never dispatched
+            m_streams[stream_key(op.slots, op.passed, op.length, true)] =
+                uint32_t(m_ops.size() - 1);
     }
     void end_pass(const TilePass& p) override { m_pass = p; }
 
     const TilePass& pass() const { return m_pass; }
     // Ids a stable partition of op i moves: the same for every configuration.
     uint32_t moved_ids(size_t i) const { return m_moved[i]; }
+    // The earlier op whose partition produced op i's stream, or -1 when none did (then op i is
+    // taken to depend on every earlier partition). The same for every configuration.
+    int32_t producer(size_t i) const { return m_producer[i]; }
     size_t size() const { return m_ops.size(); }
     // The op with its views pointing into this buffer.
     StreamOp at(size_t i) const {
@@ -45,12 +58,27 @@ public:
     }
 
 private:
+    // A hash of a stream: every id (`passing_only`: only the passing ones), in order.
+    static uint64_t stream_key(const uint32_t* slots, const uint8_t* passed, uint32_t length,
+                               bool passing_only) {
+        uint64_t h = 0x9e3779b97f4a7c15ull, n = 0;
+        for (uint32_t i = 0; i < length; ++i) {
+            if (passing_only && !passed[i]) continue;
+            h = (h ^ slots[i]) * 0x100000001b3ull;
+            h ^= h >> 29;
+            ++n;
+        }
+        return h ^ (n * 0xbf58476d1ce4e5b9ull);
+    }
+
     TilePass m_pass;
     std::vector<StreamOp> m_ops;
     std::vector<size_t> m_offsets;
     std::vector<uint32_t> m_slots;
     std::vector<uint8_t> m_passed;
     std::vector<uint32_t> m_moved;
+    std::vector<int32_t> m_producer;
+    std::unordered_map<uint64_t, uint32_t> m_streams;  // passing-stream key -> latest op
 };
 
 }  // namespace sfx

@@ -51,7 +51,7 @@ void PartitionUnit::run() {
         m_core.clock().wait_until(ready);
         const uint64_t end = m_core.model().partition(r.op, ready);
         m_core.clock().wait_until(end);
-        m_core.partition_done(ready, end);
+        m_core.partition_done(r.op, ready, end);
         m_core.op_finished(end);
     }
 }
@@ -80,8 +80,9 @@ void Core::op_finished(uint64_t cycle) {
     if (--m_outstanding == 0) m_op_event.notify(sc_core::SC_ZERO_TIME);
 }
 
-void Core::partition_done(uint64_t start, uint64_t end) {
-    m_partition_pending = false;
+void Core::partition_done(uint32_t op, uint64_t start, uint64_t end) {
+    --m_partitions_pending;
+    m_partitioned[op] = 1;
     m_partition_start = start;
     m_partition_end = end;
     m_partition_event.notify(sc_core::SC_ZERO_TIME);
@@ -90,6 +91,7 @@ void Core::partition_done(uint64_t start, uint64_t end) {
 void Core::dispatch() {
     const uint32_t units = m_model.units(), width = m_model.width();
     const uint32_t prefetch = m_model.config().scene_memory.prefetch_depth;
+    const uint32_t window = m_model.config().cores.op_window;
     uint32_t next_unit = 0;
     for (;;) {
         const std::shared_ptr<const PassBuffer> pass = m_source.next_pass();
@@ -97,12 +99,20 @@ void Core::dispatch() {
         m_model.begin_pass(pass.get(), start);
         m_last_completion = start;
         const uint32_t ops = uint32_t(pass->size());
+        m_partitioned.assign(ops, 0);
         uint32_t next_scene = 0;
         for (uint32_t i = 0; i < ops; ++i) {
             const StreamOp op = pass->at(i);
             if (op.length == 0) continue;
+            // Released once the partition that produced its stream is done (every pending one
+            // when no op's did), with fewer than `window` partitions pending.
+            const int32_t producer = pass->producer(i);
+            auto released = [&] {
+                if (m_partitions_pending >= window) return false;
+                return producer < 0 ? m_partitions_pending == 0 : m_partitioned[producer] != 0;
+            };
             bool waited = false;
-            while (m_partition_pending) {
+            while (!released()) {
                 wait(m_partition_event);
                 waited = true;
             }
@@ -128,7 +138,7 @@ void Core::dispatch() {
                 }
                 next_unit = (next_unit + 1) % units;
             }
-            if (m_model.profile(i).partitions) m_partition_pending = true;
+            if (m_model.profile(i).partitions) ++m_partitions_pending;
         }
         while (m_outstanding > 0) wait(m_op_event);
         const uint64_t end = std::max(m_clock.now(), m_last_completion);

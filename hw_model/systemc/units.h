@@ -101,8 +101,8 @@ class Core : public sc_core::sc_module {
 
     // An op's last group completes (or its partition ends) at `cycle`.
     void op_finished(uint64_t cycle);
-    // The partition of the op the dispatcher waits on occupied [start, end).
-    void partition_done(uint64_t start, uint64_t end);
+    // The partition of op `op` occupied [start, end).
+    void partition_done(uint32_t op, uint64_t start, uint64_t end);
 
   private:
     void dispatch();
@@ -114,8 +114,9 @@ class Core : public sc_core::sc_module {
     std::vector<std::unique_ptr<SimdUnit>> m_simd;
     std::unique_ptr<PartitionUnit> m_partition;
     sc_core::sc_event m_partition_event, m_op_event;
-    bool m_partition_pending = false;
-    uint64_t m_partition_start = 0, m_partition_end = 0;
+    uint32_t m_partitions_pending = 0;
+    std::vector<uint8_t> m_partitioned;  // per op of the pass: its partition is done
+    uint64_t m_partition_start = 0, m_partition_end = 0;  // the latest partition done
     uint64_t m_outstanding = 0;
     uint64_t m_last_completion = 0;
 };
