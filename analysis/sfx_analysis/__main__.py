@@ -129,7 +129,7 @@ def main(argv=None) -> int:
     pp.add_argument("--command", default="", help="the command named on the page as its source")
     pp.add_argument("--quiet", action="store_true", help="print only where the page is")
     pp.set_defaults(run=_paper)
-    si = sub.add_parser("silicon", help="the silicon check page (docs/silicon-check.md)")
+    si = sub.add_parser("silicon", help="the silicon check page (docs/silicon-check-*.md)")
     si.add_argument("rows", help="`sfx calibrate --check --json` output")
     si.add_argument("-o", "--output", required=True, help="page to write (Markdown)")
     si.add_argument("--plot", default="silicon-check.png", help="plot file name, beside the page")

@@ -185,6 +185,17 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // leaves test it.
     const uint32_t floor_leaf = uint32_t(
         std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), 0u) - bvh.prim_ids().begin());
+    // The box test's nodes: the root (every ray passes) and the nodes below it, breadth first
+    // (a share of the rays passes, as in a frame, where a stream's lanes pass and fail: the
+    // filter's per-lane branches and compress see both); the samples take them in turn.
+    std::vector<uint32_t> box_nodes = {0};
+    for (size_t i = 0; i < box_nodes.size() && box_nodes.size() < 7; ++i) {
+        const BvhNode& node = bvh.nodes()[box_nodes[i]];
+        if (node.is_leaf()) continue;
+        box_nodes.push_back(BvhNode::left(box_nodes[i]));
+        box_nodes.push_back(node.right());
+    }
+    uint32_t box_sample = 0;
 
     for (OpKind kind : kinds) {
         for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
@@ -196,6 +207,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 if (n > slots) continue;
                 std::vector<double> times;
                 uint32_t passed = 0;
+                const uint32_t box_node = box_nodes[box_sample++ % box_nodes.size()];
                 for (uint32_t rep = 0; rep < options.repeats; ++rep) {
                     // A fresh random stream: n slots of the buffer in increasing order, as the
                     // tracer's streams are (the camera's, and every stable partition of one);
@@ -256,7 +268,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 // The tracer's box_filter with the trace off: the kernel, then
                                 // the failing ids copied back behind the passing ones.
                                 uint32_t negative = 0;
-                                const BvhNode& node = bvh.nodes()[0];
+                                const BvhNode& node = bvh.nodes()[box_node];
                                 passed =
                                     kernels.box_filter(b.trav.view(), node.bounds, node.axis, ids,
                                                        n, ids, scratch, nullptr, negative);

@@ -289,3 +289,23 @@ def test_paper_check_end_to_end(tmp_path):
     done = subprocess.run([os.path.join(REPO, "scripts", "paper-check"), "--no-build", "--page"],
                           capture_output=True, text=True, timeout=60, env=env)
     assert done.returncode == 2 and "--page needs a value" in done.stderr
+
+
+def test_what_table6_implies(tmp_path):
+    # Conference at a tenth of Table 6, half of its cycles stalled, 2 units, 3.2e9 compute
+    # instructions per 16-spp frame: without stalls it would run at a fifth of the paper's
+    # fps (gap 5x); the paper's 1-spp pass of 500e6 / 20.32 cycles needs 1e8 instructions per
+    # unit, 4.06 per cycle.
+    extra = {"frame_cycles": 1e9, "stall_cycles.total": 5e8, "hw.simd.units": 2,
+             "op_mix.instructions": 6.4e9}
+    points = [paper_point(scene, 64, 16, fps_factor=0.1, **extra)
+              for _, scene, _ in paper.SCENES]
+    for p in points:
+        p["op_mix.compute_percent"] = 50.0
+    header, rows = rows_of(build(tmp_path, points), "implied")
+    conf = next(r for r in rows if r[0].startswith("conference"))
+    assert conf[header.index("stalled")] == "50 %"
+    assert conf[header.index("ours without stalls")] == f"{2.032 * 2:.3f}"
+    assert conf[header.index("gap left (x)")] == "5.0"
+    assert conf[header.index("implied issue (instr/cycle/unit)")] == \
+        f"{1e8 / (500e6 / 20.32):.1f}"

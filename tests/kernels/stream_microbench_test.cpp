@@ -48,7 +48,7 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
         CHECK(m.cycles >= 0.0);
     }
     // Every kind of the plain tracer; a workload option's own kinds (entry-point search,
-    // reordering) are not benchmarked, so the host timing has no cost for them.
+    // reordering) are not benchmarked, so a host file has no cost for them.
     uint32_t plain_kinds = 0;
     for (uint32_t k = 0; k < k_op_kind_count; ++k) plain_kinds += !is_option_kind(OpKind(k));
     CHECK(kinds.size() == plain_kinds);
