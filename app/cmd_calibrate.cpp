@@ -63,7 +63,7 @@ void add_calibrate_command(CLI::App& app) {
         std::string output = "host.hw.yaml";
         std::string check;
         std::string isa = "auto";
-        uint32_t repeats = 9;
+        uint32_t repeats = 21;
         std::string scenes = "cornell,furnace,atrium,conference,temple";
         std::string tiles = "16,32,64";
         std::string res = "64x64,128x128";

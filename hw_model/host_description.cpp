@@ -1,5 +1,7 @@
 #include "hw_model/host_description.h"
 
+#include "base/core_clock.h"
+
 #include <cpuid.h>
 #include <x86intrin.h>
 
@@ -197,6 +199,7 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     h.simd_width = simd_width;
     h.isa = isa;
     h.tsc_mhz = measure_tsc_mhz();
+    h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21);
     h.caches = read_host_caches();
     for (const HostCacheLevel& c : h.caches) {
         // Half the level: it fits there, and not in the level before (which is smaller). At
@@ -211,8 +214,8 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
 HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig>& op_costs) {
     HwConfig c;
     c.name = "host";
-    c.clock.core_mhz = h.tsc_mhz;
-    c.clock.interconnect_mhz = h.tsc_mhz;
+    c.clock.core_mhz = h.core_mhz > 0 ? h.core_mhz : h.tsc_mhz;
+    c.clock.interconnect_mhz = c.clock.core_mhz;
     c.simd.width = h.simd_width;
     c.simd.units = 1;
     c.cores.count = 1;
@@ -252,9 +255,10 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "# the same machine model as the paper's machine (hw_model/core_model.h): one SIMD unit,\n"
       << "# ray buffers behind the L1D, partition by compress, measured per-op costs.\n"
       << "version: 1\nname: host\nclock:\n"
-      << "  core_mhz: " << fmt(h.tsc_mhz, 3)
-      << "  # measured: TSC ticks over 0.2 s of the steady clock\n"
-      << "  interconnect_mhz: " << fmt(h.tsc_mhz, 3)
+      << "  core_mhz: " << fmt(c.clock.core_mhz, 3)
+      << "  # measured: a chain of dependent adds (one a core cycle) against the TSC ("
+      << fmt(h.tsc_mhz, 3) << " MHz, over 0.2 s of the steady clock); op costs are core cycles\n"
+      << "  interconnect_mhz: " << fmt(c.clock.core_mhz, 3)
       << "  # one clock (unused: storage l1d has no interconnect)\n"
       << "simd:\n  width: " << h.simd_width << "  # cpuid: " << h.isa << "\n"
       << "  units: 1  # the native tracer runs its filters on one core's vector unit\n"

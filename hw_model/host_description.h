@@ -41,6 +41,7 @@ struct HostDescription {
     uint32_t simd_width = 1;
     std::string isa;  // e.g. "avx512 (16 lanes)"
     double tsc_mhz = 0.0;
+    double core_mhz = 0.0;  // the core's clock while measured (base/core_clock.h), boost included
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)

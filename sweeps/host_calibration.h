@@ -48,8 +48,9 @@ struct SiliconMeasurement {
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses
     double predicted_frame = 0.0;
-    // Cycles: process CPU time at the TSC rate (the TSC alone counts the neighbours' time on
-    // a shared machine); the median of the unclocked renders.
+    // Core cycles: process CPU time at the core's clock measured just before each render (the
+    // TSC alone counts the neighbours' time on a shared machine, and the core's clock moves);
+    // the fastest of the unclocked renders (the microbenchmarks take their fastest too).
     double measured_frame = 0.0;
     double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
     std::vector<double> frame_samples;       // every unclocked render's cycles

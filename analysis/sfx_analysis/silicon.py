@@ -258,7 +258,7 @@ def scatter_plot(df, path):
     ax.plot([lo, hi], [lo, hi], "k-", lw=1, label="y = x")
     ax.plot([lo, hi], [lo * 1.25, hi * 1.25], "k:", lw=0.8, label="±25 %")
     ax.plot([lo, hi], [lo / 1.25, hi / 1.25], "k:", lw=0.8)
-    ax.set_xlabel("measured Mcycles per frame (CPU time at the TSC rate, median)")
+    ax.set_xlabel("measured Mcycles per frame (core cycles, fastest render)")
     ax.set_ylabel("predicted Mcycles per frame")
     ax.set_title("frames")
     ax.legend(fontsize=6, ncol=2)

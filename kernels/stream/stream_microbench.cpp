@@ -6,6 +6,7 @@
 #include <numeric>
 #include <random>
 
+#include "base/core_clock.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/path.h"
@@ -64,14 +65,14 @@ Scene synthetic_scene(bool dense = false) {
 
 struct Buffers {
     std::vector<PathState> path, saved_path;
-    std::vector<Ray> ray, next;
-    TraversalRays trav, saved_trav;  // the filters' fields, t included
-    std::vector<RayPrecomp> pre;      // the full primitive tests' constants
+    std::vector<Ray> ray, next, saved_ray;
+    TraversalRays trav;                      // the filters' fields, t included
+    std::vector<RayPrecomp> pre, saved_pre;  // the full primitive tests' constants
     std::vector<Hit> hit, saved_hit;
-    std::vector<uint8_t> any_hit, mask;
-    std::vector<SurfaceHit> surf;
+    std::vector<uint8_t> any_hit, mask, saved_any_hit;
+    std::vector<SurfaceHit> surf, saved_surf;
     std::vector<uint32_t> ids, scratch, scratch2, positions;
-    std::vector<float> sphere_t;  // the sphere filter's distances
+    std::vector<float> sphere_t;     // the sphere filter's distances
     std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
     // Where a made ray is set up for the next generation's traversal (set_up_ray): arrays of
     // their own, so a repeated call finds its inputs as they were.
@@ -125,9 +126,30 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
         if (b.hit[i].valid()) b.surf[i] = surface_at(scene, r, b.hit[i]);
     }
     b.saved_path = b.path;
-    b.saved_trav = b.trav;
+    b.saved_ray = b.ray;
+    b.saved_pre = b.pre;
     b.saved_hit = b.hit;
+    b.saved_any_hit = b.any_hit;
+    b.saved_surf = b.surf;
     return b;
+}
+
+// Deals the buffer's rays (with their paths, hits and surfaces) to its slots in the order
+// `deal`, so that a stream of the same slots meets other rays each time: a branch predictor
+// learns a sequence of outcomes that repeats, and a frame's streams never repeat one.
+// `hits`: shading filters read the hits the setup found; intersection tests start from none,
+// as after the tracer's load_rays.
+void deal_rays(Buffers& b, const std::vector<uint32_t>& deal, bool hits) {
+    for (uint32_t i = 0; i < uint32_t(deal.size()); ++i) {
+        const uint32_t from = deal[i];
+        b.path[i] = b.saved_path[from];
+        b.ray[i] = b.saved_ray[from];
+        b.pre[i] = b.saved_pre[from];
+        b.trav.set(i, b.pre[i], b.ray[i].t_max);
+        b.hit[i] = hits ? b.saved_hit[from] : Hit{};
+        b.any_hit[i] = b.saved_any_hit[from];
+        b.surf[i] = b.saved_surf[from];
+    }
 }
 
 double median(std::vector<double> v) {
@@ -201,36 +223,41 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
             const uint32_t slots = options.buffer_slots[bi];
             Buffers& b = buffers[bi];
-            std::vector<uint32_t> order(slots);
+            std::vector<uint32_t> order(slots), deal(slots);
             std::iota(order.begin(), order.end(), 0u);
+            std::iota(deal.begin(), deal.end(), 0u);
+            std::vector<uint32_t> streams;
             for (uint32_t n : options.lengths) {
                 if (n > slots) continue;
                 std::vector<double> times;
                 uint32_t passed = 0;
+                const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
                 const uint32_t box_node = box_nodes[box_sample++ % box_nodes.size()];
+                // Short streams run several times in the timed region (the TSC ticks in steps
+                // of tens of cycles here), each time on another stream.
+                const uint32_t inner = std::max(1u, 256u / n);
+                const uint32_t stride = n + k_stream_padding;
+                streams.assign(size_t(inner) * stride, 0u);
                 for (uint32_t rep = 0; rep < options.repeats; ++rep) {
-                    // A fresh random stream: n slots of the buffer in increasing order, as the
-                    // tracer's streams are (the camera's, and every stable partition of one);
-                    // the whole buffer touched in random order first, so the L1D holds what a
-                    // pass over this buffer leaves in it.
-                    std::shuffle(order.begin(), order.end(), rng);
-                    std::copy(order.begin(), order.begin() + n, b.ids.begin());
-                    std::sort(b.ids.begin(), b.ids.begin() + n);
-                    std::copy(b.saved_path.begin(), b.saved_path.end(), b.path.begin());
-                    b.trav = b.saved_trav;
-                    // Intersection tests start from no hit, as after the tracer's load_rays;
-                    // shading filters read the hits the setup found.
-                    if (stage_of(kind) == OpStage::shading)
-                        std::copy(b.saved_hit.begin(), b.saved_hit.end(), b.hit.begin());
-                    else
-                        std::fill(b.hit.begin(), b.hit.end(), Hit{});
+                    // Fresh random streams: n slots of the buffer each, in increasing order, as
+                    // the tracer's streams are (the camera's, and every stable partition of
+                    // one), with the rays dealt anew; the whole buffer touched in random order
+                    // first, so the L1D holds what a pass over this buffer leaves in it.
+                    std::shuffle(deal.begin(), deal.end(), rng);
+                    deal_rays(b, deal, stage_of(kind) == OpStage::shading);
+                    for (uint32_t j = 0; j < inner; ++j) {
+                        std::shuffle(order.begin(), order.end(), rng);
+                        uint32_t* stream = streams.data() + size_t(j) * stride;
+                        std::copy(order.begin(), order.begin() + n, stream);
+                        std::sort(stream, stream + n);
+                    }
                     float touch = 0.f;
                     for (uint32_t id : order)
                         touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
                                  b.surf[id].position.x + b.path[id].radiance.x + b.hit[id].t;
                     if (touch == 12345.f) b.mask[0] = 1;
 
-                    uint32_t* ids = b.ids.data();
+                    uint32_t* ids = streams.data();
                     uint8_t* mask = b.mask.data();
                     uint32_t* scratch = b.scratch.data();
                     NoTrace trace;
@@ -246,12 +273,10 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                    b.next_pre[id], b.next_trav);
                         return true;
                     };
-                    // Short streams run several times in the timed region: the TSC ticks in
-                    // steps of tens of cycles here. Repeats test the same ids again, as
-                    // traversal tests one stream against node after node.
-                    const uint32_t inner = std::max(1u, 256u / n);
                     const uint64_t start = __rdtsc();
-                    for (uint32_t again = 0; again < inner; ++again) switch (kind) {
+                    for (uint32_t again = 0; again < inner; ++again) {
+                        ids = streams.data() + size_t(again) * stride;
+                        switch (kind) {
                             case OpKind::camera:
                                 for (uint32_t i = 0; i < n; ++i) {
                                     const uint32_t slot = ids[i];
@@ -406,10 +431,12 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             case OpKind::count:
                                 break;
                         }
+                    }
                     const uint64_t end = __rdtsc();
                     times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
                 }
-                out.push_back({kind, slots, n, passed, median(times)});
+                out.push_back({kind, slots, n, passed,
+                               *std::min_element(times.begin(), times.end()) / ticks_per_cycle});
             }
         }
         if (progress) progress(++done, uint32_t(kinds.size()));
@@ -460,13 +487,14 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats,
                 sample.ops[k] = counts.kind_ops(OpKind(k));
             job.sink = nullptr;
             std::vector<double> times;
+            const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
             for (uint32_t rep = 0; rep < repeats; ++rep) {
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
                 times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
             }
-            sample.cycles = median(times);
+            sample.cycles = *std::min_element(times.begin(), times.end()) / ticks_per_cycle;
             out.push_back(sample);
         }
     return out;
@@ -507,9 +535,11 @@ std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t re
                     e = __rdtsc();
                     compress_t.push_back((double(e - s) - overhead) / n);
                 }
-                out.push_back(
-                    {"field read (box kernel, 7 fields)", slots, n, scattered, median(gather_t)});
-                out.push_back({"compress partition", slots, n, scattered, median(compress_t)});
+                const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
+                out.push_back({"field read (box kernel, 7 fields)", slots, n, scattered,
+                               median(gather_t) / ticks_per_cycle});
+                out.push_back({"compress partition", slots, n, scattered,
+                               median(compress_t) / ticks_per_cycle});
             }
         }
     }

@@ -5,7 +5,8 @@
 // run with the trace off on streams of a chosen length whose ids are a random subset, in
 // increasing order (as the tracer's stable partitions keep them), of a ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
 // glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
-// the median of several repetitions. An op is timed with all the per-ray work the tracer does for
+// the fastest of several repetitions (a shared machine only ever adds time), in core cycles
+// (the TSC over base/core_clock.h's ticks per core cycle, taken just before). An op is timed with all the per-ray work the tracer does for
 // it: the emission filter computes the hits' surfaces (surface_at), and the camera and every
 // shader that makes a ray set it up for the next generation's traversal (set_up_ray, the
 // tracer's load_rays). `sfx calibrate --describe-host` fits the host's per-op costs to these
@@ -30,12 +31,14 @@ struct MicrobenchSample {
     uint32_t slots = 0;   // the ray buffer the stream's ids are scattered over
     uint32_t lanes = 0;   // stream length
     uint32_t passed = 0;  // lanes that passed (the filter's result)
-    double cycles = 0.0;  // TSC ticks per call, median over repetitions
+    double cycles = 0.0;  // core cycles per call (base/core_clock.h), fastest repetition
 };
 
 struct MicrobenchOptions {
     Isa isa = Isa::automatic;
-    std::vector<uint32_t> buffer_slots = {256, 1024, 4096};  // 16^2, 32^2, 64^2 ray buffers
+    // 8^2 (inside a 32 KiB L1D: what tells the per-lane cost from the cost beyond the L1D),
+    // 16^2, 32^2 and 64^2 ray buffers.
+    std::vector<uint32_t> buffer_slots = {64, 256, 1024, 4096};
     std::vector<uint32_t> lengths = {1, 8, 16, 24, 48, 96, 200, 512, 1024, 4096};
     uint32_t repeats = 9;
     uint64_t seed = 1;
@@ -54,7 +57,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
 struct OneRaySample {
     uint32_t rays = 0;
     std::array<uint64_t, k_op_kind_count> ops{};  // per kind, counted by the same traversals
-    double cycles = 0.0;                          // TSC ticks, median over repetitions
+    double cycles = 0.0;                          // core cycles, fastest repetition
 };
 // Batches of 1 to 32 random rays (several batches of each size).
 std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats = 9,
