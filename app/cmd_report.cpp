@@ -140,7 +140,8 @@ void add_report_command(CLI::App& app) {
                   "of the report (docs/paper-check.md; see scripts/paper-check)");
     c->add_option("--silicon", options->silicon,
                   "`sfx calibrate --check --json` output (scripts/silicon-check writes "
-                  "out/silicon-check/rows.json): adds the timing model on silicon to the report")
+                  "out/silicon-check/rows-WIDEST.json): adds the timing model on silicon to the "
+                  "report")
         ->check(CLI::ExistingFile);
     c->add_option("--trace-stats", options->trace_stats,
                   "with --paper: `sfx trace-stats conference --json` output, for the trace-side "
