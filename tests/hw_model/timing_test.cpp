@@ -6,6 +6,7 @@
 #include <string>
 
 #include "hw_model/analytic_model.h"
+#include "hw_model/host_description.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/accelerator.h"
 #include "hw_model/systemc/systemc_timing.h"
@@ -29,6 +30,18 @@ WorkloadShape triangle_shape(uint32_t tile) {
     s.bvh_nodes = 64;
     s.tile = tile;
     return s;
+}
+
+// A host as sfx calibrate --describe-host describes one, without measuring this machine.
+HostDescription test_host_description() {
+    HostDescription h;
+    h.simd_width = 8;
+    h.isa = "avx2 (8 lanes)";
+    h.tsc_mhz = h.core_mhz = 3000.0;
+    h.caches = {{1, "data", 32, 64, 8, false, "test"}, {2, "unified", 512, 64, 8, false, "test"}};
+    h.latency_ns = {1.3, 4.0, 90.0};
+    h.slot_bytes = 330;
+    return h;
 }
 
 struct CraftedOp {
@@ -328,6 +341,24 @@ TEST_CASE(
         for (size_t i = 1; i < configs.size(); ++i)
             CHECK(timing.timing(i).cycles <= timing.timing(i - 1).cycles);
         CHECK(timing.timing(0).stalls.bank_conflict > timing.timing(4).stalls.bank_conflict);
+    }
+    {
+        // A CPU core (the host's knobs: buffers behind the L1D, compress, measured costs, the
+        // op window) beside the paper's machine: the image is still the same bytes.
+        HwConfig host = host_hw_config(test_host_description(), {});
+        for (const OpKindInfo& k : k_op_kinds) {
+            OpCostConfig c;
+            c.op = k.name;
+            c.per_group_cycles = 10;
+            c.per_lane_cycles = 2;
+            host.op_costs.push_back(c);
+        }
+        host.cores.op_window = 4;
+        SystemcTiming timing({HwConfig(), host}, shape);
+        const RenderResult timed = render_stream(scene, bvh, settings, &timing);
+        CHECK(std::memcmp(plain.image.pixels.data(), timed.image.pixels.data(),
+                          plain.image.pixels.size() * sizeof(Vec3)) == 0);
+        CHECK(timing.timing(1).cycles > 0);
     }
     std::vector<HwConfig> widths;
     for (uint32_t w : {1u, 2u, 4u, 8u, 12u, 16u, 32u, 64u}) widths.push_back(with_width(w));
