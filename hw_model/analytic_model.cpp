@@ -293,12 +293,14 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             moves = std::ceil(moved_ids / n);
         }
         const double bubble = p.partitions && !l1d ? first_fetch + tail + compare + moves : 0.0;
-        // Scene data is requested at dispatch (or prefetch_depth ops earlier): what the first
+        // Scene data is requested at dispatch (or prefetch_depth ops earlier; a prefetch of
+        // children at least one op earlier, while the op that feeds it runs): what the first
         // fetch and the earlier ops do not cover shows.
+        const double ahead =
+            double(c.scene_memory.prefetch_depth) + (c.scene_memory.prefetch_children ? 1.0 : 0.0);
         const double memory_stall =
             p.scene_bytes
-                ? std::max(0.0, fetch_cycles - first_fetch -
-                                    double(c.scene_memory.prefetch_depth) * (exec + bubble)) *
+                ? std::max(0.0, fetch_cycles - first_fetch - ahead * (exec + bubble)) *
                       double(bucket.fetches) / ops
                 : 0.0;
         const double op_cycles = exec + bubble + memory_stall;

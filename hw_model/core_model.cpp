@@ -61,6 +61,7 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_pass_start = now;
     const size_t n = pass->size();
     m_scene_ready.assign(n, 0);
+    m_scene_requested.assign(n, 0);
     m_groups_left.assign(n, 0);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
@@ -108,6 +109,8 @@ void CoreModel::dispatch_op(uint32_t index) {
 }
 
 void CoreModel::request_scene(uint32_t index, uint64_t now) {
+    if (m_scene_requested[index]) return;  // prefetched: the earlier request stands
+    m_scene_requested[index] = 1;
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
     if (!p.scene_bytes || op.object == k_no_object || op.length == 0) {

@@ -44,7 +44,8 @@ class CoreModel {
     void begin_pass(const PassBuffer* pass, uint64_t now);
     // Counts an op as it is dispatched (ops, lanes, groups, the op mix).
     void dispatch_op(uint32_t op);
-    // Requests op's scene data (a node, primitive or material) at `now`.
+    // Requests op's scene data (a node, primitive or material) at `now`, unless it was
+    // requested before (prefetched).
     void request_scene(uint32_t op, uint64_t now);
 
     // The access side of a group at `now`: id-stream read, address generation, gathers through
@@ -110,6 +111,7 @@ class CoreModel {
     const PassBuffer* m_pass = nullptr;
     uint64_t m_pass_start = 0;
     std::vector<uint64_t> m_scene_ready;    // per op
+    std::vector<uint8_t> m_scene_requested;  // per op: its scene data was requested
     std::vector<uint32_t> m_groups_left;    // per op
     std::vector<uint64_t> m_op_completion;  // per op: latest group completion so far
     std::vector<uint64_t> m_unit_free;      // per SIMD unit

@@ -239,9 +239,10 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.push_back(cl);
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
-    // The native tracer prefetches a node's children while it tests the node (prefetch_below
-    // in kernels/stream/stream_kernels_impl.h): depth first, the next op's node.
-    c.scene_memory.prefetch_depth = 1;
+    // The native tracer prefetches a node's children (a leaf's primitives) while it tests the
+    // node (prefetch_below in kernels/stream/stream_kernels_impl.h), and nothing else.
+    c.scene_memory.prefetch_depth = 0;
+    c.scene_memory.prefetch_children = true;
     c.op_costs = op_costs;
     return c;
 }
@@ -287,8 +288,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  # measured: pointer chase over 256 MiB\n"
       << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
       << "  # assumed: not measured; DRAM lines queue for it\n"
-      << "  prefetch_depth: 1  # the native tracer prefetches a node's children as it tests the node\n"
-      << "                     # (prefetch_below, kernels/stream): depth first, the next op's node\n";
+      << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
+      << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) as it\n"
+      << "                           # tests the node (prefetch_below, kernels/stream)\n";
     y << "# Fitted: " << fit_note << "\n";
     if (op_costs.empty()) {
         y << "op_costs: []\n";

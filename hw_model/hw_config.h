@@ -209,6 +209,10 @@ struct SceneMemoryConfig {
     double dram_bandwidth_gbps = 25.6;  // assumed: three DDR3-1066 channels, an X5670 configuration
     // Assumed: G&R describe no prefetch. 0: an op's scene data is requested when it dispatches.
     uint32_t prefetch_depth = 0;
+    // Assumed: G&R describe no prefetch. true: when an op is dispatched, the scene data of the
+    // ops whose streams its partition produces (a node's children, a leaf's primitives) is
+    // requested too.
+    bool prefetch_children = false;
 
     template <class V>
     void visit(V& v) {
@@ -220,6 +224,9 @@ struct SceneMemoryConfig {
                 "stream operations ahead of dispatch whose scene data is requested early (the "
                 "traversal order makes the next nodes known)",
                 0u, 1024u);
+        v.param("prefetch_children", prefetch_children, "",
+                "request the scene data of the ops an op's partition feeds (a node's children, "
+                "a leaf's primitives) when it is dispatched");
     }
 };
 

@@ -22,6 +22,8 @@ public:
         m_passed.clear();
         m_producer.clear();
         m_streams.clear();
+        m_consumers.clear();
+        m_consumer_start.clear();
     }
     void op(const StreamOp& op) override {
         StreamOp copy = op;
@@ -40,7 +42,18 @@ public:
             m_streams[stream_key(op.slots, op.passed, op.length, true)] =
                 uint32_t(m_ops.size() - 1);
     }
-    void end_pass(const TilePass& p) override { m_pass = p; }
+    void end_pass(const TilePass& p) override {
+        m_pass = p;
+        // The consumers of each op, grouped by producer (counting sort: in op order).
+        m_consumer_start.assign(m_ops.size() + 1, 0);
+        for (const int32_t producer : m_producer)
+            if (producer >= 0) ++m_consumer_start[size_t(producer) + 1];
+        for (size_t i = 0; i < m_ops.size(); ++i) m_consumer_start[i + 1] += m_consumer_start[i];
+        m_consumers.resize(m_consumer_start.back());
+        std::vector<uint32_t> next(m_consumer_start.begin(), m_consumer_start.end() - 1);
+        for (size_t i = 0; i < m_producer.size(); ++i)
+            if (m_producer[i] >= 0) m_consumers[next[size_t(m_producer[i])]++] = uint32_t(i);
+    }
 
     const TilePass& pass() const { return m_pass; }
     // Ids a stable partition of op i moves: the same for every configuration.
@@ -48,6 +61,13 @@ public:
     // The earlier op whose partition produced op i's stream, or -1 when none did (then op i is
     // taken to depend on every earlier partition). The same for every configuration.
     int32_t producer(size_t i) const { return m_producer[i]; }
+    // The ops whose producer op i is, in order (after end_pass).
+    const uint32_t* consumers_begin(size_t i) const {
+        return m_consumers.data() + m_consumer_start[i];
+    }
+    const uint32_t* consumers_end(size_t i) const {
+        return m_consumers.data() + m_consumer_start[i + 1];
+    }
     size_t size() const { return m_ops.size(); }
     // The op with its views pointing into this buffer.
     StreamOp at(size_t i) const {
@@ -78,6 +98,7 @@ private:
     std::vector<uint8_t> m_passed;
     std::vector<uint32_t> m_moved;
     std::vector<int32_t> m_producer;
+    std::vector<uint32_t> m_consumers, m_consumer_start;
     std::unordered_map<uint64_t, uint32_t> m_streams;  // passing-stream key -> latest op
 };
 

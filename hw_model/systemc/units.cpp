@@ -92,6 +92,7 @@ void Core::dispatch() {
     const uint32_t units = m_model.units(), width = m_model.width();
     const uint32_t prefetch = m_model.config().scene_memory.prefetch_depth;
     const uint32_t window = m_model.config().cores.op_window;
+    const bool children = m_model.config().scene_memory.prefetch_children;
     uint32_t next_unit = 0;
     for (;;) {
         const std::shared_ptr<const PassBuffer> pass = m_source.next_pass();
@@ -119,6 +120,9 @@ void Core::dispatch() {
             const uint64_t now = m_clock.now();
             const uint32_t horizon = std::min(ops - 1, i + prefetch);
             for (; next_scene <= horizon; ++next_scene) m_model.request_scene(next_scene, now);
+            if (children)
+                for (const uint32_t* c = pass->consumers_begin(i); c != pass->consumers_end(i); ++c)
+                    m_model.request_scene(*c, now);
             m_model.dispatch_op(i);
             ++m_outstanding;
             for (uint32_t first = 0; first < op.length; first += width) {

@@ -11,7 +11,8 @@
 // SIMD units; it holds an op back only until the partition its stream depends on is done (an op
 // that does not partition leaves its stream as it was, so the next op's groups flow on: the
 // access side runs ahead of execution, decoupled access/execute). Scene data is requested as an
-// op is dispatched, or scene_memory.prefetch_depth ops earlier.
+// op is dispatched, or scene_memory.prefetch_depth ops earlier, or (prefetch_children) when the
+// op whose partition feeds it is dispatched.
 
 #include <deque>
 #include <memory>

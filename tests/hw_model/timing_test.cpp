@@ -274,6 +274,12 @@ TEST_CASE("An op window releases an op once the partition that produced its stre
     CHECK(buffer.producer(1) == 0);
     CHECK(buffer.producer(2) == 0);
 
+    buffer.end_pass(TilePass{});
+    REQUIRE(buffer.consumers_end(0) - buffer.consumers_begin(0) == 2);
+    CHECK(buffer.consumers_begin(0)[0] == 1);
+    CHECK(buffer.consumers_begin(0)[1] == 2);
+    CHECK(buffer.consumers_end(1) == buffer.consumers_begin(1));
+
     HwConfig in_order, window;
     window.cores.op_window = 2;
     const FrameTiming a = time_passes(in_order, {ops}), b = time_passes(window, {ops});
@@ -283,6 +289,28 @@ TEST_CASE("An op window releases an op once the partition that produced its stre
     CHECK(b.stalls.pipeline_fill < a.stalls.pipeline_fill);
     // Never slower, and the same work.
     CHECK(b.mix.total() == a.mix.total());
+}
+
+TEST_CASE("Prefetching an op's children requests the back child's node with the front child's",
+          "[hw_model][systemc]") {
+    // A parent and its two children, each on its own node, every node first read from DRAM.
+    const std::vector<uint32_t> all = consecutive(32), half = consecutive(16);
+    std::vector<uint8_t> parent_pass(32, 0), child_pass(16, 0);
+    for (uint32_t i = 0; i < 16; ++i) parent_pass[i] = 1;
+    for (uint32_t i = 0; i < 16; i += 2) child_pass[i] = 1;
+    const std::vector<CraftedOp> ops = {{OpKind::box_test, all, parent_pass, 1},
+                                        {OpKind::box_test, half, child_pass, 20},
+                                        {OpKind::box_test, half, child_pass, 40}};
+    HwConfig next_op, children;
+    for (HwConfig* c : {&next_op, &children})
+        c->scene_memory.dram_latency_ns = 2000;  // 1000 cycles: longer than any op here
+    next_op.scene_memory.prefetch_depth = 1;
+    children.scene_memory.prefetch_children = true;
+    const FrameTiming a = time_passes(next_op, {ops}), b = time_passes(children, {ops});
+    // Both request the front child's node as the parent dispatches; only the children's
+    // prefetch requests the back child's node then too, not when the front child dispatches.
+    CHECK(b.stalls.scene_memory < a.stalls.scene_memory);
+    CHECK(b.cycles < a.cycles);
 }
 
 TEST_CASE("More units, more cores, deeper queues are never slower on the same trace",
