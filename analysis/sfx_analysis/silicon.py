@@ -169,28 +169,27 @@ def _verdict(r):
     return f"{'yes' if r['right'] else 'no'} ({r['pairs_right']} of {r['pairs']} pairs)"
 
 
-def ranking_text(df):
-    rank = ranking(df)
-    lines = ["| back end | scene | res | predicted (fastest first) | measured | right |",
-             "|---|---|---|---|---|---|"]
+def _ranking_table(rank, keys, order):
+    """A ranking's rows: the `keys` columns, both orders (`order` names them), the verdict."""
+    titles = {"isa": "back end"}
+    lines = ["| " + " | ".join(titles.get(k, k) for k in keys) +
+             f" | predicted ({order}) | measured | right |", "|" + "---|" * (len(keys) + 3)]
     for _, r in rank.iterrows():
-        lines.append(f"| {r['isa']} | {r['scene']} | {r['res']} | "
-                     f"{', '.join(map(str, r['predicted']))} | "
-                     f"{', '.join(map(str, r['measured']))} | {_verdict(r)} |")
+        cells = [str(r[k]) for k in keys] + [", ".join(map(str, r["predicted"])),
+                                             ", ".join(map(str, r["measured"])), _verdict(r)]
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def ranking_text(df):
+    return _ranking_table(ranking(df), ["isa", "scene", "res"], "fastest first")
 
 
 def width_ranking_text(df):
     rank = width_ranking(df)
     if rank.empty:
         return "One back end only: no width ranking."
-    lines = ["| scene | res | tile | predicted (fastest first, lanes) | measured | right |",
-             "|---|---|---|---|---|---|"]
-    for _, r in rank.iterrows():
-        lines.append(f"| {r['scene']} | {r['res']} | {r['tile']} | "
-                     f"{', '.join(map(str, r['predicted']))} | "
-                     f"{', '.join(map(str, r['measured']))} | {_verdict(r)} |")
-    return "\n".join(lines)
+    return _ranking_table(rank, ["scene", "res", "tile"], "fastest first, lanes")
 
 
 def misses_text(df):

@@ -11,6 +11,7 @@
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "base/input_error.h"
+#include "tests/hw_model/test_hosts.h"
 
 using namespace sfx;
 
@@ -28,16 +29,6 @@ OpCostConfig cost(const char* op, double per_op, double group, double lane, doub
     return c;
 }
 
-HostDescription small_host() {
-    HostDescription h;
-    h.simd_width = 16;
-    h.isa = "avx512 (16 lanes)";
-    h.tsc_mhz = 1000.0;  // 1 cycle per ns
-    h.caches = {{1, "data", 32, 64, 8, false, "test"}, {2, "unified", 256, 64, 8, false, "test"}};
-    h.latency_ns = {1.0, 5.0, 81.0};
-    h.slot_bytes = 64;
-    return h;
-}
 
 // A host configuration with a cost for every op kind: `costs` as given, the rest free.
 HwConfig host_with(std::vector<OpCostConfig> costs) {
@@ -50,14 +41,7 @@ HwConfig host_with(std::vector<OpCostConfig> costs) {
 }
 
 WorkloadShape shape() {
-    WorkloadShape s;
-    s.features.triangles = true;
-    s.features.lambertian = true;
-    s.features.light_count = 1;
-    s.triangles = 100;
-    s.bvh_nodes = 64;
-    s.tile = 8;
-    return s;
+    return triangle_shape(8);
 }
 
 // One box test of `lanes` lanes (all passing) on node `node`, per pass, in passes of `slots`

@@ -7,6 +7,7 @@
 
 #include "hw_model/analytic_model.h"
 #include "hw_model/host_description.h"
+#include "tests/hw_model/test_hosts.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/accelerator.h"
 #include "hw_model/systemc/systemc_timing.h"
@@ -21,28 +22,6 @@ using namespace sfx;
 
 namespace {
 
-WorkloadShape triangle_shape(uint32_t tile) {
-    WorkloadShape s;
-    s.features.triangles = true;
-    s.features.lambertian = true;
-    s.features.light_count = 1;
-    s.triangles = 100;
-    s.bvh_nodes = 64;
-    s.tile = tile;
-    return s;
-}
-
-// A host as sfx calibrate --describe-host describes one, without measuring this machine.
-HostDescription test_host_description() {
-    HostDescription h;
-    h.simd_width = 8;
-    h.isa = "avx2 (8 lanes)";
-    h.tsc_mhz = h.core_mhz = 3000.0;
-    h.caches = {{1, "data", 32, 64, 8, false, "test"}, {2, "unified", 512, 64, 8, false, "test"}};
-    h.latency_ns = {1.3, 4.0, 90.0};
-    h.slot_bytes = 330;
-    return h;
-}
 
 struct CraftedOp {
     OpKind kind = OpKind::box_test;
@@ -255,18 +234,22 @@ TEST_CASE("Partition and scene-memory stalls are charged where they occur", "[hw
     CHECK(i.mix.scatter_gather == 2 * 7 + 2 * 5);
 }
 
-TEST_CASE("An op window releases an op once the partition that produced its stream is done",
-          "[hw_model][systemc]") {
-    // A parent box test on 32 rays, 16 passing; its front child on those 16 (half pass, so its
-    // own passing stream is a new one); the back child on the parent's 16 again: the back
-    // child's stream comes from the parent, not from the front child.
+// A parent box test on 32 rays (node 1), 16 passing; its front child on those 16 (node 20;
+// half pass, so its own passing stream is a new one); the back child on the parent's 16 again
+// (node 40): the back child's stream comes from the parent, not from the front child.
+std::vector<CraftedOp> parent_and_children() {
     const std::vector<uint32_t> all = consecutive(32), half = consecutive(16);
     std::vector<uint8_t> parent_pass(32, 0), child_pass(16, 0);
     for (uint32_t i = 0; i < 16; ++i) parent_pass[i] = 1;
     for (uint32_t i = 0; i < 16; i += 2) child_pass[i] = 1;
-    const std::vector<CraftedOp> ops = {{OpKind::box_test, all, parent_pass},
-                                        {OpKind::box_test, half, child_pass},
-                                        {OpKind::box_test, half, child_pass}};
+    return {{OpKind::box_test, all, parent_pass, 1},
+            {OpKind::box_test, half, child_pass, 20},
+            {OpKind::box_test, half, child_pass, 40}};
+}
+
+TEST_CASE("An op window releases an op once the partition that produced its stream is done",
+          "[hw_model][systemc]") {
+    const std::vector<CraftedOp> ops = parent_and_children();
     PassBuffer buffer;
     buffer.begin_pass(TilePass{});
     for (const CraftedOp& c : ops) buffer.op(to_stream_op(c));
@@ -293,14 +276,8 @@ TEST_CASE("An op window releases an op once the partition that produced its stre
 
 TEST_CASE("Prefetching an op's children requests the back child's node with the front child's",
           "[hw_model][systemc]") {
-    // A parent and its two children, each on its own node, every node first read from DRAM.
-    const std::vector<uint32_t> all = consecutive(32), half = consecutive(16);
-    std::vector<uint8_t> parent_pass(32, 0), child_pass(16, 0);
-    for (uint32_t i = 0; i < 16; ++i) parent_pass[i] = 1;
-    for (uint32_t i = 0; i < 16; i += 2) child_pass[i] = 1;
-    const std::vector<CraftedOp> ops = {{OpKind::box_test, all, parent_pass, 1},
-                                        {OpKind::box_test, half, child_pass, 20},
-                                        {OpKind::box_test, half, child_pass, 40}};
+    // Every node first read from DRAM.
+    const std::vector<CraftedOp> ops = parent_and_children();
     HwConfig next_op, children;
     for (HwConfig* c : {&next_op, &children})
         c->scene_memory.dram_latency_ns = 2000;  // 1000 cycles: longer than any op here
@@ -373,7 +350,7 @@ TEST_CASE(
     {
         // A CPU core (the host's knobs: buffers behind the L1D, compress, measured costs, the
         // op window) beside the paper's machine: the image is still the same bytes.
-        HwConfig host = host_hw_config(test_host_description(), {});
+        HwConfig host = host_hw_config(small_host(), {});
         for (const OpKindInfo& k : k_op_kinds) {
             OpCostConfig c;
             c.op = k.name;
