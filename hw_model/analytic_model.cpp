@@ -173,10 +173,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     // A CPU core (storage l1d): the lanes' loads, stores and compress-stores are inside the
     // measured op costs, and so is an L1D hit on scene data.
     const bool l1d = c.ray_buffer.storage == "l1d";
-    const double scene_hidden =
-        l1d && !c.scene_memory.caches.empty()
-            ? double(ns_to_cycles(c.scene_memory.caches.front().hit_latency_ns, c.clock.core_mhz))
-            : 0.0;
     const RayBufferModel buffer(c.ray_buffer, layout.words(), std::max(1u, shape.slots()));
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
@@ -184,10 +180,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const double fetch_cycles = std::max(
         0.0, expected_fetch_cycles(c.scene_memory, c.clock.core_mhz,
                                    footprint ? *footprint : profile, &global_misses) -
-                 scene_hidden);
-    const uint32_t slot_bytes = c.ray_buffer.slot_bytes ? c.ray_buffer.slot_bytes : layout.bytes();
+                 double(scene_latency_in_costs(c)));
     const double beyond_l1 =
-        l1d ? beyond_l1_fraction(std::max(1u, shape.slots()), slot_bytes, c.ray_buffer.kib) : 0.0;
+        slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()));
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank =

@@ -78,6 +78,11 @@ uint64_t ns_to_cycles(double ns, double mhz) {
     return uint64_t(std::ceil(ns * mhz / 1000.0 - 1e-9));
 }
 
+uint64_t scene_latency_in_costs(const HwConfig& c) {
+    if (c.ray_buffer.storage != "l1d" || c.scene_memory.caches.empty()) return 0;
+    return ns_to_cycles(c.scene_memory.caches.front().hit_latency_ns, c.clock.core_mhz);
+}
+
 SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores)
     : m_config(config),
       m_dram_latency(ns_to_cycles(config.dram_latency_ns, core_mhz)),

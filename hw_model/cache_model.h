@@ -40,6 +40,11 @@ class SetAssociativeCache {
 // usable from the first clock edge after it arrives).
 uint64_t ns_to_cycles(double ns, double mhz);
 
+// Cycles of scene-data latency a configuration's measured op costs already hold: an L1D hit
+// (the microbenchmarks read their scene data from it) on a CPU core (ray_buffer.storage l1d);
+// nothing for a machine priced from instruction counts.
+uint64_t scene_latency_in_costs(const HwConfig& config);
+
 // The scene-data memory of a machine: per-core private levels and shared levels (as
 // configured), then DRAM, whose bandwidth all cores share. Reads are timed: a read issued at a
 // cycle returns the cycle its data arrives.

@@ -30,13 +30,8 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_map(map),
       m_core(core_index),
       m_l1d(config.ray_buffer.storage == "l1d"),
-      m_slot_bytes(config.ray_buffer.slot_bytes ? config.ray_buffer.slot_bytes : record_words * 4),
-      // Measured op costs were timed with their scene data in the L1D: only the latency of a
-      // farther level is the model's to add.
-      m_scene_hidden(m_l1d && !config.scene_memory.caches.empty()
-                         ? ns_to_cycles(config.scene_memory.caches.front().hit_latency_ns,
-                                        config.clock.core_mhz)
-                         : 0),
+      m_record_bytes(record_words * 4),
+      m_scene_hidden(scene_latency_in_costs(config)),
       m_layout(config.ray_buffer, record_words, slot_capacity),
       m_banks{BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer)),
               BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer))},
@@ -68,9 +63,7 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_partition_free = std::max(m_partition_free, now);
     m_timing = FrameTiming();
     m_timing.passes = 1;
-    m_beyond_l1 =
-        m_l1d ? beyond_l1_fraction(pass->pass().slot_count, m_slot_bytes, m_config.ray_buffer.kib)
-              : 0.0;
+    m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
 
 void CoreModel::dispatch_op(uint32_t index) {

@@ -29,15 +29,9 @@ OpCostConfig cost(const char* op, double per_op, double group, double lane, doub
     return c;
 }
 
-
 // A host configuration with a cost for every op kind: `costs` as given, the rest free.
 HwConfig host_with(std::vector<OpCostConfig> costs) {
-    for (const OpKindInfo& k : k_op_kinds) {
-        bool given = false;
-        for (const OpCostConfig& c : costs) given |= c.op == k.name;
-        if (!given) costs.push_back(cost(k.name, 0, 0, 0, 0, 0));
-    }
-    return host_hw_config(small_host(), costs);
+    return host_hw_config(small_host(), costs_for_every_kind(std::move(costs)));
 }
 
 WorkloadShape shape() {

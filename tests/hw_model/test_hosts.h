@@ -2,6 +2,8 @@
 // What the hardware-model tests share: a small triangle workload's shape, and a host described
 // as sfx calibrate --describe-host would, without measuring this machine.
 
+#include <vector>
+
 #include "hw_model/host_description.h"
 #include "hw_model/workload_shape.h"
 
@@ -29,6 +31,18 @@ inline HostDescription small_host() {
     h.latency_ns = {1.0, 5.0, 81.0};
     h.slot_bytes = 64;
     return h;
+}
+
+// `costs`, and a free cost for every other op kind: a host that can time any workload.
+inline std::vector<OpCostConfig> costs_for_every_kind(std::vector<OpCostConfig> costs) {
+    for (const OpKindInfo& k : k_op_kinds) {
+        bool given = false;
+        for (const OpCostConfig& c : costs) given |= c.op == k.name;
+        if (given) continue;
+        costs.emplace_back();
+        costs.back().op = k.name;
+    }
+    return costs;
 }
 
 }  // namespace sfx

@@ -350,14 +350,15 @@ TEST_CASE(
     {
         // A CPU core (the host's knobs: buffers behind the L1D, compress, measured costs, the
         // op window) beside the paper's machine: the image is still the same bytes.
-        HwConfig host = host_hw_config(small_host(), {});
+        OpCostConfig cost;
+        cost.per_group_cycles = 10;
+        cost.per_lane_cycles = 2;
+        std::vector<OpCostConfig> costs;
         for (const OpKindInfo& k : k_op_kinds) {
-            OpCostConfig c;
-            c.op = k.name;
-            c.per_group_cycles = 10;
-            c.per_lane_cycles = 2;
-            host.op_costs.push_back(c);
+            cost.op = k.name;
+            costs.push_back(cost);
         }
+        HwConfig host = host_hw_config(small_host(), costs);
         host.cores.op_window = 4;
         SystemcTiming timing({HwConfig(), host}, shape);
         const RenderResult timed = render_stream(scene, bvh, settings, &timing);
