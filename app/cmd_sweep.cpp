@@ -24,6 +24,7 @@
 #include "app/progress.h"
 #include "sweeps/engine.h"
 #include "sweeps/group_runner.h"
+#include "sweeps/host_time_estimate.h"
 #include "sweeps/results_store.h"
 #include "sweeps/sweep.h"
 #include "base/host_clock.h"
@@ -39,8 +40,11 @@ std::string fixed(double v, int digits) {
     return s.str();
 }
 
-std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
-    const SweepPoint& p = sweep.points[points.front()];
+std::string group_label(const PointGroup& group, size_t points) {
+    const struct {
+        const WorkloadConfig& workload;
+        Fidelity fidelity;
+    } p{group.workload, group.fidelity};
     std::string scene = p.workload.scene;
     if (scene.find('/') != std::string::npos) scene = scene.substr(scene.find_last_of('/') + 1);
     return scene + " " + std::to_string(p.workload.width) + "x" +
@@ -58,9 +62,13 @@ std::string group_label(const Sweep& sweep, const std::vector<size_t>& points) {
                       std::to_string(p.workload.batching_queue) + " rays/queue " +
                       std::to_string(p.workload.batching_cell_prims) + " prims/cell"
                 : std::string()) +
-           " " + to_string(p.fidelity) + " (" + std::to_string(points.size()) + " config" +
-           (points.size() == 1 ? "" : "s") + ")";
+           " " + to_string(p.fidelity) + " (" + std::to_string(points) + " config" +
+           (points == 1 ? "" : "s") + ")";
 }
+
+// Dask: groups submitted and unfinished at most, so the client holds a bounded part of the
+// sweep; enough to keep a few hundred worker threads busy.
+constexpr unsigned k_dask_window = 256;
 
 struct Failure {
     size_t group;
@@ -68,8 +76,14 @@ struct Failure {
     std::string message;
 };
 
-void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set<std::string>& ran,
-                   std::ostream& out) {
+// Rows of the summary table at most; a larger sweep's rows are in the store (--csv, sfx report).
+constexpr size_t k_summary_rows = 200;
+
+// (expansion index, key) of every point of the sweep, in expansion order.
+using PointKeys = std::vector<std::pair<size_t, std::string>>;
+
+void print_summary(const Sweep& sweep, const PointKeys& keys, const ResultsStore& store,
+                   const std::set<std::string>& ran, std::ostream& out) {
     std::vector<std::string> headers = {"#"};
     for (const std::string& a : sweep.axes) headers.push_back(a);
     const std::vector<std::pair<std::string, std::string>> metrics = {
@@ -83,10 +97,11 @@ void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set
     for (const auto& m : metrics) headers.push_back(m.second);
     headers.push_back("");
     std::vector<std::vector<std::string>> rows;
-    for (const SweepPoint& p : sweep.points) {
-        std::vector<std::string> row = {std::to_string(p.index)};
-        for (const auto& av : p.axis_values) row.push_back(av.second);
-        const std::map<std::string, double> n = store.numbers(p.key);
+    for (size_t k = 0; k < std::min(keys.size(), k_summary_rows); ++k) {
+        const auto& [index, key] = keys[k];
+        std::vector<std::string> row = {std::to_string(index)};
+        for (const auto& av : sweep.axis_values(index)) row.push_back(av.second);
+        const std::map<std::string, double> n = store.numbers(key);
         auto get = [&](const std::string& k) {
             auto it = n.find(k);
             return it == n.end() ? std::nan("") : it->second;
@@ -104,7 +119,7 @@ void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set
             const double interval = get("error.relative");
             row.push_back(interval >= 0 ? "+-" + fixed(100 * interval, 2) + "%" : "unknown");
             row.push_back(fixed(get("host_seconds"), 3));
-            row.push_back(ran.count(p.key) ? "" : "stored");
+            row.push_back(ran.count(key) ? "" : "stored");
         }
         rows.push_back(std::move(row));
     }
@@ -125,139 +140,199 @@ void print_summary(const Sweep& sweep, const ResultsStore& store, const std::set
     };
     print(headers);
     for (const auto& r : rows) print(r);
+    if (keys.size() > rows.size())
+        out << "... and " << keys.size() - rows.size()
+            << " more rows: every row is in the store (--csv FILE writes them; sfx report)\n";
+}
+
+void print_dry_run(const Sweep& sweep, bool json) {
+    const std::vector<FidelityEstimate> estimate = estimate_host_seconds(sweep);
+    if (json) {
+        nlohmann::ordered_json j;
+        j["sweep"] = sweep.name;
+        j["points"] = sweep.point_count;
+        j["groups"] = sweep.groups.size();
+        j["duplicates"] = sweep.duplicates;
+        j["axes"] = sweep.axes;
+        j["estimate"] = nlohmann::ordered_json::array();
+        for (const FidelityEstimate& e : estimate)
+            j["estimate"].push_back({{"fidelity", to_string(e.fidelity)},
+                                     {"points", e.points},
+                                     {"groups", e.groups},
+                                     {"host_seconds", e.seconds}});
+        std::cout << j.dump(2) << "\n";
+        return;
+    }
+    std::cout << "sweep " << sweep.name << ": " << sweep.point_count << " points in "
+              << sweep.groups.size() << " renders";
+    if (sweep.duplicates) std::cout << " (" << sweep.duplicates << " duplicate points dropped)";
+    std::cout << "\n";
+    constexpr size_t k_listed = 50;  // a large sweep's groups are counted, not listed
+    for (size_t g = 0; g < std::min(k_listed, sweep.groups.size()); ++g)
+        std::cout << "  group " << g << ": " << group_label(sweep.groups[g], sweep.groups[g].points.size()) << "\n";
+    if (sweep.groups.size() > k_listed) std::cout << "  ... and " << sweep.groups.size() - k_listed << " more groups\n";
+    std::cout << "estimated host time (one core; " << k_estimate_basis << "):\n";
+    double total = 0;
+    for (const FidelityEstimate& e : estimate) {
+        std::cout << "  " << std::setw(8) << to_string(e.fidelity) << ": " << e.points << " points in "
+                  << e.groups << " renders, " << duration_text(e.seconds) << "\n";
+        total += e.seconds;
+    }
+    std::cout << "  total: " << duration_text(total) << " of CPU time, about "
+              << duration_text(total / std::max(1u, std::thread::hardware_concurrency()))
+              << " on this machine's " << std::max(1u, std::thread::hardware_concurrency())
+              << " cores\n";
 }
 
 void run_sweep(const std::string& path, const std::string& store_path, const std::string& csv,
                const std::string& engine, const std::string& scheduler, unsigned jobs,
-               uint32_t threads, const std::vector<std::string>& sets, bool dry_run, bool json) {
+               uint32_t threads, const std::vector<std::string>& sets, bool dry_run, bool json,
+               size_t max_points) {
     if (engine == "dask" && scheduler.empty())
         throw InputError("command line", 0, "--scheduler", "--engine dask needs --scheduler tcp://HOST:PORT");
     // Everything is checked before the store is opened: a bad sweep writes nothing, and an
     // output that cannot be written fails now, not after the sweep has run.
     if (!csv.empty()) check_output_file(csv, "--csv");
     if (!store_path.empty() && access(store_path.c_str(), F_OK) != 0) check_output_file(store_path, "--store");
-    const Sweep sweep = load_sweep(path, sets);
+    const Sweep sweep = load_sweep(path, sets, max_points);
     if (dry_run) {
-        if (json) {
-            nlohmann::ordered_json j;
-            j["sweep"] = sweep.name;
-            j["points"] = sweep.points.size();
-            j["groups"] = sweep.groups.size();
-            j["duplicates"] = sweep.duplicates;
-            j["axes"] = sweep.axes;
-            std::cout << j.dump(2) << "\n";
-        } else {
-            std::cout << "sweep " << sweep.name << ": " << sweep.points.size() << " points in "
-                      << sweep.groups.size() << " renders";
-            if (sweep.duplicates) std::cout << " (" << sweep.duplicates << " duplicate points dropped)";
-            std::cout << "\n";
-            for (size_t g = 0; g < sweep.groups.size(); ++g)
-                std::cout << "  group " << g << ": " << group_label(sweep, sweep.groups[g].points) << "\n";
-        }
+        print_dry_run(sweep, json);
         return;
     }
     if (store_path.empty()) throw InputError("command line", 0, "--store", "required (or --dry-run)");
     ResultsStore store(store_path);
-    const std::set<std::string> stored = store.keys();
 
-    std::map<std::string, size_t> point_of_key;
-    for (size_t i = 0; i < sweep.points.size(); ++i) point_of_key[sweep.points[i].key] = i;
-    std::vector<std::vector<size_t>> pending(sweep.groups.size());
-    size_t pending_points = 0;
-    for (size_t g = 0; g < sweep.groups.size(); ++g)
-        for (size_t i : sweep.groups[g].points)
-            if (!stored.count(sweep.points[i].key)) {
-                pending[g].push_back(i);
-                ++pending_points;
-            }
-    std::vector<GroupJob> todo;
-    for (size_t g = 0; g < sweep.groups.size(); ++g)
-        if (!pending[g].empty()) todo.push_back({g, ""});
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const unsigned parallel = std::max(1u, std::min<unsigned>(jobs ? jobs : cores, unsigned(std::max<size_t>(1, todo.size()))));
+    const unsigned parallel = std::max(1u, std::min<unsigned>(jobs ? jobs : cores, unsigned(std::max<size_t>(1, sweep.groups.size()))));
     // Local children share the cores; a Dask task may use its whole worker (0: all cores).
     const uint32_t group_threads = threads ? threads : engine == "local" ? std::max(1u, cores / parallel) : 0;
-    for (GroupJob& job : todo) job.spec = group_spec_json(sweep, pending[job.group], group_threads).dump();
-
     if (!json)
-        std::cerr << "sweep " << sweep.name << ": " << sweep.points.size() << " points in "
-                  << sweep.groups.size() << " renders; " << (sweep.points.size() - pending_points)
-                  << " already stored, " << pending_points << " to run in " << todo.size()
-                  << " groups on " << (engine == "local" ? std::to_string(parallel) + " local processes x " +
-                                                               std::to_string(group_threads) + " threads"
-                                                         : "Dask at " + scheduler)
-                  << "\n";
+        std::cerr << "sweep " << sweep.name << ": " << sweep.point_count << " points in "
+                  << sweep.groups.size() << " renders on "
+                  << (engine == "local" ? std::to_string(parallel) + " local processes x " +
+                                              std::to_string(group_threads) + " threads"
+                                        : "Dask at " + scheduler)
+                  << "; points already stored are skipped\n";
     // Points done / total, ETA and the running group: a bar on a terminal, else one line per
-    // finished group.
-    Progress progress("sweep", pending_points, "points", 0.0);
+    // finished group. The total drops as stored points are found.
+    Progress progress("sweep", sweep.point_count, "points", 0.0);
+
+    // Groups are made (points, keys, a look in the store) as the engine asks for them, and a
+    // group's rows are written in one transaction when it finishes.
+    struct Running {
+        std::vector<SweepPoint> points;  // not yet stored
+        std::vector<ResultsStore::PointRow> rows;
+    };
+    std::map<size_t, Running> running;
+    PointKeys keys;
+    keys.reserve(sweep.point_count);
+    size_t next_group = 0, already_stored = 0, groups_run = 0;
+    const NextGroup next = [&](GroupJob& job) {
+        while (next_group < sweep.groups.size()) {
+            const size_t g = next_group++;
+            std::vector<SweepPoint> points;
+            std::vector<std::string> group_keys;
+            for (size_t i : sweep.groups[g].points) {
+                points.push_back(sweep.point(i));
+                group_keys.push_back(points.back().key);
+                keys.emplace_back(i, points.back().key);
+            }
+            const std::set<std::string> stored = store.stored_keys(group_keys);
+            points.erase(std::remove_if(points.begin(), points.end(),
+                                        [&](const SweepPoint& p) { return stored.count(p.key) > 0; }),
+                         points.end());
+            already_stored += stored.size();
+            progress.set_total(sweep.point_count - already_stored);
+            if (points.empty()) continue;
+            job.group = g;
+            job.spec = group_spec_json(points, group_threads).dump();
+            running[g].points = std::move(points);
+            ++groups_run;
+            return true;
+        }
+        return false;
+    };
     std::set<std::string> ran;
     std::vector<Failure> failures;
-    std::vector<size_t> rows_of_group(sweep.groups.size(), 0);
+    // The rows a group returned, in one transaction; each point counted once.
+    auto write_rows = [&](size_t g) {
+        Running& r = running[g];
+        store.write_points(r.rows, sweep.name);
+        for (const ResultsStore::PointRow& row : r.rows)
+            if (ran.insert(row.run.key).second) progress.advance(1);
+    };
     EngineEvents events;
-    events.started = [&](size_t g) { progress.set_label(group_label(sweep, pending[g])); };
+    events.started = [&](size_t g) {
+        progress.set_label(group_label(sweep.groups[g], running[g].points.size()));
+    };
     events.row = [&](size_t g, const PointRun& run) {
-        auto it = point_of_key.find(run.key);
-        if (it == point_of_key.end() ||
-            std::find(pending[g].begin(), pending[g].end(), it->second) == pending[g].end())
+        Running& r = running[g];
+        auto it = std::find_if(r.points.begin(), r.points.end(),
+                               [&](const SweepPoint& p) { return p.key == run.key; });
+        if (it == r.points.end())
             throw std::runtime_error("a worker returned a point this group did not ask for (key " + run.key +
                                      ", worker sfx " + run.sfx_version + ", this sfx " + sfx_version() +
                                      "): workers must run the same sfx version");
-        store.write_point(sweep.points[it->second], sweep.name, run);
-        if (ran.insert(run.key).second) {
-            ++rows_of_group[g];
-            progress.advance(1);
-        }
+        for (const ResultsStore::PointRow& row : r.rows)
+            if (row.run.key == run.key) return;  // a repeat
+        r.rows.push_back({&*it, run});
     };
     events.finished = [&](size_t g) {
-        if (rows_of_group[g] != pending[g].size())
-            failures.push_back({g, 1, "returned " + std::to_string(rows_of_group[g]) + " of " +
-                                          std::to_string(pending[g].size()) + " rows"});
+        write_rows(g);
+        const Running& r = running[g];
+        if (r.rows.size() != r.points.size())
+            failures.push_back({g, 1, "returned " + std::to_string(r.rows.size()) + " of " +
+                                          std::to_string(r.points.size()) + " rows"});
         if (!progress.terminal())
-            progress.log("sweep: done " + group_label(sweep, pending[g]) + "  " +
+            progress.log("sweep: done " + group_label(sweep.groups[g], r.points.size()) + "  " +
                          progress.status());
+        running.erase(g);
     };
     events.failed = [&](size_t g, int code, const std::string& message) {
+        write_rows(g);  // rows returned before the failure are kept
         failures.push_back({g, code, message});
         if (progress.terminal())
             progress.clear();
         else
-            progress.log("sweep: FAILED " + group_label(sweep, pending[g]) + "  " +
+            progress.log("sweep: FAILED " + group_label(sweep.groups[g], running[g].points.size()) + "  " +
                          progress.status());
+        running.erase(g);
     };
-    if (!todo.empty()) {
-        if (engine == "local") run_local(todo, parallel, self_executable(), events);
-        else run_dask(todo, scheduler, self_executable(), events);
-    }
+    if (engine == "local") run_local(next, parallel, self_executable(), events);
+    else run_dask(next, scheduler, self_executable(), k_dask_window, events);
     progress.finish();
     const double seconds = progress.elapsed();
 
-    std::vector<std::string> keys;
-    for (const SweepPoint& p : sweep.points) keys.push_back(p.key);
-    if (!csv.empty()) store.export_csv(csv, keys);
+    std::sort(keys.begin(), keys.end());
+    if (!csv.empty()) {
+        std::vector<std::string> in_order;
+        for (const auto& [index, key] : keys) in_order.push_back(key);
+        store.export_csv(csv, in_order);
+    }
     if (json) {
         nlohmann::ordered_json j;
         j["sweep"] = sweep.name;
         j["store"] = store_path;
-        j["points"] = sweep.points.size();
+        j["points"] = sweep.point_count;
         j["groups"] = sweep.groups.size();
-        j["already_stored"] = sweep.points.size() - pending_points;
+        j["already_stored"] = already_stored;
         j["ran"] = ran.size();
         j["failed_groups"] = failures.size();
         j["seconds"] = seconds;
         j["rows"] = nlohmann::ordered_json::array();
-        for (const SweepPoint& p : sweep.points) {
+        for (const auto& [index, key] : keys) {
             nlohmann::ordered_json r;
-            r["point_index"] = p.index;
-            r["key"] = p.key;
-            for (const auto& [axis, value] : p.axis_values) r[axis] = value;
-            for (const auto& [name, value] : store.numbers(p.key))
+            r["point_index"] = index;
+            r["key"] = key;
+            for (const auto& [axis, value] : sweep.axis_values(index)) r[axis] = value;
+            for (const auto& [name, value] : store.numbers(key))
                 if (name != "point_index") r[name] = value;
             j["rows"].push_back(r);
         }
         std::cout << j.dump(2) << "\n";
     } else {
-        print_summary(sweep, store, ran, std::cout);
-        std::cout << "\n" << ran.size() << " points run, " << (sweep.points.size() - pending_points)
+        print_summary(sweep, keys, store, ran, std::cout);
+        std::cout << "\n" << ran.size() << " points run, " << already_stored
                   << " already stored, in " << fixed(seconds, 1) << " s; store " << store_path;
         if (!csv.empty()) std::cout << ", CSV " << csv;
         std::cout << "\n";
@@ -265,11 +340,12 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
     if (!failures.empty()) {
         bool input_error = false;
         for (const Failure& f : failures) {
-            std::cerr << "sfx: group " << f.group << " (" << group_label(sweep, pending[f.group])
+            std::cerr << "sfx: group " << f.group << " ("
+                      << group_label(sweep.groups[f.group], sweep.groups[f.group].points.size())
                       << ") failed: " << f.message << "\n";
             input_error |= f.exit_code == 2;
         }
-        const std::string what = std::to_string(failures.size()) + " of " + std::to_string(todo.size()) +
+        const std::string what = std::to_string(failures.size()) + " of " + std::to_string(groups_run) +
                                  " groups failed; re-run to retry them (stored points are kept)";
         if (input_error) throw InputError(path, 0, "", what);
         throw std::runtime_error(what);
@@ -285,6 +361,7 @@ void add_sweep_command(CLI::App& app) {
         uint32_t threads = 0;
         std::vector<std::string> sets;
         bool dry_run = false, json = false;
+        size_t max_points = k_default_max_points;
     };
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand("sweep", "run every point of a sweep into the results store (resumable)");
@@ -301,11 +378,16 @@ void add_sweep_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0u, k_max_threads));
     c->add_option("--set", o->sets, "change the base point: PATH=VALUE (workload.res=64x64, hw.simd.width=8)");
-    c->add_flag("--dry-run", o->dry_run, "check and expand the sweep, run nothing, write nothing");
+    c->add_flag("--dry-run", o->dry_run,
+                "check and expand the sweep, print its groups and estimated host time, run nothing, write nothing");
+    c->add_option("--max-points", o->max_points,
+                  "refuse a sweep (or an axis) of more points than this: a guard against a typo in a range")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(1), size_t(1) << 40));
     c->add_flag("--json", o->json, "print one JSON document");
     c->callback([o] {
         run_sweep(o->sweep, o->store, o->csv, o->engine, o->scheduler, o->jobs, o->threads, o->sets,
-                  o->dry_run, o->json);
+                  o->dry_run, o->json, o->max_points);
     });
 
     // Hidden: the unit of work of both engines. A group spec on stdin, one JSON row per line.

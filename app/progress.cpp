@@ -8,8 +8,10 @@
 namespace sfx {
 
 std::string duration_text(double seconds) {
-    if (!(seconds >= 0) || seconds > 1e7) return "?";
+    if (!(seconds >= 0) || seconds > 1e10) return "?";
     const long s = long(std::lround(seconds));
+    if (s >= 172800) return std::to_string(s / 86400) + "d" + (s % 86400 / 3600 < 10 ? "0" : "") +
+                            std::to_string(s % 86400 / 3600) + "h";
     if (s < 60) return std::to_string(s) + "s";
     if (s < 3600)
         return std::to_string(s / 60) + "m" + (s % 60 < 10 ? "0" : "") + std::to_string(s % 60) +

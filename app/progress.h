@@ -12,7 +12,7 @@
 
 namespace sfx {
 
-// "42s", "3m07s", "1h05m"; "?" for a negative or absurd value.
+// "42s", "3m07s", "1h05m", "3d04h"; "?" for a negative or absurd value.
 std::string duration_text(double seconds);
 
 class Progress {

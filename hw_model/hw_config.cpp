@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <set>
+#include <string_view>
 #include <sstream>
 
 #include "kernels/trace.h"
@@ -121,7 +122,7 @@ public:
     }
     void choice(const char* name, std::string& value, std::initializer_list<const char*> allowed,
                 const char*) {
-        if (join(m_prefix, name) != m_target) return;
+        if (!is_target(name)) return;
         for (const char* a : allowed)
             if (m_value == a) {
                 value = m_value;
@@ -130,12 +131,16 @@ public:
             }
         throw InputError(m_file, m_line, m_target, "'" + m_value + "' is not an allowed value");
     }
+    // Groups and lists off the target's path are not entered: a sweep sets parameters at
+    // every point, so this walk is on its hot path.
     template <class G> void group(const char* name, G& g) {
+        if (!leads_to_target(name, '.')) return;
         Setter s(m_target, m_value, m_file, m_line, join(m_prefix, name));
         g.visit(s);
         m_found |= s.m_found;
     }
     template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        if (!leads_to_target(name, '[')) return;
         for (size_t i = 0; i < items.size(); ++i) {
             Setter s(m_target, m_value, m_file, m_line,
                      join(m_prefix, name) + "[" + std::to_string(i) + "]");
@@ -145,8 +150,26 @@ public:
     }
 
 private:
+    // The rest of the target below this setter's prefix (empty if the target is not below it).
+    std::string_view below_prefix() const {
+        std::string_view t(m_target);
+        if (m_prefix.empty()) return t;
+        if (t.size() <= m_prefix.size() || t.compare(0, m_prefix.size(), m_prefix) != 0 ||
+            t[m_prefix.size()] != '.')
+            return {};
+        return t.substr(m_prefix.size() + 1);
+    }
+    // join(m_prefix, name) == m_target, without building the string.
+    bool is_target(const char* name) const { return below_prefix() == name; }
+    // The target is inside `name`: it continues with `next` ('.' or '[') after the name.
+    bool leads_to_target(const char* name, char next) const {
+        const std::string_view rest = below_prefix();
+        const size_t n = std::char_traits<char>::length(name);
+        return rest.size() > n && rest.compare(0, n, name) == 0 && rest[n] == next;
+    }
+
     template <class T> bool assign(const char* name, T& value) {
-        if (join(m_prefix, name) != m_target) return false;
+        if (!is_target(name)) return false;
         T parsed{};
         if (!parse_scalar(m_value, parsed))
             throw InputError(m_file, m_line, m_target, std::string("expected ") + type_name(parsed));

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """The Dask side of `sfx sweep --engine dask`: runs point groups on an existing Dask cluster.
 
-stdin:  one JSON line per point group: {"group": i, "spec": {...}} (sfx run-group's input).
+stdin:  one JSON line per point group: {"group": i, "spec": {...}} (sfx run-group's input),
+        read as the window (--window groups submitted and unfinished) has room, so a sweep of
+        any size streams through a bounded client.
 stdout: one JSON line per finished group, as groups finish, in any order:
         {"group": i, "rows": [...]}                 the rows `sfx run-group` printed
         {"group": i, "error": "...", "exit_code": n} the group failed (not retried if n == 2)
@@ -46,6 +48,7 @@ def main():
     parser.add_argument("--sfx", required=True, help="path of the sfx binary on the workers")
     parser.add_argument("--timeout", default="30s", help="time to reach the scheduler")
     parser.add_argument("--retries", type=int, default=2, help="re-runs of a failing group")
+    parser.add_argument("--window", type=int, default=64, help="groups submitted and unfinished at most")
     args = parser.parse_args()
 
     try:
@@ -53,22 +56,33 @@ def main():
     except ImportError as e:
         sys.exit("dask_client: Dask is not installed (Debian: python3-distributed): %s" % e)
 
-    groups = [json.loads(line) for line in sys.stdin if line.strip()]
     try:
         client = Client(args.scheduler, timeout=args.timeout)
     except Exception as e:  # noqa: BLE001 - report any connection failure plainly
         sys.exit("dask_client: cannot reach the Dask scheduler at %s: %s" % (args.scheduler, e))
 
     futures = {}
-    for g in groups:
-        spec_line = json.dumps(g["spec"]) + "\n"
-        # pure=False: two groups with equal specs are still two tasks; the key names the group.
-        future = client.submit(run_group, args.sfx, spec_line, key="sfx-group-%d-%d" % (g["group"], os.getpid()),
-                               pure=False, retries=args.retries)
-        futures[future] = g["group"]
+    pending = as_completed()
 
-    for future in as_completed(futures):
-        group = futures[future]
+    def submit_next():
+        """Submits the next group from stdin; False at its end."""
+        for line in sys.stdin:
+            if not line.strip():
+                continue
+            g = json.loads(line)
+            spec_line = json.dumps(g["spec"]) + "\n"
+            # pure=False: two groups with equal specs are still two tasks; the key names the group.
+            future = client.submit(run_group, args.sfx, spec_line, key="sfx-group-%d-%d" % (g["group"], os.getpid()),
+                                   pure=False, retries=args.retries)
+            futures[future] = g["group"]
+            pending.add(future)
+            return True
+        return False
+
+    while len(futures) < max(1, args.window) and submit_next():
+        pass
+    for future in pending:
+        group = futures.pop(future)
         try:
             result = future.result()
         except Exception as e:  # noqa: BLE001 - KilledWorker, a task's RuntimeError, ...
@@ -76,6 +90,7 @@ def main():
         result["group"] = group
         sys.stdout.write(json.dumps(result) + "\n")
         sys.stdout.flush()
+        submit_next()
     client.close()
 
 

@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
+#include <map>
 #include <cerrno>
 #include <cstring>
 #include <mutex>
@@ -70,6 +70,20 @@ std::string self_executable() {
 
 int run_process(const std::vector<std::string>& argv, const std::string& input,
                 const std::function<void(const std::string&)>& on_line, std::string* err) {
+    bool given = false;
+    return run_process(
+        argv,
+        [&](std::string& chunk) {
+            if (given) return false;
+            given = true;
+            chunk += input;
+            return true;
+        },
+        on_line, err);
+}
+
+int run_process(const std::vector<std::string>& argv, const InputSource& input,
+                const std::function<void(const std::string&)>& on_line, std::string* err) {
     Pipe in, out, errp;
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -89,8 +103,16 @@ int run_process(const std::vector<std::string>& argv, const std::string& input,
     if (!err) errp.close_end(0);
     fcntl(in.fd[1], F_SETFL, O_NONBLOCK);
 
+    std::string pending;  // given by the source, not yet written
     size_t written = 0;
-    if (input.empty()) in.close_end(1);
+    auto refill = [&] {
+        pending.erase(0, written);
+        written = 0;
+        while (pending.empty())
+            if (!input(pending)) return false;
+        return true;
+    };
+    if (!refill()) in.close_end(1);
     std::string line_buf;
     char chunk[65536];
     while (out.fd[0] >= 0 || errp.fd[0] >= 0) {
@@ -105,10 +127,11 @@ int run_process(const std::vector<std::string>& argv, const std::string& input,
             break;
         }
         if (in_i >= 0 && fds[in_i].revents) {
-            const ssize_t w = write(in.fd[1], input.data() + written, input.size() - written);
+            const ssize_t w = write(in.fd[1], pending.data() + written, pending.size() - written);
             if (w > 0) written += size_t(w);
             // EPIPE (the child exited without reading everything) ends the input too.
-            if (written == input.size() || (w < 0 && errno != EAGAIN && errno != EINTR)) in.close_end(1);
+            if (w < 0 && errno != EAGAIN && errno != EINTR) in.close_end(1);
+            else if (written == pending.size() && !refill()) in.close_end(1);
         }
         if (out_i >= 0 && fds[out_i].revents) {
             const ssize_t r = read(out.fd[0], chunk, sizeof chunk);
@@ -139,18 +162,18 @@ int run_process(const std::vector<std::string>& argv, const std::string& input,
     return 1;
 }
 
-void run_local(const std::vector<GroupJob>& jobs, unsigned parallel, const std::string& sfx_path,
+void run_local(const NextGroup& next, unsigned parallel, const std::string& sfx_path,
                const EngineEvents& events) {
     // A child whose reader is gone must not kill us; write errors are handled instead.
     signal(SIGPIPE, SIG_IGN);
     std::mutex mutex;  // serializes the callbacks
-    std::atomic<size_t> next{0};
     const std::string parent = std::to_string(getpid());
     auto worker = [&] {
-        for (size_t j; (j = next++) < jobs.size();) {
-            const GroupJob& job = jobs[j];
+        for (;;) {
+            GroupJob job;
             {
                 std::lock_guard<std::mutex> lock(mutex);
+                if (!next(job)) return;
                 events.started(job.group);
             }
             std::string err;
@@ -192,24 +215,31 @@ void run_local(const std::vector<GroupJob>& jobs, unsigned parallel, const std::
     for (std::thread& t : threads) t.join();
 }
 
-void run_dask(const std::vector<GroupJob>& jobs, const std::string& scheduler,
-              const std::string& sfx_path, const EngineEvents& events) {
+void run_dask(const NextGroup& next, const std::string& scheduler, const std::string& sfx_path,
+              unsigned window, const EngineEvents& events) {
     signal(SIGPIPE, SIG_IGN);
-    std::string input;
-    for (const GroupJob& job : jobs)
-        input += nlohmann::json{{"group", job.group}, {"spec", nlohmann::json::parse(job.spec)}}.dump() + "\n";
-    size_t groups = 0;
-    for (const GroupJob& job : jobs) groups = std::max(groups, job.group + 1);
-    std::vector<bool> done(groups, false);
-    std::string client_error;
+    // Groups given to the client and not yet reported: true once reported.
+    std::map<size_t, bool> done;
+    // The client reads a group's line only when its window has room, so the pipe holds the
+    // backlog and the specs are made as the cluster takes them.
+    const InputSource input = [&](std::string& chunk) {
+        GroupJob job;
+        if (!next(job)) return false;
+        done.emplace(job.group, false);
+        chunk += "{\"group\":" + std::to_string(job.group) + ",\"spec\":" + job.spec + "}\n";
+        return true;
+    };
     // The client's own stderr (Dask's warnings, its fatal errors) goes to ours.
     const int code = run_process(
-        {"/usr/bin/python3", SFX_DASK_CLIENT, "--scheduler", scheduler, "--sfx", sfx_path}, input,
+        {"/usr/bin/python3", SFX_DASK_CLIENT, "--scheduler", scheduler, "--sfx", sfx_path,
+         "--window", std::to_string(std::max(1u, window))},
+        input,
         [&](const std::string& line) {
             nlohmann::ordered_json msg;
             if (!parse_row_line(line, msg) || !msg.contains("group")) return;
             const size_t group = msg["group"].get<size_t>();
-            if (group >= done.size() || done[group]) return;  // a late duplicate of a retried task
+            auto it = done.find(group);
+            if (it == done.end() || it->second) return;  // a late duplicate of a retried task
             if (msg.contains("error")) {
                 done[group] = true;
                 events.failed(group, msg.value("exit_code", 1), msg["error"].get<std::string>());
@@ -231,9 +261,9 @@ void run_dask(const std::vector<GroupJob>& jobs, const std::string& scheduler,
             }
         },
         nullptr);
-    for (const GroupJob& job : jobs)
-        if (!done[job.group])
-            events.failed(job.group, 1,
+    for (const auto& [group, reported] : done)
+        if (!reported)
+            events.failed(group, 1,
                           "not run: the Dask client exited with status " + std::to_string(code) +
                               " (its own message is above)");
 }

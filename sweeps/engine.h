@@ -32,16 +32,28 @@ struct EngineEvents {
     std::function<void(size_t group, int exit_code, const std::string& message)> failed;
 };
 
-void run_local(const std::vector<GroupJob>& jobs, unsigned parallel, const std::string& sfx_path,
+// The groups to run, made as the engine asks for them (a large sweep's specs never all exist at
+// once): fills `job` and returns true, or returns false when there are no more. Called one at a
+// time, never concurrently with the events.
+using NextGroup = std::function<bool(GroupJob& job)>;
+
+void run_local(const NextGroup& next, unsigned parallel, const std::string& sfx_path,
                const EngineEvents& events);
 
-// Throws std::runtime_error if the client cannot start or reach the scheduler.
-void run_dask(const std::vector<GroupJob>& jobs, const std::string& scheduler,
-              const std::string& sfx_path, const EngineEvents& events);
+// The client holds at most `window` groups submitted and not finished. Throws
+// std::runtime_error if the client cannot start or reach the scheduler.
+void run_dask(const NextGroup& next, const std::string& scheduler, const std::string& sfx_path,
+              unsigned window, const EngineEvents& events);
 
-// Runs argv with `input` on its stdin (written concurrently with reading, so neither side
-// blocks the other), calls on_line for every stdout line as it arrives, and returns the exit
-// status (128 + signal if killed). stderr is collected into *err, or inherited if err is null.
+// More input for a process: appends to `chunk` and returns true, or returns false at the end.
+using InputSource = std::function<bool(std::string& chunk)>;
+
+// Runs argv with its stdin fed from `input` (written concurrently with reading, so neither side
+// blocks the other; a source is asked for more only when the pipe has taken what it gave),
+// calls on_line for every stdout line as it arrives, and returns the exit status (128 + signal
+// if killed). stderr is collected into *err, or inherited if err is null.
+int run_process(const std::vector<std::string>& argv, const InputSource& input,
+                const std::function<void(const std::string&)>& on_line, std::string* err);
 int run_process(const std::vector<std::string>& argv, const std::string& input,
                 const std::function<void(const std::string&)>& on_line, std::string* err);
 

@@ -10,12 +10,11 @@
 
 namespace sfx {
 
-nlohmann::json group_spec_json(const Sweep& sweep, const std::vector<size_t>& points,
-                               uint32_t threads) {
+nlohmann::json group_spec_json(const std::vector<SweepPoint>& points, uint32_t threads) {
     nlohmann::json spec;
     spec["threads"] = threads;
     spec["points"] = nlohmann::json::array();
-    for (size_t i : points) spec["points"].push_back(sweep.points[i].config_yaml);
+    for (const SweepPoint& p : points) spec["points"].push_back(p.config_yaml);
     return spec;
 }
 

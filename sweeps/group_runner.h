@@ -15,8 +15,7 @@
 
 namespace sfx {
 
-nlohmann::json group_spec_json(const Sweep& sweep, const std::vector<size_t>& points,
-                               uint32_t threads);
+nlohmann::json group_spec_json(const std::vector<SweepPoint>& points, uint32_t threads);
 
 // Parses every point (strictly), checks they share one render, runs run_point_group once and
 // returns one row per point, in order. Throws InputError on a bad spec (or sampled fidelity).

@@ -312,16 +312,50 @@ void ResultsStore::ensure_column(const std::string& name, const char* type) {
 }
 
 bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep, const PointRun& run) {
-    std::vector<HwColumn> hw_columns;
-    HwColumns visitor(hw_columns);
-    const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
-    const std::vector<HwParamInfo> hw_values = flatten_hw_config(point.hw);
+    return write_points({{&point, run}}, sweep) == 1;
+}
 
+std::set<std::string> ResultsStore::stored_keys(const std::vector<std::string>& keys) const {
+    std::set<std::string> out;
+    constexpr size_t k_batch = 500;  // below SQLite's bound-parameter limit
+    for (size_t first = 0; first < keys.size(); first += k_batch) {
+        const size_t n = std::min(k_batch, keys.size() - first);
+        std::string sql = "SELECT key FROM points WHERE key IN (?";
+        for (size_t i = 1; i < n; ++i) sql += ", ?";
+        Statement s(m_db, sql + ")");
+        for (size_t i = 0; i < n; ++i) s.bind(int(i + 1), keys[first + i]);
+        while (s.step()) out.insert(s.text(0));
+    }
+    return out;
+}
+
+size_t ResultsStore::write_points(const std::vector<PointRow>& rows, const std::string& sweep) {
+    if (rows.empty()) return 0;
     exec("BEGIN IMMEDIATE");
     try {
         // Another process may have added columns since we looked: re-read inside the lock.
         m_columns.clear();
         for (const std::string& c : columns()) m_columns.insert(c);
+        size_t inserted = 0;
+        for (const PointRow& row : rows) inserted += insert_point(*row.point, sweep, row.run);
+        hold_before_commit_for_tests(rows.front().point->key);
+        exec("COMMIT");
+        return inserted;
+    } catch (...) {
+        sqlite3_exec(m_db, "ROLLBACK", nullptr, nullptr, nullptr);
+        m_columns.clear();
+        for (const std::string& c : columns()) m_columns.insert(c);
+        throw;
+    }
+}
+
+// One row, inside the caller's transaction; true if its key was new.
+bool ResultsStore::insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run) {
+    std::vector<HwColumn> hw_columns;
+    HwColumns visitor(hw_columns);
+    const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
+    const std::vector<HwParamInfo> hw_values = flatten_hw_config(point.hw);
+    {
         const std::vector<WorkloadColumn> workload = workload_columns(point.workload);
         std::vector<std::string> names = {"key",        "sfx_version", "sweep",      "point_index",
                                           "started_at", "finished_at", "config_yaml"};
@@ -385,15 +419,7 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
             insert.bind(i++, value);
         }
         insert.step();
-        const bool inserted = sqlite3_changes(m_db) == 1;
-        hold_before_commit_for_tests(point.key);
-        exec("COMMIT");
-        return inserted;
-    } catch (...) {
-        sqlite3_exec(m_db, "ROLLBACK", nullptr, nullptr, nullptr);
-        m_columns.clear();
-        for (const std::string& c : columns()) m_columns.insert(c);
-        throw;
+        return sqlite3_changes(m_db) == 1;
     }
 }
 

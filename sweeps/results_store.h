@@ -50,6 +50,15 @@ public:
     bool contains(const std::string& key) const;
     // Writes one point in one transaction; false if its key was already stored.
     bool write_point(const SweepPoint& point, const std::string& sweep, const PointRun& run);
+    // Writes a batch of points (a group's rows) in one transaction: all of them or none.
+    // Returns how many were new.
+    struct PointRow {
+        const SweepPoint* point;
+        PointRun run;
+    };
+    size_t write_points(const std::vector<PointRow>& rows, const std::string& sweep);
+    // Which of `keys` are stored (one query per few hundred keys).
+    std::set<std::string> stored_keys(const std::vector<std::string>& keys) const;
 
     // Metric and column values of one stored row by column name (NULLs left out).
     std::map<std::string, double> numbers(const std::string& key) const;
@@ -70,6 +79,7 @@ public:
     sqlite3* handle() const { return m_db; }
 
 private:
+    bool insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run);
     void exec(const std::string& sql) const;
     void ensure_column(const std::string& name, const char* type);
 

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <unordered_set>
 #include <sstream>
 #include <stdexcept>
 
@@ -35,10 +36,6 @@ namespace sfx {
 const char* sfx_version() { return SFX_VERSION; }
 
 namespace {
-
-// A typo in a range must not eat the machine: every point is expanded (its key hashed) before
-// anything runs, about 0.5 ms each, so the cap keeps a --dry-run within seconds.
-constexpr size_t k_max_points = 10000;
 
 using strict_yaml::line_of;
 
@@ -88,6 +85,33 @@ void set_hw_at(HwConfig& c, const std::string& path, const std::string& value,
     }
 }
 
+// Each field's text, in visit() order.
+struct WorkloadTextCollector {
+    std::vector<std::string> values;
+    void text(const char*, std::string& value, const char*, const char* const* = nullptr) {
+        values.push_back(value);
+    }
+    template <class T>
+    void param(const char*, T& value, const char*, const char*, uint64_t, uint64_t,
+               const char* = nullptr) {
+        values.push_back(std::to_string(value));
+    }
+};
+
+// A resolved workload and fidelity as text: equal texts, one render.
+std::string workload_identity(const WorkloadConfig& w, Fidelity fidelity) {
+    WorkloadTextCollector fields;
+    const_cast<WorkloadConfig&>(w).visit(fields);  // the collector only reads
+    std::string text = to_string(fidelity);
+    for (const std::string& v : fields.values) text += '\n' + v;
+    return text;
+}
+
+std::string too_many(size_t max_points, const char* what) {
+    return std::string("more than ") + std::to_string(max_points) + " " + what +
+           " (sfx sweep --max-points raises the limit)";
+}
+
 struct Axis {
     std::string path;   // "hw.simd.width", "workload.tile", "fidelity"
     std::string field;  // the path below hw./workload.
@@ -98,7 +122,8 @@ struct Axis {
 };
 
 // Values of one axis: a list of scalars, {values: [...]} or {from, to, step}.
-void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& file) {
+void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& file,
+                      size_t max_points) {
     const std::string key = "axes." + axis.path;
     YAML::Node list = node;
     if (node.IsMap() && node["values"]) {
@@ -132,8 +157,8 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     if (parse_unsigned(from, ifrom) && parse_unsigned(to, ito) && parse_unsigned(step, istep)) {
         if (istep == 0) throw InputError(file, line_of(node["step"]), key + ".step", "must be positive");
         if (ito < ifrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
-        if ((ito - ifrom) / istep >= k_max_points)
-            throw InputError(file, line, key, "more than " + std::to_string(k_max_points) + " values");
+        if ((ito - ifrom) / istep >= max_points)
+            throw InputError(file, line, key, too_many(max_points, "values"));
         for (uint64_t v = ifrom; v <= ito; v += istep) {
             axis.values.push_back(std::to_string(v));
             axis.value_lines.push_back(line);
@@ -148,18 +173,21 @@ void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& fil
     if (dto < dfrom) throw InputError(file, line_of(node["to"]), key + ".to", "must not be below from");
     // Inclusive of `to` up to rounding: 0.1 to 0.3 step 0.1 has three values.
     const double count = std::floor((dto - dfrom) / dstep * (1 + 1e-12) + 1e-9) + 1;
-    if (count > double(k_max_points))
-        throw InputError(file, line, key, "more than " + std::to_string(k_max_points) + " values");
+    if (count > double(max_points))
+        throw InputError(file, line, key, too_many(max_points, "values"));
     for (uint64_t i = 0; i < uint64_t(count); ++i) {
         axis.values.push_back(shortest_text(dfrom + double(i) * dstep));
         axis.value_lines.push_back(line);
     }
 }
 
-class SweepParser {
+}  // namespace
+
+// The parsed sweep (base, axes, dimensions) that expands it and makes its points.
+class SweepExpansion {
 public:
-    SweepParser(std::string file, std::string base_dir)
-        : m_file(std::move(file)), m_base_dir(std::move(base_dir)) {}
+    SweepExpansion(std::string file, std::string base_dir, size_t max_points)
+        : m_file(std::move(file)), m_base_dir(std::move(base_dir)), m_max_points(max_points) {}
 
     Sweep parse(const std::string& text, const std::vector<std::string>& sets) {
         const YAML::Node root = parse_yaml_document(text, m_file);
@@ -311,7 +339,7 @@ private:
                 throw InputError(m_file, axis.line, key,
                                  "an axis path starts with hw. or workload., or is fidelity");
             }
-            read_axis_values(axis, kv.second, m_file);
+            read_axis_values(axis, kv.second, m_file, m_max_points);
             // Every value is checked now, on scratch copies, before anything runs.
             for (size_t i = 0; i < axis.values.size(); ++i) apply(axis, i, m_base, m_workload, m_fidelity, true);
             m_axes.push_back(std::move(axis));
@@ -334,7 +362,7 @@ private:
             WorkloadConfig copy;
             WorkloadConfig& target = scratch ? (copy = w) : w;
             set_workload(target, axis.field, value, m_base_dir, m_file, line, key);
-            if (scratch && axis.field == "scene") scene_features(target.scene, line, key);
+            if (scratch && axis.field == "scene") scene_info(target.scene, line, key);
         } else {
             const Fidelity parsed = parse_fidelity_at(value, m_file, line, key);
             if (!scratch) f = parsed;
@@ -388,109 +416,203 @@ private:
         }
     }
 
-    const FeatureSet& scene_features(const std::string& scene, int line,
-                                     const std::string& key) const {
+    struct SceneInfo {
+        FeatureSet features;
+        uint32_t primitives = 0;
+    };
+    const SceneInfo& scene_info(const std::string& scene, int line, const std::string& key) const {
         auto it = m_scenes.find(scene);
         if (it != m_scenes.end()) return it->second;
         try {
             const Scene s = load_scene(scene);
-            return m_scenes.emplace(scene, s.features()).first->second;
+            return m_scenes.emplace(scene, SceneInfo{s.features(), s.primitive_count()}).first->second;
         } catch (const InputError& e) {
             if (e.file() == scene && e.line() == 0) throw InputError(m_file, line, key, e.message());
             throw;  // an error inside the scene file names that file
         }
     }
 
+    // Every point is checked and grouped here, but none is kept: odometer order (the last
+    // dimension fastest), re-applying only the dimensions that moved, so a point costs a few
+    // microseconds. A point is a duplicate when its group already holds its hardware class:
+    // the tuple of its dimensions' first indices with the same hardware values.
     void expand(Sweep& sweep) {
+        const size_t dims = m_dimensions.size();
+        m_sizes.assign(dims, 0);
         size_t total = 1;
-        for (const auto& d : m_dimensions) {
-            total *= m_axes[d[0]].values.size();
-            if (total > k_max_points)
-                throw InputError(m_file, line_of_axes(), "axes", "more than " + std::to_string(k_max_points) + " points");
+        for (size_t d = 0; d < dims; ++d) {
+            m_sizes[d] = m_axes[m_dimensions[d][0]].values.size();
+            if (total > m_max_points / m_sizes[d])
+                throw InputError(m_file, line_of_axes(), "axes", too_many(m_max_points, "points"));
+            total *= m_sizes[d];
         }
-        std::map<std::string, size_t> by_key;
-        std::vector<std::pair<WorkloadConfig, Fidelity>> group_keys;
-        std::vector<size_t> at(m_dimensions.size(), 0);
-        for (size_t n = 0; n < total; ++n) {
-            SweepPoint p;
-            p.index = n;
-            p.hw = m_base;
-            WorkloadConfig w = m_workload;
-            p.fidelity = m_fidelity;
-            HwLineMap lines = m_hw_lines;
-            std::map<std::string, int> workload_lines = m_workload_lines;
-            for (size_t d = 0; d < m_dimensions.size(); ++d)
-                for (size_t a : m_dimensions[d]) {
-                    const Axis& axis = m_axes[a];
-                    apply(axis, at[d], p.hw, w, p.fidelity, false);
-                    p.axis_values.emplace_back(axis.path, axis.values[at[d]]);
-                    if (axis.kind == Axis::hw) lines[axis.field] = axis.value_lines[at[d]];
-                    if (axis.kind == Axis::workload) workload_lines[axis.field] = axis.value_lines[at[d]];
-                }
-            check_point_hw(p, lines);
-            p.workload = resolve(w, p, workload_lines);
-            p.config_yaml = point_config_yaml(p.hw, p.workload, p.fidelity);
-            p.key = point_key(p.config_yaml);
-            if (by_key.count(p.key)) {
-                ++sweep.duplicates;
-            } else {
-                by_key[p.key] = sweep.points.size();
-                size_t g = 0;
-                while (g < group_keys.size() &&
-                       !(group_keys[g].second == p.fidelity && group_keys[g].first == p.workload))
-                    ++g;
-                if (g == group_keys.size()) {
-                    group_keys.emplace_back(p.workload, p.fidelity);
-                    sweep.groups.emplace_back();
-                }
-                sweep.groups[g].points.push_back(sweep.points.size());
-                sweep.points.push_back(std::move(p));
+        std::vector<size_t> hw_class_of_value_stride(dims, 0);
+        std::vector<std::vector<size_t>> hw_class_of_value(dims);
+        size_t hw_stride = 1;
+        for (size_t d = dims; d-- > 0;) {
+            bool has_hw = false;
+            for (size_t a : m_dimensions[d]) has_hw |= m_axes[a].kind == Axis::hw;
+            if (!has_hw) continue;
+            std::map<std::string, size_t> first;
+            for (size_t i = 0; i < m_sizes[d]; ++i) {
+                std::string values;
+                for (size_t a : m_dimensions[d])
+                    if (m_axes[a].kind == Axis::hw) {
+                        // "8" and "8.0" set the same number: equal values, one class.
+                        double x = 0;
+                        const std::string& v = m_axes[a].values[i];
+                        values += (parse_finite(v, x) ? shortest_text(x) : v) + '\n';
+                    }
+                hw_class_of_value[d].push_back(first.emplace(values, i).first->second);
             }
+            hw_class_of_value_stride[d] = hw_stride;
+            hw_stride *= m_sizes[d];
+        }
+
+        HwConfig hw = m_base;
+        WorkloadConfig w = m_workload;
+        Fidelity f = m_fidelity;
+        std::vector<size_t> at(dims, 0);
+        size_t first_moved = 0;  // dimensions from here on take new values
+        WorkloadConfig resolved;
+        size_t group = 0;
+        std::map<std::string, size_t> group_of_workload;
+        std::vector<std::unordered_set<uint64_t>> classes_of_group;
+        for (size_t n = 0; n < total; ++n) {
+            bool hw_moved = n == 0, workload_moved = n == 0;
+            for (size_t d = first_moved; d < dims; ++d)
+                for (size_t a : m_dimensions[d]) {
+                    apply(m_axes[a], at[d], hw, w, f, false);
+                    (m_axes[a].kind == Axis::hw ? hw_moved : workload_moved) = true;
+                }
+            if (hw_moved) check_point_hw(hw, n, at);
+            if (hw_moved || workload_moved) {
+                const SceneInfo& scene = scene_info(w.scene, line_at(at, "scene"), "workload.scene");
+                WorkloadConfig r = resolve(w, hw, scene.features, n, at);
+                if (n == 0 || !(r == resolved) || f != sweep.groups[group].fidelity) {
+                    resolved = std::move(r);
+                    const std::string identity = workload_identity(resolved, f);
+                    auto [it, added] = group_of_workload.emplace(identity, sweep.groups.size());
+                    if (added) {
+                        sweep.groups.push_back({{}, resolved, f, scene.primitives});
+                        classes_of_group.emplace_back();
+                    }
+                    group = it->second;
+                }
+            }
+            uint64_t hw_class = 0;
+            for (size_t d = 0; d < dims; ++d)
+                if (!hw_class_of_value[d].empty()) hw_class += hw_class_of_value[d][at[d]] * hw_class_of_value_stride[d];
+            if (classes_of_group[group].insert(hw_class).second)
+                sweep.groups[group].points.push_back(n);
+            else
+                ++sweep.duplicates;
             // Odometer: the last dimension moves fastest.
-            for (size_t d = m_dimensions.size(); d-- > 0;) {
-                if (++at[d] < m_axes[m_dimensions[d][0]].values.size()) break;
+            for (size_t d = dims; d-- > 0;) {
+                if (++at[d] < m_sizes[d]) {
+                    first_moved = d;
+                    break;
+                }
                 at[d] = 0;
             }
         }
+        sweep.point_count = total - sweep.duplicates;
+    }
+
+public:
+    // One point, made again from its expansion index (checked when the sweep was expanded).
+    SweepPoint point(size_t n) const {
+        const size_t dims = m_dimensions.size();
+        const std::vector<size_t> at = position(n);
+        SweepPoint p;
+        p.index = n;
+        p.hw = m_base;
+        WorkloadConfig w = m_workload;
+        p.fidelity = m_fidelity;
+        for (size_t d = 0; d < dims; ++d)
+            for (size_t a : m_dimensions[d]) {
+                apply(m_axes[a], at[d], p.hw, w, p.fidelity, false);
+                p.axis_values.emplace_back(m_axes[a].path, m_axes[a].values[at[d]]);
+            }
+        p.workload = resolve(w, p.hw, scene_info(w.scene, 0, "workload.scene").features, n, at);
+        p.config_yaml = point_config_yaml(p.hw, p.workload, p.fidelity);
+        p.key = point_key(p.config_yaml);
+        return p;
+    }
+
+    std::vector<std::pair<std::string, std::string>> axis_values(size_t n) const {
+        const std::vector<size_t> at = position(n);
+        std::vector<std::pair<std::string, std::string>> out;
+        for (size_t d = 0; d < at.size(); ++d)
+            for (size_t a : m_dimensions[d]) out.emplace_back(m_axes[a].path, m_axes[a].values[at[d]]);
+        return out;
+    }
+
+private:
+    // Each dimension's value index at expansion index n (the last dimension fastest).
+    std::vector<size_t> position(size_t n) const {
+        std::vector<size_t> at(m_dimensions.size(), 0);
+        for (size_t d = at.size(); d-- > 0;) {
+            at[d] = n % m_sizes[d];
+            n /= m_sizes[d];
+        }
+        return at;
     }
 
     int line_of_axes() const { return m_axes.empty() ? 0 : m_axes.front().line; }
 
-    std::string describe(const SweepPoint& p) const {
-        std::string s;
-        for (const auto& [k, v] : p.axis_values) s += (s.empty() ? "" : ", ") + k + "=" + v;
-        return s.empty() ? "the base point" : s;
+    // The line of a hardware or workload field at a point: its axis value's, else the base's.
+    int line_at(const std::vector<size_t>& at, const std::string& field, bool hw = false) const {
+        for (size_t d = 0; d < at.size(); ++d)
+            for (size_t a : m_dimensions[d])
+                if (m_axes[a].field == field && (m_axes[a].kind == Axis::hw) == hw)
+                    return m_axes[a].value_lines[at[d]];
+        const auto& lines = hw ? m_hw_lines : m_workload_lines;
+        auto it = lines.find(field);
+        return it == lines.end() ? 0 : it->second;
     }
 
-    void check_point_hw(const SweepPoint& p, const HwLineMap& lines) const {
+    std::string describe(size_t n, const std::vector<size_t>& at) const {
+        std::string s;
+        for (size_t d = 0; d < at.size(); ++d)
+            for (size_t a : m_dimensions[d])
+                s += (s.empty() ? "" : ", ") + m_axes[a].path + "=" + m_axes[a].values[at[d]];
+        return "at point " + std::to_string(n) + ": " + (s.empty() ? "the base point" : s);
+    }
+
+    void check_point_hw(const HwConfig& hw, size_t n, const std::vector<size_t>& at) const {
         try {
-            check_hw_config(p.hw, m_file, lines);
-        } catch (const InputError& e) {
-            throw InputError(m_file, e.line() > 0 ? e.line() : line_of_axes(), "hw." + e.key(),
-                             e.message() + " (at point " + std::to_string(p.index) + ": " +
-                                 describe(p) + ")");
+            check_hw_config(hw, m_file);
+        } catch (const InputError&) {
+            // Failures only: the lines of this point's values, for the message.
+            HwLineMap lines = m_hw_lines;
+            for (size_t d = 0; d < at.size(); ++d)
+                for (size_t a : m_dimensions[d])
+                    if (m_axes[a].kind == Axis::hw) lines[m_axes[a].field] = m_axes[a].value_lines[at[d]];
+            try {
+                check_hw_config(hw, m_file, lines);
+            } catch (const InputError& e) {
+                throw InputError(m_file, e.line() > 0 ? e.line() : line_of_axes(), "hw." + e.key(),
+                                 e.message() + " (" + describe(n, at) + ")");
+            }
+            throw;
         }
     }
 
-    WorkloadConfig resolve(const WorkloadConfig& w, const SweepPoint& p,
-                           const std::map<std::string, int>& lines) const {
-        auto line = [&](const char* field) {
-            auto it = lines.find(field);
-            return it == lines.end() ? 0 : it->second;
-        };
-        const FeatureSet& features = scene_features(w.scene, line("scene"), "workload.scene");
-        // tile: auto is resolved per point (its own buffer), so a buffer-size axis changes
-        // the tile; points then group by the resolved tile.
+    // tile: auto is resolved per point (its own buffer), so a buffer-size axis changes the
+    // tile; points then group by the resolved tile.
+    WorkloadConfig resolve(const WorkloadConfig& w, const HwConfig& hw, const FeatureSet& features,
+                           size_t n, const std::vector<size_t>& at) const {
         try {
-            return resolve_workload(w, features, {p.hw}, "workload.tile").config;
+            return resolve_workload(w, features, {hw}, "workload.tile").config;
         } catch (const InputError& e) {
-            throw InputError(m_file, line("tile"), "workload.tile",
-                             e.message() + " (at point " + std::to_string(p.index) + ": " +
-                                 describe(p) + ")");
+            throw InputError(m_file, line_at(at, "tile"), "workload.tile",
+                             e.message() + " (" + describe(n, at) + ")");
         }
     }
 
     std::string m_file, m_base_dir;
+    size_t m_max_points;
     HwConfig m_base;
     HwLineMap m_hw_lines;
     WorkloadConfig m_workload;
@@ -500,20 +622,42 @@ private:
     std::vector<int> m_dimension_of;
     std::vector<std::vector<size_t>> m_zips;
     std::vector<std::vector<size_t>> m_dimensions;  // axes moving together, outermost first
-    mutable std::map<std::string, FeatureSet> m_scenes;
+    std::vector<size_t> m_sizes;                    // values per dimension
+    mutable std::map<std::string, SceneInfo> m_scenes;
 };
 
-}  // namespace
-
 Sweep parse_sweep(const std::string& text, const std::string& file, const std::string& base_dir,
-                  const std::vector<std::string>& sets) {
-    return SweepParser(file, base_dir).parse(text, sets);
+                  const std::vector<std::string>& sets, size_t max_points) {
+    auto expansion = std::make_shared<SweepExpansion>(file, base_dir, max_points);
+    Sweep sweep = expansion->parse(text, sets);
+    sweep.expansion = std::move(expansion);
+    return sweep;
 }
 
-Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets) {
+Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets, size_t max_points) {
     const std::string text = read_input_file(path, "sweep file");
     const fs::path dir = fs::absolute(fs::path(path)).parent_path();
-    return parse_sweep(text, path, dir.string(), sets);
+    return parse_sweep(text, path, dir.string(), sets, max_points);
+}
+
+SweepPoint Sweep::point(size_t index) const { return expansion->point(index); }
+
+std::vector<std::pair<std::string, std::string>> Sweep::axis_values(size_t index) const {
+    return expansion->axis_values(index);
+}
+
+std::vector<size_t> Sweep::point_indices() const {
+    std::vector<size_t> out;
+    out.reserve(point_count);
+    for (const PointGroup& g : groups) out.insert(out.end(), g.points.begin(), g.points.end());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::vector<SweepPoint> Sweep::all_points() const {
+    std::vector<SweepPoint> out;
+    for (size_t i : point_indices()) out.push_back(point(i));
+    return out;
 }
 
 namespace {
@@ -545,18 +689,6 @@ struct WorkloadYamlWriter {
     }
 };
 
-// Each field's text, in visit() order.
-struct WorkloadTextCollector {
-    std::vector<std::string> values;
-    void text(const char*, std::string& value, const char*, const char* const* = nullptr) {
-        values.push_back(value);
-    }
-    template <class T>
-    void param(const char*, T& value, const char*, const char*, uint64_t, uint64_t,
-               const char* = nullptr) {
-        values.push_back(std::to_string(value));
-    }
-};
 }  // namespace
 
 std::string point_config_yaml(const HwConfig& hw, const WorkloadConfig& w, Fidelity fidelity) {

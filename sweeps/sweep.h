@@ -8,6 +8,7 @@
 // fits. Errors are InputErrors naming the sweep file, the line and the dotted path.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,23 +36,49 @@ struct SweepPoint {
 // Points sharing one functional render: the same scene, resolution, spp, depth, resolved tile,
 // seed and fidelity.
 struct PointGroup {
-    std::vector<size_t> points;  // indices into Sweep::points, in expansion order
+    std::vector<size_t> points;  // expansion indices of the group's points, in order
+    WorkloadConfig workload;     // resolved, shared by every point of the group
+    Fidelity fidelity = Fidelity::full;
+    uint32_t scene_primitives = 0;  // for the host-time estimate
 };
 
+class SweepExpansion;
+
+// A sweep is expanded lazily: parsing checks every point (cross-parameter rules, tile fits) and
+// groups them, keeping per point only its place in a group; a point's configuration, YAML and
+// key are made when asked for (point()), so a 10^6-point sweep costs megabytes, not gigabytes.
 struct Sweep {
     std::string name;  // `name:`, else the file name without .sweep.yaml
     std::string file;
     std::vector<std::string> axes;  // dotted axis paths in file order
-    std::vector<SweepPoint> points;
     std::vector<PointGroup> groups;
-    size_t duplicates = 0;  // expanded points identical to an earlier one (dropped)
+    size_t point_count = 0;  // distinct points: the expansion less its duplicates
+    size_t duplicates = 0;   // expanded points identical to an earlier one (dropped)
+
+    // The point at this expansion index (an index of some group's `points`).
+    SweepPoint point(size_t index) const;
+    // Only its axis values (SweepPoint::axis_values), without making the point.
+    std::vector<std::pair<std::string, std::string>> axis_values(size_t index) const;
+    // Every distinct point in expansion order: for small sweeps and tests.
+    std::vector<SweepPoint> all_points() const;
+    // Every distinct point's expansion index, in order.
+    std::vector<size_t> point_indices() const;
+
+    std::shared_ptr<const SweepExpansion> expansion;
 };
+
+// The guard against a typo in a range eating the machine: a sweep (and an axis) may expand to at
+// most this many points unless the user raises it (`sfx sweep --max-points`).
+constexpr size_t k_default_max_points = 1000000;
 
 // Reads, checks and expands a sweep. Relative `hw:` and scene paths are relative to the file.
 // `sets` are command-line "PATH=VALUE" changes to the base point ("workload.res=32x32").
-Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets = {});
+// `max_points` bounds the expansion (the cross product, duplicates included).
+Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets = {},
+                 size_t max_points = k_default_max_points);
 Sweep parse_sweep(const std::string& yaml_text, const std::string& file_name,
-                  const std::string& base_dir, const std::vector<std::string>& sets = {});
+                  const std::string& base_dir, const std::vector<std::string>& sets = {},
+                  size_t max_points = k_default_max_points);
 
 // One point as YAML (comment-free, so the key depends on values only) and its store key:
 // hex SHA-256 of (config_yaml + "\n" + sfx version).

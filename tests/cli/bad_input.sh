@@ -142,13 +142,15 @@ read_only_store)  # a finished store in a read-only directory can still be compa
   [ -s "$work/report/index.html" ] || fail "no report was written"
   ls ro | grep -qv '^s.db$' && fail "files were added to the read-only directory: $(ls ro)"
   ;;
-sweep_cap)  # expansion is bounded at its own cap, and says so at once
-  printf 'version: 1\nhw: %s\nworkload: {scene: cornell}\nfidelity: analytic\naxes:\n  workload.seed: {from: 0, to: 999, step: 1}\n  workload.spp: {from: 1, to: 1000, step: 1}\n' "$gr08" > big.sweep.yaml
+sweep_cap)  # expansion is bounded by a guard the user can raise, and says so at once
+  printf 'version: 1\nhw: %s\nworkload: {scene: cornell}\nfidelity: analytic\naxes:\n  workload.seed: {from: 0, to: 999, step: 1}\n  workload.spp: {from: 1, to: 1001, step: 1}\n' "$gr08" > big.sweep.yaml
   start=$SECONDS
-  expect 2 "big.sweep.yaml:6: axes: more than 10000 points" "$sfx" sweep big.sweep.yaml --dry-run
+  expect 2 "big.sweep.yaml:6: axes: more than 1000000 points \(sfx sweep --max-points raises the limit\)" "$sfx" sweep big.sweep.yaml --dry-run
   [ $((SECONDS - start)) -le 5 ] || fail "refusing took $((SECONDS - start)) s"
+  expect 2 "big.sweep.yaml:6: axes: more than 5000 points" "$sfx" sweep big.sweep.yaml --dry-run --max-points 5000
+  expect 2 "--max-points" "$sfx" sweep big.sweep.yaml --dry-run --max-points 0
   printf 'version: 1\nhw: %s\nworkload: {scene: cornell}\naxes:\n  workload.seed: {from: 0, to: 1e15, step: 1}\n' "$gr08" > wide.sweep.yaml
-  expect 2 "wide.sweep.yaml:5: axes.workload.seed: (more than 10000 values|expected)" "$sfx" sweep wide.sweep.yaml --dry-run
+  expect 2 "wide.sweep.yaml:5: axes.workload.seed: (more than 1000000 values|expected)" "$sfx" sweep wide.sweep.yaml --dry-run
   ;;
 generator_budget)  # parameters each in range that together ask too much: refused up front
   printf 'version: 1\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nmaterials: [{name: a, kind: lambertian}]\nobjects:\n  - {type: generator, generator: temple, rubble_stones: 1000000, rubble_detail: 6,\n     materials: {stone: a, relief: a, floor: a, sky: a, sanctuary: a}}\n' > g.scene.yaml

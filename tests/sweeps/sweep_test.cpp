@@ -74,24 +74,24 @@ TEST_CASE("Axes expand as a cross product, last axis fastest, zip groups move to
                           "  hw.ray_buffer.kib: {values: [256, 512, 1024]}\n"
                           "zip:\n"
                           "  - [workload.tile, hw.ray_buffer.kib]\n");
-    REQUIRE(s.points.size() == 6);
+    REQUIRE(s.point_count == 6);
     CHECK(s.name == "t");
     CHECK(s.axes == std::vector<std::string>{"hw.simd.width", "workload.tile", "hw.ray_buffer.kib"});
-    CHECK(s.points[0].hw.simd.width == 4);
-    CHECK(s.points[0].workload.tile == 8);
-    CHECK(s.points[0].hw.ray_buffer.kib == 256);
-    CHECK(s.points[2].workload.tile == 32);
-    CHECK(s.points[2].hw.ray_buffer.kib == 1024);
-    CHECK(s.points[3].hw.simd.width == 8);
-    CHECK(s.points[3].workload.tile == 8);
-    CHECK(value_of(s.points[4], "hw.ray_buffer.kib") == "512");
-    for (size_t i = 0; i < s.points.size(); ++i) CHECK(s.points[i].index == i);
+    CHECK(s.all_points()[0].hw.simd.width == 4);
+    CHECK(s.all_points()[0].workload.tile == 8);
+    CHECK(s.all_points()[0].hw.ray_buffer.kib == 256);
+    CHECK(s.all_points()[2].workload.tile == 32);
+    CHECK(s.all_points()[2].hw.ray_buffer.kib == 1024);
+    CHECK(s.all_points()[3].hw.simd.width == 8);
+    CHECK(s.all_points()[3].workload.tile == 8);
+    CHECK(value_of(s.all_points()[4], "hw.ray_buffer.kib") == "512");
+    for (size_t i = 0; i < s.point_count; ++i) CHECK(s.all_points()[i].index == i);
     // One render per tile: both widths of a tile share it.
     REQUIRE(s.groups.size() == 3);
     for (const PointGroup& g : s.groups) {
         REQUIRE(g.points.size() == 2);
-        CHECK(s.points[g.points[0]].workload == s.points[g.points[1]].workload);
-        CHECK(s.points[g.points[0]].hw.simd.width != s.points[g.points[1]].hw.simd.width);
+        CHECK(s.point(g.points[0]).workload == s.point(g.points[1]).workload);
+        CHECK(s.point(g.points[0]).hw.simd.width != s.point(g.points[1]).hw.simd.width);
     }
 }
 
@@ -104,16 +104,16 @@ TEST_CASE("Ranges, overrides, command-line sets and the scene's depth", "[sweeps
                           "  hw.ray_buffer.kib: {from: 128, to: 512, step: 128}\n"
                           "  hw.scene_memory.dram_bandwidth_gbps: {from: 0.5, to: 1.5, step: 0.5}\n",
                           {"workload.spp=2", "hw.scene_memory.caches[0].kib=64"});
-    REQUIRE(s.points.size() == 12);
-    CHECK(s.points[0].hw.ray_buffer.kib == 128);
-    CHECK(s.points[11].hw.ray_buffer.kib == 512);
-    CHECK(value_of(s.points[1], "hw.scene_memory.dram_bandwidth_gbps") == "1");
-    CHECK(s.points[2].hw.scene_memory.dram_bandwidth_gbps == 1.5);
-    CHECK(s.points[5].hw.ray_buffer.banks == 16);
-    CHECK(s.points[5].hw.clock.core_mhz == 250.0);
-    CHECK(s.points[5].hw.scene_memory.caches[0].kib == 64);
-    CHECK(s.points[5].workload.spp == 2);
-    CHECK(s.points[5].workload.depth == 3);  // cornell's own
+    REQUIRE(s.point_count == 12);
+    CHECK(s.all_points()[0].hw.ray_buffer.kib == 128);
+    CHECK(s.all_points()[11].hw.ray_buffer.kib == 512);
+    CHECK(value_of(s.all_points()[1], "hw.scene_memory.dram_bandwidth_gbps") == "1");
+    CHECK(s.all_points()[2].hw.scene_memory.dram_bandwidth_gbps == 1.5);
+    CHECK(s.all_points()[5].hw.ray_buffer.banks == 16);
+    CHECK(s.all_points()[5].hw.clock.core_mhz == 250.0);
+    CHECK(s.all_points()[5].hw.scene_memory.caches[0].kib == 64);
+    CHECK(s.all_points()[5].workload.spp == 2);
+    CHECK(s.all_points()[5].workload.depth == 3);  // cornell's own
     CHECK(s.groups.size() == 1);              // tile fixed: one render for all
 }
 
@@ -124,18 +124,72 @@ TEST_CASE("tile: auto resolves per point from its buffer; points group by the re
                           "  hw.ray_buffer.kib: [128, 512, 512]\n"
                           "  hw.simd.width: [8, 16]\n");
     CHECK(s.duplicates == 2);  // the repeated 512 KiB points
-    REQUIRE(s.points.size() == 4);
-    CHECK(s.points[0].workload.tile < s.points[2].workload.tile);
+    REQUIRE(s.point_count == 4);
+    CHECK(s.all_points()[0].workload.tile < s.all_points()[2].workload.tile);
     CHECK(s.groups.size() == 2);
     for (const PointGroup& g : s.groups) CHECK(g.points.size() == 2);
-    CHECK(s.points[0].fidelity == Fidelity::full);  // the default
+    CHECK(s.all_points()[0].fidelity == Fidelity::full);  // the default
+}
+
+TEST_CASE("Expansion is lazy: 10^5 points are checked and grouped, each made on demand", "[sweeps]") {
+    const Sweep s = parse(std::string(k_head) +
+                          "axes:\n  workload.seed: {from: 0, to: 1562, step: 1}\n"
+                          "  hw.simd.width: {from: 1, to: 64, step: 1}\n");
+    CHECK(s.point_count == 100032);
+    CHECK(s.duplicates == 0);
+    REQUIRE(s.groups.size() == 1563);  // one render per seed, the widths share it
+    const PointGroup& g = s.groups[987];
+    REQUIRE(g.points.size() == 64);
+    CHECK(g.workload.seed == 987);
+    // A point made from its index is the one the odometer would reach: the last axis fastest.
+    const SweepPoint p = s.point(g.points[17]);
+    CHECK(p.index == 987 * 64 + 17);
+    CHECK(p.workload == g.workload);
+    CHECK(p.hw.simd.width == 18);
+    CHECK(p.key == point_key(p.config_yaml));
+    CHECK(s.axis_values(p.index) == p.axis_values);
+    // The same point from a sweep of one point has the same key and YAML.
+    const Sweep one = parse(std::string(k_head) + "hw_overrides: {simd.width: 18}\n"
+                            "axes:\n  workload.seed: [987]\n");
+    CHECK(one.all_points()[0].config_yaml == p.config_yaml);
+}
+
+TEST_CASE("The expansion guard is the caller's: more points or values than max_points are refused", "[sweeps]") {
+    const std::string text = std::string(k_head) + "axes:\n  workload.seed: {from: 0, to: 99, step: 1}\n"
+                                                   "  hw.simd.width: [4, 8]\n";
+    CHECK(parse_sweep(text, "t.sweep.yaml", k_presets, {}, 200).point_count == 200);
+    try {
+        parse_sweep(text, "t.sweep.yaml", k_presets, {}, 199);
+        FAIL("199 points allowed 200");
+    } catch (const InputError& e) {
+        CHECK(e.line() == 6);
+        CHECK(e.key() == "axes");
+        CHECK_THAT(e.message(), Catch::Contains("more than 199 points") && Catch::Contains("--max-points"));
+    }
+    try {
+        parse_sweep(text, "t.sweep.yaml", k_presets, {}, 50);
+        FAIL("an axis of 100 values allowed at 50");
+    } catch (const InputError& e) {
+        CHECK(e.key() == "axes.workload.seed");
+        CHECK_THAT(e.message(), Catch::Contains("more than 50 values"));
+    }
+}
+
+TEST_CASE("Equal values spelled differently are one point; duplicates are dropped per render", "[sweeps]") {
+    const Sweep s = parse(std::string(k_head) +
+                          "axes:\n  workload.seed: [1, 2]\n  hw.clock.core_mhz: [500, 500.0, 5e2, 250]\n");
+    CHECK(s.duplicates == 4);  // per seed: 500.0 and 5e2 are 500
+    CHECK(s.point_count == 4);
+    std::set<std::string> keys;
+    for (const SweepPoint& p : s.all_points()) keys.insert(p.key);
+    CHECK(keys.size() == 4);
 }
 
 TEST_CASE("Point YAML round-trips and its key depends on values and nothing else", "[sweeps]") {
     const Sweep s = parse(std::string(k_head) + "axes:\n  hw.simd.width: [8, 12]\n  workload.seed: [0, 7]\n");
-    REQUIRE(s.points.size() == 4);
+    REQUIRE(s.point_count == 4);
     std::set<std::string> keys;
-    for (const SweepPoint& p : s.points) {
+    for (const SweepPoint& p : s.all_points()) {
         keys.insert(p.key);
         CHECK(p.key.size() == 64);
         CHECK(p.key == point_key(p.config_yaml));
@@ -150,19 +204,19 @@ TEST_CASE("Point YAML round-trips and its key depends on values and nothing else
     const Sweep t = parse("version: 1\nhw: gr08.hw.yaml\nfidelity: analytic\n"
                           "workload:\n  seed: 7\n  tile: 8\n  width: 16\n  height: 16\n  spp: 1\n  scene: cornell\n"
                           "hw_overrides: {simd.width: 12}\n");
-    REQUIRE(t.points.size() == 1);
-    CHECK(t.points[0].key == s.points[3].key);
+    REQUIRE(t.point_count == 1);
+    CHECK(t.all_points()[0].key == s.all_points()[3].key);
     // A point with fewer cache levels keeps exactly those.
     HwConfig two;
     two.scene_memory.caches.pop_back();
-    const std::string yaml = point_config_yaml(two, s.points[0].workload, Fidelity::full);
+    const std::string yaml = point_config_yaml(two, s.all_points()[0].workload, Fidelity::full);
     CHECK(parse_point_config(yaml, "row").hw.scene_memory.caches.size() == 2);
 }
 
 TEST_CASE("A point's workload YAML keeps its text (stored keys stay valid)", "[sweeps]") {
     const Sweep s = parse(std::string(k_head) + "axes:\n  workload.seed: [7]\n");
-    REQUIRE(s.points.size() == 1);
-    const std::string& yaml = s.points[0].config_yaml;
+    REQUIRE(s.point_count == 1);
+    const std::string& yaml = s.all_points()[0].config_yaml;
     const std::string workload =
         "workload:\n  scene: \"cornell\"\n  width: 16\n  height: 16\n  spp: 1\n  depth: 3\n"
         "  tile: 8\n  seed: 7\nfidelity: analytic\n";
@@ -243,8 +297,8 @@ TEST_CASE("A sweep's hw may name a preset, as the command line does", "[sweeps]"
     // Parsed from sweeps/, where no file is called gr08: the name is the shipped preset.
     const Sweep s = parse_sweep("version: 1\nhw: gr08\nworkload: {scene: cornell, res: 16x16}\n",
                                 "t.sweep.yaml", SFX_SOURCE_DIR "/sweeps");
-    REQUIRE(s.points.size() == 1);
-    CHECK(dump_hw_config(s.points[0].hw) == dump_hw_config(load_hw_config("gr08")));
+    REQUIRE(s.point_count == 1);
+    CHECK(dump_hw_config(s.all_points()[0].hw) == dump_hw_config(load_hw_config("gr08")));
 }
 
 TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {
@@ -259,23 +313,23 @@ TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {
         if (name.size() < 11 || name.substr(name.size() - 11) != ".sweep.yaml") continue;
         INFO(name);
         const Sweep s = load_sweep(entry.path().string());
-        CHECK(!s.points.empty());
+        CHECK(s.point_count > 0);
         auto it = expected.find(s.name);
         if (it != expected.end()) {
             ++found;
-            CHECK(s.points.size() == it->second);
+            CHECK(s.point_count == it->second);
         }
     }
     CHECK(found == expected.size());
     const Sweep q = load_sweep(SFX_SOURCE_DIR "/sweeps/quickstart.sweep.yaml");
     CHECK(q.groups.size() == 12);  // scenes x tiles x fidelities; the widths share renders
     std::set<std::string> scenes;
-    for (const SweepPoint& p : q.points) scenes.insert(p.workload.scene);
+    for (const SweepPoint& p : q.all_points()) scenes.insert(p.workload.scene);
     CHECK(scenes.size() == 2);
     // The buffer sweep: tile auto gives each buffer size its own tile, so its own render.
     const Sweep b = load_sweep(SFX_SOURCE_DIR "/sweeps/quickstart-buffer.sweep.yaml");
     CHECK(b.groups.size() == 8);
     std::set<uint32_t> tiles;
-    for (const SweepPoint& p : b.points) tiles.insert(p.workload.tile);
+    for (const SweepPoint& p : b.all_points()) tiles.insert(p.workload.tile);
     CHECK(tiles == std::set<uint32_t>{36, 52, 73, 104});
 }
