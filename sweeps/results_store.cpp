@@ -355,72 +355,70 @@ bool ResultsStore::insert_point(const SweepPoint& point, const std::string& swee
     HwColumns visitor(hw_columns);
     const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
     const std::vector<HwParamInfo> hw_values = flatten_hw_config(point.hw);
-    {
-        const std::vector<WorkloadColumn> workload = workload_columns(point.workload);
-        std::vector<std::string> names = {"key",        "sfx_version", "sweep",      "point_index",
-                                          "started_at", "finished_at", "config_yaml"};
-        for (const WorkloadColumn& c : workload) {
-            ensure_column(c.name, c.integer ? "INTEGER" : "TEXT");  // a store from before the field
-            names.push_back(c.name);
-        }
-        names.push_back("fidelity");
-        Statement unit(m_db,
-                       "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");
-        auto add_unit = [&](const std::string& name, const std::string& u, const std::string& d) {
-            unit.bind(1, name);
-            unit.bind(2, u);
-            unit.bind(3, d);
-            unit.step();
-            sqlite3_reset(unit.get());
-        };
-        for (const WorkloadColumn& c : workload) add_unit(c.name, c.unit, c.description);
-        for (const HwColumn& c : hw_columns) {
-            ensure_column("hw." + c.name, c.numeric ? "REAL" : "TEXT");
-            names.push_back("hw." + c.name);
-            add_unit("hw." + c.name, c.unit, c.description);
-        }
-        for (const auto& [name, value] : run.metrics) {
-            (void)value;
-            ensure_column(name, "REAL");
-            names.push_back(name);
-            const auto u = run.units.find(name);
-            if (u != run.units.end()) add_unit(name, u->second.first, u->second.second);
-        }
-        std::string sql = "INSERT OR IGNORE INTO points(";
-        std::string marks;
-        for (size_t i = 0; i < names.size(); ++i) {
-            sql += (i ? ", " : "") + sql_quote_identifier(names[i]);
-            marks += i ? ", ?" : "?";
-        }
-        sql += ") VALUES(" + marks + ")";
-        Statement insert(m_db, sql);
-        int i = 1;
-        insert.bind(i++, point.key);
-        insert.bind(i++, run.sfx_version);
-        insert.bind(i++, sweep);
-        insert.bind_int(i++, int64_t(point.index));
-        insert.bind(i++, run.started_at);
-        insert.bind(i++, run.finished_at);
-        insert.bind(i++, point.config_yaml);
-        for (const WorkloadColumn& c : workload) {
-            if (c.integer)
-                insert.bind_int(i++, c.number);
-            else
-                insert.bind(i++, c.text);
-        }
-        insert.bind(i++, std::string(to_string(point.fidelity)));
-        for (size_t k = 0; k < hw_columns.size(); ++k) {
-            if (hw_columns[k].numeric)
-                insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));
-            else insert.bind(i++, hw_values[k].value);
-        }
-        for (const auto& [name, value] : run.metrics) {
-            (void)name;
-            insert.bind(i++, value);
-        }
-        insert.step();
-        return sqlite3_changes(m_db) == 1;
+    const std::vector<WorkloadColumn> workload = workload_columns(point.workload);
+    std::vector<std::string> names = {"key",        "sfx_version", "sweep",      "point_index",
+                                      "started_at", "finished_at", "config_yaml"};
+    for (const WorkloadColumn& c : workload) {
+        ensure_column(c.name, c.integer ? "INTEGER" : "TEXT");  // a store from before the field
+        names.push_back(c.name);
     }
+    names.push_back("fidelity");
+    Statement unit(m_db,
+                   "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");
+    auto add_unit = [&](const std::string& name, const std::string& u, const std::string& d) {
+        unit.bind(1, name);
+        unit.bind(2, u);
+        unit.bind(3, d);
+        unit.step();
+        sqlite3_reset(unit.get());
+    };
+    for (const WorkloadColumn& c : workload) add_unit(c.name, c.unit, c.description);
+    for (const HwColumn& c : hw_columns) {
+        ensure_column("hw." + c.name, c.numeric ? "REAL" : "TEXT");
+        names.push_back("hw." + c.name);
+        add_unit("hw." + c.name, c.unit, c.description);
+    }
+    for (const auto& [name, value] : run.metrics) {
+        (void)value;
+        ensure_column(name, "REAL");
+        names.push_back(name);
+        const auto u = run.units.find(name);
+        if (u != run.units.end()) add_unit(name, u->second.first, u->second.second);
+    }
+    std::string sql = "INSERT OR IGNORE INTO points(";
+    std::string marks;
+    for (size_t i = 0; i < names.size(); ++i) {
+        sql += (i ? ", " : "") + sql_quote_identifier(names[i]);
+        marks += i ? ", ?" : "?";
+    }
+    sql += ") VALUES(" + marks + ")";
+    Statement insert(m_db, sql);
+    int i = 1;
+    insert.bind(i++, point.key);
+    insert.bind(i++, run.sfx_version);
+    insert.bind(i++, sweep);
+    insert.bind_int(i++, int64_t(point.index));
+    insert.bind(i++, run.started_at);
+    insert.bind(i++, run.finished_at);
+    insert.bind(i++, point.config_yaml);
+    for (const WorkloadColumn& c : workload) {
+        if (c.integer)
+            insert.bind_int(i++, c.number);
+        else
+            insert.bind(i++, c.text);
+    }
+    insert.bind(i++, std::string(to_string(point.fidelity)));
+    for (size_t k = 0; k < hw_columns.size(); ++k) {
+        if (hw_columns[k].numeric)
+            insert.bind(i++, std::strtod(hw_values[k].value.c_str(), nullptr));
+        else insert.bind(i++, hw_values[k].value);
+    }
+    for (const auto& [name, value] : run.metrics) {
+        (void)name;
+        insert.bind(i++, value);
+    }
+    insert.step();
+    return sqlite3_changes(m_db) == 1;
 }
 
 std::map<std::string, double> ResultsStore::numbers(const std::string& key) const {
