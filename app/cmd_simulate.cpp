@@ -15,16 +15,31 @@
 
 namespace sfx {
 
-nlohmann::json prediction_json(const Prediction& p) {
+nlohmann::json prediction_json(const Prediction& p, const ConfigLabel& label) {
     nlohmann::json j;
     j["config"] = p.config.name;
+    j["label"] = label.name;
+    j["differs_from_first"] = label.differences;
     j["fidelity"] = to_string(p.fidelity);
     j["simd_width"] = p.config.simd.width;
     for (const Stat& s : p.stats()) j[s.name] = s.value;
     return j;
 }
 
-void print_predictions(const std::vector<Prediction>& predictions, std::ostream& out) {
+void print_predictions(const std::vector<Prediction>& predictions,
+                       const std::vector<ConfigLabel>& labels, std::ostream& out) {
+    if (predictions.size() > 1) {
+        // The table's columns are narrow: the labels, and what sets each apart, come first.
+        out << "configurations (and the parameters in which each differs from the first):\n";
+        for (size_t i = 0; i < labels.size(); ++i) {
+            out << "  " << labels[i].name;
+            for (size_t k = 0; k < labels[i].differences.size(); ++k)
+                out << (k ? ", " : "  ") << labels[i].differences[k];
+            if (i > 0 && labels[i].differences.empty()) out << "  (the same parameters)";
+            out << "\n";
+        }
+        out << "\n";
+    }
     auto row = [&](const std::string& label, auto value_of) {
         out << std::left << std::setw(38) << label;
         for (const Prediction& p : predictions) out << std::right << std::setw(16) << value_of(p);
@@ -40,7 +55,11 @@ void print_predictions(const std::vector<Prediction>& predictions, std::ostream&
         s << std::fixed << std::setprecision(digits) << v;
         return s.str();
     };
-    row("configuration", [](const Prediction& p) { return p.config.name; });
+    size_t column = 0;
+    row("configuration", [&](const Prediction&) {
+        const std::string& n = labels[column++].name;
+        return n.size() > 15 ? n.substr(0, 14) + "~" : n;
+    });
     row("fidelity", [](const Prediction& p) { return std::string(to_string(p.fidelity)); });
     row("simd width", [](const Prediction& p) { return std::to_string(p.config.simd.width); });
     row("tile", [](const Prediction& p) { return std::to_string(p.tile); });
@@ -143,6 +162,7 @@ void add_simulate_command(CLI::App& app) {
         const auto tech = std::make_shared<const TechTable>(resolve_tech_table(o->tech));
         std::vector<HwConfig> configs;
         for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
+        const std::vector<ConfigLabel> labels = label_configs(configs, o->hw);
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
@@ -159,10 +179,11 @@ void add_simulate_command(CLI::App& app) {
         for (Prediction& p : r.predictions) p.tech = tech;
         if (o->json) {
             if (r.predictions.size() == 1) {
-                std::cout << prediction_json(r.predictions[0]).dump(2) << "\n";
+                std::cout << prediction_json(r.predictions[0], labels[0]).dump(2) << "\n";
             } else {
                 nlohmann::json list = nlohmann::json::array();
-                for (const Prediction& p : r.predictions) list.push_back(prediction_json(p));
+                for (size_t i = 0; i < r.predictions.size(); ++i)
+                    list.push_back(prediction_json(r.predictions[i], labels[i]));
                 std::cout << list.dump(2) << "\n";
             }
             return;
@@ -171,7 +192,7 @@ void add_simulate_command(CLI::App& app) {
                   << " x " << settings.spp << " spp, depth " << settings.max_depth << ", tile "
                   << settings.tile << ", " << r.render.rays() << " rays, stream back end "
                   << describe_isa(settings.isa) << "\n\n";
-        print_predictions(r.predictions, std::cout);
+        print_predictions(r.predictions, labels, std::cout);
         std::cout << "\nhost seconds for the group: " << r.host_seconds;
         if (r.timing_seconds > 0.0)
             std::cout << " (timing model " << r.timing_seconds << ", render and the rest "

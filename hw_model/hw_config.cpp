@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string_view>
 #include <sstream>
@@ -294,6 +295,45 @@ std::vector<HwParamInfo> flatten_hw_config(const HwConfig& config) {
     std::vector<HwParamInfo> out;
     Flattener f(out);
     const_cast<HwConfig&>(config).visit(f);  // the flattener only reads
+    return out;
+}
+
+std::vector<ConfigLabel> label_configs(const std::vector<HwConfig>& configs,
+                                       const std::vector<std::string>& sources) {
+    auto stem = [](const std::string& source) {
+        std::string n = std::filesystem::path(source).filename().string();
+        for (const std::string suffix : {".hw.yaml", ".yaml"})
+            if (n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0) {
+                n.resize(n.size() - suffix.size());
+                break;
+            }
+        return n;
+    };
+    auto unique = [](const std::vector<std::string>& names, size_t i) {
+        return std::count(names.begin(), names.end(), names[i]) == 1;
+    };
+    std::vector<std::string> names, stems;
+    for (size_t i = 0; i < configs.size(); ++i) {
+        names.push_back(configs[i].name);
+        stems.push_back(i < sources.size() ? stem(sources[i]) : configs[i].name);
+    }
+    std::vector<ConfigLabel> out(configs.size());
+    const std::vector<HwParamInfo> first = configs.empty() ? std::vector<HwParamInfo>{}
+                                                           : flatten_hw_config(configs.front());
+    for (size_t i = 0; i < configs.size(); ++i) {
+        out[i].name = unique(names, i)   ? names[i]
+                      : unique(stems, i) ? stems[i]
+                                         : names[i] + " #" + std::to_string(i + 1);
+        if (i == 0) continue;
+        const std::vector<HwParamInfo> mine = flatten_hw_config(configs[i]);
+        std::map<std::string, std::string> base;
+        for (const HwParamInfo& p : first) base[p.path] = p.value;
+        for (const HwParamInfo& p : mine) {
+            if (p.path == "name") continue;
+            auto it = base.find(p.path);
+            if (it == base.end() || it->second != p.value) out[i].differences.push_back(p.path + "=" + p.value);
+        }
+    }
     return out;
 }
 

@@ -361,6 +361,16 @@ struct HwParamInfo {
 // Every parameter of a configuration, in declaration order.
 std::vector<HwParamInfo> flatten_hw_config(const HwConfig& config);
 
+// How rows of several configurations are told apart (sfx simulate): each one's `name`, else
+// (when another configuration shares it) the file's stem, else "name #i"; and the parameters
+// in which it differs from the first configuration, as "path=value".
+struct ConfigLabel {
+    std::string name;
+    std::vector<std::string> differences;  // empty for the first
+};
+std::vector<ConfigLabel> label_configs(const std::vector<HwConfig>& configs,
+                                       const std::vector<std::string>& sources);
+
 // Sets one parameter by dotted path from YAML scalar text ("16", "true", "[..]" is not a
 // scalar); throws InputError(file, line, path, ...) for an unknown path or a bad value.
 void set_hw_param(HwConfig& config, const std::string& path, const std::string& value,

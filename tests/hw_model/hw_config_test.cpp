@@ -150,3 +150,29 @@ TEST_CASE("Keys that are lists or maps, and second documents, are input errors",
     CHECK(second.line() == 4);
     CHECK(std::string(second.what()).find("second YAML document") != std::string::npos);
 }
+
+TEST_CASE("Rows of several configurations are told apart: name, else file stem, and their differences",
+          "[hw_config]") {
+    HwConfig a, b, c;  // all named gr08, as copies of the preset with one knob changed are
+    b.simd.width = 8;
+    c.simd.width = 4;
+    c.ray_buffer.kib = 256;
+    std::vector<ConfigLabel> l = label_configs({a, b, c}, {"gr08", "dir/w8.hw.yaml", "w4-256k.yaml"});
+    REQUIRE(l.size() == 3);
+    CHECK(l[0].name == "gr08");
+    CHECK(l[1].name == "w8");
+    CHECK(l[2].name == "w4-256k");
+    CHECK(l[0].differences.empty());
+    CHECK(l[1].differences == std::vector<std::string>{"simd.width=8"});
+    CHECK(l[2].differences == std::vector<std::string>{"simd.width=4", "ray_buffer.kib=256"});
+    // Distinct names are kept; the same name and the same stem get a number.
+    b.name = "wide";
+    l = label_configs({a, b}, {"x.hw.yaml", "x.hw.yaml"});
+    CHECK(l[0].name == "gr08");
+    CHECK(l[1].name == "wide");
+    CHECK(l[1].differences == std::vector<std::string>{"simd.width=8"});  // the name is no knob
+    l = label_configs({a, a}, {"x.hw.yaml", "x.hw.yaml"});
+    CHECK(l[0].name == "gr08 #1");
+    CHECK(l[1].name == "gr08 #2");
+    CHECK(l[1].differences.empty());
+}
