@@ -71,9 +71,12 @@ uint64_t ply_count_max(const std::string& type) {
     }
 }
 
-// assimp 5.2 loops for ever on some malformed PLY headers (a second `format` line, an
-// unknown keyword, no end_header): the header is checked against the PLY grammar first.
-PlyLayout check_ply_header(const std::string& text) {
+// assimp 5.2 loops for ever on some malformed PLY headers (no end_header) and misreads others:
+// the header is checked against the PLY grammar first. A line that starts with no PLY keyword
+// (Blender writes a bare "Created by Blender ..." line) is read past by assimp, as a comment, and
+// accepted with a warning where that is harmless: not among an element's properties, whose
+// list it would cut short (assimp then skips the properties after it and misreads the body).
+PlyLayout check_ply_header(const std::string& text, std::vector<std::string>* warnings) {
     static const std::set<std::string> types = {
         "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
@@ -99,6 +102,9 @@ PlyLayout check_ply_header(const std::string& text) {
              "end_header must end its line");
     PlyLayout layout;
     layout.body = text.find('\n', after) + 1;
+    static const std::set<std::string> keywords = {"ply",      "format",  "element",   "property",
+                                                   "comment",  "obj_info", "end_header"};
+    int free_text_line = 0;  // the last line read past as a comment, until an element starts
     std::istringstream in(text.substr(0, header_end));
     std::string row;
     int line = 0;
@@ -118,7 +124,13 @@ PlyLayout check_ply_header(const std::string& text) {
                      "1.0'");
             layout.format = t[1];
         } else if (t.empty() || t[0] == "comment" || t[0] == "obj_info") {
+        } else if (!keywords.count(t[0]) && line > 2) {
+            free_text_line = line;
+            if (warnings)
+                warnings->push_back("line " + std::to_string(line) + ": '" + row.substr(0, 60) +
+                                    "' is no PLY keyword; read as a comment");
         } else if (t[0] == "element") {
+            free_text_line = 0;
             if (t.size() != 3 || t[2].find_first_not_of("0123456789") != std::string::npos ||
                 t[2].size() > 10)
                 fail(line, "expected 'element NAME COUNT'");
@@ -152,12 +164,16 @@ PlyLayout check_ply_header(const std::string& text) {
                 fail(line,
                      "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an "
                      "element");
+            if (free_text_line)
+                fail(free_text_line, "a line that is no PLY keyword among the properties of element '" +
+                                         layout.elements.back().name +
+                                         "' (assimp would skip the properties after it)");
             if (list && !count_types.count(t[2]))
                 fail(line, "a list's count type must be an integer type, not '" + t[2] + "'");
             layout.elements.back().properties.push_back(list ? PlyProperty{true, t[2], t[3], t[4]}
                                                              : PlyProperty{false, "", t[1], t[2]});
         } else {
-            fail(line, "unknown keyword '" + t[0] + "'");
+            fail(line, "a second '" + t[0] + "' line");
         }
     }
     // end_header must be a line of its own, after a newline.
@@ -290,13 +306,13 @@ void check_ply_body(const std::string& text, const PlyLayout& layout) {
 // assimp's number reader takes "1.#INF" (an old C library's infinity) as 1 and "0x1p200" as 0:
 // in the text formats, every coordinate must be a finite decimal number before assimp reads it.
 // OBJ: every number of a `v` line; ASCII PLY: every token after the header.
-void check_text_formats(const std::string& path) {
+void check_text_formats(const std::string& path, std::vector<std::string>& warnings) {
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     const std::string text = read_input_file(path, "mesh");
     const bool obj = ext == ".obj";
     if (ext == ".ply" || text.compare(0, 4, "ply\n") == 0 || text.compare(0, 5, "ply\r\n") == 0)
-        check_ply_body(text, check_ply_header(text));
+        check_ply_body(text, check_ply_header(text, &warnings));
     const bool ascii_ply =
         text.compare(0, 3, "ply") == 0 && text.find("format ascii") < text.find("end_header");
     if (!obj && !ascii_ply) return;
@@ -329,7 +345,8 @@ void check_text_formats(const std::string& path) {
 
 TriangleMesh import_mesh(const std::string& path) {
     check_regular_file(path, "mesh");  // assimp would block on a FIFO
-    check_text_formats(path);
+    TriangleMesh mesh;
+    check_text_formats(path, mesh.warnings);
     Assimp::Importer importer;
     // Points and lines are removed rather than kept as degenerate triangles; vertices are
     // joined so that shared edges stay watertight for the triangle test.
@@ -359,7 +376,6 @@ TriangleMesh import_mesh(const std::string& path) {
                                      aiProcess_PreTransformVertices | aiProcess_SortByPType);
     if (!scene)
         throw std::runtime_error(std::string("cannot import: ") + importer.GetErrorString());
-    TriangleMesh mesh;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh* am = scene->mMeshes[m];
         const uint32_t base = uint32_t(mesh.positions.size());

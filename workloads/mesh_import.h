@@ -13,6 +13,8 @@ namespace sfx {
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<uint32_t> indices;  // three per triangle
+    // What was read past and how ("line 3: 'Created by ...' is no PLY keyword; read as a comment").
+    std::vector<std::string> warnings;
 
     size_t triangle_count() const { return indices.size() / 3; }
 };

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <set>
 
@@ -320,6 +321,9 @@ private:
             try {
                 mesh = import_mesh(full.string());
                 b.expect(mesh.triangle_count());
+                for (const std::string& w : mesh.warnings)
+                    std::cerr << "sfx: warning: " << r.file() << ":" << strict_yaml::line_of(node["file"]) << ": " << path
+                              << ".file: mesh '" << full.string() << "': " << w << "\n";
             } catch (const InputError& e) {
                 r.fail(node["file"], path + ".file", "mesh '" + full.string() + "': " + e.message());
             } catch (const std::exception& e) {

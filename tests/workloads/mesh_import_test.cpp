@@ -133,9 +133,25 @@ TEST_CASE("mesh import: a malformed PLY header is refused, never read for ever",
         import_text("c.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float\n" + header +
                                  "end_header\n" + body),
         Contains("line 4: not a PLY header: expected 'property TYPE NAME'"));
-    CHECK_THROWS_WITH(import_text("d.ply", "ply\nformat ascii 1.0\nelementr vertex 3\n" + header +
-                                               "end_header\n" + body),
-                      Contains("unknown keyword 'elementr'"));
+    // A line that is no PLY keyword is read past, as assimp does (Blender writes a bare
+    // "Created by Blender ..." line), with a warning naming it; among an element's properties
+    // it is refused, as assimp would skip the properties after it and misread the body.
+    const TriangleMesh blender = import_text(
+        "d.ply", "ply\nformat ascii 1.0\nCreated by Blender 3.6.0 - www.blender.org\n" + header +
+                     "elementr\nend_header\n" + body);
+    CHECK(blender.triangle_count() == 1);
+    REQUIRE(blender.warnings.size() == 2);
+    CHECK_THAT(blender.warnings[0], Contains("line 3: 'Created by Blender 3.6.0 - www.blender.org' is no PLY keyword"));
+    CHECK_THAT(blender.warnings[1], Contains("line 10: 'elementr'"));
+    CHECK(blender.positions == import_text("ok.ply", "ply\nformat ascii 1.0\n" + header + "end_header\n" + body).positions);
+    CHECK_THROWS_WITH(
+        import_text("d2.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nCreated by\n"
+                              "property float y\nproperty float z\nelement face 1\n"
+                              "property list uchar int vertex_indices\nend_header\n" + body),
+        Contains("line 5: not a PLY header: a line that is no PLY keyword among the properties of element 'vertex'"));
+    CHECK_THROWS_WITH(import_text("d3.ply", "ply\nformat ascii 1.0\nformat ascii 1.0\n" + header +
+                                                "end_header\n" + body),
+                      Contains("line 3: not a PLY header: a second 'format' line"));
     CHECK_THROWS_WITH(
         import_text("e.ply", "ply\nformat ascii 1.0\n" + header + "end_header " + body),
         Contains("line 9: not a PLY header: end_header must end its line"));
