@@ -181,8 +181,11 @@ public:
         const size_t n = y.size();
         double sy = 0, sx = 0;
         for (size_t i = 0; i < n; ++i) { sy += y[i]; sx += x[i]; }
-        if (n < 2 || sx <= 0.0) return {1.0, -1.0};
+        if (n < 1 || sx <= 0.0) return {1.0, -1.0};
         const double r = sy / sx, mean_x = sx / double(n);
+        // Every pass of the frame timed: the ratio is the frame's own (no sampling error).
+        if (n >= m_unit) return {r, 0.0};
+        if (n < 2) return {1.0, -1.0};
         double s2 = 0.0;
         for (size_t i = 0; i < n; ++i) s2 += (y[i] - r * x[i]) * (y[i] - r * x[i]);
         s2 /= double(n - 1);
@@ -205,6 +208,47 @@ private:
     std::vector<std::vector<double>> m_cycle;
     std::vector<TraceProfile> m_profiles;  // of the sampled passes
 };
+
+// Configurations of a group calibrated at cycle level: all of a small group, else a systematic
+// sample across it (a sweep's last axis moves fastest, so every axis is spanned).
+constexpr size_t k_calibrated_configs = 8;
+std::vector<size_t> calibration_subset(size_t configs) {
+    std::vector<size_t> out;
+    const size_t n = std::min(configs, k_calibrated_configs);
+    for (size_t k = 0; k < n; ++k) out.push_back(k * configs / n + configs / (2 * n));
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+// Every k-th tile pass is calibrated, k = 1 / fraction, but at least k_calibration_passes of
+// the frame's (all of a frame with fewer): a small frame still gets an interval.
+constexpr uint64_t k_calibration_passes = 4;
+uint32_t calibration_stride(double fraction, uint64_t frame_passes) {
+    const uint64_t wanted = uint64_t(std::max(1L, std::lround(1.0 / fraction)));
+    return uint32_t(std::max<uint64_t>(1, std::min(wanted, frame_passes / k_calibration_passes)));
+}
+
+// The ratio and relative half-width for a configuration outside the calibrated sample: the
+// sample's mean ratio, and a prediction interval for one more configuration's ratio (Student's
+// t over the sample's spread, sqrt(1 + 1/n)) combined with the calibrated ratios' own mean
+// sampling error. One calibrated configuration gives no spread: its own interval, doubled.
+std::pair<double, double> uncalibrated_ratio(const std::vector<double>& r, const std::vector<double>& half,
+                                             double confidence) {
+    const size_t n = r.size();
+    if (n == 0 || std::any_of(half.begin(), half.end(), [](double h) { return h < 0.0; }))
+        return {1.0, -1.0};  // a calibration without an interval says nothing of the others
+    double mean = 0, mean_half = 0;
+    for (size_t k = 0; k < n; ++k) {
+        mean += r[k] / double(n);
+        mean_half += half[k] / double(n);
+    }
+    if (n < 2 || mean <= 0.0) return {mean > 0.0 ? mean : 1.0, 2.0 * mean_half};
+    double s2 = 0;
+    for (double x : r) s2 += (x - mean) * (x - mean) / double(n - 1);
+    const double spread = student_t_quantile_two_sided(confidence, double(n - 1)) *
+                          std::sqrt(s2 * (1.0 + 1.0 / double(n))) / mean;
+    return {mean, std::sqrt(spread * spread + mean_half * mean_half)};
+}
 
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt,
@@ -373,11 +417,18 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     std::unique_ptr<SystemcTiming> systemc;
     std::unique_ptr<TimedSink> timed_systemc;
     std::unique_ptr<AnalyticCalibration> calibration;
+    const uint64_t frame_passes =
+        uint64_t(make_tiles(settings.width, settings.height, settings.tile).size()) * settings.spp;
+    // SMARTS-style: the cycle-level calibration runs on a systematic sample of the group's
+    // configurations; the others take the sample's mean ratio and an interval from its spread.
+    const std::vector<size_t> calibrated = calibration_subset(configs.size());
+    std::vector<HwConfig> calibrated_configs;
+    for (size_t c : calibrated) calibrated_configs.push_back(configs[c]);
     if (fidelity == Fidelity::analytic) {
         fan.add(&profile);
         if (sampling.calibration_fraction > 0.0) {
             calibration = std::make_unique<AnalyticCalibration>(
-                configs, shape, uint32_t(std::lround(1.0 / sampling.calibration_fraction)));
+                calibrated_configs, shape, calibration_stride(sampling.calibration_fraction, frame_passes));
             fan.add(calibration.get());
         }
     } else {
@@ -387,16 +438,33 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     }
     std::unique_ptr<ProgressSink> progress_sink;  // last: counts a pass once it is timed
     if (progress) {
-        const uint64_t passes =
-            uint64_t(make_tiles(settings.width, settings.height, settings.tile).size()) *
-            settings.spp;
-        progress_sink = std::make_unique<ProgressSink>(progress, passes);
+        progress_sink = std::make_unique<ProgressSink>(progress, frame_passes);
         fan.add(progress_sink.get());
     }
     PointGroupResult result;
     result.render = render_stream(scene, bvh, settings, &fan).stats;
     const double shared_seconds = seconds_since(start);
     result.timing_seconds = timed_systemc ? timed_systemc->seconds() : 0.0;
+
+    // Calibration ratios (cycle level / analytic) and their intervals, per calibrated
+    // configuration; the rest of the group is priced from their spread.
+    std::vector<std::pair<double, double>> ratios(configs.size(), {1.0, -1.0});
+    if (calibration && calibration->sampled() >= 1) {
+        std::vector<double> r, half;
+        for (size_t k = 0; k < calibrated.size(); ++k) {
+            ratios[calibrated[k]] = calibration->ratio(k, sampling.confidence, profile);
+            r.push_back(ratios[calibrated[k]].first);
+            half.push_back(ratios[calibrated[k]].second);
+        }
+        const std::pair<double, double> others = uncalibrated_ratio(r, half, sampling.confidence);
+        for (size_t i = 0, k = 0; i < configs.size(); ++i) {
+            if (k < calibrated.size() && calibrated[k] == i) {
+                ++k;
+                continue;
+            }
+            ratios[i] = others;
+        }
+    }
 
     for (size_t i = 0; i < configs.size(); ++i) {
         const auto model_start = HostClock::now();
@@ -412,14 +480,14 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
         // the calibration sample, if any.
         p.total_passes = counts.passes();
         p.sample_passes = fidelity == Fidelity::full ? counts.passes() : 0;
-        if (calibration && calibration->sampled() >= 2) {
-            const auto [r, error] = calibration->ratio(i, sampling.confidence, profile);
-            p.timing.cycles = uint64_t(std::llround(double(p.timing.cycles) * r));
-            p.error_relative = error;
-            p.sample_passes = calibration->sampled();
+        if (ratios[i].second >= 0.0) {
+            p.timing.cycles = uint64_t(std::llround(double(p.timing.cycles) * ratios[i].first));
+            p.error_relative = ratios[i].second;
+            if (std::binary_search(calibrated.begin(), calibrated.end(), i))
+                p.sample_passes = calibration->sampled();
         }
         // Full fidelity is the reference the other levels are measured against: no sampling
-        // error. The analytic model's error is unknown until measured (sfx accuracy).
+        // error. An uncalibrated analytic point's error is unknown (-1).
         if (fidelity == Fidelity::full) p.error_relative = 0.0;
         fill_workload(p, counts, result.render);
         // The functional render and the shared simulation are split evenly over the group.

@@ -198,3 +198,54 @@ TEST_CASE("Calibrated analytic fidelity: within its interval of full; uncalibrat
     CHECK(raw.error_relative < 0.0);
     CHECK(raw.sample_passes == 0);
 }
+
+TEST_CASE("A large analytic group calibrates a sample of its configurations; every point states "
+          "an error, the others' from the sample's spread",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings settings = small_settings(scene);
+    settings.spp = 2;  // 128 passes: the default 2 % calibrates 4 (every 32nd)
+    std::vector<HwConfig> configs;
+    for (uint32_t width : {4u, 8u, 12u, 16u})
+        for (uint32_t units : {1u, 2u})
+            for (uint32_t banks : {16u, 32u}) {
+                HwConfig c;
+                c.simd.width = width;
+                c.simd.units = units;
+                c.ray_buffer.banks = banks;
+                configs.push_back(c);
+            }
+    const PointGroupResult full = run_point_group(scene, bvh, settings, configs, Fidelity::full);
+    const PointGroupResult analytic = run_point_group(scene, bvh, settings, configs, Fidelity::analytic);
+    size_t calibrated = 0;
+    for (size_t c = 0; c < configs.size(); ++c) {
+        const Prediction& a = analytic.predictions[c];
+        const double error = std::fabs(double(a.timing.cycles) / double(full.predictions[c].timing.cycles) - 1.0);
+        INFO("config " << c << " analytic error " << error << " stated +-" << a.error_relative
+                       << " calibrated passes " << a.sample_passes);
+        CHECK(a.error_relative >= 0.0);
+        CHECK(error <= a.error_relative);
+        if (a.sample_passes > 0) {
+            CHECK(a.sample_passes == 4);
+            ++calibrated;
+        }
+    }
+    CHECK(calibrated == 8);  // of 16: a systematic sample across the group
+}
+
+TEST_CASE("An analytic frame of fewer passes than the calibration's minimum is calibrated on all of them",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings settings = small_settings(scene);
+    settings.tile = 32;
+    settings.spp = 1;  // 4 passes
+    const std::vector<HwConfig> configs = {HwConfig{}};
+    const Prediction a = run_point_group(scene, bvh, settings, configs, Fidelity::analytic).predictions[0];
+    CHECK(a.sample_passes == 4);
+    CHECK(a.error_relative == 0.0);
+    const Prediction f = run_point_group(scene, bvh, settings, configs, Fidelity::full).predictions[0];
+    INFO("analytic " << a.timing.cycles << " full " << f.timing.cycles);
+    CHECK(double(a.timing.cycles) == Approx(double(f.timing.cycles)).epsilon(0.02));
+}
