@@ -98,6 +98,27 @@ inline std::string to_text(double v) {
     return shortest_text(v);
 }
 
+// Text as a YAML double-quoted scalar: backslash, quote and control characters escaped, so any
+// string reads back as itself (written without yaml-cpp's emitter, which is slow on hot paths).
+inline std::string double_quoted(const std::string& v) {
+    std::string out = "\"";
+    for (char ch : v) {
+        const unsigned char c = static_cast<unsigned char>(ch);
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += ch;
+        } else if (c < 0x20 || c == 0x7f) {
+            static const char* const hex = "0123456789ABCDEF";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += ch;
+        }
+    }
+    return out + "\"";
+}
+
 template <class T>
 bool in_range(const T& v, const T& lo, const T& hi) {
     return v >= lo && v <= hi;

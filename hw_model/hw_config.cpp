@@ -71,6 +71,59 @@ private:
     YAML::Emitter& m_out;
 };
 
+// Values only, as block YAML at a given indent, written directly: a sweep writes one per point.
+// Strings are double-quoted, numbers as to_text writes them; parse_hw_config reads it back.
+class ValuesWriter {
+public:
+    ValuesWriter(std::string& out, size_t indent) : m_out(out), m_indent(indent) {}
+    template <class T, class B> void param(const char* name, T& value, const char* unit,
+                                           const char* description, B, B) {
+        param(name, value, unit, description);
+    }
+    template <class T> void param(const char* name, T& value, const char*, const char*) {
+        key(name);
+        m_out += ' ';
+        m_out += text(value);
+        m_out += '\n';
+    }
+    void choice(const char* name, std::string& value, std::initializer_list<const char*>,
+                const char*) {
+        param(name, value, "", "");
+    }
+    template <class G> void group(const char* name, G& g) {
+        key(name);
+        m_out += '\n';
+        ValuesWriter inner(m_out, m_indent + 2);
+        g.visit(inner);
+    }
+    template <class G> void list(const char* name, std::vector<G>& items, const char*) {
+        key(name);
+        if (items.empty()) {
+            m_out += " []\n";
+            return;
+        }
+        m_out += '\n';
+        for (G& item : items) {
+            // "- " takes the place of the item's first two columns of indent.
+            const size_t start = m_out.size();
+            ValuesWriter inner(m_out, m_indent + 4);
+            item.visit(inner);
+            m_out[start + m_indent + 2] = '-';
+        }
+    }
+
+private:
+    void key(const char* name) {
+        m_out.append(m_indent, ' ');
+        m_out += name;
+        m_out += ':';
+    }
+    static std::string text(const std::string& v) { return double_quoted(v); }
+    template <class T> static std::string text(const T& v) { return to_text(v); }
+    std::string& m_out;
+    size_t m_indent;
+};
+
 class Flattener {
 public:
     explicit Flattener(std::vector<HwParamInfo>& out, std::string prefix = "")
@@ -230,7 +283,10 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
 }
 
 HwConfig parse_hw_config(const std::string& text, const std::string& file) {
-    const YAML::Node root = parse_yaml_document(text, file);
+    return hw_config_from_yaml(parse_yaml_document(text, file), file);
+}
+
+HwConfig hw_config_from_yaml(const YAML::Node& root, const std::string& file) {
     HwConfig config;
     HwLineMap lines;
     YamlReader reader(root, file, "", lines);
@@ -289,6 +345,13 @@ std::string dump_hw_config(const HwConfig& config) {
     const_cast<HwConfig&>(config).visit(writer);  // the writer only reads
     out << YAML::EndMap;
     return std::string(out.c_str()) + "\n";
+}
+
+std::string hw_config_values_yaml(const HwConfig& config, size_t indent) {
+    std::string out;
+    ValuesWriter writer(out, indent);
+    const_cast<HwConfig&>(config).visit(writer);  // the writer only reads
+    return out;
 }
 
 std::vector<HwParamInfo> flatten_hw_config(const HwConfig& config) {

@@ -11,6 +11,10 @@
 #include <utility>
 #include <vector>
 
+namespace YAML {
+class Node;
+}
+
 namespace sfx {
 
 // Every default below is the paper's machine (Gribble & Ramani 2008, "G&R" below) and names
@@ -338,6 +342,8 @@ struct HwConfig {
 HwConfig load_hw_config(const std::string& path);
 std::vector<std::string> builtin_preset_names();
 HwConfig parse_hw_config(const std::string& yaml_text, const std::string& file_name);
+// The same from a parsed node (a section of a larger document; lines are the document's).
+HwConfig hw_config_from_yaml(const YAML::Node& root, const std::string& file_name);
 // Cross-parameter checks only (after programmatic changes, e.g. a sweep axis). `lines` maps
 // dotted keys to the lines they were read from, for the message.
 using HwLineMap = std::map<std::string, int>;
@@ -351,6 +357,9 @@ void check_machine_model_config(const HwConfig& config);
 
 // The fully resolved configuration as YAML: load(dump(c)) == c.
 std::string dump_hw_config(const HwConfig& config);
+// Its values only (no comments), as block YAML indented by `indent` spaces, written without
+// yaml-cpp's emitter (a sweep's point keys): parse_hw_config of it (unindented) == config.
+std::string hw_config_values_yaml(const HwConfig& config, size_t indent = 0);
 
 struct HwParamInfo {
     std::string path;  // dotted, e.g. "ray_buffer.banks" or "scene_memory.caches[1].kib"

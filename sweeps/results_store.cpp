@@ -12,6 +12,9 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <memory>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -329,15 +332,22 @@ std::set<std::string> ResultsStore::stored_keys(const std::vector<std::string>& 
     return out;
 }
 
+struct ResultsStore::Batch {
+    std::set<std::string> units;                                // names whose unit row was written
+    std::map<std::string, std::unique_ptr<Statement>> inserts;  // by SQL text
+    std::unique_ptr<Statement> unit;
+};
+
 size_t ResultsStore::write_points(const std::vector<PointRow>& rows, const std::string& sweep) {
     if (rows.empty()) return 0;
+    Batch batch;
     exec("BEGIN IMMEDIATE");
     try {
         // Another process may have added columns since we looked: re-read inside the lock.
         m_columns.clear();
         for (const std::string& c : columns()) m_columns.insert(c);
         size_t inserted = 0;
-        for (const PointRow& row : rows) inserted += insert_point(*row.point, sweep, row.run);
+        for (const PointRow& row : rows) inserted += insert_point(*row.point, sweep, row.run, batch);
         hold_before_commit_for_tests(rows.front().point->key);
         exec("COMMIT");
         return inserted;
@@ -350,7 +360,8 @@ size_t ResultsStore::write_points(const std::vector<PointRow>& rows, const std::
 }
 
 // One row, inside the caller's transaction; true if its key was new.
-bool ResultsStore::insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run) {
+bool ResultsStore::insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run,
+                                Batch& batch) {
     std::vector<HwColumn> hw_columns;
     HwColumns visitor(hw_columns);
     const_cast<HwConfig&>(point.hw).visit(visitor);  // the visitor only reads names and types
@@ -363,9 +374,12 @@ bool ResultsStore::insert_point(const SweepPoint& point, const std::string& swee
         names.push_back(c.name);
     }
     names.push_back("fidelity");
-    Statement unit(m_db,
-                   "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");
+    if (!batch.unit)
+        batch.unit = std::make_unique<Statement>(
+            m_db, "INSERT OR IGNORE INTO units(name, unit, description) VALUES(?, ?, ?)");
+    Statement& unit = *batch.unit;
     auto add_unit = [&](const std::string& name, const std::string& u, const std::string& d) {
+        if (!batch.units.insert(name).second) return;
         unit.bind(1, name);
         unit.bind(2, u);
         unit.bind(3, d);
@@ -392,7 +406,10 @@ bool ResultsStore::insert_point(const SweepPoint& point, const std::string& swee
         marks += i ? ", ?" : "?";
     }
     sql += ") VALUES(" + marks + ")";
-    Statement insert(m_db, sql);
+    std::unique_ptr<Statement>& prepared = batch.inserts[sql];
+    if (!prepared) prepared = std::make_unique<Statement>(m_db, sql);
+    Statement& insert = *prepared;
+    sqlite3_reset(insert.get());
     int i = 1;
     insert.bind(i++, point.key);
     insert.bind(i++, run.sfx_version);

@@ -79,7 +79,9 @@ public:
     sqlite3* handle() const { return m_db; }
 
 private:
-    bool insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run);
+    // What a batch's rows share: prepared inserts by column list, units already written.
+    struct Batch;
+    bool insert_point(const SweepPoint& point, const std::string& sweep, const PointRun& run, Batch& batch);
     void exec(const std::string& sql) const;
     void ensure_column(const std::string& name, const char* type);
 

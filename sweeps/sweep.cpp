@@ -666,7 +666,7 @@ namespace {
 // default, so points of workloads without the option keep the text, and the key, they had
 // before the option existed.
 struct WorkloadYamlWriter {
-    YAML::Emitter& out;
+    std::string& out;
     std::vector<std::string> default_text;  // per field in visit() order, of `defaults`
     size_t field = 0;
 
@@ -675,9 +675,7 @@ struct WorkloadYamlWriter {
         if (i < default_text.size() && WorkloadConfig::is_option_field(name) &&
             default_text[i] == value)
             return;
-        out << YAML::Key << name << YAML::Value;
-        if (quoted) out << YAML::DoubleQuoted;
-        out << value;
+        out += std::string("  ") + name + ": " + (quoted ? strict_yaml::double_quoted(value) : value) + "\n";
     }
     void text(const char* name, std::string& value, const char*, const char* const* = nullptr) {
         write(name, value, true);
@@ -692,19 +690,17 @@ struct WorkloadYamlWriter {
 }  // namespace
 
 std::string point_config_yaml(const HwConfig& hw, const WorkloadConfig& w, Fidelity fidelity) {
-    // Values only, in a fixed order: the key must not change when a description does.
-    // dump_hw_config's text read back drops its comments and keeps its scalars verbatim.
-    YAML::Emitter out;
-    out << YAML::BeginMap << YAML::Key << "hw" << YAML::Value << YAML::Load(dump_hw_config(hw));
-    out << YAML::Key << "workload" << YAML::Value << YAML::BeginMap;
-    WorkloadTextCollector defaults;
-    WorkloadConfig().visit(defaults);
-    WorkloadYamlWriter writer{out, defaults.values};
+    // Values only, in a fixed order: the key must not change when a description does. Written
+    // directly, not through yaml-cpp's emitter: a sweep writes one per point.
+    std::string out = "hw:\n" + hw_config_values_yaml(hw, 2) + "workload:\n";
+    static const std::vector<std::string> defaults = [] {
+        WorkloadTextCollector c;
+        WorkloadConfig().visit(c);
+        return c.values;
+    }();
+    WorkloadYamlWriter writer{out, defaults};
     const_cast<WorkloadConfig&>(w).visit(writer);  // the writer only reads
-    out << YAML::EndMap;
-    out << YAML::Key << "fidelity" << YAML::Value << to_string(fidelity);
-    out << YAML::EndMap;
-    return std::string(out.c_str()) + "\n";
+    return out + "fidelity: " + to_string(fidelity) + "\n";
 }
 
 std::string point_key(const std::string& config_yaml) {
@@ -718,9 +714,8 @@ ParsedPoint parse_point_config(const std::string& text, const std::string& file)
     for (const char* k : {"hw", "workload", "fidelity"})
         if (!root[k]) throw InputError(file, 1, k, "missing");
     ParsedPoint p;
-    // The hw section is a whole configuration as dump_hw_config writes it (lines shift by one
-    // in messages: they count from the hw: key).
-    p.hw = parse_hw_config(YAML::Dump(root["hw"]), file + " (hw)");
+    // The hw section is a whole configuration, as hw_config_values_yaml writes it.
+    p.hw = hw_config_from_yaml(root["hw"], file + " (hw)");
 
     const YAML::Node w = root["workload"];
     if (!w.IsMap()) throw InputError(file, line_of(w), "workload", "expected a mapping");

@@ -176,3 +176,25 @@ TEST_CASE("Rows of several configurations are told apart: name, else file stem, 
     CHECK(l[1].name == "gr08 #2");
     CHECK(l[1].differences.empty());
 }
+
+TEST_CASE("The values-only YAML of a configuration reads back as the configuration", "[hw_config]") {
+    HwConfig c;
+    c.name = "a \"quoted\" name\\ with: colon, # hash\nand a newline";
+    c.clock.core_mhz = 1234.5678;
+    c.scene_memory.caches.pop_back();
+    OpCostConfig box, leaf;
+    box.per_lane_cycles = 1.25;
+    leaf.op = "triangle_test";
+    leaf.per_op_cycles = 3e-7;
+    c.op_costs = {box, leaf};
+    for (const HwConfig& config : {HwConfig{}, c}) {
+        const std::string text = hw_config_values_yaml(config);
+        INFO(text);
+        const HwConfig back = parse_hw_config(text, "values.yaml");
+        CHECK(dump_hw_config(back) == dump_hw_config(config));
+        // Indented, it is the same text shifted.
+        const std::string indented = hw_config_values_yaml(config, 4);
+        CHECK(indented.size() == text.size() + 4 * size_t(std::count(text.begin(), text.end(), '\n')));
+    }
+    CHECK(hw_config_values_yaml(HwConfig{}).find("op_costs: []\n") != std::string::npos);
+}
