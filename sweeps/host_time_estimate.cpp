@@ -16,6 +16,10 @@ namespace {
 constexpr double k_render_rate = 6.5e-8;
 constexpr double k_analytic_rate = 5e-9;
 constexpr double k_full_rate = 6.7e-7;
+// CPU seconds of the sweep machinery per point, whatever the frame: its key, the worker's parse,
+// its row's write. bench/scale-analytic.sweep.yaml's first 40 seeds (2560 analytic points of a
+// 32x32 cornell frame, whose model work the rates above put at 0.3 s) took 7.2 s of CPU.
+constexpr double k_point_overhead = 2.7e-3;
 
 double work_units(const PointGroup& g) {
     const WorkloadConfig& w = g.workload;
@@ -57,7 +61,8 @@ std::vector<FidelityEstimate> estimate_host_seconds(const Sweep& sweep) {
             if (g.fidelity != f) continue;
             ++e.groups;
             e.points += g.points.size();
-            e.seconds += k_render_rate * work_units(g) + point_seconds(g) * double(g.points.size());
+            e.seconds += k_render_rate * work_units(g) +
+                         (k_point_overhead + point_seconds(g)) * double(g.points.size());
         }
         if (e.groups) out.push_back(e);
     }

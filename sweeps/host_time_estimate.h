@@ -1,6 +1,7 @@
 #pragma once
 // What running a sweep would cost, said before it runs (`sfx sweep --dry-run`): per fidelity,
-// each group's functional render plus the timing of each of its points, in CPU seconds.
+// each group's functional render plus the timing of each of its points, plus the sweep
+// machinery's cost per point, in CPU seconds.
 //
 // Both scale with the frame's work: paths (pixels x spp) x bounces (depth + 1) x the depth of
 // the scene's BVH (log2 of its primitives). The rates per unit of work are measured on the
