@@ -6,6 +6,7 @@
 // book them at their own simulated time.
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -86,7 +87,11 @@ class BankSchedule {
 class CapacityServer {
   public:
     static constexpr uint32_t k_window = 1024;
-    explicit CapacityServer(double per_cycle) : m_per_cycle(per_cycle) {
+    explicit CapacityServer(double per_cycle)
+        : m_per_cycle(per_cycle),
+          m_whole(per_cycle >= 1.0 && per_cycle < 1e9 && per_cycle == std::floor(per_cycle)
+                      ? uint64_t(per_cycle)
+                      : 0) {
         m_tag.fill(~uint64_t(0));  // every entry stale: used() zeroes it when first touched
     }
 
@@ -94,6 +99,13 @@ class CapacityServer {
     // (it is usable from the next one). Zero work returns `ready`.
     uint64_t serve(uint64_t ready, double amount);
     double per_cycle() const { return m_per_cycle; }
+    // Cycles an idle pool takes for `amount`: ceil(amount / per_cycle), in integers when the
+    // capacity is whole (the same value; asked for every lane group, where a division and a
+    // floating-point ceiling showed in profiles).
+    uint64_t idle_cycles(uint64_t amount) const {
+        if (m_whole > 0) return (amount + m_whole - 1) / m_whole;
+        return uint64_t(std::ceil(double(amount) / m_per_cycle - 1e-9));
+    }
     double work() const { return m_work; }
 
   private:
@@ -111,6 +123,7 @@ class CapacityServer {
     }
 
     double m_per_cycle;
+    uint64_t m_whole;  // per_cycle when it is a whole number, else 0
     uint64_t m_base = 0;
     std::array<double, k_window> m_used;
     std::array<uint64_t, k_window> m_tag;  // the cycle each entry holds
