@@ -65,13 +65,16 @@ class BankSchedule {
         return ((bits << by) | (bits >> (m_banks - by))) & m_full;
     }
 
-    static constexpr uint32_t k_fast_layers = 4;
+    static constexpr uint32_t k_fast_layers = 64;
     uint32_t m_banks, m_words, m_occupancy;
     uint64_t m_full;  // the bank bits of one word, when m_words is 1
     // The lanes: with pipelined banks, at most 64 of them and k_fast_layers requests per bank,
-    // as bit layers (layer k: the banks with more than k requests); else each lane's bank.
+    // as bit layers (layer k: the banks with more than k requests; m_layers of them, as many
+    // as the most requests to one bank: a tile's column of rays falls in one bank); else each
+    // lane's bank.
     bool m_fast = true;
     uint32_t m_lane_count = 0;
+    uint32_t m_layers = 0;
     uint64_t m_layer[k_fast_layers] = {};
     std::vector<uint32_t> m_lanes;
     uint64_t m_base = 0;            // first cycle of the window
