@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string_view>
 
 namespace sfx {
 
@@ -70,7 +71,7 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint
     p.moved_ids = moved_ids;
     // Compress: the SIMD unit wrote each group's ids as it executed it (OpCostTable counts
     // those instructions); nothing is left for a partition pass.
-    if (config.kind == "compress") return p;
+    if (std::string_view(config.kind) == "compress") return p;  // per op: no strlen, no call
     const uint64_t per_cycle = uint64_t(width) * config.comparators_per_lane;
     p.compare_cycles = (uint64_t(length) + per_cycle - 1) / per_cycle;
     p.moved_ids = moved_ids;
