@@ -4,7 +4,10 @@
 //     SC_METHOD) over as many cycles — target >= 2x; also at 4 units and at 4 cores (their
 //     simulated cycles: the frame's, core-cycles over cores);
 //  2. the cost of each extra hardware configuration timed on the same trace, as a fraction of
-//     the first configuration's cost (functional render included) — target <= 10 %.
+//     the first configuration's cost (functional render included) — target <= 25 % (issue 32).
+//     Configurations with the same scene-data lookups (these four) share one cache simulation;
+//     the rest of a configuration's cost is its own: its lane groups through its SystemC
+//     processes (about half the time, in the kernel) and its bookings.
 // Usage: sfx_bench_hw_model [scene] [WxH] [spp] [repetitions]
 
 #include <algorithm>
@@ -160,7 +163,7 @@ int main(int argc, char** argv) {
         std::printf("render + %zu configuration%s %.3f s\n", k, k == 1 ? " " : "s", group_s[k - 1]);
     }
     const double extra = (group_s.back() - group_s.front()) / double(configs.size() - 1);
-    std::printf("each extra configuration  %.1f %% of the first (target <= 10 %%)\n",
+    std::printf("each extra configuration  %.1f %% of the first (target <= 25 %%)\n",
                 100.0 * extra / group_s.front());
     return 0;
 }

@@ -83,13 +83,82 @@ uint64_t scene_latency_in_costs(const HwConfig& c) {
     return ns_to_cycles(c.scene_memory.caches.front().hit_latency_ns, c.clock.core_mhz);
 }
 
-SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores)
+bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
+    const SceneMemoryConfig &x = a.scene_memory, &y = b.scene_memory;
+    if (a.cores.count != 1 || b.cores.count != 1 || x.caches.size() != y.caches.size() ||
+        x.prefetch_depth != y.prefetch_depth || x.prefetch_children != y.prefetch_children)
+        return false;
+    for (size_t i = 0; i < x.caches.size(); ++i)
+        if (x.caches[i].kib != y.caches[i].kib ||
+            x.caches[i].line_bytes != y.caches[i].line_bytes ||
+            x.caches[i].ways != y.caches[i].ways)
+            return false;
+    return true;
+}
+
+namespace {
+
+// The nearest of `levels` caches holding `address` (`levels`: none); each level missed fills
+// it (inclusive), as a read does.
+template <class CacheOf>
+uint32_t first_holding(uint32_t levels, uint64_t address, CacheOf cache_of) {
+    uint32_t level = 0;
+    while (level < levels && !cache_of(level).access(address)) ++level;
+    return level;
+}
+
+}  // namespace
+
+SharedCacheLookups::SharedCacheLookups(const std::vector<CacheLevelConfig>& levels) {
+    for (const CacheLevelConfig& level : levels) m_levels.emplace_back(level);
+}
+
+uint32_t SharedCacheLookups::add_reader() {
+    if (m_first > 0 || !m_found.empty())
+        throw std::logic_error("SharedCacheLookups: a reader joins after the first lookup");
+    m_next.push_back(0);
+    return uint32_t(m_next.size() - 1);
+}
+
+uint32_t SharedCacheLookups::level_of(uint32_t reader, uint64_t address) {
+    const uint64_t i = m_next[reader]++ - m_first;
+    if (i < m_found.size()) {
+        if (m_addresses[i] != address)
+            throw std::logic_error("SharedCacheLookups: readers look up different lines");
+        return m_found[i];
+    }
+    // This reader is the first here: simulate, and keep the outcome for the others.
+    const uint32_t level =
+        first_holding(uint32_t(m_levels.size()), address,
+                      [&](uint32_t l) -> SetAssociativeCache& { return m_levels[l]; });
+    m_addresses.push_back(address);
+    m_found.push_back(uint8_t(level));
+    // Forget what every reader has read (now and then, so each erase moves little).
+    if (m_found.size() >= 4096) {
+        const uint64_t read_by_all = *std::min_element(m_next.begin(), m_next.end()) - m_first;
+        if (read_by_all >= m_found.size() / 2) {
+            m_addresses.erase(m_addresses.begin(), m_addresses.begin() + ptrdiff_t(read_by_all));
+            m_found.erase(m_found.begin(), m_found.begin() + ptrdiff_t(read_by_all));
+            m_first += read_by_all;
+        }
+    }
+    return level;
+}
+
+SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores,
+                                   std::shared_ptr<SharedCacheLookups> shared)
     : m_config(config),
+      m_shared(std::move(shared)),
+      m_hits(config.caches.size(), 0),
+      m_misses(config.caches.size(), 0),
       m_dram_latency(ns_to_cycles(config.dram_latency_ns, core_mhz)),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
       m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz) {
+    if (m_shared) m_reader = m_shared->add_reader();
     for (const CacheLevelConfig& level : config.caches) {
-        m_levels.emplace_back(level.shared ? 1 : std::max(1u, cores), SetAssociativeCache(level));
+        if (!m_shared)
+            m_levels.emplace_back(level.shared ? 1 : std::max(1u, cores),
+                                  SetAssociativeCache(level));
         m_latency.push_back(ns_to_cycles(level.hit_latency_ns, core_mhz));
     }
     m_line_bytes = config.caches.empty() ? 64 : config.caches.back().line_bytes;
@@ -100,31 +169,24 @@ SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
     return v[v.size() == 1 ? 0 : core % v.size()];
 }
 
-uint64_t SceneMemoryModel::hits(uint32_t level) const {
-    uint64_t n = 0;
-    for (const SetAssociativeCache& c : m_levels[level]) n += c.hits();
-    return n;
-}
-
-uint64_t SceneMemoryModel::misses(uint32_t level) const {
-    uint64_t n = 0;
-    for (const SetAssociativeCache& c : m_levels[level]) n += c.misses();
-    return n;
-}
-
-void SceneMemoryModel::clear() {
-    for (auto& level : m_levels)
-        for (SetAssociativeCache& c : level) c.clear();
-    m_dram = RateServer(m_dram.per_cycle());
-    m_dram_reads = m_requests = 0;
+uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line) {
+    const uint64_t address = line * m_line_bytes;
+    const uint32_t levels = level_count();
+    const uint32_t level =
+        m_shared ? m_shared->level_of(m_reader, address)
+                 : first_holding(levels, address, [&](uint32_t l) -> SetAssociativeCache& {
+                       return instance(l, core);
+                   });
+    for (uint32_t l = 0; l < level; ++l) ++m_misses[l];
+    if (level < levels) ++m_hits[level];
+    return level;
 }
 
 void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {
     if (bytes == 0) return;
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line)
-        for (uint32_t level = 0; level < m_levels.size(); ++level)
-            if (instance(level, core).access(line * m_line_bytes)) break;
+        look_up(core, line);
 }
 
 uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now) {
@@ -133,16 +195,11 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
     const uint64_t first = address / m_line_bytes, last = (address + bytes - 1) / m_line_bytes;
     uint64_t arrival = now;
     for (uint64_t line = first; line <= last; ++line) {
+        const uint32_t level = look_up(core, line);
         uint64_t ready = 0;
-        bool from_dram = true;
-        for (uint32_t level = 0; level < m_levels.size(); ++level) {  // inclusive: all filled
-            if (instance(level, core).access(line * m_line_bytes)) {
-                ready = now + m_latency[level];
-                from_dram = false;
-                break;
-            }
-        }
-        if (from_dram) {
+        if (level < level_count()) {
+            ready = now + m_latency[level];
+        } else {
             ++m_dram_reads;
             // The line leaves DRAM after its latency, then occupies the channel for its transfer.
             const double start = m_dram.serve(double(now + m_dram_latency), double(m_line_bytes));

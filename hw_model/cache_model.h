@@ -4,6 +4,7 @@
 // SystemC scene-memory module wraps it. Reads only: scene data is read-only while tracing.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,12 +46,41 @@ uint64_t ns_to_cycles(double ns, double mhz);
 // nothing for a machine priced from instruction counts.
 uint64_t scene_latency_in_costs(const HwConfig& config);
 
+// Whether two configurations look up the same scene-data lines in the same order, with caches
+// of the same geometry, so that every lookup finds its line at the same level: one core each
+// (several cores take passes in an order their timing decides), equal cache sizes, lines and
+// ways (latencies may differ) and equal prefetch (which decides when an op's data is looked
+// up). The trace decides the rest: ops are dispatched in order on every machine.
+bool same_cache_lookups(const HwConfig& a, const HwConfig& b);
+
+// The lookups of one cache hierarchy shared by configurations with same_cache_lookups: the
+// first reader to reach a lookup simulates it, the others read the level it found, so the
+// cache simulation is paid once per point group rather than once per configuration. Each
+// reader's line is checked against the one simulated (a mismatch is a logic error).
+class SharedCacheLookups {
+  public:
+    explicit SharedCacheLookups(const std::vector<CacheLevelConfig>& levels);
+    uint32_t add_reader();
+    // The level holding `address` at `reader`'s next lookup (levels: none, DRAM).
+    uint32_t level_of(uint32_t reader, uint64_t address);
+
+  private:
+    std::vector<SetAssociativeCache> m_levels;
+    // Lookups simulated and not yet read by every reader, from lookup number m_first on.
+    std::vector<uint64_t> m_addresses;
+    std::vector<uint8_t> m_found;
+    uint64_t m_first = 0;
+    std::vector<uint64_t> m_next;  // per reader: its next lookup's number
+};
+
 // The scene-data memory of a machine: per-core private levels and shared levels (as
 // configured), then DRAM, whose bandwidth all cores share. Reads are timed: a read issued at a
-// cycle returns the cycle its data arrives.
+// cycle returns the cycle its data arrives. With `shared` lookups (same_cache_lookups), the
+// caches are those lookups' and only latency and DRAM are this model's own.
 class SceneMemoryModel {
   public:
-    SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores = 1);
+    SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores = 1,
+                     std::shared_ptr<SharedCacheLookups> shared = nullptr);
 
     // Cycle at which `bytes` at `address`, requested by `core` at cycle `now`, have arrived:
     // each line comes from the nearest level holding it (lines of one request overlap: the
@@ -60,21 +90,25 @@ class SceneMemoryModel {
     void warm(uint32_t core, uint64_t address, uint32_t bytes);
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
-    void clear();
 
     uint32_t level_count() const { return uint32_t(m_config.caches.size()); }
     // Hits and misses of a level, summed over its instances (one per core when private).
-    uint64_t hits(uint32_t level) const;
-    uint64_t misses(uint32_t level) const;
+    uint64_t hits(uint32_t level) const { return m_hits[level]; }
+    uint64_t misses(uint32_t level) const { return m_misses[level]; }
     uint64_t dram_reads() const { return m_dram_reads; }
     uint64_t requests() const { return m_requests; }
 
   private:
     SetAssociativeCache& instance(uint32_t level, uint32_t core);
+    // The nearest level holding `line` for `core` (level_count(): DRAM), counted.
+    uint32_t look_up(uint32_t core, uint64_t line);
 
     SceneMemoryConfig m_config;
-    std::vector<std::vector<SetAssociativeCache>> m_levels;  // [level][instance]
-    std::vector<uint64_t> m_latency;                         // per level, cycles
+    std::vector<std::vector<SetAssociativeCache>> m_levels;  // [level][instance]; none if shared
+    std::shared_ptr<SharedCacheLookups> m_shared;
+    uint32_t m_reader = 0;                   // this model's reader number in m_shared
+    std::vector<uint64_t> m_hits, m_misses;  // per level, over its instances
+    std::vector<uint64_t> m_latency;         // per level, cycles
     uint64_t m_dram_latency;
     uint32_t m_line_bytes;
     RateServer m_dram;  // bytes per cycle

@@ -147,9 +147,8 @@ uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& wor
 
 uint64_t CoreModel::cross(uint64_t ready, uint64_t words, uint64_t& wait_cycles) {
     if (words == 0) return ready;
-    const double rate = m_interconnect.per_cycle();
     // An idle interconnect moves them in ceil(words / rate) cycles.
-    const uint64_t alone = ready + ceil_cycle(double(words) / rate) - 1;
+    const uint64_t alone = ready + m_interconnect.idle_cycles(words) - 1;
     const uint64_t last =
         m_config.interconnect.contention ? m_interconnect.serve(ready, double(words)) : alone;
     if (last > alone) wait_cycles += last - alone;
@@ -173,9 +172,8 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     act.agu_addresses += gathered;
     act.interconnect_word_hops += gathered * m_config.interconnect.mux_levels;
     act.busy_cycles[size_t(HwUnit::ray_buffer)] += ids.cycles + gathers;
-    act.busy_cycles[size_t(HwUnit::agu)] += ceil_cycle(double(gathered) / m_agu.per_cycle());
-    act.busy_cycles[size_t(HwUnit::interconnect)] +=
-        ceil_cycle(double(gathered) / m_interconnect.per_cycle());
+    act.busy_cycles[size_t(HwUnit::agu)] += m_agu.idle_cycles(gathered);
+    act.busy_cycles[size_t(HwUnit::interconnect)] += m_interconnect.idle_cycles(gathered);
     if (m_l1d) {
         // A CPU core: the lanes' loads are part of the op's measured cost, issued with it.
         t.data_ready = now;
@@ -188,15 +186,11 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     // Addresses: one per gathered lane word, on the core's address-generation units, which
     // every SIMD unit's access side shares; a word's requests leave the cycle after its
     // addresses are done. What a busier pool adds over an idle one is address stall.
-    const double per_cycle = m_agu.per_cycle();
     std::vector<uint64_t>& ready_at = m_ready_at;
     ready_at.resize(gathers);
-    for (size_t w = 0; w < gathers; ++w) {
-        const uint64_t done = m_agu.serve(ids_done, double(t.lanes)) + 1;
-        const uint64_t alone = ids_done + ceil_cycle(double((w + 1) * t.lanes) / per_cycle);
-        if (w == 0 && done > alone) t.address += done - alone;
-        ready_at[w] = done;
-    }
+    for (size_t w = 0; w < gathers; ++w) ready_at[w] = m_agu.serve(ids_done, double(t.lanes)) + 1;
+    const uint64_t alone = ids_done + m_agu.idle_cycles(t.lanes);  // the first word's
+    if (ready_at[0] > alone) t.address += ready_at[0] - alone;
     const uint64_t first_issue = ready_at[0];
     const uint64_t last_grant = book_words(buffer, p.gather_words, slots, t.lanes, first_issue,
                                            &ready_at, t.conflict, t.address);

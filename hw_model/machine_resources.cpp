@@ -18,19 +18,21 @@ void BankSchedule::set_lanes(const uint32_t* lane_banks, uint32_t count) {
     m_lane_count = count;
     m_fast = m_words == 1 && m_occupancy == 1;
     if (m_fast) {
-        // The layers branch-free: each lane's bit carries up to the first layer without it.
-        uint64_t layer[k_fast_layers] = {}, overflow = 0;
+        // Each lane's bit goes to the first layer without it (mostly the first).
+        m_layers = 0;
         for (uint32_t i = 0; i < count; ++i) {
-            uint64_t carry = uint64_t(1) << lane_banks[i];
-            for (uint32_t k = 0; k < k_fast_layers; ++k) {
-                const uint64_t had = layer[k] & carry;
-                layer[k] |= carry;
-                carry = had;
+            const uint64_t bit = uint64_t(1) << lane_banks[i];
+            uint32_t k = 0;
+            while (k < m_layers && (m_layer[k] & bit)) ++k;
+            if (k == m_layers) {
+                if (k == k_fast_layers) {
+                    m_fast = false;
+                    break;
+                }
+                m_layer[m_layers++] = 0;
             }
-            overflow |= carry;
+            m_layer[k] |= bit;
         }
-        m_fast = overflow == 0;
-        std::copy(layer, layer + k_fast_layers, m_layer);
     }
     if (!m_fast) m_lanes.assign(lane_banks, lane_banks + count);
 }
@@ -40,16 +42,18 @@ uint64_t BankSchedule::book_lanes(uint32_t rotation, uint64_t ready) {
     if (m_fast) {
         // Pipelined banks: each cycle grants every wanting bank that is free in it.
         uint64_t layer[k_fast_layers];
-        for (uint32_t k = 0; k < k_fast_layers; ++k) layer[k] = rotate(m_layer[k], rotation);
+        uint32_t layers = m_layers;
+        for (uint32_t k = 0; k < layers; ++k) layer[k] = rotate(m_layer[k], rotation);
         for (uint64_t cycle = ready > m_base ? ready : m_base;; ++cycle) {
             uint64_t& bits = *busy<true>(cycle);
             const uint64_t granted = layer[0] & ~bits;
             if (!granted) continue;
             bits |= granted;
             // One request fewer per granted bank: layer k keeps it only if layer k+1 has it.
-            for (uint32_t k = 0; k + 1 < k_fast_layers; ++k) layer[k] &= ~granted | layer[k + 1];
-            layer[k_fast_layers - 1] &= ~granted;
+            for (uint32_t k = 0; k + 1 < layers; ++k) layer[k] &= ~granted | layer[k + 1];
+            layer[layers - 1] &= ~granted;
             if (!layer[0]) return cycle;
+            if (!layer[layers - 1]) --layers;  // at most one layer empties per cycle
         }
     }
     // The general case: the layers a bit per lane, as many as the most requests to one bank.

@@ -6,6 +6,7 @@
 // book them at their own simulated time.
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -64,13 +65,16 @@ class BankSchedule {
         return ((bits << by) | (bits >> (m_banks - by))) & m_full;
     }
 
-    static constexpr uint32_t k_fast_layers = 4;
+    static constexpr uint32_t k_fast_layers = 64;
     uint32_t m_banks, m_words, m_occupancy;
     uint64_t m_full;  // the bank bits of one word, when m_words is 1
     // The lanes: with pipelined banks, at most 64 of them and k_fast_layers requests per bank,
-    // as bit layers (layer k: the banks with more than k requests); else each lane's bank.
+    // as bit layers (layer k: the banks with more than k requests; m_layers of them, as many
+    // as the most requests to one bank: a tile's column of rays falls in one bank); else each
+    // lane's bank.
     bool m_fast = true;
     uint32_t m_lane_count = 0;
+    uint32_t m_layers = 0;
     uint64_t m_layer[k_fast_layers] = {};
     std::vector<uint32_t> m_lanes;
     uint64_t m_base = 0;            // first cycle of the window
@@ -86,7 +90,11 @@ class BankSchedule {
 class CapacityServer {
   public:
     static constexpr uint32_t k_window = 1024;
-    explicit CapacityServer(double per_cycle) : m_per_cycle(per_cycle) {
+    explicit CapacityServer(double per_cycle)
+        : m_per_cycle(per_cycle),
+          m_whole(per_cycle >= 1.0 && per_cycle < 1e9 && per_cycle == std::floor(per_cycle)
+                      ? uint64_t(per_cycle)
+                      : 0) {
         m_tag.fill(~uint64_t(0));  // every entry stale: used() zeroes it when first touched
     }
 
@@ -94,6 +102,13 @@ class CapacityServer {
     // (it is usable from the next one). Zero work returns `ready`.
     uint64_t serve(uint64_t ready, double amount);
     double per_cycle() const { return m_per_cycle; }
+    // Cycles an idle pool takes for `amount`: ceil(amount / per_cycle), in integers when the
+    // capacity is whole (the same value; asked for every lane group, where a division and a
+    // floating-point ceiling showed in profiles).
+    uint64_t idle_cycles(uint64_t amount) const {
+        if (m_whole > 0) return (amount + m_whole - 1) / m_whole;
+        return uint64_t(std::ceil(double(amount) / m_per_cycle - 1e-9));
+    }
     double work() const { return m_work; }
 
   private:
@@ -111,6 +126,7 @@ class CapacityServer {
     }
 
     double m_per_cycle;
+    uint64_t m_whole;  // per_cycle when it is a whole number, else 0
     uint64_t m_base = 0;
     std::array<double, k_window> m_used;
     std::array<uint64_t, k_window> m_tag;  // the cycle each entry holds

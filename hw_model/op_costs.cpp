@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
 #include "base/input_error.h"
 #include "workloads/ray_layout.h"
@@ -145,11 +146,20 @@ void OpCostTable::check_measured(const std::array<bool, k_op_kind_count>& needed
                                  "--describe-host)");
 }
 
+namespace {
+
+// Asked twice per lane group: a view's comparison with a literal of known length is two loads,
+// where std::string's with a const char* was a strlen and a memcmp call (1.6 % of a profile).
+bool programmable(const DatapathConfig& d) {
+    return std::string_view(d.issue) == "programmable";
+}
+
+}  // namespace
+
 double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_t lanes,
                                uint32_t passed, bool first, double beyond_l1) const {
     if (!measured)
-        return d.issue == "programmable" ? double(compute_instructions)
-                                         : double(d.initiation_interval);
+        return programmable(d) ? double(compute_instructions) : double(d.initiation_interval);
     // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
     if (length == 1 && cost.one_lane_cycles > 0) return cost.one_lane_cycles;
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
@@ -159,8 +169,7 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
 
 double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
     if (measured) return issue;
-    return d.issue == "programmable" ? std::max(issue, double(latency_cycles))
-                                     : double(latency_cycles);
+    return programmable(d) ? std::max(issue, double(latency_cycles)) : double(latency_cycles);
 }
 
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string_view>
 
 namespace sfx {
 
@@ -14,6 +15,10 @@ RayBufferModel::RayBufferModel(const RayBufferConfig& config, uint32_t record_wo
     if (m_banks == 0 || m_line_words == 0 || m_latency == 0)
         throw std::invalid_argument("ray buffer: banks, line_words and latency must be >= 1");
     if ((m_banks & (m_banks - 1)) == 0) m_bank_mask = m_banks - 1;
+    if ((m_line_words & (m_line_words - 1)) == 0) {
+        m_line_shift = 0;
+        while ((1u << m_line_shift) < m_line_words) ++m_line_shift;
+    }
 }
 
 RayBufferModel::Access RayBufferModel::access_field(uint32_t field_word, const uint32_t* slots,
@@ -36,10 +41,14 @@ RayBufferModel::Contiguous RayBufferModel::access_contiguous(uint64_t offset,
                                                               uint32_t lanes) const {
     Contiguous c;
     if (lanes == 0) return c;
-    const uint64_t first = offset / m_line_words, last = (offset + lanes - 1) / m_line_words;
+    // Per lane group of every op: shifts, not divisions, for lines of a power of two words.
+    auto line_of = [&](uint64_t word) {
+        return m_line_shift >= 0 ? word >> m_line_shift : word / m_line_words;
+    };
+    const uint64_t first = line_of(offset), last = line_of(offset + lanes - 1);
     const uint64_t lines = last - first + 1;
-    const uint64_t ideal = (lanes + m_line_words - 1) / m_line_words;
-    const uint64_t realign = offset % m_line_words != 0 ? 1 : 0;  // shift through the mux tree
+    const uint64_t ideal = line_of(lanes + m_line_words - 1);
+    const uint64_t realign = first * m_line_words != offset ? 1 : 0;  // shift through the mux tree
     c.cycles = lines + realign;
     c.alignment_cycles = c.cycles - ideal;
     return c;
@@ -62,7 +71,7 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint
     p.moved_ids = moved_ids;
     // Compress: the SIMD unit wrote each group's ids as it executed it (OpCostTable counts
     // those instructions); nothing is left for a partition pass.
-    if (config.kind == "compress") return p;
+    if (std::string_view(config.kind) == "compress") return p;  // per op: no strlen, no call
     const uint64_t per_cycle = uint64_t(width) * config.comparators_per_lane;
     p.compare_cycles = (uint64_t(length) + per_cycle - 1) / per_cycle;
     p.moved_ids = moved_ids;

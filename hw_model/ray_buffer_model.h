@@ -78,6 +78,7 @@ private:
 
     uint32_t m_banks, m_line_words, m_latency, m_slot_count, m_record_words;
     uint32_t m_bank_mask = 0;  // banks - 1 when banks is a power of two: no division per lane
+    int32_t m_line_shift = -1;  // log2(line_words) when it is a power of two, else -1
     bool m_pipelined, m_aos;
     mutable std::vector<uint16_t> m_per_bank;  // scratch: zero between calls
 };

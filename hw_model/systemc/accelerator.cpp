@@ -3,12 +3,12 @@
 namespace sfx {
 
 Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c,
-                         const WorkloadShape& shape)
+                         const WorkloadShape& shape, std::shared_ptr<SharedCacheLookups> lookups)
     : sc_module(name),
       m_config(c),
       m_costs(RayRecordLayout(shape.features), c),
-      m_scene_memory(
-          std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz, c.cores.count)) {
+      m_scene_memory(std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz,
+                                                        c.cores.count, std::move(lookups))) {
     m_costs.check_measured(shape.needed_kinds(), c.name);
     const RayRecordLayout layout(shape.features);
     const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());

@@ -15,7 +15,9 @@ namespace sfx {
 
 class Accelerator : public sc_core::sc_module, public PassSource {
   public:
-    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape);
+    // `lookups`: the scene-data cache lookups it shares with other configurations (else null).
+    Accelerator(sc_core::sc_module_name name, const HwConfig& config, const WorkloadShape& shape,
+                std::shared_ptr<SharedCacheLookups> lookups = nullptr);
 
     // Queues a pass for the next idle core (runs when the simulation does).
     void enqueue(std::shared_ptr<const PassBuffer> pass);

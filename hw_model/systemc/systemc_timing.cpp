@@ -32,9 +32,20 @@ SystemcTiming::SystemcTiming(const std::vector<HwConfig>& configs, const Workloa
         throw std::logic_error("one SystemcTiming at a time: SystemC has one simulation context");
     try {
         new_simulation_context();
+        // Configurations whose scene-data lookups are the same share one cache simulation.
+        std::vector<std::shared_ptr<SharedCacheLookups>> lookups(configs.size());
+        for (size_t i = 0; i < configs.size(); ++i)
+            for (size_t j = i + 1; j < configs.size(); ++j)
+                if (!configs[i].scene_memory.caches.empty() &&
+                    same_cache_lookups(configs[i], configs[j])) {
+                    if (!lookups[i])
+                        lookups[i] =
+                            std::make_shared<SharedCacheLookups>(configs[i].scene_memory.caches);
+                    lookups[j] = lookups[i];
+                }
         for (size_t i = 0; i < configs.size(); ++i) {
             m_accelerators.push_back(std::make_unique<Accelerator>(
-                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape));
+                ("accelerator_" + std::to_string(i)).c_str(), configs[i], shape, lookups[i]));
             m_batch = std::max(m_batch, configs[i].cores.count);
         }
         sc_core::sc_start(sc_core::SC_ZERO_TIME);  // end elaboration; processes wait for passes

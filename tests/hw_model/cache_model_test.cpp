@@ -73,3 +73,45 @@ TEST_CASE("Private levels are per core; shared levels see every core", "[hw_mode
     CHECK(memory.read(1, 8192, 4, 2000) == 2000 + 7);  // core 1 finds it in the shared L3
     CHECK(cold > 7);
 }
+
+TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw_model][cache]") {
+    // Two machines with the same lookups (same_cache_lookups: one core, equal geometry and
+    // prefetch) but other latencies, each reading the same addresses; one reads ahead of the
+    // other, as one configuration of a group runs ahead of another.
+    HwConfig a, b;
+    b.scene_memory.caches[1].hit_latency_ns = 9.0;
+    b.scene_memory.dram_latency_ns = 80.0;
+    REQUIRE(same_cache_lookups(a, b));
+    HwConfig other = a;
+    other.scene_memory.caches[0].ways = 4;
+    CHECK_FALSE(same_cache_lookups(a, other));
+    other = a;
+    other.cores.count = 2;  // passes go to cores as their timing decides
+    CHECK_FALSE(same_cache_lookups(a, other));
+
+    auto shared = std::make_shared<SharedCacheLookups>(a.scene_memory.caches);
+    SceneMemoryModel own_a(a.scene_memory, 500.0), own_b(b.scene_memory, 500.0);
+    SceneMemoryModel shared_a(a.scene_memory, 500.0, 1, shared);
+    SceneMemoryModel shared_b(b.scene_memory, 500.0, 1, shared);
+    std::vector<uint64_t> addresses;
+    uint64_t x = 12345;
+    for (int i = 0; i < 20000; ++i) {  // enough to forget what both have read
+        x = x * 6364136223846793005ull + 1442695040888963407ull;
+        addresses.push_back((x >> 33) % (4u << 20));
+    }
+    for (size_t i = 0; i < addresses.size(); ++i) {
+        CHECK(shared_a.read(0, addresses[i], 36, i) == own_a.read(0, addresses[i], 36, i));
+        if (i >= 5000) {  // b trails a by 5000 reads
+            const size_t j = i - 5000;
+            CHECK(shared_b.read(0, addresses[j], 36, j) == own_b.read(0, addresses[j], 36, j));
+        }
+    }
+    for (uint32_t level = 0; level < own_a.level_count(); ++level) {
+        CHECK(shared_a.hits(level) == own_a.hits(level));
+        CHECK(shared_a.misses(level) == own_a.misses(level));
+        CHECK(shared_b.hits(level) == own_b.hits(level));
+    }
+    CHECK(shared_a.dram_reads() == own_a.dram_reads());
+    // A reader that looks up another line than the one simulated is a logic error.
+    CHECK_THROWS_AS(shared_b.read(0, addresses[0] + 4096 * 64, 4, 0), std::logic_error);
+}

@@ -30,7 +30,7 @@ struct ReferenceBank {
 TEST_CASE("bank schedule grants a SIMD access's lanes as banks that never forget would",
           "[machine]") {
     // 32 and 64 banks take the one-word path; 100 the multi-word one. Lanes draw their banks from
-    // a few, so several share a bank (deeper than the fast path's four layers too).
+    // a few, so several share a bank (up to 16 deep).
     for (const uint32_t bank_count : {32u, 64u, 100u}) {
         for (const uint32_t occupancy : {1u, 3u}) {
             std::mt19937 rng(bank_count * 10 + occupancy);
