@@ -15,10 +15,13 @@ Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c,
     m_map.nodes = shape.bvh_nodes;
     m_map.triangles = shape.triangles;
     m_map.spheres = shape.spheres;
+    // The cores share one clock and one table of wake-ups: their processes due in the same
+    // cycle resume in an order of this accelerator's own making.
+    const auto wakeups = std::make_shared<CycleWakeups>();
     for (uint32_t i = 0; i < c.cores.count; ++i)
         m_cores.push_back(std::make_unique<Core>(
             ("core_" + std::to_string(i)).c_str(), c, m_costs, m_map, layout.words(),
-            std::max(capacity, shape.slots()), i, m_scene_memory, *this));
+            std::max(capacity, shape.slots()), i, m_scene_memory, wakeups, *this));
 }
 
 void Accelerator::enqueue(std::shared_ptr<const PassBuffer> pass) {

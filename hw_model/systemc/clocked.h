@@ -4,15 +4,51 @@
 // waits exactly to its edge, so time stays on the clock however many clocks share a simulation.
 
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <systemc>
+#include <vector>
 
 namespace sfx {
 
+// The wake-ups of one accelerator's processes: one event per time any of them waits for. Its
+// processes due at the same time then resume in an order of the accelerator's own making (the
+// order in which they began to wait), never in the order SystemC's timed-event queue breaks
+// ties in, which depends on every other configuration simulated beside it: a configuration's
+// prediction must not depend on its point group.
+class CycleWakeups {
+  public:
+    // The event notified at time `target` (in units of the time resolution; now < target).
+    sc_core::sc_event& at(uint64_t target, uint64_t now) {
+        // Events of times past have fired: they are free again.
+        while (!m_pending.empty() && m_pending.begin()->first <= now) {
+            m_free.push_back(std::move(m_pending.begin()->second));
+            m_pending.erase(m_pending.begin());
+        }
+        std::unique_ptr<sc_core::sc_event>& e = m_pending[target];
+        if (!e) {
+            if (m_free.empty()) {
+                e = std::make_unique<sc_core::sc_event>();
+            } else {
+                e = std::move(m_free.back());
+                m_free.pop_back();
+            }
+            e->notify(sc_core::sc_time::from_value(target - now));
+        }
+        return *e;
+    }
+
+  private:
+    std::map<uint64_t, std::unique_ptr<sc_core::sc_event>> m_pending;
+    std::vector<std::unique_ptr<sc_core::sc_event>> m_free;
+};
+
 class CoreClock {
   public:
-    explicit CoreClock(double mhz)
+    CoreClock(double mhz, std::shared_ptr<CycleWakeups> wakeups)
         : m_period(uint64_t(
-              std::llround(1e6 / mhz / sc_core::sc_get_time_resolution().to_seconds() / 1e12))) {}
+              std::llround(1e6 / mhz / sc_core::sc_get_time_resolution().to_seconds() / 1e12))),
+          m_wakeups(std::move(wakeups)) {}
     uint64_t now() const {
         const uint64_t t = sc_core::sc_time_stamp().value();
         return (t + m_period - 1) / m_period;
@@ -20,11 +56,12 @@ class CoreClock {
     // Waits until cycle `cycle` (returns at once if it has begun).
     void wait_until(uint64_t cycle) const {
         const uint64_t target = cycle * m_period, t = sc_core::sc_time_stamp().value();
-        if (target > t) sc_core::wait(sc_core::sc_time::from_value(target - t));
+        if (target > t) sc_core::wait(m_wakeups->at(target, t));
     }
 
   private:
     uint64_t m_period;  // in units of the time resolution
+    std::shared_ptr<CycleWakeups> m_wakeups;  // the accelerator's
 };
 
 }  // namespace sfx

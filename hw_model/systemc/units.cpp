@@ -58,10 +58,11 @@ void PartitionUnit::run() {
 
 Core::Core(sc_core::sc_module_name name, const HwConfig& config, const OpCostTable& costs,
            const SceneDataMap& map, uint32_t record_words, uint32_t slot_capacity, uint32_t index,
-           std::shared_ptr<SceneMemoryModel> scene_memory, PassSource& source)
+           std::shared_ptr<SceneMemoryModel> scene_memory, std::shared_ptr<CycleWakeups> wakeups,
+           PassSource& source)
     : sc_module(name),
       m_model(config, costs, map, record_words, slot_capacity, index, std::move(scene_memory)),
-      m_clock(config.clock.core_mhz),
+      m_clock(config.clock.core_mhz, std::move(wakeups)),
       m_source(source) {
     for (uint32_t u = 0; u < config.simd.units; ++u) {
         m_simd.push_back(std::make_unique<SimdUnit>(("simd_" + std::to_string(u)).c_str(), *this, u,

@@ -92,7 +92,8 @@ class Core : public sc_core::sc_module {
     SC_HAS_PROCESS(Core);
     Core(sc_core::sc_module_name name, const HwConfig& config, const OpCostTable& costs,
          const SceneDataMap& map, uint32_t record_words, uint32_t slot_capacity, uint32_t index,
-         std::shared_ptr<SceneMemoryModel> scene_memory, PassSource& source);
+         std::shared_ptr<SceneMemoryModel> scene_memory, std::shared_ptr<CycleWakeups> wakeups,
+         PassSource& source);
 
     CoreModel& model() { return m_model; }
     const CoreClock& clock() const { return m_clock; }

@@ -320,6 +320,48 @@ TEST_CASE("More units, more cores, deeper queues are never slower on the same tr
     }
 }
 
+TEST_CASE("A configuration's prediction does not depend on the group it is timed in",
+          "[hw_model][systemc]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    const RenderSettings settings = small_frame(scene);
+    HwConfig w8, three_cores, queue1;
+    std::vector<OpCostConfig> costs = costs_for_every_kind({});
+    for (OpCostConfig& c : costs) {
+        c.per_op_cycles = 10;
+        c.per_group_cycles = 4;
+        c.per_lane_cycles = 1;
+        c.beyond_l1_per_lane_cycles = 2;
+    }
+    const HwConfig host = host_hw_config(small_host(), costs);
+    w8.simd.width = 8;
+    three_cores.cores.count = 3;
+    three_cores.cores.op_window = 2;
+    queue1.agu.queue_depth = 1;
+    queue1.simd.units = 4;
+    const std::vector<HwConfig> configs = {HwConfig{}, w8, three_cores, queue1, host};
+    const PointGroupResult group = run_point_group(scene, bvh, settings, configs, Fidelity::full);
+    // Timed beside an identical copy of itself and in reverse order, too: processes due in the
+    // same cycle must resume in an order of their accelerator's own making.
+    const std::vector<HwConfig> reversed(configs.rbegin(), configs.rend());
+    const PointGroupResult back = run_point_group(scene, bvh, settings, reversed, Fidelity::full);
+    for (size_t i = 0; i < configs.size(); ++i) {
+        const PointGroupResult alone =
+            run_point_group(scene, bvh, settings, {configs[i], configs[i]}, Fidelity::full);
+        const std::vector<Stat> a = alone.predictions[0].stats(), b = alone.predictions[1].stats(),
+                                g = group.predictions[i].stats(),
+                                r = back.predictions[configs.size() - 1 - i].stats();
+        REQUIRE(a.size() == g.size());
+        for (size_t k = 0; k < a.size(); ++k) {
+            if (a[k].name == "host_seconds") continue;
+            INFO("configuration " << i << " " << a[k].name);
+            CHECK(a[k].value == b[k].value);
+            CHECK(a[k].value == g[k].value);
+            CHECK(a[k].value == r[k].value);
+        }
+    }
+}
+
 TEST_CASE(
     "The hardware model never changes the image; more banks never slower; more lanes "
     "never more instructions",
