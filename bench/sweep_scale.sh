@@ -51,12 +51,14 @@ port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0
 scheduler="tcp://127.0.0.1:$port"
 setsid /usr/bin/dask-scheduler --host 127.0.0.1 --port "$port" --no-dashboard >"$work/scheduler.log" 2>&1 &
 pids+=($!)
+disown  # killed on purpose at the end: no "Killed" line from the shell
 wait_for 60 grep -q "Scheduler at" "$work/scheduler.log" || fail "scheduler did not start"
 for i in 1 2 3; do
   setsid /usr/bin/dask-worker "$scheduler" --host 127.0.0.1 --nthreads 1 --no-nanny \
     --no-dashboard --local-directory "$work/w$i" --death-timeout 60 >"$work/worker$i.log" 2>&1 &
   pids+=($!)
   eval "worker$i=$!"
+  disown
 done
 for i in 1 2 3; do
   wait_for 60 grep -q "Registered to" "$work/worker$i.log" || fail "worker $i did not register"
