@@ -216,7 +216,7 @@ TEST_CASE("Point YAML round-trips and its key depends on values and nothing else
 TEST_CASE("A point's workload YAML keeps its text (stored keys stay valid)", "[sweeps]") {
     const Sweep s = parse(std::string(k_head) + "axes:\n  workload.seed: [7]\n");
     REQUIRE(s.point_count == 1);
-    const std::string& yaml = s.all_points()[0].config_yaml;
+    const std::string yaml = s.all_points()[0].config_yaml;
     const std::string workload =
         "workload:\n  scene: \"cornell\"\n  width: 16\n  height: 16\n  spp: 1\n  depth: 3\n"
         "  tile: 8\n  seed: 7\nfidelity: analytic\n";
