@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/point_runner.h"
 #include "app/progress.h"
 #include "sweeps/engine.h"
 #include "sweeps/group_runner.h"
@@ -65,16 +66,6 @@ std::string group_label(const PointGroup& group, size_t points) {
            " " + to_string(p.fidelity) + " (" + std::to_string(points) + " config" +
            (points == 1 ? "" : "s") + ")";
 }
-
-// Dask: groups submitted and unfinished at most, so the client holds a bounded part of the
-// sweep; enough to keep a few hundred worker threads busy.
-constexpr unsigned k_dask_window = 256;
-
-struct Failure {
-    size_t group;
-    int exit_code;
-    std::string message;
-};
 
 // Rows of the summary table at most; a larger sweep's rows are in the store (--csv, sfx report).
 constexpr size_t k_summary_rows = 200;
@@ -202,106 +193,41 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
     if (store_path.empty()) throw InputError("command line", 0, "--store", "required (or --dry-run)");
     ResultsStore store(store_path);
 
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const unsigned parallel = std::max(1u, std::min<unsigned>(jobs ? jobs : cores, unsigned(std::max<size_t>(1, sweep.groups.size()))));
-    // Local children share the cores; a Dask task may use its whole worker (0: all cores).
-    const uint32_t group_threads = threads ? threads : engine == "local" ? std::max(1u, cores / parallel) : 0;
+    const EngineSettings settings = engine_settings(engine, scheduler, jobs, threads, sweep.groups.size());
     if (!json)
         std::cerr << "sweep " << sweep.name << ": " << sweep.point_count << " points in "
                   << sweep.groups.size() << " renders on "
-                  << (engine == "local" ? std::to_string(parallel) + " local processes x " +
-                                              std::to_string(group_threads) + " threads"
+                  << (engine == "local" ? std::to_string(settings.parallel) + " local processes x " +
+                                              std::to_string(settings.group_threads) + " threads"
                                         : "Dask at " + scheduler)
                   << "; points already stored are skipped\n";
     // Points done / total, ETA and the running group: a bar on a terminal, else one line per
     // finished group. The total drops as stored points are found.
     Progress progress("sweep", sweep.point_count, "points", 0.0);
 
-    // Groups are made (points, keys, a look in the store) as the engine asks for them, and a
-    // group's rows are written in one transaction when it finishes.
-    struct Running {
-        std::vector<SweepPoint> points;  // not yet stored
-        std::vector<ResultsStore::PointRow> rows;
-    };
-    std::map<size_t, Running> running;
+    // Groups are made (points, keys) as the engine asks for them.
     PointKeys keys;
     keys.reserve(sweep.point_count);
-    size_t next_group = 0, already_stored = 0, groups_run = 0;
-    const NextGroup next = [&](GroupJob& job) {
-        while (next_group < sweep.groups.size()) {
-            const size_t g = next_group++;
-            std::vector<SweepPoint> points;
-            std::vector<std::string> group_keys;
-            for (size_t i : sweep.groups[g].points) {
-                points.push_back(sweep.point(i));
-                group_keys.push_back(points.back().key);
-                keys.emplace_back(i, points.back().key);
-            }
-            const std::set<std::string> stored = store.stored_keys(group_keys);
-            points.erase(std::remove_if(points.begin(), points.end(),
-                                        [&](const SweepPoint& p) { return stored.count(p.key) > 0; }),
-                         points.end());
-            already_stored += stored.size();
-            progress.set_total(sweep.point_count - already_stored);
-            if (points.empty()) continue;
-            job.group = g;
-            job.spec = group_spec_json(points, group_threads).dump();
-            running[g].points = std::move(points);
-            ++groups_run;
-            return true;
+    size_t next_group = 0, found = 0;
+    const NextRunGroup next = [&](RunGroup& group) {
+        if (next_group >= sweep.groups.size()) return false;
+        const PointGroup& g = sweep.groups[next_group++];
+        group.points.clear();
+        for (size_t i : g.points) {
+            group.points.push_back(sweep.point(i));
+            keys.emplace_back(i, group.points.back().key);
         }
-        return false;
+        group.label = group_label(g, g.points.size());
+        return true;
     };
-    std::set<std::string> ran;
-    std::vector<Failure> failures;
-    // The rows a group returned, in one transaction; each point counted once.
-    auto write_rows = [&](size_t g) {
-        Running& r = running[g];
-        store.write_points(r.rows, sweep.name);
-        for (const ResultsStore::PointRow& row : r.rows)
-            if (ran.insert(row.run.key).second) progress.advance(1);
-    };
-    EngineEvents events;
-    events.started = [&](size_t g) {
-        progress.set_label(group_label(sweep.groups[g], running[g].points.size()));
-    };
-    events.row = [&](size_t g, const PointRun& run) {
-        Running& r = running[g];
-        auto it = std::find_if(r.points.begin(), r.points.end(),
-                               [&](const SweepPoint& p) { return p.key == run.key; });
-        if (it == r.points.end())
-            throw std::runtime_error("a worker returned a point this group did not ask for (key " + run.key +
-                                     ", worker sfx " + run.sfx_version + ", this sfx " + sfx_version() +
-                                     "): workers must run the same sfx version");
-        for (const ResultsStore::PointRow& row : r.rows)
-            if (row.run.key == run.key) return;  // a repeat
-        r.rows.push_back({&*it, run});
-    };
-    events.finished = [&](size_t g) {
-        write_rows(g);
-        const Running& r = running[g];
-        if (r.rows.size() != r.points.size())
-            failures.push_back({g, 1, "returned " + std::to_string(r.rows.size()) + " of " +
-                                          std::to_string(r.points.size()) + " rows"});
-        if (!progress.terminal())
-            progress.log("sweep: done " + group_label(sweep.groups[g], r.points.size()) + "  " +
-                         progress.status());
-        running.erase(g);
-    };
-    events.failed = [&](size_t g, int code, const std::string& message) {
-        write_rows(g);  // rows returned before the failure are kept
-        failures.push_back({g, code, message});
-        if (progress.terminal())
-            progress.clear();
-        else
-            progress.log("sweep: FAILED " + group_label(sweep.groups[g], running[g].points.size()) + "  " +
-                         progress.status());
-        running.erase(g);
-    };
-    if (engine == "local") run_local(next, parallel, self_executable(), events);
-    else run_dask(next, scheduler, self_executable(), k_dask_window, events);
+    const RunOutcome outcome = run_point_groups(next, store, sweep.name, settings, progress, [&](size_t n) {
+        found += n;
+        progress.set_total(sweep.point_count - found);
+    });
     progress.finish();
-    const double seconds = progress.elapsed();
+    const double seconds = outcome.seconds;
+    const std::set<std::string>& ran = outcome.ran;
+    const size_t already_stored = outcome.already_stored;
 
     std::sort(keys.begin(), keys.end());
     if (!csv.empty()) {
@@ -317,7 +243,7 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
         j["groups"] = sweep.groups.size();
         j["already_stored"] = already_stored;
         j["ran"] = ran.size();
-        j["failed_groups"] = failures.size();
+        j["failed_groups"] = outcome.failures.size();
         j["seconds"] = seconds;
         j["rows"] = nlohmann::ordered_json::array();
         for (const auto& [index, key] : keys) {
@@ -337,19 +263,7 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
         if (!csv.empty()) std::cout << ", CSV " << csv;
         std::cout << "\n";
     }
-    if (!failures.empty()) {
-        bool input_error = false;
-        for (const Failure& f : failures) {
-            std::cerr << "sfx: group " << f.group << " ("
-                      << group_label(sweep.groups[f.group], sweep.groups[f.group].points.size())
-                      << ") failed: " << f.message << "\n";
-            input_error |= f.exit_code == 2;
-        }
-        const std::string what = std::to_string(failures.size()) + " of " + std::to_string(groups_run) +
-                                 " groups failed; re-run to retry them (stored points are kept)";
-        if (input_error) throw InputError(path, 0, "", what);
-        throw std::runtime_error(what);
-    }
+    if (!outcome.failures.empty()) throw_group_failures(outcome, path);
 }
 
 }  // namespace

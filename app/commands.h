@@ -62,6 +62,7 @@ void add_scene_info_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_accuracy_command(CLI::App& app);
 void add_sweep_command(CLI::App& app);  // also the hidden run-group
+void add_explore_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);  // --describe-host, --check

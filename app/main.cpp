@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     sfx::add_simulate_command(app);
     sfx::add_accuracy_command(app);
     sfx::add_sweep_command(app);
+    sfx::add_explore_command(app);
     sfx::add_compare_command(app);
     sfx::add_report_command(app);
     sfx::add_calibrate_command(app);

@@ -40,6 +40,7 @@ public:
     // "[12/48 points, 1m15s elapsed, ETA 25s]"
     std::string status() const;
     bool terminal() const { return m_tty; }
+    const std::string& what() const { return m_what; }
 
 private:
     void update(bool force);

@@ -318,6 +318,83 @@ bool ResultsStore::write_point(const SweepPoint& point, const std::string& sweep
     return write_points({{&point, run}}, sweep) == 1;
 }
 
+void ResultsStore::begin_explore(const std::string& name, const std::string& file,
+                                 const std::string& fingerprint, const std::string& spec_json) {
+    exec("BEGIN IMMEDIATE");
+    try {
+        exec("CREATE TABLE IF NOT EXISTS explores(name TEXT PRIMARY KEY, file TEXT, fingerprint TEXT, spec TEXT)");
+        exec("CREATE TABLE IF NOT EXISTS explore_configs(explore TEXT, config INTEGER, stage TEXT, "
+             "trial INTEGER, knobs TEXT, fps REAL, fps_error REAL, area_mm2 REAL, energy_mj REAL, "
+             "power_w REAL, fps_per_mm2 REAL, feasible INTEGER, front INTEGER, "
+             "PRIMARY KEY(explore, config, stage))");
+        {
+            Statement old(m_db, "SELECT fingerprint FROM explores WHERE name = ?");
+            old.bind(1, name);
+            if (old.step() && old.text(0) != fingerprint) {
+                Statement del(m_db, "DELETE FROM explore_configs WHERE explore = ?");
+                del.bind(1, name);
+                del.step();
+            }
+        }
+        Statement up(m_db, "INSERT OR REPLACE INTO explores(name, file, fingerprint, spec) VALUES(?, ?, ?, ?)");
+        up.bind(1, name);
+        up.bind(2, file);
+        up.bind(3, fingerprint);
+        up.bind(4, spec_json);
+        up.step();
+        exec("COMMIT");
+    } catch (...) {
+        exec("ROLLBACK");
+        throw;
+    }
+}
+
+void ResultsStore::write_explore_configs(const std::string& explore, const std::vector<ExploreConfigRow>& rows) {
+    exec("BEGIN IMMEDIATE");
+    try {
+        Statement ins(m_db,
+                      "INSERT OR REPLACE INTO explore_configs(explore, config, stage, trial, knobs, fps, "
+                      "fps_error, area_mm2, energy_mj, power_w, fps_per_mm2, feasible, front) "
+                      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        for (const ExploreConfigRow& r : rows) {
+            sqlite3_reset(ins.get());
+            ins.bind(1, explore);
+            ins.bind_int(2, int64_t(r.config));
+            ins.bind(3, r.stage);
+            ins.bind_int(4, r.trial);
+            ins.bind(5, r.knobs_json);
+            ins.bind(6, r.fps);
+            ins.bind(7, r.fps_error >= 0 ? r.fps_error : std::nan(""));
+            ins.bind(8, r.area_mm2);
+            ins.bind(9, r.energy_mj);
+            ins.bind(10, r.power_w);
+            ins.bind(11, r.fps_per_mm2);
+            ins.bind_int(12, r.feasible);
+            ins.bind_int(13, r.front);
+            ins.step();
+        }
+        exec("COMMIT");
+    } catch (...) {
+        exec("ROLLBACK");
+        throw;
+    }
+}
+
+std::vector<std::pair<size_t, int64_t>> ResultsStore::explore_configs(const std::string& explore,
+                                                                      const std::string& stage) const {
+    std::vector<std::pair<size_t, int64_t>> out;
+    {
+        Statement t(m_db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'explore_configs'");
+        if (!t.step()) return out;
+    }
+    Statement s(m_db, "SELECT config, trial FROM explore_configs WHERE explore = ? AND stage = ? ORDER BY config");
+    s.bind(1, explore);
+    s.bind(2, stage);
+    while (s.step())
+        out.emplace_back(size_t(sqlite3_column_int64(s.get(), 0)), sqlite3_column_int64(s.get(), 1));
+    return out;
+}
+
 std::set<std::string> ResultsStore::stored_keys(const std::vector<std::string>& keys) const {
     std::set<std::string> out;
     constexpr size_t k_batch = 500;  // below SQLite's bound-parameter limit

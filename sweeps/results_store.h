@@ -76,6 +76,27 @@ public:
     // column except config_yaml, in table order; rows by sweep and point index.
     void export_csv(const std::string& csv_path, const std::vector<std::string>& keys = {}) const;
 
+    // Explores (`sfx explore`): explores(name, file, fingerprint, spec) and
+    // explore_configs(explore, config, stage, trial, knobs, fps, fps_error, area_mm2, energy_mj,
+    // power_w, fps_per_mm2, feasible, front): each configuration an explore screened
+    // (stage 'screen') and each one of the screened front it re-ran (stage 'confirm'). The
+    // tables are made by the first explore. An explore whose fingerprint changed (its file's
+    // space or objectives) starts anew: its old configurations are removed.
+    void begin_explore(const std::string& name, const std::string& file, const std::string& fingerprint,
+                       const std::string& spec_json);
+    struct ExploreConfigRow {
+        size_t config = 0;
+        std::string stage;  // screen | confirm
+        int64_t trial = -1;  // the Optuna trial that first asked for it (-1: none)
+        std::string knobs_json;
+        double fps = 0, fps_error = -1, area_mm2 = 0, energy_mj = 0, power_w = 0, fps_per_mm2 = 0;
+        bool feasible = false, front = false;
+    };
+    // Inserts or replaces rows, in one transaction.
+    void write_explore_configs(const std::string& explore, const std::vector<ExploreConfigRow>& rows);
+    // (config, trial) of an explore's rows at `stage`, by config.
+    std::vector<std::pair<size_t, int64_t>> explore_configs(const std::string& explore, const std::string& stage) const;
+
     sqlite3* handle() const { return m_db; }
 
 private:

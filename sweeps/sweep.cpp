@@ -113,6 +113,7 @@ std::string too_many(size_t max_points, const char* what) {
 }
 
 struct Axis {
+    std::string section = "axes";  // the file's key above it, for messages ("knobs" in explores)
     std::string path;   // "hw.simd.width", "workload.tile", "fidelity"
     std::string field;  // the path below hw./workload.
     enum Kind { hw, workload, fidelity } kind = hw;
@@ -124,7 +125,7 @@ struct Axis {
 // Values of one axis: a list of scalars, {values: [...]} or {from, to, step}.
 void read_axis_values(Axis& axis, const YAML::Node& node, const std::string& file,
                       size_t max_points) {
-    const std::string key = "axes." + axis.path;
+    const std::string key = axis.section + "." + axis.path;
     YAML::Node list = node;
     if (node.IsMap() && node["values"]) {
         check_keys(node, file, key, {"values"});
@@ -214,6 +215,43 @@ public:
         return sweep;
     }
 
+    // An explore file's space: its base (hw, hw_overrides, workload without a scene), the
+    // scenes of `workloads` as the first axis and the `knobs` (hardware paths) as the others.
+    // The caller has checked the explore's own keys.
+    Sweep parse_space(const YAML::Node& root, const std::string& name, Fidelity fidelity,
+                      const std::vector<std::string>& sets) {
+        Sweep sweep;
+        sweep.file = m_file;
+        sweep.name = name;
+        read_hw(root);
+        Axis scenes;
+        scenes.path = "workload.scene";
+        scenes.field = "scene";
+        scenes.kind = Axis::workload;
+        scenes.section = "workloads";
+        const YAML::Node list = root["workloads"];
+        scenes.line = line_of(list);
+        for (size_t i = 0; i < list.size(); ++i) {
+            const std::string key = "workloads[" + std::to_string(i) + "].scene";
+            scenes.values.push_back(scalar(list[i]["scene"], m_file, key));
+            scenes.value_lines.push_back(line_of(list[i]["scene"]));
+        }
+        m_workload.scene = scenes.values.at(0);
+        read_workload(root, false);
+        apply_sets(sets);
+        m_fidelity = fidelity;
+        for (size_t i = 0; i < scenes.values.size(); ++i) apply(scenes, i, m_base, m_workload, m_fidelity, true);
+        m_axes.push_back(std::move(scenes));
+        read_axes(root["knobs"], "knobs");
+        read_zip(root["zip"]);  // none: the explore's keys have no zip
+        for (const Axis& a : m_axes) {
+            sweep.axes.push_back(a.path);
+            sweep.axis_choices.push_back(a.values);
+        }
+        expand(sweep);
+        return sweep;
+    }
+
 private:
     std::string default_name() const {
         std::string n = fs::path(m_file).filename().string();
@@ -251,14 +289,19 @@ private:
         apply_overrides(over);
     }
 
-    void read_workload(const YAML::Node& root) {
+    // An explore's scenes are its `workloads`: its workload has none (scene_here false).
+    void read_workload(const YAML::Node& root, bool scene_here = true) {
         const YAML::Node w = root["workload"];
-        if (!w) throw InputError(m_file, 1, "workload", "missing (at least workload.scene)");
+        if (!w) {
+            if (!scene_here) return;
+            throw InputError(m_file, 1, "workload", "missing (at least workload.scene)");
+        }
         if (!w.IsMap()) throw InputError(m_file, line_of(w), "workload", "expected a mapping");
         std::vector<std::string> allowed = workload_field_names();
         allowed.push_back("res");
+        if (!scene_here) allowed.erase(std::find(allowed.begin(), allowed.end(), "scene"));
         check_keys(w, m_file, "workload", allowed);
-        if (!w["scene"]) throw InputError(m_file, line_of(w), "workload.scene", "missing");
+        if (scene_here && !w["scene"]) throw InputError(m_file, line_of(w), "workload.scene", "missing");
         if (w["res"] && (w["width"] || w["height"]))
             throw InputError(m_file, line_of(w["res"]), "workload.res", "give res or width/height, not both");
         for (const auto& kv : w) {
@@ -318,15 +361,19 @@ private:
         }
     }
 
-    void read_axes(const YAML::Node& axes) {
-        if (!axes.IsMap()) throw InputError(m_file, line_of(axes), "axes", "expected a mapping of dotted paths to values");
+    // `section` "knobs" (an explore's): hardware paths only.
+    void read_axes(const YAML::Node& axes, const std::string& section = "axes") {
+        if (!axes.IsMap()) throw InputError(m_file, line_of(axes), section, "expected a mapping of dotted paths to values");
         std::set<std::string> seen;
         for (const auto& kv : axes) {
             Axis axis;
+            axis.section = section;
             axis.path = kv.first.as<std::string>();
             axis.line = line_of(kv.first);
-            const std::string key = "axes." + axis.path;
-            if (!seen.insert(axis.path).second) throw InputError(m_file, axis.line, key, "duplicate axis");
+            const std::string key = section + "." + axis.path;
+            if (!seen.insert(axis.path).second) throw InputError(m_file, axis.line, key, "duplicate " + std::string(section == "axes" ? "axis" : "knob"));
+            if (section != "axes" && axis.path.rfind("hw.", 0) != 0)
+                throw InputError(m_file, axis.line, key, "a knob is a hardware path: hw.simd.width, hw.ray_buffer.kib, ...");
             if (axis.path.rfind("hw.", 0) == 0) {
                 axis.kind = Axis::hw;
                 axis.field = axis.path.substr(3);
@@ -351,7 +398,7 @@ private:
 
     void apply(const Axis& axis, size_t i, HwConfig& hw, WorkloadConfig& w, Fidelity& f,
                bool scratch) const {
-        const std::string key = "axes." + axis.path;
+        const std::string key = axis.section + "." + axis.path;
         const std::string& value = axis.values[i];
         const int line = axis.value_lines[i];
         if (axis.kind == Axis::hw) {
@@ -630,6 +677,15 @@ Sweep parse_sweep(const std::string& text, const std::string& file, const std::s
                   const std::vector<std::string>& sets, size_t max_points) {
     auto expansion = std::make_shared<SweepExpansion>(file, base_dir, max_points);
     Sweep sweep = expansion->parse(text, sets);
+    sweep.expansion = std::move(expansion);
+    return sweep;
+}
+
+Sweep parse_explore_space(const YAML::Node& root, const std::string& name, Fidelity fidelity,
+                          const std::string& file, const std::string& base_dir,
+                          const std::vector<std::string>& sets, size_t max_points) {
+    auto expansion = std::make_shared<SweepExpansion>(file, base_dir, max_points);
+    Sweep sweep = expansion->parse_space(root, name, fidelity, sets);
     sweep.expansion = std::move(expansion);
     return sweep;
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "hw_model/hw_config.h"
+#include <yaml-cpp/yaml.h>
 #include "hw_model/prediction.h"
 #include "sweeps/workload_config.h"
 
@@ -51,6 +52,7 @@ struct Sweep {
     std::string name;  // `name:`, else the file name without .sweep.yaml
     std::string file;
     std::vector<std::string> axes;  // dotted axis paths in file order
+    std::vector<std::vector<std::string>> axis_choices;  // each axis's values (explore spaces)
     std::vector<PointGroup> groups;
     size_t point_count = 0;  // distinct points: the expansion less its duplicates
     size_t duplicates = 0;   // expanded points identical to an earlier one (dropped)
@@ -79,6 +81,15 @@ Sweep load_sweep(const std::string& path, const std::vector<std::string>& sets =
 Sweep parse_sweep(const std::string& yaml_text, const std::string& file_name,
                   const std::string& base_dir, const std::vector<std::string>& sets = {},
                   size_t max_points = k_default_max_points);
+
+// An explore file's space (sweeps/explore.h): `workloads` scenes as the first axis, then the
+// `knobs`, every point at `fidelity`. The explore's own keys are checked by the caller.
+// `sets`: command-line changes to the base, as load_sweep's (a scene set is overruled by the
+// workloads' scenes; a fidelity set by the explore's fidelity policy).
+Sweep parse_explore_space(const YAML::Node& root, const std::string& name, Fidelity fidelity,
+                          const std::string& file, const std::string& base_dir,
+                          const std::vector<std::string>& sets = {},
+                          size_t max_points = k_default_max_points);
 
 // One point as YAML (comment-free, so the key depends on values only) and its store key:
 // hex SHA-256 of (config_yaml + "\n" + sfx version).

@@ -6,9 +6,10 @@ from __future__ import annotations
 import datetime
 import html
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, List
 
+from . import explore as explore_module
 from . import paper as paper_module
 from . import plots as plots_module
 from . import tables as tables_module
@@ -45,10 +46,12 @@ class Report:
     tables: List[tables_module.Table]
     plots: List[plots_module.Plot]
     store: Store
+    explore_plots: List[plots_module.Plot] = field(default_factory=list)  # "What to build"
 
     def files(self) -> List[str]:
         return [self.index, self.tables_md, self.points_csv] + \
-            [os.path.join(self.directory, p.file) for p in self.plots if p.file]
+            [os.path.join(self.directory, p.file) for p in self.plots + self.explore_plots
+             if p.file]
 
 
 def _values(store: Store, column: str) -> str:
@@ -127,7 +130,8 @@ def _seed_options_section(store: Store, tables, plots) -> str:
 
 
 # The page, top to bottom: each section is a function (store, tables, plots) -> HTML. A new
-# kind of answer adds its function here.
+# kind of answer adds its function here. Above them all: the "What to build" sections of the
+# store's explores (explore.py; they draw their own plots, so write_report makes them).
 SECTIONS: List[Callable[[Store, list, list], str]] = [
     _summary_section,
     _plots_section,
@@ -137,11 +141,13 @@ SECTIONS: List[Callable[[Store, list, list], str]] = [
 ]
 
 
-def _index_html(store: Store, tables, plots, title: str, extra: List[str]) -> str:
+def _index_html(store: Store, tables, plots, title: str, extra: List[str],
+                lead: List[str] = ()) -> str:
     e = html.escape
     out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
            f"<title>{e(title)}</title>", f"<style>{_CSS}</style>", "</head><body>",
            f"<h1>{e(title)}</h1>"]
+    out.extend(lead)  # sections answering the question first (what to build)
     out.extend(section(store, tables, plots) for section in SECTIONS)
     out.extend(extra)  # sections from other inputs than the store (the silicon check)
     generated = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -153,7 +159,7 @@ def _index_html(store: Store, tables, plots, title: str, extra: List[str]) -> st
 def write_report(db: str, directory: str, silicon_rows: str = "") -> Report:
     """silicon_rows: `sfx calibrate --check --json` output, for the silicon-check section."""
     # Steps for a progress bar: the store, the tables, each plot, the files.
-    steps = Steps(3 + len(plots_module.PLOTTERS) + bool(silicon_rows))
+    steps = Steps(4 + len(plots_module.PLOTTERS) + bool(silicon_rows))
     steps.start("reading the store")
     store = load_store(db)
     silicon_df = None
@@ -171,6 +177,9 @@ def write_report(db: str, directory: str, silicon_rows: str = "") -> Report:
             from None
     if not os.path.isdir(directory):
         raise StoreError(f"{directory}: not a directory")
+
+    steps.start("what to build")
+    lead, explore_plots = explore_module.html_sections(db, directory)
 
     steps.start("tables")
     tables = tables_module.build_tables(store)
@@ -196,6 +205,6 @@ def write_report(db: str, directory: str, silicon_rows: str = "") -> Report:
         points_csv, index=False)
     index = os.path.join(directory, "index.html")
     with open(index, "w", encoding="utf-8") as f:
-        f.write(_index_html(store, tables, plots, title, extra))
+        f.write(_index_html(store, tables, plots, title, extra, lead))
     steps.finish()
-    return Report(directory, index, tables_md, points_csv, tables, plots, store)
+    return Report(directory, index, tables_md, points_csv, tables, plots, store, explore_plots)
