@@ -293,6 +293,7 @@ struct Options {
     unsigned jobs = 0;
     uint32_t threads = 0;
     std::vector<std::string> sets;
+    std::string sampler;
     long seed = -1;
     size_t budget = 0;
     bool exhaustive = false, json = false;
@@ -302,6 +303,7 @@ void run_explore(const Options& o) {
     if (!o.store.empty() && access(o.store.c_str(), F_OK) != 0) check_output_file(o.store, "--store");
     ExploreSpec spec = load_explore(o.file, o.sets);
     if (o.seed >= 0) spec.seed = uint64_t(o.seed);
+    if (!o.sampler.empty()) spec.sampler = o.sampler;
     if (o.budget) spec.budget_evaluations = std::min(o.budget, spec.configurations());
     if (o.exhaustive) {
         spec.name += "/grid";
@@ -486,6 +488,8 @@ void add_explore_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0u, k_max_threads));
     c->add_option("--set", o->sets, "change the base point: PATH=VALUE (workload.res=64x64, hw.clock.core_mhz=1000)");
+    c->add_option("--sampler", o->sampler, "tpe | nsga2 | random (default: search.sampler of the file)")
+        ->check(CLI::IsMember({"tpe", "nsga2", "random"}));
     c->add_option("--seed", o->seed, "the search's seed (default: search.seed of the file)")->check(CLI::Range(0L, 1L << 30));
     c->add_option("--budget", o->budget, "configurations to screen at most (default: budget.evaluations of the file)")
         ->check(CLI::Range(size_t(1), size_t(1) << 40));

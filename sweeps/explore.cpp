@@ -158,8 +158,9 @@ ExploreSpec parse_explore(const std::string& text, const std::string& file, cons
         check_keys(s, file, "search", {"sampler", "seed", "batch", "startup"});
         if (s["sampler"]) {
             spec.sampler = scalar(s["sampler"], file, "search.sampler");
-            if (spec.sampler != "tpe" && spec.sampler != "nsga2")
-                throw InputError(file, line_of(s["sampler"]), "search.sampler", "'" + spec.sampler + "' is not one of: tpe, nsga2");
+            if (spec.sampler != "tpe" && spec.sampler != "nsga2" && spec.sampler != "random")
+                throw InputError(file, line_of(s["sampler"]), "search.sampler",
+                                 "'" + spec.sampler + "' is not one of: tpe, nsga2, random");
         }
         if (s["seed"]) spec.seed = count(s["seed"], file, "search.seed", 0, 1u << 30);
         if (s["batch"]) spec.batch = count(s["batch"], file, "search.batch", 1, 4096);

@@ -9,7 +9,7 @@ and the number of trials so far, so the same file and seed give the same sequenc
 
 request:  {"storage": PATH, "study": NAME,
            "space": [{"name": "hw.simd.width", "values": ["4", "8"], "ordinal": true}, ...],
-           "directions": ["maximize", "minimize", ...], "sampler": "tpe" | "nsga2",
+           "directions": ["maximize", "minimize", ...], "sampler": "tpe" | "nsga2" | "random",
            "seed": 1, "batch": 8, "startup": 10, "fingerprint": "...",
            "results": [{"number": 3, "values": [...], "constraints": [...]},
                        {"number": 4, "failed": true}],     told first (may be empty)
@@ -44,6 +44,8 @@ def make_sampler(req, trials_so_far):
     # Re-seeded per call from the count so far: each call is a new process, and the same seed
     # would otherwise replay the same draws.
     seed = int(req["seed"]) * 100003 + trials_so_far
+    if req["sampler"] == "random":  # the baseline a search must beat
+        return optuna.samplers.RandomSampler(seed=seed)
     if req["sampler"] == "nsga2":
         return optuna.samplers.NSGAIISampler(
             population_size=max(2, int(req["batch"])), seed=seed, constraints_func=constraints_of)

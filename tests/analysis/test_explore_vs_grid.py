@@ -27,7 +27,7 @@ if "--exhaustive" in args:
            "objectives": objs, "screened": configs, "front": [], "screen_front": []}
 else:
     seed = int(args[args.index("--seed") + 1])
-    assert "--study" in args
+    assert "--study" in args and args[args.index("--sampler") + 1] == "tpe"
     chosen = SEARCH[seed]
     doc = {"explore": "fake", "configurations": 16, "evaluations": len(chosen), "seconds": 0.1,
            "objectives": objs,
@@ -49,7 +49,7 @@ def fake_sfx(tmp_path, search):
 def run(tmp_path, search, seeds="1,2,3"):
     sfx = fake_sfx(tmp_path, search)
     return subprocess.run([sys.executable, BENCH, sfx, "x.yaml", str(tmp_path / "w"),
-                           "--seeds", seeds], capture_output=True, text=True, timeout=120)
+                           "--seeds", seeds, "--samplers", "tpe"], capture_output=True, text=True, timeout=120)
 
 
 def test_self_check():
@@ -65,7 +65,7 @@ def test_whole_run_with_a_stand_in(tmp_path):
     done = run(tmp_path, {1: front, 2: front + [5], 3: [0, 1, 3]}, seeds="1,3")
     assert done.returncode in (0, 1), done.stderr
     result = json.load(open(tmp_path / "w" / "explore_vs_grid.json"))
-    shares = [r["hv_share"] for r in result["seeds"]]
+    shares = [r["hv_share"] for r in result["samplers"]["tpe"]["seeds"]]
     assert abs(shares[0] - 1.0) < 1e-12 and shares[1] < 1.0
     assert result["grid"] == {"configurations": 16, "feasible": 15, "front": 4}
     assert "median over 2 seeds" in done.stdout
