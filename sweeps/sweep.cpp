@@ -398,7 +398,9 @@ private:
 
     void apply(const Axis& axis, size_t i, HwConfig& hw, WorkloadConfig& w, Fidelity& f,
                bool scratch) const {
-        const std::string key = axis.section + "." + axis.path;
+        // An explore's scenes are items of its workloads list.
+        const std::string key = axis.section == "workloads" ? "workloads[" + std::to_string(i) + "].scene"
+                                                            : axis.section + "." + axis.path;
         const std::string& value = axis.values[i];
         const int line = axis.value_lines[i];
         if (axis.kind == Axis::hw) {
