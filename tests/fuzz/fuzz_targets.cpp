@@ -13,6 +13,7 @@
 #include "hw_model/hw_config.h"
 #include "kernels/trace.h"
 #include "sweeps/results_store.h"
+#include "sweeps/explore.h"
 #include "sweeps/sweep.h"
 #include "base/input_error.h"
 #include "workloads/mesh_import.h"
@@ -151,6 +152,21 @@ void sweep(const uint8_t* data, size_t size) {
     }
 }
 
+void explore(const uint8_t* data, size_t size) {
+    const std::string text(reinterpret_cast<const char*>(data), size);
+    try {
+        const ExploreSpec e = parse_explore(text, "fuzz.yaml", SFX_SOURCE_DIR "/sweeps", {}, 10000);
+        const size_t n = e.configurations();
+        if (n == 0 || e.budget_evaluations == 0 || e.budget_evaluations > n) bug("an explore's budget outside its space");
+        for (size_t c : {size_t(0), n / 2, n - 1}) {
+            if (e.config_of(e.knob_positions(c)) != c) bug("a configuration's knob positions do not round-trip");
+            for (size_t w = 0; w < e.workloads.size() && w < 2; ++w)
+                if (e.point(w, c, e.confirm).key.empty()) bug("an explore point without a key");
+        }
+    } catch (const InputError&) {
+    }
+}
+
 namespace {
 // import_mesh reports assimp's refusals as std::runtime_error (mesh_import.h); the scene
 // loader turns them into InputErrors. An accepted mesh must be finite and indexed in range.
@@ -209,7 +225,7 @@ void trace(const uint8_t* data, size_t size) {
 
 const std::vector<TargetInfo>& targets() {
     static const std::vector<TargetInfo> list = {
-        {"hw_config", hw_config}, {"scene", scene}, {"sweep", sweep}, {"mesh_obj", mesh_obj},
+        {"hw_config", hw_config}, {"scene", scene}, {"sweep", sweep}, {"explore", explore}, {"mesh_obj", mesh_obj},
         {"mesh_ply", mesh_ply},   {"store", store}, {"trace", trace},
     };
     return list;

@@ -25,6 +25,9 @@ void hw_config(const uint8_t* data, size_t size);
 void scene(const uint8_t* data, size_t size);
 // sweep: a *.sweep.yaml, resolved against sweeps/, expanded (at most the expansion cap).
 void sweep(const uint8_t* data, size_t size);
+// explore: an explore file (sfx explore), resolved against sweeps/; every configuration's
+// positions round-trip and its points are made and keyed.
+void explore(const uint8_t* data, size_t size);
 // mesh_obj, mesh_ply: a mesh file through assimp; accepted meshes are finite and indexed right.
 void mesh_obj(const uint8_t* data, size_t size);
 void mesh_ply(const uint8_t* data, size_t size);
