@@ -17,6 +17,7 @@
 #include "app/commands.h"
 #include "app/point_runner.h"
 #include "app/progress.h"
+#include "app/text_table.h"
 #include "base/input_error.h"
 #include "base/strict_number.h"
 #include "base/user_files.h"
@@ -273,19 +274,7 @@ void print_front(const ExploreSpec& spec, const std::vector<size_t>& front, cons
         row.push_back(to_string(has_confirm ? spec.confirm : spec.screen));
         rows.push_back(row);
     }
-    std::vector<size_t> width(headers.size());
-    for (size_t c = 0; c < headers.size(); ++c) {
-        width[c] = headers[c].size();
-        for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
-    }
-    auto print = [&](const std::vector<std::string>& r) {
-        std::string line;
-        for (size_t c = 0; c < r.size(); ++c) line += (c ? "  " : "") + r[c] + std::string(width[c] - r[c].size(), ' ');
-        while (!line.empty() && line.back() == ' ') line.pop_back();
-        out << "  " << line << "\n";
-    };
-    print(headers);
-    for (const auto& r : rows) print(r);
+    print_text_table(out, headers, rows, [](size_t) { return true; }, "  ");
 }
 
 struct Options {

@@ -23,6 +23,7 @@
 #include "app/commands.h"
 #include "app/point_runner.h"
 #include "app/progress.h"
+#include "app/text_table.h"
 #include "sweeps/engine.h"
 #include "sweeps/group_runner.h"
 #include "sweeps/host_time_estimate.h"
@@ -114,23 +115,8 @@ void print_summary(const Sweep& sweep, const PointKeys& keys, const ResultsStore
         }
         rows.push_back(std::move(row));
     }
-    std::vector<size_t> width(headers.size());
-    for (size_t c = 0; c < headers.size(); ++c) {
-        width[c] = headers[c].size();
-        for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
-    }
-    auto print = [&](const std::vector<std::string>& r) {
-        std::string line;
-        for (size_t c = 0; c < r.size(); ++c) {
-            const bool left = c > 0 && c <= sweep.axes.size();
-            const std::string pad(width[c] - r[c].size(), ' ');
-            line += (c ? "  " : "") + (left ? r[c] + pad : pad + r[c]);
-        }
-        while (!line.empty() && line.back() == ' ') line.pop_back();
-        out << line << "\n";
-    };
-    print(headers);
-    for (const auto& r : rows) print(r);
+    // Axis values left-aligned, numbers right-aligned.
+    print_text_table(out, headers, rows, [&](size_t c) { return c > 0 && c <= sweep.axes.size(); });
     if (keys.size() > rows.size())
         out << "... and " << keys.size() - rows.size()
             << " more rows: every row is in the store (--csv FILE writes them; sfx report)\n";

@@ -8,14 +8,8 @@
 set -euo pipefail
 sfx=$1
 src=$(cd "$(dirname "$0")/../.." && pwd)
-work=$(mktemp -d "${TMPDIR:-/tmp}/sfx-explore-test.XXXXXX")
-pid=
-cleanup() {
-  [ -z "$pid" ] || kill -9 -- "-$pid" 2>/dev/null || true
-  if [ -n "${KEEP:-}" ]; then echo "kept $work"; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
 . "$(dirname "$0")/test_lib.sh"
+make_work sfx-explore-test
 field() { /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print(eval(sys.argv[2]))' "$@"; }
 
 # 4 widths x 3 unit counts = 12 configurations on two scenes at 16x16.

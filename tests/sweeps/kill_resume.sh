@@ -7,14 +7,8 @@
 # committed. Every wait is bounded; whatever it started is killed on exit.
 set -euo pipefail
 sfx=$1 sweep=$2 mode=${3:-}
-work=$(mktemp -d "${TMPDIR:-/tmp}/sfx-kill-test.XXXXXX")
-pid=
-cleanup() {
-  [ -z "$pid" ] || kill -9 -- "-$pid" 2>/dev/null || true
-  if [ -n "${KEEP:-}" ]; then echo "kept $work"; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
 . "$(dirname "$0")/test_lib.sh"
+make_work sfx-kill-test
 db="$work/results.db"
 rows() { [ -s "$db" ] && sqlite3 "$db" "SELECT count(*) FROM points" 2>/dev/null || echo 0; }
 

@@ -1,0 +1,28 @@
+#include "app/text_table.h"
+
+#include <algorithm>
+
+namespace sfx {
+
+void print_text_table(std::ostream& out, const std::vector<std::string>& headers,
+                      const std::vector<std::vector<std::string>>& rows,
+                      const std::function<bool(size_t column)>& left, const std::string& indent) {
+    std::vector<size_t> width(headers.size());
+    for (size_t c = 0; c < headers.size(); ++c) {
+        width[c] = headers[c].size();
+        for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
+    }
+    auto print = [&](const std::vector<std::string>& r) {
+        std::string line;
+        for (size_t c = 0; c < r.size(); ++c) {
+            const std::string pad(width[c] - r[c].size(), ' ');
+            line += (c ? "  " : "") + (left(c) ? r[c] + pad : pad + r[c]);
+        }
+        while (!line.empty() && line.back() == ' ') line.pop_back();
+        out << indent << line << "\n";
+    };
+    print(headers);
+    for (const auto& r : rows) print(r);
+}
+
+}  // namespace sfx

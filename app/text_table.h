@@ -1,0 +1,18 @@
+#pragma once
+// A plain-text table for stdout: columns padded to their widest cell, two spaces apart, no
+// trailing blanks. Used by the commands that print one row per point or configuration.
+
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace sfx {
+
+// `left(c)`: whether column c is left-aligned (else right-aligned); each line starts with
+// `indent`. Every row has the headers' column count.
+void print_text_table(std::ostream& out, const std::vector<std::string>& headers,
+                      const std::vector<std::vector<std::string>>& rows,
+                      const std::function<bool(size_t column)>& left, const std::string& indent = "");
+
+}  // namespace sfx
