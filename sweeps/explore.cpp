@@ -224,8 +224,15 @@ std::vector<std::pair<std::string, std::string>> ExploreSpec::knob_values(size_t
 
 std::string ExploreSpec::fingerprint() const {
     std::ostringstream s;
-    s << "sampler " << sampler << " seed " << seed << " batch " << batch << " startup " << startup << "\n";
+    // Not the budget, batch or startup: a search may go on with more evaluations or other
+    // batches; everything that changes what a configuration scores, or which sequence a seed
+    // draws, is in.
+    s << "sampler " << sampler << " seed " << seed << "\n";
     for (const ExploreObjective& o : objectives) s << "objective " << o.metric << " " << o.maximize << "\n";
+    for (const ExploreConstraint& c : constraints)
+        s << "constraint " << c.metric << " " << (c.has_min ? shortest_text(c.min) : "-") << " "
+          << (c.has_max ? shortest_text(c.max) : "-") << "\n";
+    for (const ExploreWorkload& w : workloads) s << "weight " << shortest_text(w.weight) << "\n";
     for (size_t a = 0; a < space.axes.size(); ++a) {
         s << "axis " << space.axes[a];
         for (const std::string& v : space.axis_choices[a]) s << " " << v;

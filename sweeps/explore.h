@@ -65,8 +65,8 @@ struct ExploreSpec {
     SweepPoint point(size_t workload, size_t config, Fidelity fidelity) const;
     // {knob path: value} of configuration c.
     std::vector<std::pair<std::string, std::string>> knob_values(size_t config) const;
-    // Objectives, constraints, search settings and space as one canonical text: a study made for
-    // another fingerprint is not this explore's.
+    // Space, base point, workload weights, objectives, constraints, sampler and seed as one
+    // canonical text: a study or stored search made for another fingerprint is not this one's.
     std::string fingerprint() const;
 };
 

@@ -4,7 +4,8 @@
 #    exhaustive explore then runs no point, and a search runs only its confirmation points.
 # 2. Resume: an explore killed (SIGKILL, with its children) once it has stored points is re-run;
 #    it finishes its budget, every point is stored once, the points stored before the kill are
-#    not run again, and a third run runs nothing and prints the same front.
+#    not run again, and a third run runs nothing and prints the same front; a fourth with a
+#    larger budget goes on from the 6 configurations screened.
 set -euo pipefail
 sfx=$1
 src=$(cd "$(dirname "$0")/../.." && pwd)
@@ -81,4 +82,9 @@ ran=$(field "$work/second.json" 'd["points_run"]')
 [ "$(field "$work/third.json" 'd["points_run"]')" = 0 ] || fail "the third run ran points again"
 [ "$(field "$work/second.json" 'sorted(f["config"] for f in d["front"])')" = \
   "$(field "$work/third.json" 'sorted(f["config"] for f in d["front"])')" ] || fail "the third run's front differs"
-echo "PASS: killed with $before points stored, resumed with $ran more ($after in all, each once); a third run ran nothing"
+# A larger budget goes on with the same search: 2 more configurations screened, the 6 kept.
+"$sfx" explore "$work/t.yaml" --store "$db" --budget 8 --json >"$work/more.json" 2>"$work/more.log" || fail "the run with --budget 8 failed"
+[ "$(field "$work/more.json" 'd["evaluations"]')" = 8 ] || fail "--budget 8 did not screen 8 configurations"
+[ "$(sqlite3 "$db" "SELECT count(*) FROM explore_configs WHERE explore = 't' AND stage = 'screen'")" = 8 ] ||
+  fail "--budget 8 did not keep the first 6 configurations"
+echo "PASS: killed with $before points stored, resumed with $ran more ($after in all, each once); a third run ran nothing; --budget 8 went on"

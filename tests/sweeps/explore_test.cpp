@@ -93,6 +93,10 @@ TEST_CASE("An explore file parses into its space, objectives, constraints and bu
     CHECK(big.point(0, 0, Fidelity::analytic).workload.width == 32);
     CHECK(big.fingerprint() != s.fingerprint());
     CHECK(parse(k_good).fingerprint() == s.fingerprint());
+    // A larger budget goes on with the same search; other constraints or weights start anew.
+    CHECK(parse(with_line(13, "budget: {evaluations: 5}")).fingerprint() == s.fingerprint());
+    CHECK(parse(with_line(12, "constraints: {area_mm2: {max: 40}}")).fingerprint() != s.fingerprint());
+    CHECK(parse(with_line(7, "  - {scene: furnace, weight: 2}")).fingerprint() != s.fingerprint());
 }
 
 TEST_CASE("An explore configuration's point has the key a sweep of the same values gives", "[sweeps]") {
