@@ -21,8 +21,9 @@ namespace fs = std::filesystem;
 using strict_yaml::check_keys;
 using strict_yaml::line_of;
 
+// `n` must be present (an absent key has no line: callers check for it first).
 std::string scalar(const YAML::Node& n, const std::string& file, const std::string& key) {
-    if (!n || !n.IsScalar()) throw InputError(file, line_of(n), key, "expected a single value");
+    if (!n.IsScalar()) throw InputError(file, line_of(n), key, "expected a single value");
     return n.Scalar();
 }
 
@@ -93,6 +94,7 @@ ExploreSpec parse_explore(const std::string& text, const std::string& file, cons
         const YAML::Node w = workloads[i];
         require_map(w, file, key, "{scene, weight}");
         check_keys(w, file, key, {"scene", "weight"});
+        if (!w["scene"]) throw InputError(file, line_of(w), key + ".scene", "missing");
         ExploreWorkload ew;
         ew.scene = scalar(w["scene"], file, key + ".scene");
         if (!scenes.insert(ew.scene).second)

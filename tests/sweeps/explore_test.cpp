@@ -125,6 +125,7 @@ TEST_CASE("Bad explore files name file, line and key", "[sweeps]") {
         {with_line(2, "nmae: t"), 2, "nmae", "unknown key"},
         {with_line(11, ""), 1, "objectives", "missing"},
         {with_line(6, "  - scene"), 6, "workloads[0]", "expected a mapping"},
+        {with_line(6, "  - {weight: 2}"), 6, "workloads[0].scene", "missing"},
         {with_line(6, "  - {scene: cornel}"), 6, "workloads[0].scene", "no such scene"},
         {with_line(7, "  - {scene: furnace, weight: 0}"), 7, "workloads[1].weight", "positive"},
         {with_line(7, "  - {scene: cornell}"), 7, "workloads[1].scene", "twice"},
