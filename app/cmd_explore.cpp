@@ -187,26 +187,20 @@ nlohmann::ordered_json scores_json(const ExploreScore& s) {
 
 ResultsStore::ExploreConfigRow store_row(const ExploreSpec& spec, size_t config, const std::string& stage,
                                          int64_t trial, const ExploreScore& s, bool front) {
-    ResultsStore::ExploreConfigRow r;
-    r.config = config;
-    r.stage = stage;
-    r.trial = trial;
-    r.knobs_json = knobs_json(spec, config).dump();
-    r.fps = s.fps;
-    r.fps_error = s.fps_error;
-    r.area_mm2 = s.area_mm2;
-    r.energy_mj = s.energy_mj;
-    r.power_w = s.power_w;
-    r.fps_per_mm2 = s.fps_per_mm2;
-    r.feasible = feasible(spec, s);
-    r.front = front;
-    return r;
+    return {config, stage, trial, knobs_json(spec, config).dump(), s, feasible(spec, s), front};
 }
 
+nlohmann::ordered_json objectives_json(const ExploreSpec& spec) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::array();
+    for (const ExploreObjective& o : spec.objectives)
+        j.push_back({{"metric", o.metric}, {"direction", o.maximize ? "maximize" : "minimize"}});
+    return j;
+}
+
+// The explores table's spec: what the report needs to draw and judge the front.
 std::string spec_json(const ExploreSpec& spec) {
     nlohmann::ordered_json j;
-    for (const ExploreObjective& o : spec.objectives)
-        j["objectives"].push_back({{"metric", o.metric}, {"direction", o.maximize ? "maximize" : "minimize"}});
+    j["objectives"] = objectives_json(spec);
     j["constraints"] = nlohmann::ordered_json::array();
     for (const ExploreConstraint& c : spec.constraints) {
         nlohmann::ordered_json x = {{"metric", c.metric}};
@@ -225,11 +219,6 @@ std::string spec_json(const ExploreSpec& spec) {
     return j.dump();
 }
 
-std::string fixed(double v, int digits) {
-    std::ostringstream s;
-    s << std::fixed << std::setprecision(digits) << v;
-    return s.str();
-}
 std::string sig(double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%.4g", v);
@@ -265,7 +254,7 @@ void print_front(const ExploreSpec& spec, const std::vector<size_t>& front, cons
         std::vector<std::string> row;
         for (const auto& kv : spec.knob_values(c)) row.push_back(kv.second);
         row.push_back(sig(s.fps));
-        row.push_back(s.fps_error >= 0 ? "+-" + fixed(100 * s.fps_error, 1) + "%" : "unknown");
+        row.push_back(s.fps_error >= 0 ? "+-" + fixed_text(100 * s.fps_error, 1) + "%" : "unknown");
         row.push_back(sig(s.area_mm2));
         row.push_back(sig(s.energy_mj));
         row.push_back(sig(s.power_w));
@@ -423,8 +412,7 @@ void run_explore(const Options& o) {
         j["seconds"] = progress.elapsed();
         j["screen"] = to_string(spec.screen);
         j["confirm"] = to_string(spec.confirm);
-        for (const ExploreObjective& ob : spec.objectives)
-            j["objectives"].push_back({{"metric", ob.metric}, {"direction", ob.maximize ? "maximize" : "minimize"}});
+        j["objectives"] = objectives_json(spec);
         auto entry = [&](size_t c, const ExploreScore& s) {
             return nlohmann::ordered_json{{"config", c},
                                           {"trial", trial_of[c]},
@@ -455,7 +443,7 @@ void run_explore(const Options& o) {
         print_front(spec, front, screened, confirmed, has_confirm, std::cout);
     }
     std::cout << "\n" << cx.ran << " points run, " << cx.stored << " already stored, in "
-              << fixed(progress.elapsed(), 1) << " s; store " << o.store;
+              << fixed_text(progress.elapsed(), 1) << " s; store " << o.store;
     if (!o.exhaustive) std::cout << ", study " << study;
     std::cout << " (sfx report " << o.store << " -o DIR shows the front)\n";
 }

@@ -36,11 +36,6 @@
 namespace sfx {
 namespace {
 
-std::string fixed(double v, int digits) {
-    std::ostringstream s;
-    s << std::fixed << std::setprecision(digits) << v;
-    return s.str();
-}
 
 std::string group_label(const PointGroup& group, size_t points) {
     const struct {
@@ -106,11 +101,11 @@ void print_summary(const Sweep& sweep, const PointKeys& keys, const ResultsStore
             std::snprintf(fps, sizeof fps, "%.4g", get("fps"));
             row.push_back(fps);
             for (const char* s : {"traversal", "intersection", "shading"})
-                row.push_back(fixed(100 * get(std::string("simd_utilization.") + s), 1) + "%");
-            row.push_back(fixed(100 * get("stall_cycles.total") / std::max(1.0, get("frame_cycles")), 1));
+                row.push_back(fixed_text(100 * get(std::string("simd_utilization.") + s), 1) + "%");
+            row.push_back(fixed_text(100 * get("stall_cycles.total") / std::max(1.0, get("frame_cycles")), 1));
             const double interval = get("error.relative");
-            row.push_back(interval >= 0 ? "+-" + fixed(100 * interval, 2) + "%" : "unknown");
-            row.push_back(fixed(get("host_seconds"), 3));
+            row.push_back(interval >= 0 ? "+-" + fixed_text(100 * interval, 2) + "%" : "unknown");
+            row.push_back(fixed_text(get("host_seconds"), 3));
             row.push_back(ran.count(key) ? "" : "stored");
         }
         rows.push_back(std::move(row));
@@ -245,7 +240,7 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
     } else {
         print_summary(sweep, keys, store, ran, std::cout);
         std::cout << "\n" << ran.size() << " points run, " << already_stored
-                  << " already stored, in " << fixed(seconds, 1) << " s; store " << store_path;
+                  << " already stored, in " << fixed_text(seconds, 1) << " s; store " << store_path;
         if (!csv.empty()) std::cout << ", CSV " << csv;
         std::cout << "\n";
     }

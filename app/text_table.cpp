@@ -1,8 +1,16 @@
 #include "app/text_table.h"
 
 #include <algorithm>
+#include <iomanip>
+#include <sstream>
 
 namespace sfx {
+
+std::string fixed_text(double v, int digits) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(digits) << v;
+    return s.str();
+}
 
 void print_text_table(std::ostream& out, const std::vector<std::string>& headers,
                       const std::vector<std::vector<std::string>>& rows,

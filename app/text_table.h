@@ -9,6 +9,9 @@
 
 namespace sfx {
 
+// A table cell: `v` with `digits` after the point ("12.50").
+std::string fixed_text(double v, int digits);
+
 // `left(c)`: whether column c is left-aligned (else right-aligned); each line starts with
 // `indent`. Every row has the headers' column count.
 void print_text_table(std::ostream& out, const std::vector<std::string>& headers,

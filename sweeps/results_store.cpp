@@ -363,12 +363,13 @@ void ResultsStore::write_explore_configs(const std::string& explore, const std::
             ins.bind(3, r.stage);
             ins.bind_int(4, r.trial);
             ins.bind(5, r.knobs_json);
-            ins.bind(6, r.fps);
-            ins.bind(7, r.fps_error >= 0 ? r.fps_error : std::nan(""));
-            ins.bind(8, r.area_mm2);
-            ins.bind(9, r.energy_mj);
-            ins.bind(10, r.power_w);
-            ins.bind(11, r.fps_per_mm2);
+            const ExploreScore& x = r.score;
+            ins.bind(6, x.fps);
+            ins.bind(7, x.fps_error >= 0 ? x.fps_error : std::nan(""));  // unknown: NULL
+            ins.bind(8, x.area_mm2);
+            ins.bind(9, x.energy_mj);
+            ins.bind(10, x.power_w);
+            ins.bind(11, x.fps_per_mm2);
             ins.bind_int(12, r.feasible);
             ins.bind_int(13, r.front);
             ins.step();

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "sweeps/explore.h"
 #include "sweeps/sweep.h"
 
 struct sqlite3;
@@ -89,7 +90,7 @@ public:
         std::string stage;  // screen | confirm
         int64_t trial = -1;  // the Optuna trial that first asked for it (-1: none)
         std::string knobs_json;
-        double fps = 0, fps_error = -1, area_mm2 = 0, energy_mj = 0, power_w = 0, fps_per_mm2 = 0;
+        ExploreScore score;
         bool feasible = false, front = false;
     };
     // Inserts or replaces rows, in one transaction.
