@@ -65,7 +65,7 @@ TEST_CASE("DRAM bandwidth is shared: lines queue for the channel", "[hw_model][c
     CHECK(ns_to_cycles(2.1, 500.0) == 2);
 }
 
-TEST_CASE("Private levels are per core; shared levels see every core", "[hw_model][cache]") {
+TEST_CASE("Private levels are per core, shared levels see every core", "[hw_model][cache]") {
     SceneMemoryConfig config;  // l1, l2 private; l3 shared
     SceneMemoryModel memory(config, 500.0, 2);
     const uint64_t cold = memory.read(0, 8192, 4, 0);

@@ -32,7 +32,7 @@ TEST_CASE("The gr08 preset parses and is the in-class default", "[hw_config]") {
     CHECK(preset.scene_memory.caches[2].ways == 16);
 }
 
-TEST_CASE("a preset is found by its name; an unknown name lists the presets", "[hw_config]") {
+TEST_CASE("a preset is found by its name, an unknown name lists the presets", "[hw_config]") {
     CHECK(dump_hw_config(load_hw_config("gr08-w8")) ==
           dump_hw_config(load_hw_config(SFX_SOURCE_DIR "/hw_model/presets/gr08-w8.hw.yaml")));
     CHECK(load_hw_config("gr08-w8").simd.width == 8);

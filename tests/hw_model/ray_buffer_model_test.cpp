@@ -8,7 +8,7 @@
 
 using namespace sfx;
 
-TEST_CASE("Gathers: distinct banks cost one issue; one bank serialises every lane",
+TEST_CASE("Gathers: distinct banks cost one issue, one bank serialises every lane",
           "[hw_model]") {
     RayBufferConfig c;  // 32 banks, 2-cycle pipelined
     const RayBufferModel buffer(c, 24, 4096);

@@ -363,7 +363,7 @@ TEST_CASE("A configuration's prediction does not depend on the group it is timed
 }
 
 TEST_CASE(
-    "The hardware model never changes the image; more banks never slower; more lanes "
+    "The hardware model never changes the image, more banks never slower, more lanes "
     "never more instructions",
     "[hw_model][systemc]") {
     const Scene scene = load_scene("cornell");
@@ -437,7 +437,7 @@ TEST_CASE("Analytic fidelity is within 15% of full on small scenes", "[hw_model]
     }
 }
 
-TEST_CASE("Tile auto is the largest stream that fits; a tile that does not fit is an error",
+TEST_CASE("Tile auto is the largest stream that fits, a tile that does not fit is an error",
           "[hw_model]") {
     FeatureSet all;
     all.triangles = all.spheres = all.lambertian = all.dielectric = all.glossy = true;

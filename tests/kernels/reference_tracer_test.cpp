@@ -67,7 +67,7 @@ TEST_CASE("Furnace: Kd 1 in a uniform environment gives exactly the environment"
     CHECK(r.stats.extension_rays > 0);  // the sphere was hit and bounced off
 }
 
-TEST_CASE("Furnace: a glass sphere in a white furnace is invisible; glossy never exceeds 1",
+TEST_CASE("Furnace: a glass sphere in a white furnace is invisible, glossy never exceeds 1",
           "[reference][furnace]") {
     Material glass;
     glass.kind = MaterialKind::dielectric;

@@ -89,7 +89,7 @@ Scene sphere_wall() {
 
 }  // namespace
 
-TEST_CASE("Frustum proxy: a box any of its rays enters overlaps; boxes off to one side do not",
+TEST_CASE("Frustum proxy: a box any of its rays enters overlaps, boxes off to one side do not",
           "[stream][seeds]") {
     std::vector<RayPrecomp> rays;
     for (float x : {-0.1f, 0.1f})
@@ -287,7 +287,7 @@ TEST_CASE("RayGrid: the cut's cells hold every primitive once, none more than as
 
 TEST_CASE(
     "RayGrid: the image is bit-identical alone, with reordering and with AEPSA, at every SIMD "
-    "back end; primary streams are untouched",
+    "back end, primary streams are untouched",
     "[stream][seeds]") {
     std::vector<Isa> isas = {Isa::scalar};
     for (const Isa isa : {Isa::avx2, Isa::avx512})

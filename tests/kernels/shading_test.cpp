@@ -129,7 +129,7 @@ TEST_CASE("Glossy sampling passes a chi-square test, also at grazing incidence",
     }
 }
 
-TEST_CASE("Thin lens: zero aperture equals the pinhole; lens rays meet on the focal plane",
+TEST_CASE("Thin lens: zero aperture equals the pinhole, lens rays meet on the focal plane",
           "[shading]") {
     ThinLensCamera cam;
     cam.eye = {1.f, 2.f, 3.f};

@@ -126,7 +126,7 @@ TEST_CASE("stream_intersect gives the same hits and trace for every back end", "
     }
 }
 
-TEST_CASE("Back ends: auto picks the widest the CPU has; an unsupported one is refused", "[simd]") {
+TEST_CASE("Back ends: auto picks the widest the CPU has, an unsupported one is refused", "[simd]") {
     CHECK(resolve_isa(Isa::automatic) == best_isa());
     CHECK(resolve_isa(Isa::scalar) == Isa::scalar);
     CHECK(supported_isas().front() == Isa::scalar);

@@ -159,7 +159,7 @@ TEST_CASE("Bad explore files name file, line and key", "[sweeps]") {
     }
 }
 
-TEST_CASE("Scores combine over workloads by weight; constraints and the front follow them", "[sweeps]") {
+TEST_CASE("Scores combine over workloads by weight, constraints and the front follow them", "[sweeps]") {
     const ExploreSpec s = parse(k_good);  // weights 3 and 1
     const std::vector<std::map<std::string, double>> numbers = {
         {{"fps", 10}, {"energy.total_per_frame_mj", 2}, {"area.total_mm2", 40}, {"error.relative", 0.05}},

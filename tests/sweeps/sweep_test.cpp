@@ -117,7 +117,7 @@ TEST_CASE("Ranges, overrides, command-line sets and the scene's depth", "[sweeps
     CHECK(s.groups.size() == 1);              // tile fixed: one render for all
 }
 
-TEST_CASE("tile: auto resolves per point from its buffer; points group by the resolved tile", "[sweeps]") {
+TEST_CASE("tile: auto resolves per point from its buffer, points group by the resolved tile", "[sweeps]") {
     const Sweep s = parse("version: 1\nhw: gr08.hw.yaml\n"
                           "workload: {scene: cornell, res: 16x16, spp: 1, tile: auto}\n"
                           "axes:\n"
@@ -175,7 +175,7 @@ TEST_CASE("The expansion guard is the caller's: more points or values than max_p
     }
 }
 
-TEST_CASE("Equal values spelled differently are one point; duplicates are dropped per render", "[sweeps]") {
+TEST_CASE("Equal values spelled differently are one point, duplicates are dropped per render", "[sweeps]") {
     const Sweep s = parse(std::string(k_head) +
                           "axes:\n  workload.seed: [1, 2]\n  hw.clock.core_mhz: [500, 500.0, 5e2, 250]\n");
     CHECK(s.duplicates == 4);  // per seed: 500.0 and 5e2 are 500
