@@ -2,7 +2,8 @@
 // point states covers it: a grid of 24 configurations (SIMD widths 4/8/16 x units 1/2 x banks
 // 16/32 x ray buffers 256/512 KiB) timed at analytic and at full fidelity on the same render,
 // per scene. The analytic group calibrates a systematic sample of 8 of its 24 configurations at
-// cycle level (sweeps/point_group.cpp); the other 16 state an interval from the sample's spread.
+// cycle level (sweeps/point_group.cpp); the other 16 take a ratio and interval from the sample
+// (uncalibrated_ratios, sweeps/point_group.h): they are the check on those intervals.
 // Prints each configuration's error and stated interval, then the distribution of |error|
 // (median, 90th percentile, worst), how many stated intervals cover their error, and the host
 // time of each level.

@@ -228,27 +228,105 @@ uint32_t calibration_stride(double fraction, uint64_t frame_passes) {
     return uint32_t(std::max<uint64_t>(1, std::min(wanted, frame_passes / k_calibration_passes)));
 }
 
-// The ratio and relative half-width for a configuration outside the calibrated sample: the
-// sample's mean ratio, and a prediction interval for one more configuration's ratio (Student's
-// t over the sample's spread, sqrt(1 + 1/n)) combined with the calibrated ratios' own mean
-// sampling error. One calibrated configuration gives no spread: its own interval, doubled.
-std::pair<double, double> uncalibrated_ratio(const std::vector<double>& r, const std::vector<double>& half,
-                                             double confidence) {
-    const size_t n = r.size();
+}  // namespace
+
+std::vector<std::vector<std::string>> varying_parameters(const std::vector<HwConfig>& configs) {
+    std::vector<std::vector<HwParamInfo>> flat;
+    for (const HwConfig& c : configs) flat.push_back(flatten_hw_config(c));
+    std::vector<size_t> varying;  // parameter indices whose values differ in the group
+    for (size_t p = 0; !flat.empty() && p < flat[0].size(); ++p) {
+        if (flat[0][p].path == "name") continue;
+        for (const auto& f : flat)
+            if (f.size() != flat[0].size() || f[p].value != flat[0][p].value) {
+                varying.push_back(p);
+                break;
+            }
+    }
+    std::vector<std::vector<std::string>> out(configs.size());
+    for (size_t i = 0; i < configs.size(); ++i)
+        for (size_t p : varying)
+            // A configuration with another cache hierarchy lists other parameters: its own value.
+            out[i].push_back(p < flat[i].size() && flat[i].size() == flat[0].size()
+                                 ? flat[i][p].value
+                                 : "#" + std::to_string(i));
+    return out;
+}
+
+std::vector<std::pair<double, double>> uncalibrated_ratios(
+    const std::vector<std::vector<std::string>>& knobs, const std::vector<size_t>& calibrated,
+    const std::vector<double>& r, const std::vector<double>& half, double confidence) {
+    const size_t n = r.size(), configs = knobs.size();
+    std::vector<std::pair<double, double>> out(configs, {1.0, -1.0});
+    std::vector<uint8_t> is_calibrated(configs, 0);
+    for (size_t c : calibrated) is_calibrated[c] = 1;
     if (n == 0 || std::any_of(half.begin(), half.end(), [](double h) { return h < 0.0; }))
-        return {1.0, -1.0};  // a calibration without an interval says nothing of the others
+        return out;  // a calibration without an interval says nothing of the others
     double mean = 0, mean_half = 0;
     for (size_t k = 0; k < n; ++k) {
         mean += r[k] / double(n);
         mean_half += half[k] / double(n);
     }
-    if (n < 2 || mean <= 0.0) return {mean > 0.0 ? mean : 1.0, 2.0 * mean_half};
+    if (n < 2 || mean <= 0.0) {
+        for (size_t i = 0; i < configs; ++i)
+            if (!is_calibrated[i]) out[i] = {mean > 0.0 ? mean : 1.0, 2.0 * mean_half};
+        return out;
+    }
+    const double t = student_t_quantile_two_sided(confidence, double(n - 1));
+    // The mean of the calibrated ratios sharing configuration i's value of parameter `p`
+    // (every calibrated one when p is none), leaving out calibrated number `skip`; false if
+    // none is left.
+    const size_t none = knobs.empty() ? 0 : knobs[0].size();
+    auto stratum_mean = [&](size_t i, size_t p, size_t skip, double& ratio, double& h) {
+        double sum = 0, sum_half = 0;
+        size_t count = 0;
+        for (size_t k = 0; k < n; ++k) {
+            if (k == skip || (p < none && knobs[calibrated[k]][p] != knobs[i][p])) continue;
+            sum += r[k];
+            sum_half += half[k];
+            ++count;
+        }
+        if (count == 0) return false;
+        ratio = sum / double(count);
+        h = sum_half / double(count);
+        return true;
+    };
+    // Leave-one-out: the mean squared relative error of rule p (none: the sample's mean) when
+    // each calibrated configuration is predicted from the others.
+    auto left_out_error = [&](size_t p) {
+        double sq = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            double predicted = 0, h = 0;
+            if (!stratum_mean(calibrated[k], p, k, predicted, h))
+                stratum_mean(calibrated[k], none, k, predicted, h);
+            sq += (predicted / r[k] - 1.0) * (predicted / r[k] - 1.0) / double(n);
+        }
+        return sq;
+    };
+    size_t best = none;
+    double best_sq = left_out_error(none);
+    for (size_t p = 0; p < none; ++p) {
+        const double sq = left_out_error(p);
+        if (sq < best_sq) {
+            best = p;
+            best_sq = sq;
+        }
+    }
     double s2 = 0;
     for (double x : r) s2 += (x - mean) * (x - mean) / double(n - 1);
-    const double spread = student_t_quantile_two_sided(confidence, double(n - 1)) *
-                          std::sqrt(s2 * (1.0 + 1.0 / double(n))) / mean;
-    return {mean, std::sqrt(spread * spread + mean_half * mean_half)};
+    const double mean_spread = t * std::sqrt(s2 * (1.0 + 1.0 / double(n))) / mean;
+    const double stratum_spread = t * std::sqrt(best_sq);
+    for (size_t i = 0; i < configs; ++i) {
+        if (is_calibrated[i]) continue;
+        double ratio = 0, h = 0;
+        if (best != none && stratum_mean(i, best, n, ratio, h))
+            out[i] = {ratio, std::sqrt(stratum_spread * stratum_spread + h * h)};
+        else
+            out[i] = {mean, std::sqrt(mean_spread * mean_spread + mean_half * mean_half)};
+    }
+    return out;
 }
+
+namespace {
 
 PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                              const std::vector<HwConfig>& configs, const SamplingOptions& opt,
@@ -420,7 +498,7 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     const uint64_t frame_passes =
         uint64_t(make_tiles(settings.width, settings.height, settings.tile).size()) * settings.spp;
     // SMARTS-style: the cycle-level calibration runs on a systematic sample of the group's
-    // configurations; the others take the sample's mean ratio and an interval from its spread.
+    // configurations; the others take a ratio and an interval from it (uncalibrated_ratios).
     const std::vector<size_t> calibrated = calibration_subset(configs.size());
     std::vector<HwConfig> calibrated_configs;
     for (size_t c : calibrated) calibrated_configs.push_back(configs[c]);
@@ -451,19 +529,17 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     std::vector<std::pair<double, double>> ratios(configs.size(), {1.0, -1.0});
     if (calibration && calibration->sampled() >= 1) {
         std::vector<double> r, half;
+        std::vector<uint8_t> is_calibrated(configs.size(), 0);
         for (size_t k = 0; k < calibrated.size(); ++k) {
             ratios[calibrated[k]] = calibration->ratio(k, sampling.confidence, profile);
             r.push_back(ratios[calibrated[k]].first);
             half.push_back(ratios[calibrated[k]].second);
+            is_calibrated[calibrated[k]] = 1;
         }
-        const std::pair<double, double> others = uncalibrated_ratio(r, half, sampling.confidence);
-        for (size_t i = 0, k = 0; i < configs.size(); ++i) {
-            if (k < calibrated.size() && calibrated[k] == i) {
-                ++k;
-                continue;
-            }
-            ratios[i] = others;
-        }
+        const std::vector<std::pair<double, double>> others = uncalibrated_ratios(
+            varying_parameters(configs), calibrated, r, half, sampling.confidence);
+        for (size_t i = 0; i < configs.size(); ++i)
+            if (!is_calibrated[i]) ratios[i] = others[i];
     }
 
     for (size_t i = 0; i < configs.size(); ++i) {

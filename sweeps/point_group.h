@@ -41,4 +41,26 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
                                  const SamplingOptions& sampling = {},
                                  const PassProgress& progress = {});
 
+// Analytic fidelity's pricing of the configurations left out of the calibration sample.
+// `varying_parameters`: per configuration, its values of the hardware parameters that differ
+// within the group. `uncalibrated_ratios`: each uncalibrated configuration's ratio (cycle
+// level / analytic) and relative half-width, from the ratios `r` and half-widths `half` of the
+// `calibrated` configurations (indices, ascending); {1, -1} for the calibrated ones. One of
+// these rules prices them, whichever predicts the sample best when each calibrated
+// configuration is left out in turn (mean squared relative error; ties keep the first):
+//  - the sample's mean ratio, with a prediction interval for one more configuration's ratio
+//    (Student's t, n - 1 degrees of freedom, over the sample's spread, sqrt(1 + 1/n));
+//  - for one parameter p, the mean ratio of the calibrated configurations with the same value
+//    of p (a stratum: the unit count, say, when it moves the ratio most), with Student's t
+//    times the root mean square of that rule's leave-one-out errors; a configuration whose
+//    value no calibrated one has takes the sample's mean.
+// Either interval is combined with the calibrated ratios' own sampling error. One calibrated
+// configuration gives no spread: its ratio, and its own interval doubled. Choosing the rule on
+// the same sample makes its leave-one-out error a little optimistic: the bench
+// (bench/analytic_error_bench.cpp) checks the intervals on configurations outside the sample.
+std::vector<std::vector<std::string>> varying_parameters(const std::vector<HwConfig>& configs);
+std::vector<std::pair<double, double>> uncalibrated_ratios(
+    const std::vector<std::vector<std::string>>& knobs, const std::vector<size_t>& calibrated,
+    const std::vector<double>& r, const std::vector<double>& half, double confidence);
+
 }  // namespace sfx

@@ -138,7 +138,7 @@ TEST_CASE("Stratified sampling: the 99.7% interval covers the full-fidelity tota
     CHECK(e.total == Approx(truth));
 }
 
-TEST_CASE("Sampled fidelity agrees with full within its interval; adaptive sampling stops at "
+TEST_CASE("Sampled fidelity agrees with full within its interval, adaptive sampling stops at "
           "its target",
           "[sampling]") {
     const Scene scene = load_scene("cornell");
@@ -170,7 +170,7 @@ TEST_CASE("Sampled fidelity agrees with full within its interval; adaptive sampl
     }
 }
 
-TEST_CASE("Calibrated analytic fidelity: within its interval of full; uncalibrated says unknown",
+TEST_CASE("Calibrated analytic fidelity: within its interval of full, uncalibrated says unknown",
           "[sampling]") {
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
@@ -199,7 +199,7 @@ TEST_CASE("Calibrated analytic fidelity: within its interval of full; uncalibrat
     CHECK(raw.sample_passes == 0);
 }
 
-TEST_CASE("A large analytic group calibrates a sample of its configurations; every point states "
+TEST_CASE("A large analytic group calibrates a sample of its configurations, every point states "
           "an error, the others' from the sample's spread",
           "[sampling]") {
     const Scene scene = load_scene("cornell");
@@ -248,4 +248,61 @@ TEST_CASE("An analytic frame of fewer passes than the calibration's minimum is c
     const Prediction f = run_point_group(scene, bvh, settings, configs, Fidelity::full).predictions[0];
     INFO("analytic " << a.timing.cycles << " full " << f.timing.cycles);
     CHECK(double(a.timing.cycles) == Approx(double(f.timing.cycles)).epsilon(0.02));
+}
+
+TEST_CASE("Configurations left out of the calibration take their stratum's ratio when a "
+          "parameter splits the sample's ratios, else the sample's mean",
+          "[sampling]") {
+    // Widths 8/16 x units 1/2 x banks 16/32 (the values varying_parameters lists).
+    std::vector<HwConfig> configs;
+    for (uint32_t width : {8u, 16u})
+        for (uint32_t units : {1u, 2u})
+            for (uint32_t banks : {16u, 32u}) {
+                HwConfig c;
+                c.simd.width = width;
+                c.simd.units = units;
+                c.ray_buffer.banks = banks;
+                c.name = "w" + std::to_string(width);  // names are no parameter to stratify by
+                configs.push_back(c);
+            }
+    const std::vector<std::vector<std::string>> knobs = varying_parameters(configs);
+    CHECK(knobs.size() == 8);
+    CHECK(knobs[5] == std::vector<std::string>{"16", "1", "32"});  // width, units, banks
+    const std::vector<size_t> calibrated = {0, 3, 4, 7};  // w8 u1 b16, w8 u2 b32, w16 u1 b16, w16 u2 b32
+    const std::vector<double> half = {0.01, 0.01, 0.01, 0.01};
+    const double t = student_t_quantile_two_sided(0.997, 3.0);
+
+    // The ratio follows the unit count (1 unit near 1.05, 2 units near 0.93): units and banks
+    // split the sample alike, and units, listed first, is kept; each left-out one is predicted
+    // by the other of its stratum.
+    {
+        const std::vector<double> r = {1.05, 0.93, 1.06, 0.94};
+        const auto out = uncalibrated_ratios(knobs, calibrated, r, half, 0.997);
+        for (size_t c : calibrated) CHECK(out[c].second < 0.0);
+        const double e[] = {1.06 / 1.05 - 1, 0.94 / 0.93 - 1, 1.05 / 1.06 - 1, 0.93 / 0.94 - 1};
+        double sq = 0;
+        for (double x : e) sq += x * x / 4;
+        const double spread = t * std::sqrt(sq);
+        CHECK(out[1].first == Approx((1.05 + 1.06) / 2));  // w8 u1 b32: the 1-unit stratum
+        CHECK(out[2].first == Approx((0.93 + 0.94) / 2));  // w8 u2 b16
+        CHECK(out[1].second == Approx(std::sqrt(spread * spread + 0.01 * 0.01)));
+        CHECK(out[1].second < 0.1);  // the sample's mean would state about 4x that
+    }
+    // No parameter explains the spread: the sample's mean, with its prediction interval.
+    {
+        const std::vector<double> r = {1.05, 0.93, 0.93, 1.05};
+        const auto out = uncalibrated_ratios(knobs, calibrated, r, half, 0.997);
+        const double mean = 0.99;
+        double s2 = 0;
+        for (double x : r) s2 += (x - mean) * (x - mean) / 3;
+        const double spread = t * std::sqrt(s2 * (1.0 + 1.0 / 4.0)) / mean;
+        for (size_t c : {1, 2, 5, 6}) {
+            CHECK(out[c].first == Approx(mean));
+            CHECK(out[c].second == Approx(std::sqrt(spread * spread + 0.01 * 0.01)));
+        }
+    }
+    // A calibration without an interval says nothing of the others.
+    const auto unknown =
+        uncalibrated_ratios(knobs, calibrated, {1.0, 1.0, 1.0, 1.0}, {0.01, -1.0, 0.01, 0.01}, 0.997);
+    CHECK(unknown[1].second < 0.0);
 }
