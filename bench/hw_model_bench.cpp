@@ -7,7 +7,11 @@
 //     the first configuration's cost (functional render included) — target <= 25 % (issue 32).
 //     Configurations with the same scene-data lookups (these four) share one cache simulation;
 //     the rest of a configuration's cost is its own: its lane groups through its SystemC
-//     processes (about half the time, in the kernel) and its bookings.
+//     processes (about half the time, in the kernel) and its bookings;
+//  3. the floor under (2): the render with its trace (to a sink that keeps nothing) and each configuration's CoreModel arithmetic alone
+//     (fetch, execute and partition of every lane group, one after another, no SystemC
+//     processes), and the figure of (2) they would give if the kernel cost nothing. As long as
+//     every configuration books its own lane groups, (2) cannot go below it.
 // Usage: sfx_bench_hw_model [scene] [WxH] [spp] [repetitions]
 
 #include <algorithm>
@@ -17,6 +21,7 @@
 #include <systemc>
 #include <vector>
 
+#include "hw_model/core_model.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/bvh.h"
@@ -75,9 +80,74 @@ class PassRecorder : public TraceSink {
         }
     }
 
+    const std::vector<PassBuffer>& passes() const { return m_passes; }
+
   private:
     std::vector<PassBuffer> m_passes;
 };
+
+// Takes the whole trace (every op, as timing does) and keeps nothing: the render's share of (2).
+class DiscardingSink : public TraceSink {
+  public:
+    void op(const StreamOp&) override {}
+};
+
+// Host seconds of each configuration's CoreModel arithmetic on the recorded passes, with no
+// kernel: each op's groups are fetched and executed in order on the units in turn, and a
+// partitioning op's partition follows its last group. The times are the model's own, but the
+// order is not the processes' (nothing here is a prediction): only the cost is read. The
+// configurations share one cache simulation, as in (2); the first pays for it.
+std::vector<double> arithmetic_seconds(const std::vector<HwConfig>& configs,
+                                       const WorkloadShape& shape, const PassRecorder& recorded) {
+    const RayRecordLayout layout(shape.features);
+    SceneDataMap map;
+    map.nodes = shape.bvh_nodes;
+    map.triangles = shape.triangles;
+    map.spheres = shape.spheres;
+    const auto lookups = std::make_shared<SharedCacheLookups>(configs.front().scene_memory.caches);
+    std::vector<std::unique_ptr<OpCostTable>> costs;
+    std::vector<std::unique_ptr<CoreModel>> models;
+    for (const HwConfig& c : configs) {  // every reader joins before the first lookup
+        const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());
+        costs.push_back(std::make_unique<OpCostTable>(layout, c));
+        models.push_back(std::make_unique<CoreModel>(
+            c, *costs.back(), map, layout.words(), std::max(capacity, shape.slots()), 0,
+            std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz, 1, lookups)));
+    }
+    std::vector<double> seconds;
+    for (size_t k = 0; k < configs.size(); ++k) {
+        const HwConfig& c = configs[k];
+        CoreModel& model = *models[k];
+        const auto t0 = HostClock::now();
+        uint64_t now = 0;
+        for (const PassBuffer& pass : recorded.passes()) {
+            model.begin_pass(&pass, now);
+            uint32_t unit = 0;
+            for (uint32_t i = 0; i < pass.size(); ++i) {
+                const StreamOp op = pass.at(i);
+                if (op.length == 0) continue;
+                model.request_scene(i, now);
+                model.dispatch_op(i);
+                for (uint32_t first = 0; first < op.length; first += c.simd.width) {
+                    GroupToken t;
+                    t.op = i;
+                    t.first = first;
+                    t.lanes = std::min(c.simd.width, op.length - first);
+                    t.dispatched = now;
+                    now = std::max(now, model.fetch(t, now));
+                    const CoreModel::Executed e = model.execute(t, unit, now);
+                    now = std::max(now, e.issue_end);
+                    unit = (unit + 1) % c.simd.units;
+                    if (e.op_done && model.profile(i).partitions)
+                        now = std::max(now, model.partition(i, e.op_completion));
+                }
+            }
+            model.end_pass(now);
+        }
+        seconds.push_back(seconds_since(t0));
+    }
+    return seconds;
+}
 
 }  // namespace
 
@@ -165,5 +235,27 @@ int main(int argc, char** argv) {
     const double extra = (group_s.back() - group_s.front()) / double(configs.size() - 1);
     std::printf("each extra configuration  %.1f %% of the first (target <= 25 %%)\n",
                 100.0 * extra / group_s.front());
+
+    // 3. The arithmetic floor of the extra configurations: with no kernel at all, the first
+    //    configuration would cost the render plus its arithmetic, each extra one its arithmetic.
+    std::vector<std::vector<double>> arithmetic(configs.size());
+    std::vector<double> render_s;
+    for (int r = 0; r < reps; ++r) {
+        const auto t0 = HostClock::now();
+        DiscardingSink discard;
+        render_stream(scene, bvh, settings, &discard);
+        render_s.push_back(seconds_since(t0));
+        const std::vector<double> s = arithmetic_seconds(configs, shape, recorded);
+        for (size_t k = 0; k < configs.size(); ++k) arithmetic[k].push_back(s[k]);
+    }
+    std::printf("render with its trace     %.3f s\n", median(render_s));
+    double extra_floor = 0.0;
+    for (size_t k = 0; k < configs.size(); ++k) {
+        std::printf("CoreModel arithmetic alone, %-4s %.3f s\n", configs[k].name.c_str(),
+                    median(arithmetic[k]));
+        if (k > 0) extra_floor += median(arithmetic[k]) / double(configs.size() - 1);
+    }
+    std::printf("with no kernel cost, each extra configuration  %.1f %% of the first\n",
+                100.0 * extra_floor / (median(render_s) + median(arithmetic[0])));
     return 0;
 }
