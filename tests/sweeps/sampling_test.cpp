@@ -44,6 +44,24 @@ RenderSettings small_settings(const Scene& scene) {
     return s;
 }
 
+// Every width x units x banks (the rest gr08's), last fastest; named by width.
+std::vector<HwConfig> width_unit_bank_grid(std::initializer_list<uint32_t> widths,
+                                           std::initializer_list<uint32_t> units,
+                                           std::initializer_list<uint32_t> banks) {
+    std::vector<HwConfig> configs;
+    for (uint32_t w : widths)
+        for (uint32_t u : units)
+            for (uint32_t b : banks) {
+                HwConfig c;
+                c.simd.width = w;
+                c.simd.units = u;
+                c.ray_buffer.banks = b;
+                c.name = "w" + std::to_string(w);
+                configs.push_back(c);
+            }
+    return configs;
+}
+
 }  // namespace
 
 TEST_CASE("Normal and Student t quantiles", "[sampling]") {
@@ -206,16 +224,7 @@ TEST_CASE("A large analytic group calibrates a sample of its configurations, eve
     const Bvh bvh(scene);
     RenderSettings settings = small_settings(scene);
     settings.spp = 2;  // 128 passes: the default 2 % calibrates 4 (every 32nd)
-    std::vector<HwConfig> configs;
-    for (uint32_t width : {4u, 8u, 12u, 16u})
-        for (uint32_t units : {1u, 2u})
-            for (uint32_t banks : {16u, 32u}) {
-                HwConfig c;
-                c.simd.width = width;
-                c.simd.units = units;
-                c.ray_buffer.banks = banks;
-                configs.push_back(c);
-            }
+    const std::vector<HwConfig> configs = width_unit_bank_grid({4, 8, 12, 16}, {1, 2}, {16, 32});
     const PointGroupResult full = run_point_group(scene, bvh, settings, configs, Fidelity::full);
     const PointGroupResult analytic = run_point_group(scene, bvh, settings, configs, Fidelity::analytic);
     size_t calibrated = 0;
@@ -253,18 +262,9 @@ TEST_CASE("An analytic frame of fewer passes than the calibration's minimum is c
 TEST_CASE("Configurations left out of the calibration take their stratum's ratio when a "
           "parameter splits the sample's ratios, else the sample's mean",
           "[sampling]") {
-    // Widths 8/16 x units 1/2 x banks 16/32 (the values varying_parameters lists).
-    std::vector<HwConfig> configs;
-    for (uint32_t width : {8u, 16u})
-        for (uint32_t units : {1u, 2u})
-            for (uint32_t banks : {16u, 32u}) {
-                HwConfig c;
-                c.simd.width = width;
-                c.simd.units = units;
-                c.ray_buffer.banks = banks;
-                c.name = "w" + std::to_string(width);  // names are no parameter to stratify by
-                configs.push_back(c);
-            }
+    // Widths 8/16 x units 1/2 x banks 16/32: the values varying_parameters lists (names, which
+    // differ too, are no parameter to stratify by).
+    const std::vector<HwConfig> configs = width_unit_bank_grid({8, 16}, {1, 2}, {16, 32});
     const std::vector<std::vector<std::string>> knobs = varying_parameters(configs);
     CHECK(knobs.size() == 8);
     CHECK(knobs[5] == std::vector<std::string>{"16", "1", "32"});  // width, units, banks
