@@ -8,11 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iomanip>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "app/commands.h"
 #include "app/point_runner.h"
@@ -219,12 +217,6 @@ std::string spec_json(const ExploreSpec& spec) {
     return j.dump();
 }
 
-std::string sig(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.4g", v);
-    return b;
-}
-
 // The front as a table: knobs, the scores, and each configuration's rank by the first objective
 // when screened and when confirmed.
 void print_front(const ExploreSpec& spec, const std::vector<size_t>& front, const std::map<size_t, ExploreScore>& screened,
@@ -253,11 +245,11 @@ void print_front(const ExploreSpec& spec, const std::vector<size_t>& front, cons
         const ExploreScore& s = has_confirm ? confirmed.at(c) : screened.at(c);
         std::vector<std::string> row;
         for (const auto& kv : spec.knob_values(c)) row.push_back(kv.second);
-        row.push_back(sig(s.fps));
+        row.push_back(significant_text(s.fps));
         row.push_back(s.fps_error >= 0 ? "+-" + fixed_text(100 * s.fps_error, 1) + "%" : "unknown");
-        row.push_back(sig(s.area_mm2));
-        row.push_back(sig(s.energy_mj));
-        row.push_back(sig(s.power_w));
+        row.push_back(significant_text(s.area_mm2));
+        row.push_back(significant_text(s.energy_mj));
+        row.push_back(significant_text(s.power_w));
         row.push_back(has_confirm ? std::to_string(screen_rank.at(c)) + " -> " + std::to_string(confirm_rank.at(c))
                                   : std::to_string(screen_rank.at(c)));
         row.push_back(to_string(has_confirm ? spec.confirm : spec.screen));

@@ -17,7 +17,6 @@
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <thread>
 
 #include "app/commands.h"
@@ -35,7 +34,6 @@
 
 namespace sfx {
 namespace {
-
 
 std::string group_label(const PointGroup& group, size_t points) {
     const struct {
@@ -97,9 +95,8 @@ void print_summary(const Sweep& sweep, const PointKeys& keys, const ResultsStore
             for (size_t i = 0; i < metrics.size(); ++i) row.push_back("-");
             row.push_back("missing");
         } else {
-            char fps[32];  // 4 significant digits: paper-scale frames run well below 1 fps
-            std::snprintf(fps, sizeof fps, "%.4g", get("fps"));
-            row.push_back(fps);
+            // 4 significant digits: paper-scale frames run well below 1 fps.
+            row.push_back(significant_text(get("fps")));
             for (const char* s : {"traversal", "intersection", "shading"})
                 row.push_back(fixed_text(100 * get(std::string("simd_utilization.") + s), 1) + "%");
             row.push_back(fixed_text(100 * get("stall_cycles.total") / std::max(1.0, get("frame_cycles")), 1));

@@ -1,6 +1,7 @@
 #include "app/text_table.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <iomanip>
 #include <sstream>
 
@@ -10,6 +11,12 @@ std::string fixed_text(double v, int digits) {
     std::ostringstream s;
     s << std::fixed << std::setprecision(digits) << v;
     return s.str();
+}
+
+std::string significant_text(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return b;
 }
 
 void print_text_table(std::ostream& out, const std::vector<std::string>& headers,

@@ -11,6 +11,8 @@ namespace sfx {
 
 // A table cell: `v` with `digits` after the point ("12.50").
 std::string fixed_text(double v, int digits);
+// A table cell: `v` to 4 significant digits ("145", "0.3458").
+std::string significant_text(double v);
 
 // `left(c)`: whether column c is left-aligned (else right-aligned); each line starts with
 // `indent`. Every row has the headers' column count.

@@ -8,10 +8,11 @@
 //     Configurations with the same scene-data lookups (these four) share one cache simulation;
 //     the rest of a configuration's cost is its own: its lane groups through its SystemC
 //     processes (about half the time, in the kernel) and its bookings;
-//  3. the floor under (2): the render with its trace (to a sink that keeps nothing) and each configuration's CoreModel arithmetic alone
-//     (fetch, execute and partition of every lane group, one after another, no SystemC
-//     processes), and the figure of (2) they would give if the kernel cost nothing. As long as
-//     every configuration books its own lane groups, (2) cannot go below it.
+//  3. the floor under (2): the render with its trace (to a sink that keeps nothing) and each
+//     configuration's CoreModel arithmetic alone (fetch, execute and partition of every lane
+//     group, one after another, no SystemC processes), and the figure of (2) they would give
+//     if the kernel cost nothing. As long as every configuration books its own lane groups,
+//     (2) cannot go below it.
 // Usage: sfx_bench_hw_model [scene] [WxH] [spp] [repetitions]
 
 #include <algorithm>
@@ -100,18 +101,14 @@ class DiscardingSink : public TraceSink {
 std::vector<double> arithmetic_seconds(const std::vector<HwConfig>& configs,
                                        const WorkloadShape& shape, const PassRecorder& recorded) {
     const RayRecordLayout layout(shape.features);
-    SceneDataMap map;
-    map.nodes = shape.bvh_nodes;
-    map.triangles = shape.triangles;
-    map.spheres = shape.spheres;
+    const SceneDataMap map = scene_data_map(shape);
     const auto lookups = std::make_shared<SharedCacheLookups>(configs.front().scene_memory.caches);
     std::vector<std::unique_ptr<OpCostTable>> costs;
     std::vector<std::unique_ptr<CoreModel>> models;
     for (const HwConfig& c : configs) {  // every reader joins before the first lookup
-        const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());
         costs.push_back(std::make_unique<OpCostTable>(layout, c));
         models.push_back(std::make_unique<CoreModel>(
-            c, *costs.back(), map, layout.words(), std::max(capacity, shape.slots()), 0,
+            c, *costs.back(), map, layout.words(), buffer_slots(c.ray_buffer, layout.bytes(), shape.slots()), 0,
             std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz, 1, lookups)));
     }
     std::vector<double> seconds;

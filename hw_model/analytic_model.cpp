@@ -12,10 +12,7 @@
 
 namespace sfx {
 
-TraceProfile::TraceProfile(const WorkloadShape& shape) {
-    m_map.nodes = shape.bvh_nodes;
-    m_map.triangles = shape.triangles;
-    m_map.spheres = shape.spheres;
+TraceProfile::TraceProfile(const WorkloadShape& shape) : m_map(scene_data_map(shape)) {
     // Data sizes do not depend on the datapath latencies: any configuration's table will do.
     const OpCostTable costs(RayRecordLayout(shape.features), DatapathConfig{});
     for (uint32_t k = 0; k < k_op_kind_count; ++k)

@@ -172,6 +172,14 @@ double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
     return programmable(d) ? std::max(issue, double(latency_cycles)) : double(latency_cycles);
 }
 
+SceneDataMap scene_data_map(const WorkloadShape& shape) {
+    SceneDataMap map;
+    map.nodes = shape.bvh_nodes;
+    map.triangles = shape.triangles;
+    map.spheres = shape.spheres;
+    return map;
+}
+
 uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     if (object == k_no_object) return 0;
     const uint64_t triangles_base = nodes * node_bytes;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "hw_model/hw_config.h"
+#include "hw_model/workload_shape.h"
 #include "kernels/trace.h"
 #include "workloads/scene.h"
 
@@ -84,5 +85,7 @@ struct SceneDataMap {
 
     uint64_t address(OpKind kind, uint32_t object) const;
 };
+// The scene data of a workload laid out as SceneDataMap says.
+SceneDataMap scene_data_map(const WorkloadShape& shape);
 
 }  // namespace sfx

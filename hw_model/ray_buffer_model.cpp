@@ -6,6 +6,10 @@
 
 namespace sfx {
 
+uint32_t buffer_slots(const RayBufferConfig& config, uint32_t record_bytes, uint32_t pass_slots) {
+    return std::max(uint32_t(uint64_t(config.kib) * 1024 / record_bytes), pass_slots);
+}
+
 RayBufferModel::RayBufferModel(const RayBufferConfig& config, uint32_t record_words,
                                uint32_t slot_count)
     : m_banks(config.banks), m_line_words(config.line_words),

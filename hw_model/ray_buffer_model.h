@@ -16,6 +16,10 @@
 
 namespace sfx {
 
+// Ray slots in one buffer of `config` for records of `record_bytes`; never fewer than a pass's
+// `pass_slots` (a tile's rays always have their slots).
+uint32_t buffer_slots(const RayBufferConfig& config, uint32_t record_bytes, uint32_t pass_slots);
+
 class RayBufferModel {
 public:
     RayBufferModel(const RayBufferConfig& config, uint32_t record_words, uint32_t slot_count);

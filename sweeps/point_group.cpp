@@ -529,17 +529,14 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     std::vector<std::pair<double, double>> ratios(configs.size(), {1.0, -1.0});
     if (calibration && calibration->sampled() >= 1) {
         std::vector<double> r, half;
-        std::vector<uint8_t> is_calibrated(configs.size(), 0);
         for (size_t k = 0; k < calibrated.size(); ++k) {
-            ratios[calibrated[k]] = calibration->ratio(k, sampling.confidence, profile);
-            r.push_back(ratios[calibrated[k]].first);
-            half.push_back(ratios[calibrated[k]].second);
-            is_calibrated[calibrated[k]] = 1;
+            const std::pair<double, double> own = calibration->ratio(k, sampling.confidence, profile);
+            r.push_back(own.first);
+            half.push_back(own.second);
         }
-        const std::vector<std::pair<double, double>> others = uncalibrated_ratios(
-            varying_parameters(configs), calibrated, r, half, sampling.confidence);
-        for (size_t i = 0; i < configs.size(); ++i)
-            if (!is_calibrated[i]) ratios[i] = others[i];
+        ratios = uncalibrated_ratios(varying_parameters(configs), calibrated, r, half,
+                                     sampling.confidence);
+        for (size_t k = 0; k < calibrated.size(); ++k) ratios[calibrated[k]] = {r[k], half[k]};
     }
 
     for (size_t i = 0; i < configs.size(); ++i) {

@@ -11,17 +11,15 @@ Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c,
                                                         c.cores.count, std::move(lookups))) {
     m_costs.check_measured(shape.needed_kinds(), c.name);
     const RayRecordLayout layout(shape.features);
-    const uint32_t capacity = uint32_t(uint64_t(c.ray_buffer.kib) * 1024 / layout.bytes());
-    m_map.nodes = shape.bvh_nodes;
-    m_map.triangles = shape.triangles;
-    m_map.spheres = shape.spheres;
+    const uint32_t slots = buffer_slots(c.ray_buffer, layout.bytes(), shape.slots());
+    m_map = scene_data_map(shape);
     // The cores share one clock and one table of wake-ups: their processes due in the same
     // cycle resume in an order of this accelerator's own making.
     const auto wakeups = std::make_shared<CycleWakeups>();
     for (uint32_t i = 0; i < c.cores.count; ++i)
         m_cores.push_back(std::make_unique<Core>(
             ("core_" + std::to_string(i)).c_str(), c, m_costs, m_map, layout.words(),
-            std::max(capacity, shape.slots()), i, m_scene_memory, wakeups, *this));
+            slots, i, m_scene_memory, wakeups, *this));
 }
 
 void Accelerator::enqueue(std::shared_ptr<const PassBuffer> pass) {
