@@ -232,7 +232,8 @@ def test_command_writes_page_and_exit_codes(tmp_path, capsys):
     text = page.read_text(encoding="utf-8")
     for heading in ["## Summary", "## Targets", "## Table 3: effective", "## Table 5",
                     "## Table 6", "## The width knee", "## Tile 32→64", "## 256 KiB",
-                    "## Reading of Table 6"]:
+                    "## Reading of Table 6", "## Theoretical maximum (Sec. 4.2)",
+                    "## What Table 6 implies"]:
         assert heading in text, heading
     assert "-10.0 %" in text and not os.path.exists(str(page) + ".tmp")
     assert main(["paper", str(tmp_path / "none.db"), "-o", str(page)]) == 2
@@ -291,21 +292,120 @@ def test_paper_check_end_to_end(tmp_path):
     assert done.returncode == 2 and "--page needs a value" in done.stderr
 
 
-def test_what_table6_implies(tmp_path):
-    # Conference at a tenth of Table 6, half of its cycles stalled, 2 units, 3.2e9 compute
-    # instructions per 16-spp frame: without stalls it would run at a fifth of the paper's
-    # fps (gap 5x); the paper's 1-spp pass of 500e6 / 20.32 cycles needs 1e8 instructions per
-    # unit, 4.06 per cycle.
-    extra = {"frame_cycles": 1e9, "stall_cycles.total": 5e8, "hw.simd.units": 2,
-             "op_mix.instructions": 6.4e9}
-    points = [paper_point(scene, 64, 16, fps_factor=0.1, **extra)
-              for _, scene, _ in paper.SCENES]
+def with_stall_free(points, factor=1.0, full=2.0, held_out_factor=None):
+    """The points with fps_stall_free at factor x the paper's maximum per 1-spp pass (held-out
+    scenes at held_out_factor when given) and fps_stall_free_full_lanes at full x that."""
+    out = []
     for p in points:
-        p["op_mix.compute_percent"] = 50.0
-    header, rows = rows_of(build(tmp_path, points), "implied")
+        scene = p["workload.scene"]
+        f = factor if held_out_factor is None or paper.ROLE[scene] == paper.FIT else \
+            held_out_factor
+        free = paper.THEORETICAL_MAX_FPS[paper.PAPER_OF_OURS[scene]] * f / SPP
+        out.append(dict(p, fps_stall_free=free, fps_stall_free_full_lanes=free * full))
+    return out
+
+
+def test_theoretical_maximum(tmp_path):
+    fitted = {"hw.datapath.fpu_units": 4.0, "hw.datapath.alu_units": 4.0}
+    points = [dict(p, **fitted) for p in with_stall_free(paper_points(skip={("temple", 32, 8)}),
+                                                       factor=1.1)]
+    check = build(tmp_path, points)
+    header, rows = rows_of(check, "maximum")
+    # The scored configuration first, then every other width and tile the store holds.
+    assert [r[:2] for r in rows[:3]] == [["16", "64"]] * 3
+    assert len(rows) == 3 + 5 * 3 - 1                   # temple tile 32 width 8 is not stored
+    conf = rows[1]
+    assert conf[2:4] == ["conference (conf)", "FIT"]
+    assert conf[header.index("paper maximum")] == "64"
+    assert conf[header.index("ours, stalls hidden")] == f"{64 * 1.1:.2f}"      # x spp
+    assert conf[header.index("error")] == "+10.0 %"
+    assert conf[header.index("ours, stalls hidden and lanes full")] == f"{64 * 2.2:.2f}"
+    assert "datapath.fpu_units = alu_units (= 4 here)" in conf[header.index("note")]
+    assert rows[0][header.index("note")] == "scored"
+    assert all(r[header.index("note")].startswith("not scored") for r in rows[3:])
+    assert "has no" not in next(b for b in check.blocks if b.ident == "maximum").caption
+    # Only the scored row is a cell: one fit, two held out in the summary.
+    cs = [c for c in check.cells if c.quantity == "theoretical maximum (fps, stalls hidden)"]
+    assert sorted((c.scene, c.label) for c in cs) == \
+        [(s, "tile 64, width 16") for s in ("atrium-ambient", "conference", "temple")]
+    assert all(c.error == pytest.approx(10.0) for c in cs)
+    h = check.summary.header
+    row = next(r for r in check.summary.rows if r[0] == cs[0].quantity)
+    assert row[h.index("fit: cells")] == "1 of 1" and row[h.index("held out: cells")] == "2 of 2"
+    assert row[h.index("held out: worst")] == "+10.0"
+    # Placed before Table 3's blocks.
+    idents = [b.ident for b in check.blocks]
+    assert idents.index("maximum") < idents.index("implied") < idents.index("table3")
+
+
+def test_theoretical_maximum_target(tmp_path):
+    t = target(build(tmp_path, with_stall_free(paper_points(), factor=1.14)),
+               "theoretical maximum")
+    assert t.status == "met" and "all 2 cells within ±15 %" in t.detail
+    # Held out at -20 %: missed by 5 points; the fit cell is named apart.
+    check = build(tmp_path, with_stall_free(paper_points(), factor=1.0, held_out_factor=0.8,
+                                            full=3.0))
+    t = target(check, "theoretical maximum")
+    assert t.status == "missed" and "2 of 2 cells outside ±15 %" in t.detail
+    assert "-20.0 %" in t.detail and "5.0 % beyond the tolerance" in t.detail
+    assert "fitted on conference: 0.0 %" in t.pointer
+    assert "atrium-ambient +140.0 %" in t.pointer                   # 0.8 x 3 lanes full
+    assert t.scope.startswith("held-out scenes, width 16, tile 64")
+
+
+def test_latency_arithmetic():
+    # Ours busy half the frame: one stall cycle per busy cycle; the paper's at 25 %: three.
+    assert paper.latency_hidden(0.5, 0.25) == pytest.approx(1 / 3)
+    assert paper.latency_hidden(0.25, 0.5) == pytest.approx(3.0)
+    assert paper.latency_hidden(None, 0.5) is None
+    assert paper.latency_hidden(0.5, 1.0) is None       # the paper's machine never stalls
+
+
+def test_what_table6_implies(tmp_path):
+    # fps at half of Table 6 and stall-free fps at the paper's maximum: half the paper's
+    # efficiency; half the cycles stalled, 40 % of the frame pipeline_fill.
+    extra = {"frame_cycles": 1e9, "stall_cycles.total": 5e8, "stall_cycles.pipeline_fill": 4e8}
+    points = [dict(p, **extra) for p in with_stall_free(paper_points(fps_factor=0.5))]
+    check = build(tmp_path, points)
+    header, rows = rows_of(check, "implied")
     conf = next(r for r in rows if r[0].startswith("conference"))
+    e = 20.32 / 64
+    assert conf[header.index("paper fps (Table 6)")] == "20.32"
+    assert conf[header.index("paper maximum")] == "64"
+    assert conf[header.index("paper efficiency")] == f"{100 * e:.0f} %"
+    assert conf[header.index("ours fps")] == f"{64 * e * 0.5:.3f}"
+    assert conf[header.index("ours, stalls hidden")] == "64.000"
+    assert conf[header.index("ours efficiency")] == f"{50 * e:.0f} %"
     assert conf[header.index("stalled")] == "50 %"
-    assert conf[header.index("ours without stalls")] == f"{2.032 * 2:.3f}"
-    assert conf[header.index("gap left (x)")] == "5.0"
-    assert conf[header.index("implied issue (instr/cycle/unit)")] == \
-        f"{1e8 / (500e6 / 20.32):.1f}"
+    assert conf[header.index("largest stall cause")] == "pipeline_fill (40 %)"
+    assert conf[header.index("latency the paper hides (x)")] == \
+        f"{(2 / e - 1) / (1 / e - 1):.2f}"
+    # Table 6's miss points at the efficiency gap, with numbers from the cells.
+    t = target(check, "Table 6 fps")
+    assert t.status == "missed" and t.pointer.startswith("ours is too slow everywhere")
+    assert "within 0.0 % of the paper's maximum" in t.pointer
+    assert "what is missing is hidden latency: our efficiency (fps over fps with stalls " \
+        "hidden) is 13–24 % against the paper's 26–49 %" in t.pointer
+    assert "pipeline_fill" in t.pointer and "implied issue" not in t.pointer
+    assert "instructions per cycle" not in t.pointer
+
+
+def test_old_store_without_stall_free_columns(tmp_path):
+    """A store written before fps_stall_free: the blocks say so, the target is not evaluated,
+    the page is written."""
+    check = build(tmp_path, paper_points(fps_factor=0.5))
+    block = next(b for b in check.blocks if b.ident == "maximum")
+    assert "has no fps_stall_free or fps_stall_free_full_lanes column" in block.caption
+    h = block.header
+    assert all(r[h.index("ours, stalls hidden")] == paper.MISSING and
+               r[h.index("error")] == paper.MISSING for r in block.rows)
+    implied = next(b for b in check.blocks if b.ident == "implied")
+    assert "has no fps_stall_free column" in implied.caption
+    assert all(r[implied.header.index("ours efficiency")] == paper.MISSING for r in implied.rows)
+    t = target(check, "theoretical maximum")
+    assert t.status == "not evaluated" and "no fps_stall_free column" in t.detail
+    t = target(check, "Table 6 fps")
+    assert t.status == "missed" and "efficiency" not in t.pointer
+    text = paper.to_markdown(check)
+    assert "## Theoretical maximum (Sec. 4.2)" in text
+    assert "| theoretical maximum (fps, stalls hidden) | % (relative) | 0 of 1 |" in text
