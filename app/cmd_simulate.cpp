@@ -64,6 +64,9 @@ void print_predictions(const std::vector<Prediction>& predictions,
     row("simd width", [](const Prediction& p) { return std::to_string(p.config.simd.width); });
     row("tile", [](const Prediction& p) { return std::to_string(p.tile); });
     row("fps", [&](const Prediction& p) { return fixed(p.fps(), 3); });
+    row("fps, stalls hidden", [&](const Prediction& p) { return fixed(stat(p, "fps_stall_free"), 3); });
+    row("fps, stalls hidden, lanes full",
+        [&](const Prediction& p) { return fixed(stat(p, "fps_stall_free_full_lanes"), 3); });
     row("frame cycles", [&](const Prediction& p) { return std::to_string(p.timing.cycles); });
     for (const char* stage : {"traversal", "intersection", "shading"}) {
         row(std::string("utilization ") + stage + " (ideal)", [&](const Prediction& p) {

@@ -234,26 +234,64 @@ struct SceneMemoryConfig {
     }
 };
 
-// The SIMD datapath. `programmable`: filters are programs of SIMD instructions (G&R 3.3: filter
-// tests "implemented as C++ functors" compiled for the SIMD architecture), issued one per
-// cycle, the op's dependent-chain latency paid once per group before its mask is known.
+// The SIMD datapath: how a SIMD unit issues a filter's per-group body. Instruction counts,
+// their classes and dependent chains come from the op table (hw_model/op_costs.cpp).
+// `programmable`: filters are programs of SIMD instructions (G&R 3.3: filter tests
+// "implemented as C++ functors" compiled for the SIMD architecture), issued one per cycle, the
+// op's dependent-chain latency paid once per group before its mask is known.
 // `pipelined`: fixed-function filter pipelines accept a group every `initiation_interval`
-// cycles. Instruction counts and chain depths come from the op table (hw_model/op_costs.cpp).
+// cycles.
+// `cluster`: the execution subsystem of G&R's refs [11] and [16] (the perception processor,
+// Mathew's dissertation ch. 9): a VLIW cluster of function units by class running each filter
+// as a modulo-scheduled loop over its lane groups (hardware modulo support, compiler-controlled
+// dataflow). A new group starts every II cycles, II = max(resource bound: each class's
+// instructions over its units, rounded up; recurrence bound: the loop-carried chain's latency),
+// and a group's mask is known a schedule length after it starts (its dependent chain at each
+// class's latency). modulo_schedule() in hw_model/op_costs.h computes both.
 struct DatapathConfig {
-    std::string issue = "programmable";
+    std::string issue = "cluster";
     uint32_t fp_latency_cycles = 2;    // assumed: a 90 nm single-precision adder or multiplier at
                                        // 500 MHz (2 ns per cycle) in two pipeline stages
+                                       // (issue: programmable and pipelined)
     uint32_t initiation_interval = 1;  // assumed (issue: pipelined only): a group per cycle
+    // issue: cluster. Mathew, "The Perception Processor" (PhD dissertation, Utah 2004), 9.3
+    // "Function Units": "All ALU operations have single cycle latency", "All FPU operations have
+    // 7 cycle latency", "Multiply units support 32-bit integer multiply operations with 3 cycle
+    // latency"; each unit N lanes wide here (G&R 3.3: "N-wide SIMD operations").
+    uint32_t alu_latency_cycles = 1;  // Mathew 9.3 (integer add, logic, compare, select)
+    uint32_t fpu_latency_cycles = 7;  // Mathew 9.3 (float add, subtract, multiply, compare)
+    uint32_t mul_latency_cycles = 3;  // Mathew 9.3 (32-bit integer multiply)
+    // FITTED, one number for the three counts: on conference's theoretical maximum only (G&R
+    // 4.2: 64 fps), atrium-ambient and temple held out. No source gives the paper's unit mix,
+    // so every class is assumed to have as many units. The fit (conference 1024x1024, width
+    // 16, tile 64, sampled; fps with stalls hidden for 16/24/32/48/64/72/84/96 units: 26.0,
+    // 29.3, 48.1, 53.7, 53.7, 60.55, 60.65, 60.65) takes the fewest units at the least error:
+    // 84, the glossy body's 84 FPU instructions, where every filter issues a group a cycle.
+    uint32_t fpu_units = 84;
+    uint32_t alu_units = 84;
+    uint32_t mul_units = 84;
 
     template <class V>
     void visit(V& v) {
-        v.choice("issue", issue, {"programmable", "pipelined"},
+        v.choice("issue", issue, {"programmable", "pipelined", "cluster"},
                  "programmable: instruction count per group; pipelined: one group per "
-                 "initiation interval");
+                 "initiation interval; cluster: a modulo-scheduled loop on function units by "
+                 "class");
         v.param("fp_latency_cycles", fp_latency_cycles, "cycles",
-                "latency of one dependent floating-point step", 1u, 64u);
+                "latency of one dependent floating-point step (programmable, pipelined)", 1u, 64u);
         v.param("initiation_interval", initiation_interval, "cycles",
                 "cycles between groups entering a pipelined filter datapath", 1u, 64u);
+        v.param("alu_units", alu_units, "units", "cluster: integer ALUs (add, logic, select)",
+                1u, 1024u);
+        v.param("alu_latency_cycles", alu_latency_cycles, "cycles", "cluster: ALU latency", 1u,
+                64u);
+        v.param("fpu_units", fpu_units, "units",
+                "cluster: floating-point units (add, multiply, compare)", 1u, 1024u);
+        v.param("fpu_latency_cycles", fpu_latency_cycles, "cycles", "cluster: FPU latency", 1u,
+                64u);
+        v.param("mul_units", mul_units, "units", "cluster: integer multipliers", 1u, 1024u);
+        v.param("mul_latency_cycles", mul_latency_cycles, "cycles",
+                "cluster: integer multiplier latency", 1u, 64u);
     }
 };
 

@@ -43,18 +43,37 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // Fig. 5's slab test; the triangle test is watertight, with its plane distance in double).
     // Shading counts are estimates from kernels/materials.h and kernels/path.h, not exact.
     auto set = [&](OpKind k, std::initializer_list<const char*> gather,
-                   std::initializer_list<const char*> scatter, uint32_t instructions,
-                   uint32_t chain, uint32_t scene_bytes) {
+                   std::initializer_list<const char*> scatter, UnitClassCounts body,
+                   UnitClassCounts chain, uint32_t scene_bytes, UnitClassCounts recurrence = {}) {
         OpProfile& p = m_profiles[size_t(k)];
         p.gather_words = words_of(l, gather);
         p.scatter_words = words_of(l, scatter);
-        p.compute_instructions = instructions;
-        p.chain_steps = chain;
-        p.latency_cycles = chain * d.fp_latency_cycles;
+        p.body = body;
+        p.chain = chain;
+        p.recurrence = recurrence;
+        p.compute_instructions = body.total();
+        p.chain_steps = chain.total();
+        p.latency_cycles = p.chain_steps * d.fp_latency_cycles;
+        p.schedule = modulo_schedule(body, chain, recurrence, d);
         p.scene_bytes = scene_bytes;
         p.partitions = op_info(k).partitions;
         p.pushes_rays = op_info(k).pushes_rays;
     };
+    // Classes (issue: cluster; Mathew 9.3's function units): float add, subtract, multiply,
+    // compare, min/max and convert, and (assumed, one instruction each: the perception
+    // processor has no divider) divide and square root on FPUs; selects, logic, integer add,
+    // compare and shift on ALUs; integer multiplies on multipliers: two per random number
+    // (kernels/rng.h: a mix64 per number, two 64-bit multiplies; the camera draws four, a
+    // lobe choice one, a Lambertian direct sample three, an indirect one two, a dielectric one,
+    // a glossy sample three).
+    // Written {fpu, alu, mul}. The box test per axis: two selects of the near and far plane
+    // (ALU), two subtracts and two multiplies by the inverse direction (FPU), the far plane's
+    // rounding multiply (FPU); then three max and three min (FPU), t_max's scale (FPU), two
+    // compares (FPU) and their and (ALU): {24, 7, 0}; the table's 34 keeps three more (as it
+    // did before classes), assumed {2, 1, 0}: {26, 8, 0}. Chain: select, subtract, multiply,
+    // multiply, max, max, max, compare, and: {7, 2, 0}. The other kinds are split by the same rule from their counts;
+    // the shading splits are estimates, as their totals are. Groups are independent iterations
+    // (no recurrence) except where a filter carries state from group to group (noted there).
     // A ray record written whole: the camera and every shader that pushes a new ray.
     const auto whole_ray = {"origin",     "direction",     "inverse_direction",
                             "t_max",      "hit_primitive", "pixel_sample",
@@ -63,25 +82,26 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
                       "hit_barycentrics", "pixel_sample", "throughput", "state"};
     // Scene bytes: a 32-byte BVH node, a triangle's three vertices (36), a sphere (16), a
     // 64-byte material record (hw_model/op_costs.h, SceneDataMap).
-    set(OpKind::camera, {"pixel_sample"}, whole_ray, 24, 8, 0);
-    set(OpKind::box_test, {"origin", "inverse_direction", "t_max"}, {}, 34, 9, 32);
+    set(OpKind::camera, {"pixel_sample"}, whole_ray, {10, 6, 8}, {4, 2, 2}, 0);
+    set(OpKind::box_test, {"origin", "inverse_direction", "t_max"}, {}, {26, 8, 0}, {7, 2, 0}, 32);
     set(OpKind::triangle_test, {"origin", "direction", "t_max"},
-        {"t_max", "hit_primitive", "hit_t", "hit_barycentrics"}, 96, 12, 36);
+        {"t_max", "hit_primitive", "hit_t", "hit_barycentrics"}, {72, 24, 0}, {9, 3, 0}, 36);
     set(OpKind::sphere_test, {"origin", "direction", "t_max"}, {"t_max", "hit_primitive", "hit_t"},
-        51, 16, 16);
+        {40, 11, 0}, {13, 3, 0}, 16);
     set(OpKind::shadow_filter, {"state", "hit_primitive", "throughput", "radiance"}, {"radiance"},
-        5, 2, 0);
-    set(OpKind::miss_filter, {"hit_primitive", "throughput", "radiance"}, {"radiance"}, 5, 2, 0);
+        {3, 2, 0}, {1, 1, 0}, 0);
+    set(OpKind::miss_filter, {"hit_primitive", "throughput", "radiance"}, {"radiance"}, {3, 2, 0},
+        {1, 1, 0}, 0);
     set(OpKind::emission_filter, {"hit_primitive", "hit_material", "state", "throughput"},
-        {"radiance"}, 6, 3, 64);
-    set(OpKind::depth_filter, {"state"}, {}, 2, 1, 0);
-    set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, 2, 1, 64);
-    set(OpKind::ambient, {"throughput", "radiance"}, {"radiance"}, 6, 2, 64);
-    set(OpKind::lambertian_choice, {"pixel_sample", "state"}, {}, 12, 6, 0);
-    set(OpKind::lambertian_direct, hit, whole_ray, 96, 16, 36 + 64);
-    set(OpKind::lambertian_indirect, hit, whole_ray, 64, 14, 64);
-    set(OpKind::dielectric, hit, whole_ray, 72, 16, 64);
-    set(OpKind::glossy, hit, whole_ray, 110, 18, 64);
+        {"radiance"}, {3, 3, 0}, {1, 2, 0}, 64);
+    set(OpKind::depth_filter, {"state"}, {}, {0, 2, 0}, {0, 1, 0}, 0);
+    set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, {0, 2, 0}, {0, 1, 0}, 64);
+    set(OpKind::ambient, {"throughput", "radiance"}, {"radiance"}, {6, 0, 0}, {2, 0, 0}, 64);
+    set(OpKind::lambertian_choice, {"pixel_sample", "state"}, {}, {3, 7, 2}, {2, 2, 2}, 0);
+    set(OpKind::lambertian_direct, hit, whole_ray, {72, 18, 6}, {12, 2, 2}, 36 + 64);
+    set(OpKind::lambertian_indirect, hit, whole_ray, {46, 14, 4}, {10, 2, 2}, 64);
+    set(OpKind::dielectric, hit, whole_ray, {54, 16, 2}, {12, 2, 2}, 64);
+    set(OpKind::glossy, hit, whole_ray, {84, 20, 6}, {14, 2, 2}, 64);
     // AEPSA (kernels/stream/entry_point.cpp): counted from our code, not from the paper (its
     // costs are host times). The bounds fit the frustum in two sweeps over the stream: a sum of
     // normalized directions (3 mul, 2 add, a square root and 3 divides: 9), then per ray three
@@ -90,8 +110,10 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // each 3 selects, 3 products, 2 adds, a compare (11), and 4 ors (59); chain select, mul,
     // add, add, compare, 3 ors (8). It reads the node (32 bytes) and no ray data: the frustum
     // lives in the unit's registers.
-    set(OpKind::frustum_bounds, {"origin", "direction"}, {}, 51, 7, 0);
-    set(OpKind::frustum_test, {}, {}, 59, 8, 32);
+    // The bounds are a running sum, min and max over the stream: an FPU step carried from group
+    // to group.
+    set(OpKind::frustum_bounds, {"origin", "direction"}, {}, {51, 0, 0}, {7, 0, 0}, 0, {1, 0, 0});
+    set(OpKind::frustum_test, {}, {}, {30, 29, 0}, {4, 4, 0}, 32);
     // Hit-point reordering (kernels/stream/hit_point_reorder.h), counted from our code; the
     // paper gives only host times. The simplified hierarchy's filter is the box test plus a
     // compare and select keeping the nearest proxy entry (36, chain 10); the entry distance
@@ -101,9 +123,11 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // uses and a shift-or (4): 41, chain 12. A merge pass: per group, two key reads, a
     // compare, two selects, an id store and an index update (8, chain 3; assumed, the merge of
     // Sec. 5 is not given in instructions); keys and ids stay in the scratchpad.
-    set(OpKind::reorder_lod_test, {"origin", "inverse_direction", "t_max"}, {}, 36, 10, 32);
-    set(OpKind::reorder_key, {"origin", "direction", "t_max"}, {}, 41, 12, 0);
-    set(OpKind::reorder_sort, {}, {}, 8, 3, 0);
+    set(OpKind::reorder_lod_test, {"origin", "inverse_direction", "t_max"}, {}, {27, 9, 0},
+        {8, 2, 0}, 32);
+    set(OpKind::reorder_key, {"origin", "direction", "t_max"}, {}, {15, 22, 4}, {5, 5, 2}, 0);
+    // The merge's index update feeds the next group's compare: three ALU steps carried.
+    set(OpKind::reorder_sort, {}, {}, {0, 8, 0}, {0, 3, 0}, 0, {0, 3, 0});
     // RayGrid batching (kernels/stream/ray_grid.h, the tracer's grid_walk), counted from our
     // code; the paper gives only host time shares (47 % octree traversal, Sec. 4.1). A walk
     // step is the slab test (34, chain 9, as box_test) plus the walk's bookkeeping: at a cell,
@@ -115,8 +139,10 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // cell's queue tail (a load), the id store, the tail's increment and store, the compare
     // against the queue size and the select that hands a full queue on (6, chain 4: load,
     // add, compare, select); queues hold ray ids, as the paper allows (Sec. 3.2.3).
-    set(OpKind::raygrid_walk, {"origin", "inverse_direction", "t_max"}, {"t_max"}, 47, 13, 32);
-    set(OpKind::raygrid_enqueue, {"t_max"}, {}, 6, 4, 0);
+    set(OpKind::raygrid_walk, {"origin", "inverse_direction", "t_max"}, {"t_max"}, {35, 12, 0},
+        {9, 4, 0}, 32);
+    // A queue's tail (load, increment, store) is carried from group to group: three ALU steps.
+    set(OpKind::raygrid_enqueue, {"t_max"}, {}, {0, 6, 0}, {0, 4, 0}, 0, {0, 3, 0});
 }
 
 OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
@@ -124,7 +150,11 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
     for (uint32_t k = 0; k < k_op_kind_count; ++k) {
         OpProfile& p = m_profiles[k];
         // Compress: the unit stores the group's passing ids, then its failing ones.
-        if (p.partitions && config.partition.kind == "compress") p.compute_instructions += 2;
+        if (p.partitions && config.partition.kind == "compress") {
+            p.compute_instructions += 2;
+            p.body.alu += 2;
+            p.schedule = modulo_schedule(p.body, p.chain, p.recurrence, config.datapath);
+        }
         for (const OpCostConfig& c : config.op_costs)
             if (c.op == k_op_kinds[k].name) {
                 p.measured = true;
@@ -153,13 +183,33 @@ namespace {
 bool programmable(const DatapathConfig& d) {
     return std::string_view(d.issue) == "programmable";
 }
+bool cluster(const DatapathConfig& d) {
+    return std::string_view(d.issue) == "cluster";
+}
+
+uint32_t ceil_div(uint32_t a, uint32_t b) {
+    return (a + b - 1) / b;
+}
 
 }  // namespace
 
+ModuloSchedule modulo_schedule(const UnitClassCounts& body, const UnitClassCounts& chain,
+                               const UnitClassCounts& recurrence, const DatapathConfig& d) {
+    ModuloSchedule s;
+    s.resource_ii = std::max({1u, ceil_div(body.fpu, d.fpu_units), ceil_div(body.alu, d.alu_units),
+                              ceil_div(body.mul, d.mul_units)});
+    s.recurrence_ii = recurrence.latency(d);
+    s.ii = std::max(s.resource_ii, s.recurrence_ii);
+    s.length = std::max(chain.latency(d), s.ii);
+    return s;
+}
+
 double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_t lanes,
                                uint32_t passed, bool first, double beyond_l1) const {
-    if (!measured)
+    if (!measured) {
+        if (cluster(d)) return double(schedule.ii);
         return programmable(d) ? double(compute_instructions) : double(d.initiation_interval);
+    }
     // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
     if (length == 1 && cost.one_lane_cycles > 0) return cost.one_lane_cycles;
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
@@ -169,6 +219,7 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
 
 double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
     if (measured) return issue;
+    if (cluster(d)) return double(schedule.length);
     return programmable(d) ? std::max(issue, double(latency_cycles)) : double(latency_cycles);
 }
 

@@ -34,12 +34,38 @@ class RayRecordLayout {
     std::vector<uint32_t> m_none;
 };
 
+// A filter's per-group body by function-unit class (issue: cluster): instructions, or steps of
+// a dependent chain.
+struct UnitClassCounts {
+    uint32_t fpu = 0, alu = 0, mul = 0;
+    uint32_t total() const { return fpu + alu + mul; }
+    // The chain's latency at the datapath's class latencies.
+    uint32_t latency(const DatapathConfig& d) const {
+        return fpu * d.fpu_latency_cycles + alu * d.alu_latency_cycles + mul * d.mul_latency_cycles;
+    }
+};
+
+// A filter's per-group body as a modulo-scheduled loop on a cluster (Rau, "Iterative modulo
+// scheduling", MICRO 1994): a group every `ii` cycles, the larger of the resource bound (each
+// class's instructions over its units, rounded up) and the recurrence bound (the loop-carried
+// chain's latency at distance 1); a group's mask `length` cycles after it starts (its dependent
+// chain; at least ii).
+struct ModuloSchedule {
+    uint32_t resource_ii = 1, recurrence_ii = 0, ii = 1, length = 1;
+};
+ModuloSchedule modulo_schedule(const UnitClassCounts& body, const UnitClassCounts& chain,
+                               const UnitClassCounts& recurrence, const DatapathConfig& datapath);
+
 struct OpProfile {
     std::vector<uint32_t> gather_words;   // gathered for every lane
     std::vector<uint32_t> scatter_words;  // scattered for passing lanes
     uint32_t compute_instructions = 1;    // SIMD instructions per lane group
     uint32_t chain_steps = 1;             // longest dependent chain of those instructions
     uint32_t latency_cycles = 1;          // chain_steps * fp latency: paid once per group
+    // The same body by function-unit class (their totals are compute_instructions and
+    // chain_steps), the loop-carried chain, and its schedule on the configured cluster.
+    UnitClassCounts body, chain, recurrence;
+    ModuloSchedule schedule;
     uint32_t scene_bytes = 0;             // scene data fetched once per op (broadcast operand)
     bool partitions = false;              // the mask partitions the stream in place (op table)
     bool pushes_rays = false;             // passing lanes write the next generation (op table)
@@ -52,11 +78,12 @@ struct OpProfile {
     // of an op of `length` lanes (`first`: the op's first group, which carries a measured
     // per-op cost), with a share `beyond_l1` of the pass's ray slots outside an l1d buffer.
     // Fractional for measured costs (the caller carries the remainder); instruction-priced
-    // groups cost compute_instructions (programmable) or the initiation interval (pipelined).
+    // groups cost compute_instructions (programmable), the initiation interval (pipelined) or
+    // the body's modulo-schedule II (cluster).
     double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t lanes,
                         uint32_t passed, bool first, double beyond_l1) const;
     // Cycles from a group's first issue to its mask: the measured cost (its loads and chain are
-    // inside it) or the datapath's dependent chain.
+    // inside it), the datapath's dependent chain or the cluster's schedule length.
     double result_cycles(const DatapathConfig& datapath, double issue) const;
 };
 

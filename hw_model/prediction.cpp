@@ -127,6 +127,24 @@ std::vector<Stat> Prediction::stats() const {
         add("stall_cycles." + c.name(), double(v) * unit_scale, c.unit, c.description);
     });
     add("stall_cycles.total", double(st.total()) * unit_scale, "cycles", "all stall cycles");
+    // G&R 4.2's "theoretical maximum achievable frame rate ... assuming no stalls or
+    // dependencies of any kind": the frame's busy cycles alone, every unit issuing every cycle.
+    // Its groups are the trace's, partly empty where streams are short (Table 3's ideal
+    // utilization is a property of the workload, not a stall), so this is the paper's figure;
+    // the rate with every lane of every group busy as well is printed beside it.
+    double busy = 0.0, busy_full_lanes = 0.0;
+    for (const auto& by_stage : timing.stages)
+        for (const StageTiming& t : by_stage) {
+            busy += double(t.busy_cycles);
+            if (t.groups > 0)
+                busy_full_lanes += double(t.busy_cycles) * double(t.lanes) /
+                                   (double(t.groups) * double(config.simd.width));
+        }
+    const double rate = fps() * frame_cycles();  // frames per second per frame-cycle
+    add("fps_stall_free", ratio(rate, busy * unit_scale), "frames/s",
+        "frame rate with every stall hidden (G&R 4.2's theoretical maximum)");
+    add("fps_stall_free_full_lanes", ratio(rate, busy_full_lanes * unit_scale), "frames/s",
+        "frame rate with every stall hidden and every SIMD lane of every group busy");
 
     const double mix_total = double(timing.mix.total());
     OpMix::visit(timing.mix, timing.mix, [&](const CounterInfo& c, uint64_t v, uint64_t) {
