@@ -65,6 +65,7 @@ std::vector<Row> comparison_rows(const std::map<std::string, double>& a,
         rows.push_back(r);
     };
     add("fps", "fps", 0);
+    add("fps_stall_free", "fps, stalls hidden", 0);
     add("frame_cycles", "frame cycles", 0);
     for (const char* s : {"traversal", "intersection", "shading"})
         add(std::string("simd_utilization.") + s, std::string("utilization ") + s, 1);

@@ -106,7 +106,7 @@ STALL_FREE, STALL_FREE_FULL_LANES = "fps_stall_free", "fps_stall_free_full_lanes
 # one of its Tables 5 and 6.
 MAX_TILE, MAX_WIDTH = 64, 16
 # The one value fitted on conference's theoretical maximum (one number for both unit counts).
-FITTED = ("hw.datapath.fpu_units", "hw.datapath.alu_units")
+FITTED = ("hw.datapath.fpu_units", "hw.datapath.alu_units", "hw.datapath.mul_units")
 
 MISSING = "—"
 
@@ -495,10 +495,12 @@ def _missing_columns(cells: Cells, columns: Sequence[str]) -> str:
 
 
 def _fitted_text(row: Optional[pd.Series]) -> str:
-    fpu, alu = value(row, FITTED[0]), value(row, FITTED[1])
-    if fpu is None or alu is None:
+    counts = [value(row, c) for c in FITTED]
+    if any(v is None for v in counts):
         return ""
-    return f" (= {fpu:g} here)" if fpu == alu else f" (here fpu_units {fpu:g}, alu_units {alu:g})"
+    if len(set(counts)) == 1:
+        return f" (= {counts[0]:g} here)"
+    return " (here " + ", ".join(f"{c.split('.')[-1]} {v:g}" for c, v in zip(FITTED, counts)) + ")"
 
 
 def _theoretical_max(cells: Cells, out: List[Cell]) -> Block:
@@ -519,7 +521,7 @@ def _theoretical_max(cells: Cells, out: List[Cell]) -> Block:
                      f"tile {tile}, width {width}", paper, ours, relative_error(ours, paper))
             if scored:
                 out.append(c)
-                note = "scored" + (f"; the fitted value, datapath.fpu_units = alu_units"
+                note = "scored" + (f"; the fitted value, datapath.fpu_units = alu_units = mul_units"
                                    f"{_fitted_text(row)}, was fitted on this cell"
                                    if ROLE[scene] == FIT else "")
             else:
@@ -538,7 +540,8 @@ def _theoretical_max(cells: Cells, out: List[Cell]) -> Block:
                  f"names no width or tile: the width {MAX_WIDTH}, tile {MAX_TILE}, "
                  f"{BUFFER_KIB} KiB row (the headline configuration of its Tables 5 and 6) is "
                  "scored, other rows are shown only. Conference is where the model's one "
-                 "fitted value, datapath.fpu_units = alu_units (one number for both), was "
+                 "fitted value, datapath.fpu_units = alu_units = mul_units (one number for the "
+                 "three), was "
                  "fitted; atrium-ambient and temple are held out."
                  + _missing_columns(cells, (STALL_FREE, STALL_FREE_FULL_LANES)),
                  ["width", "tile", "scene", "cell", "paper maximum", "ours, stalls hidden",

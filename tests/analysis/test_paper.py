@@ -306,7 +306,8 @@ def with_stall_free(points, factor=1.0, full=2.0, held_out_factor=None):
 
 
 def test_theoretical_maximum(tmp_path):
-    fitted = {"hw.datapath.fpu_units": 4.0, "hw.datapath.alu_units": 4.0}
+    fitted = {"hw.datapath.fpu_units": 4.0, "hw.datapath.alu_units": 4.0,
+              "hw.datapath.mul_units": 4.0}
     points = [dict(p, **fitted) for p in with_stall_free(paper_points(skip={("temple", 32, 8)}),
                                                        factor=1.1)]
     check = build(tmp_path, points)
@@ -320,7 +321,7 @@ def test_theoretical_maximum(tmp_path):
     assert conf[header.index("ours, stalls hidden")] == f"{64 * 1.1:.2f}"      # x spp
     assert conf[header.index("error")] == "+10.0 %"
     assert conf[header.index("ours, stalls hidden and lanes full")] == f"{64 * 2.2:.2f}"
-    assert "datapath.fpu_units = alu_units (= 4 here)" in conf[header.index("note")]
+    assert "datapath.fpu_units = alu_units = mul_units (= 4 here)" in conf[header.index("note")]
     assert rows[0][header.index("note")] == "scored"
     assert all(r[header.index("note")].startswith("not scored") for r in rows[3:])
     assert "has no" not in next(b for b in check.blocks if b.ident == "maximum").caption
