@@ -376,6 +376,32 @@ TEST_CASE("An op window releases an op once the partition that produced its stre
     CHECK(b.mix.total() == a.mix.total());
 }
 
+TEST_CASE("A chain of dependent ops has nothing for the window or the other unit to hide",
+          "[hw_model][systemc]") {
+    // Each op's stream is the one its predecessor's partition produced (16, 8, then 4 lanes:
+    // one group each). The op window overlaps only ops whose streams come from partitions
+    // already done, and the other SIMD unit only another group: here there is neither, so the
+    // latency between the ops is exposed whole whatever the window and the units.
+    std::vector<uint8_t> first(16, 0), second(8, 0), third(4, 0);
+    for (uint32_t i = 0; i < 8; ++i) first[i] = 1;
+    for (uint32_t i = 0; i < 4; ++i) second[i] = 1;
+    const std::vector<CraftedOp> chain = {{OpKind::box_test, consecutive(16), first, 1},
+                                          {OpKind::box_test, consecutive(8), second, 2},
+                                          {OpKind::box_test, consecutive(4), third, 3}};
+    HwConfig base = with_width(16), window = with_width(16), units = with_width(16, 2);
+    window.cores.op_window = 16;
+    const FrameTiming a = time_passes(base, {chain});
+    const FrameTiming b = time_passes(window, {chain});
+    const FrameTiming c = time_passes(units, {chain});
+    CHECK(b.cycles == a.cycles);
+    CHECK(c.cycles == a.cycles);
+    // Three ops of one group each, about the 65 cycles of a group's fetch, schedule and
+    // partition apiece: 3 busy cycles, the rest stalled, most of it on that latency.
+    CHECK(a.cycles >= 3 * 60);
+    CHECK(a.stalls.total() + 3 == a.cycles);
+    CHECK(double(a.stalls.pipeline_fill) >= 0.85 * double(a.cycles));
+}
+
 TEST_CASE("Prefetching an op's children requests the back child's node with the front child's",
           "[hw_model][systemc]") {
     // Every node first read from DRAM.
