@@ -1,7 +1,5 @@
 #include "hw_model/node_clock.h"
 
-#include <algorithm>
-
 #include <cstdio>
 
 namespace sfx {

@@ -4,7 +4,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <sstream>
 
 #include "base/strict_yaml.h"
 #include "base/user_files.h"
