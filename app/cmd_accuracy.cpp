@@ -54,6 +54,7 @@ void add_accuracy_command(CLI::App& app) {
         std::string scene;
         bool json = false;
         std::string plot;
+        std::string tech;
         WorkloadFlags workload;
         SamplingFlags sampling;
     };
@@ -64,10 +65,12 @@ void add_accuracy_command(CLI::App& app) {
     c->add_option("--scene", o->scene, "scene file or built-in scene name")->required();
     c->add_flag("--json", o->json, "print a JSON list of rows");
     c->add_option("--plot", o->plot, "also draw error against host time into this PNG");
+    add_tech_option(c, o->tech);
     o->workload.add_to(c);
     o->sampling.add_to(c);
     c->callback([o] {
-        const std::vector<HwConfig> configs = {load_hw_config(o->hw)};
+        std::vector<HwConfig> configs = {load_hw_config(o->hw)};
+        apply_tech_option(configs, o->tech);
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
         if (!o->plot.empty() && (o->plot.size() < 5 || o->plot.substr(o->plot.size() - 4) != ".png"))

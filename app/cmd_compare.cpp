@@ -155,7 +155,7 @@ void compare_stored(const std::string& db, const std::string& sel_a, const std::
 
 void add_compare_command(CLI::App& app) {
     struct Options {
-        std::string a, b, scene, fidelity = "full", store, sel_a, sel_b, tech = "90nm";
+        std::string a, b, scene, fidelity = "full", store, sel_a, sel_b, tech;
         bool json = false;
         WorkloadFlags workload;
     };
@@ -183,13 +183,12 @@ void add_compare_command(CLI::App& app) {
         if (o->a.empty() || o->b.empty())
             throw InputError("command line", 0, "compare", "expected two hardware files A B (or --store DB --a ... --b ...)");
         if (o->scene.empty()) throw InputError("command line", 0, "--scene", "required with two hardware files");
-        const auto tech = std::make_shared<const TechTable>(resolve_tech_table(o->tech));
-        const std::vector<HwConfig> configs = {load_hw_config(o->a), load_hw_config(o->b)};
+        std::vector<HwConfig> configs = {load_hw_config(o->a), load_hw_config(o->b)};
+        apply_tech_option(configs, o->tech);
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
         const Bvh bvh(scene);
         PointGroupResult r = run_point_group(scene, bvh, settings, configs, parse_fidelity(o->fidelity));
-        for (Prediction& p : r.predictions) p.tech = tech;
         const Prediction& pa = r.predictions[0];
         const Prediction& pb = r.predictions[1];
         const std::vector<Row> rows = comparison_rows(stat_map(pa), stat_map(pb));

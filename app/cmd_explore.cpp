@@ -211,6 +211,7 @@ std::string spec_json(const ExploreSpec& spec) {
         j["knobs"].push_back({{"path", spec.space.axes[a]}, {"values", spec.space.axis_choices[a]}});
     j["screen"] = to_string(spec.screen);
     j["confirm"] = to_string(spec.confirm);
+    j["nodes"] = spec.nodes();
     j["configurations"] = spec.configurations();
     j["budget"] = {{"evaluations", spec.budget_evaluations}, {"host_seconds", spec.budget_seconds}};
     j["search"] = {{"sampler", spec.sampler}, {"seed", spec.seed}, {"batch", spec.batch}};
@@ -272,6 +273,7 @@ struct Options {
 void run_explore(const Options& o) {
     if (!o.store.empty() && access(o.store.c_str(), F_OK) != 0) check_output_file(o.store, "--store");
     ExploreSpec spec = load_explore(o.file, o.sets);
+    for (const std::string& w : spec.space.warnings) std::cerr << "warning: " << w << "\n";
     if (o.seed >= 0) spec.seed = uint64_t(o.seed);
     if (!o.sampler.empty()) spec.sampler = o.sampler;
     if (o.budget) spec.budget_evaluations = std::min(o.budget, spec.configurations());
@@ -404,6 +406,7 @@ void run_explore(const Options& o) {
         j["seconds"] = progress.elapsed();
         j["screen"] = to_string(spec.screen);
         j["confirm"] = to_string(spec.confirm);
+        j["nodes"] = spec.nodes();
         j["objectives"] = objectives_json(spec);
         auto entry = [&](size_t c, const ExploreScore& s) {
             return nlohmann::ordered_json{{"config", c},
@@ -422,7 +425,9 @@ void run_explore(const Options& o) {
         std::cout << j.dump(2) << "\n";
         return;
     }
-    std::cout << "explore " << spec.name << ": " << screened.size() << " of " << space
+    std::string nodes;
+    for (const std::string& n : spec.nodes()) nodes += (nodes.empty() ? "" : ", ") + n;
+    std::cout << "explore " << spec.name << " at " << nodes << ": " << screened.size() << " of " << space
               << " configurations screened at " << to_string(spec.screen) << " (" << feasible_count
               << " meet the constraints); " << screen_front.size() << " on the screened front";
     if (has_confirm) std::cout << ", " << front.size() << " still on it at " << to_string(spec.confirm);

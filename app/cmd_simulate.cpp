@@ -124,12 +124,25 @@ void print_predictions(const std::vector<Prediction>& predictions,
                                        : "energy " + what.substr(0, what.size() - 13) + " mJ/frame";
         row(label, [&](const Prediction& p) { return fixed(stat(p, s.name), 3); });
     }
-    row("power W (leakage W)", [&](const Prediction& p) {
+    row("power W (static W)", [&](const Prediction& p) {
         return fixed(stat(p, "power.w"), 3) + " (" + fixed(stat(p, "power.leakage_w"), 3) + ")";
     });
+    // Per unit: dynamic power (static power in brackets; DRAM has none on chip).
+    for (const Stat& s : predictions.front().stats()) {
+        const size_t end = s.name.rfind(".dynamic_w");
+        if (s.name.rfind("power.", 0) != 0 || end == std::string::npos) continue;
+        const std::string unit = s.name.substr(6, end - 6);
+        row("power " + unit + " W (static W)", [&](const Prediction& p) {
+            const double leak = stat(p, "power." + unit + ".static_w");
+            return fixed(stat(p, s.name), 3) + (unit == "dram" ? "" : " (" + fixed(leak, 3) + ")");
+        });
+    }
     row("fps per mm2", [&](const Prediction& p) { return fixed(stat(p, "fps_per_mm2"), 4); });
     row("frames per joule", [&](const Prediction& p) { return fixed(stat(p, "frames_per_joule"), 2); });
     row("technology node nm", [&](const Prediction& p) { return fixed(stat(p, "tech.node_nm"), 0); });
+    row("clock core / interconnect MHz", [&](const Prediction& p) {
+        return fixed(p.config.clock.core_mhz, 0) + " / " + fixed(p.config.clock.interconnect_mhz, 0);
+    });
     row("host seconds", [&](const Prediction& p) { return fixed(p.host_seconds, 3); });
     row("error estimate (interval)", [&](const Prediction& p) {
         return p.error_relative < 0 ? std::string("unknown") : "+-" + fixed(100 * p.error_relative, 2) + "%";
@@ -144,7 +157,7 @@ void add_simulate_command(CLI::App& app) {
         std::vector<std::string> hw;
         std::string scene;
         std::string fidelity = "full";
-        std::string tech = "90nm";
+        std::string tech;
         bool json = false;
         WorkloadFlags workload;
         SamplingFlags sampling;
@@ -162,9 +175,9 @@ void add_simulate_command(CLI::App& app) {
     o->workload.add_to(c);
     o->sampling.add_to(c);
     c->callback([o] {
-        const auto tech = std::make_shared<const TechTable>(resolve_tech_table(o->tech));
         std::vector<HwConfig> configs;
         for (const std::string& path : o->hw) configs.push_back(load_hw_config(path));
+        apply_tech_option(configs, o->tech);
         const std::vector<ConfigLabel> labels = label_configs(configs, o->hw);
         const Scene scene = load_scene(o->scene);
         const RenderSettings settings = o->workload.resolve(scene, configs);
@@ -179,7 +192,6 @@ void add_simulate_command(CLI::App& app) {
                                 progress.set_done(done);
                             });
         progress.finish();
-        for (Prediction& p : r.predictions) p.tech = tech;
         if (o->json) {
             if (r.predictions.size() == 1) {
                 std::cout << prediction_json(r.predictions[0], labels[0]).dump(2) << "\n";

@@ -164,6 +164,7 @@ void run_sweep(const std::string& path, const std::string& store_path, const std
     if (!csv.empty()) check_output_file(csv, "--csv");
     if (!store_path.empty() && access(store_path.c_str(), F_OK) != 0) check_output_file(store_path, "--store");
     const Sweep sweep = load_sweep(path, sets, max_points);
+    for (const std::string& w : sweep.warnings) std::cerr << "warning: " << w << "\n";
     if (dry_run) {
         print_dry_run(sweep, json);
         return;

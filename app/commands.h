@@ -51,9 +51,13 @@ struct SamplingFlags {
     SamplingOptions resolve(uint64_t seed) const;
 };
 
-// --tech NAME|FILE: the technology table pricing area and energy (a built-in name or a
-// *.tech.yaml file; default 90nm, the paper's node).
+// --tech NAME|FILE: the technology node (a built-in table name or a *.tech.yaml file) of every
+// configuration the command times; not given: each configuration's own `tech.node`.
 void add_tech_option(CLI::App* command, std::string& tech);
+// Sets every configuration's node to `tech` (unless empty), then its clocks to those the node
+// allows where the configuration does not write them (hw_model/node_clock.h), printing a
+// warning to stderr for a written clock above its critical path's.
+void apply_tech_option(std::vector<HwConfig>& configs, const std::string& tech);
 
 void add_render_command(CLI::App& app);
 void add_trace_stats_command(CLI::App& app);

@@ -1,7 +1,9 @@
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 
 #include "app/commands.h"
+#include "hw_model/node_clock.h"
 #include "hw_model/tech_table.h"
 #include "base/input_error.h"
 #include "base/strict_number.h"
@@ -123,11 +125,20 @@ SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
 void add_tech_option(CLI::App* command, std::string& tech) {
     std::string names;
     for (const std::string& n : builtin_tech_names()) names += (names.empty() ? "" : ", ") + n;
-    command
-        ->add_option("--tech", tech,
-                     "technology table for area and energy: a built-in (" + names +
-                         ") or a *.tech.yaml file")
-        ->capture_default_str();
+    command->add_option("--tech", tech,
+                        "technology node of every configuration: a built-in table (" + names +
+                            ") or a *.tech.yaml file; it prices area and energy and sets the "
+                            "clocks a configuration does not write (default: each "
+                            "configuration's tech.node, 90nm in the presets)");
+}
+
+void apply_tech_option(std::vector<HwConfig>& configs, const std::string& tech) {
+    if (!tech.empty()) {
+        tech_table_for(tech, "--tech");
+        for (HwConfig& c : configs) c.tech.node = tech;
+    }
+    for (HwConfig& c : configs)
+        for (const std::string& w : resolve_node_clocks(c)) std::cerr << "warning: " << w << "\n";
 }
 
 }  // namespace sfx

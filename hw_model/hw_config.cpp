@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "kernels/trace.h"
+#include "hw_model/tech_table.h"
 #include "base/input_error.h"
 #include "base/shipped_files.h"
 #include "base/user_files.h"
@@ -280,6 +281,9 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
         if (!known) fail(key, "'" + op + "' is not an op kind (kernels/trace.h)");
         if (!ops.insert(op).second) fail(key, "'" + op + "' has two cost entries");
     }
+    const std::string unknown = unknown_tech_reason(c.tech.node);
+    if (!unknown.empty()) fail("tech.node", unknown);
+    tech_table_for(c.tech.node);  // a table file's own errors name that file, line and key
 }
 
 HwConfig parse_hw_config(const std::string& text, const std::string& file) {
@@ -292,6 +296,8 @@ HwConfig hw_config_from_yaml(const YAML::Node& root, const std::string& file) {
     YamlReader reader(root, file, "", lines);
     config.visit(reader);
     reader.finish();
+    config.clock.core_written = lines.count("clock.core_mhz") > 0;
+    config.clock.interconnect_written = lines.count("clock.interconnect_mhz") > 0;
     check_hw_config(config, file, lines);
     return config;
 }
@@ -405,6 +411,8 @@ void set_hw_param(HwConfig& config, const std::string& path, const std::string& 
     Setter s(path, value, file, line);
     config.visit(s);
     if (!s.found()) throw InputError(file, line, path, "no such hardware parameter");
+    if (path == "clock.core_mhz") config.clock.core_written = true;
+    if (path == "clock.interconnect_mhz") config.clock.interconnect_written = true;
 }
 
 }  // namespace sfx

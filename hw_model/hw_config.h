@@ -21,16 +21,40 @@ namespace sfx {
 // its source: a sentence of G&R, another reference, or "assumed" where no source gives a value
 // (hw_model/presets/gr08.hw.yaml repeats each source beside the value).
 
+// A clock not written in a configuration (file key, override, sweep axis) follows its node:
+// the clock its critical path allows at `tech.node` (resolve_node_clocks, node_clock.h: G&R 3.3's
+// paths scaled by the node's gate delay); at 90 nm both are the values below. A written clock is
+// kept, and warned about when above that path's clock.
 struct ClockConfig {
     double core_mhz = 500.0;  // G&R 3.3: "a conservative frequency of 500 MHz at 90 nm"
     double interconnect_mhz =
         500.0;  // G&R 3.3: the same 500 MHz "to accommodate the flexible interconnect"
+    // Not parameters: whether each clock was written (so it does not follow the node).
+    bool core_written = false, interconnect_written = false;
 
     template <class V>
     void visit(V& v) {
-        v.param("core_mhz", core_mhz, "MHz", "core (SIMD, address, partition) clock", 1.0, 1e5);
+        v.param("core_mhz", core_mhz, "MHz",
+                "core (SIMD, address, partition) clock; not written: its critical path's clock at "
+                "tech.node",
+                1.0, 1e5);
         v.param("interconnect_mhz", interconnect_mhz, "MHz",
-                "interconnect clock (its own clock domain)", 1.0, 1e5);
+                "interconnect clock (its own clock domain); not written: its critical path's "
+                "clock at tech.node",
+                1.0, 1e5);
+    }
+};
+
+// The process node: its technology table prices area and energy, and its gate delay sets the
+// clocks that are not written.
+struct TechConfig {
+    std::string node = "90nm";  // G&R 3.3: "500 MHz at 90 nm"
+
+    template <class V>
+    void visit(V& v) {
+        v.param("node", node, "",
+                "technology node: a built-in table (90nm, 45nm, 32nm, 22nm, 14nm, 10nm, 7nm; "
+                "hw_model/tech/) or a *.tech.yaml file");
     }
 };
 
@@ -340,6 +364,7 @@ struct OpCostConfig {
 struct HwConfig {
     uint32_t version = 1;
     std::string name = "gr08";
+    TechConfig tech;
     ClockConfig clock;
     SimdConfig simd;
     CoreConfig cores;
@@ -356,6 +381,7 @@ struct HwConfig {
     void visit(V& v) {
         v.param("version", version, "", "configuration format version", 1u, 1u);
         v.param("name", name, "", "configuration name");
+        v.group("tech", tech);
         v.group("clock", clock);
         v.group("simd", simd);
         v.group("cores", cores);

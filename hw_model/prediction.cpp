@@ -190,8 +190,8 @@ std::vector<Stat> Prediction::stats() const {
     add("trace.batching.lanes_per_ray", batch_lanes_per_ray, "lanes",
         "RayGrid: cell-walk and enqueue lanes per secondary ray");
 
-    // Area and energy: the action counts priced with the technology table (area_energy.h).
-    const TechTable& t = tech ? *tech : default_tech_table();
+    // Area and energy: the action counts priced with the node's technology table (area_energy.h).
+    const TechTable& t = tech_table_for(config.tech.node, "tech.node");
     const AreaEnergy ae = evaluate_area_energy(config, timing.actions, uint64_t(std::llround(frame_cycles())), t);
     add("tech.node_nm", t.node_nm, "nm", "process node of the technology table");
     for (const UnitCost& u : ae.units)
@@ -204,9 +204,17 @@ std::vector<Stat> Prediction::stats() const {
             "energy of " + u.unit + " per frame, dynamic and leakage");
     add("energy.total_per_frame_mj", energy_mj, "mJ", "energy per frame");
     const double seconds = frame_seconds();
-    add("power.w", seconds > 0 ? energy_mj * 1e-3 / seconds : 0.0, "W", "average power while rendering");
-    add("power.leakage_w", seconds > 0 ? ae.leakage_mj() * 1e-3 / seconds : 0.0, "W",
-        "leakage share of the average power");
+    // Average power over the frame, mJ per frame over seconds per frame: W.
+    auto watts = [&](double mj) { return seconds > 0 ? mj * 1e-3 / seconds : 0.0; };
+    add("power.w", watts(energy_mj), "W", "average power while rendering");
+    add("power.leakage_w", watts(ae.leakage_mj()), "W", "static (leakage) share of the average power");
+    for (const UnitCost& u : ae.units) {
+        add("power." + u.unit + ".dynamic_w", watts(u.dynamic_mj), "W",
+            "dynamic power of " + u.unit + " (its actions' energy over the frame's time)");
+        if (u.unit != "dram")
+            add("power." + u.unit + ".static_w", watts(u.leakage_mj), "W",
+                "static (leakage) power of " + u.unit);
+    }
     add("fps_per_mm2", ratio(fps(), area), "frames/s/mm2", "frame rate per on-chip area");
     add("frames_per_joule", ratio(1.0, energy_mj * 1e-3), "frames/J", "frames per joule");
     return s;

@@ -223,8 +223,6 @@ struct Prediction {
     double error_relative = -1;  // half-width of the frame-cycle interval / estimate; <0: unknown
     uint64_t sample_passes = 0;  // tile passes timed (all of them at full fidelity)
     uint64_t total_passes = 0;
-    // The technology table pricing area and energy in stats(); null: default_tech_table().
-    std::shared_ptr<const TechTable> tech;
 
     // The frame's cycles: passes' core-cycles over the cores (tiles keep every core busy).
     double frame_cycles() const;

@@ -1,9 +1,12 @@
 #include "hw_model/tech_table.h"
 
-#include <fstream>
-#include <sstream>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
 
 #include "base/strict_yaml.h"
+#include "base/user_files.h"
 #include "hw_model/tech/builtin_tech.h"  // generated: k_builtin_tech[] = {name, yaml text}
 
 namespace sfx {
@@ -64,11 +67,7 @@ TechTable parse_tech_table(const std::string& text, const std::string& file) {
 }
 
 TechTable load_tech_table(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw InputError(path, 0, "", "cannot read technology table");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_tech_table(text.str(), path);
+    return parse_tech_table(read_input_file(path, "technology table"), path);
 }
 
 std::vector<std::string> builtin_tech_names() {
@@ -77,25 +76,44 @@ std::vector<std::string> builtin_tech_names() {
     return names;
 }
 
-TechTable resolve_tech_table(const std::string& name_or_path, const std::string& flag) {
+std::string unknown_tech_reason(const std::string& name_or_path) {
+    for (const BuiltinTech& t : k_builtin_tech)
+        if (name_or_path == t.name) return "";
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(name_or_path, ec)) return "";
+    std::string names;
+    for (const BuiltinTech& t : k_builtin_tech)
+        names += names.empty() ? t.name : std::string(", ") + t.name;
+    return "'" + name_or_path + "' is neither a built-in technology (" + names +
+           ") nor a readable *.tech.yaml file";
+}
+
+TechTable resolve_tech_table(const std::string& name_or_path, const std::string& key,
+                             const std::string& file, int line) {
     for (const BuiltinTech& t : k_builtin_tech)
         if (name_or_path == t.name)
             return parse_tech_table(t.yaml, std::string(t.name) + ".tech.yaml");
-    std::ifstream probe(name_or_path);
-    if (!probe) {
-        std::string names;
-        for (const BuiltinTech& t : k_builtin_tech)
-            names += names.empty() ? t.name : std::string(", ") + t.name;
-        throw InputError("command line", 0, flag,
-                         "'" + name_or_path + "' is neither a built-in technology (" + names +
-                             ") nor a readable *.tech.yaml file");
-    }
+    const std::string unknown = unknown_tech_reason(name_or_path);
+    if (!unknown.empty()) throw InputError(file, line, key, unknown);
     return load_tech_table(name_or_path);
 }
 
+const TechTable& tech_table_for(const std::string& name_or_path, const std::string& key,
+                                const std::string& file, int line) {
+    static std::mutex mutex;
+    static std::map<std::string, std::unique_ptr<const TechTable>> tables;
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto it = tables.find(name_or_path);
+    if (it == tables.end())
+        it = tables
+                 .emplace(name_or_path, std::make_unique<const TechTable>(
+                                            resolve_tech_table(name_or_path, key, file, line)))
+                 .first;
+    return *it->second;
+}
+
 const TechTable& default_tech_table() {
-    static const TechTable table = resolve_tech_table("90nm");
-    return table;
+    return tech_table_for("90nm");
 }
 
 }  // namespace sfx

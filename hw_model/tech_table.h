@@ -106,6 +106,7 @@ struct TechTable {
     std::string name;
     double node_nm = 0;
     double vdd_v = 0;
+    double gate_delay_vs_90nm = 0;  // a gate's delay over the 90 nm node's ([SB17] delay fits)
     SramTech sram;
     CacheTech cache;
     LogicTech logic;
@@ -118,6 +119,10 @@ struct TechTable {
         v.param("name", name, "", "table name");
         v.param("node_nm", node_nm, "nm", "process node", 1.0, 1000.0);
         v.param("vdd_v", vdd_v, "V", "supply voltage the energies are for", 0.1, 5.0);
+        v.param("gate_delay_vs_90nm", gate_delay_vs_90nm, "",
+                "gate delay over the 90 nm node's at 1.2 V (a critical path's clock scales by its "
+                "inverse)",
+                0.001, 100.0);
         v.group("sram", sram);
         v.group("cache", cache);
         v.group("logic", logic);
@@ -132,9 +137,16 @@ TechTable parse_tech_table(const std::string& yaml_text, const std::string& file
 TechTable load_tech_table(const std::string& path);
 // The tables built into sfx (hw_model/tech/*.tech.yaml, embedded at build time).
 std::vector<std::string> builtin_tech_names();
-// A built-in name ("90nm") or a path to a *.tech.yaml file; `flag` names the option in errors.
-TechTable resolve_tech_table(const std::string& name_or_path, const std::string& flag = "--tech");
-// The default table (the paper's node, 90 nm), parsed once.
+// Why `name_or_path` names no table (neither a built-in nor a readable file); empty if it does.
+std::string unknown_tech_reason(const std::string& name_or_path);
+// A built-in name ("90nm") or a path to a *.tech.yaml file; an unknown name is an InputError
+// naming `file`, `line` and `key` (the option or configuration key that gave it).
+TechTable resolve_tech_table(const std::string& name_or_path, const std::string& key = "--tech",
+                             const std::string& file = "command line", int line = 0);
+// The same, parsed once per name and process (a configuration's `tech.node`; thread-safe).
+const TechTable& tech_table_for(const std::string& name_or_path, const std::string& key = "--tech",
+                                const std::string& file = "command line", int line = 0);
+// The default table (the paper's node, 90 nm).
 const TechTable& default_tech_table();
 
 }  // namespace sfx

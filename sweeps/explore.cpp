@@ -224,6 +224,12 @@ std::vector<std::pair<std::string, std::string>> ExploreSpec::knob_values(size_t
     return out;
 }
 
+std::vector<std::string> ExploreSpec::nodes() const {
+    for (size_t a = 1; a < space.axes.size(); ++a)
+        if (space.axes[a] == "hw.tech.node") return space.axis_choices[a];
+    return {space.point(0).hw.tech.node};
+}
+
 std::string ExploreSpec::fingerprint() const {
     std::ostringstream s;
     // Not the budget, batch or startup: a search may go on with more evaluations or other

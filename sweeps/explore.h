@@ -65,6 +65,9 @@ struct ExploreSpec {
     SweepPoint point(size_t workload, size_t config, Fidelity fidelity) const;
     // {knob path: value} of configuration c.
     std::vector<std::pair<std::string, std::string>> knob_values(size_t config) const;
+    // The technology nodes the space is built at: a `hw.tech.node` knob's values, else the
+    // base's node.
+    std::vector<std::string> nodes() const;
     // Space, base point, workload weights, objectives, constraints, sampler and seed as one
     // canonical text: a study or stored search made for another fingerprint is not this one's.
     std::string fingerprint() const;

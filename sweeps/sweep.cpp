@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "hw_model/node_clock.h"
 #include "sweeps/point_group.h"
 #include "sweeps/sha256.h"
 #include "base/input_error.h"
@@ -534,7 +535,16 @@ private:
                     apply(m_axes[a], at[d], hw, w, f, false);
                     (m_axes[a].kind == Axis::hw ? hw_moved : workload_moved) = true;
                 }
-            if (hw_moved) check_point_hw(hw, n, at);
+            if (hw_moved) {
+                check_point_hw(hw, n, at);
+                if (hw.clock.core_written || hw.clock.interconnect_written) {
+                    HwConfig clocked = hw;  // a written clock above its node's: said once
+                    for (std::string& warning : resolve_node_clocks(clocked))
+                        if (std::find(sweep.warnings.begin(), sweep.warnings.end(), warning) ==
+                            sweep.warnings.end())
+                            sweep.warnings.push_back(std::move(warning));
+                }
+            }
             if (hw_moved || workload_moved) {
                 const SceneInfo& scene = scene_info(w.scene, line_at(at, "scene"), "workload.scene");
                 WorkloadConfig r = resolve(w, hw, scene.features, n, at);
@@ -583,6 +593,7 @@ public:
                 apply(m_axes[a], at[d], p.hw, w, p.fidelity, false);
                 p.axis_values.emplace_back(m_axes[a].path, m_axes[a].values[at[d]]);
             }
+        resolve_node_clocks(p.hw);  // clocks not written follow the point's node
         p.workload = resolve(w, p.hw, scene_info(w.scene, 0, "workload.scene").features, n, at);
         p.config_yaml = point_config_yaml(p.hw, p.workload, p.fidelity);
         p.key = point_key(p.config_yaml);

@@ -56,6 +56,9 @@ struct Sweep {
     std::vector<PointGroup> groups;
     size_t point_count = 0;  // distinct points: the expansion less its duplicates
     size_t duplicates = 0;   // expanded points identical to an earlier one (dropped)
+    // Written clocks above what their critical path allows at the point's node, each once
+    // (hw_model/node_clock.h); the commands print them.
+    std::vector<std::string> warnings;
 
     // The point at this expansion index (an index of some group's `points`).
     SweepPoint point(size_t index) const;

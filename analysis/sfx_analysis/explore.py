@@ -55,6 +55,12 @@ class Explore:
     def constraints(self) -> List[dict]:
         return [c for c in self.spec.get("constraints", []) if c.get("metric") in METRICS]
 
+    @property
+    def nodes_text(self) -> str:
+        """The technology nodes the space was built at ("7nm"), "" for an explore stored
+        before sfx recorded them."""
+        return ", ".join(str(n) for n in self.spec.get("nodes", []))
+
     def first_objective(self) -> Tuple[str, bool]:
         """(metric, True when larger is better); fps maximised when the spec names none."""
         objs = self.objectives
@@ -207,7 +213,8 @@ def plot_explore(ex: Explore, directory: str, file_stem: str) -> Plot:
     """fps against area, energy per frame as colour: every screened configuration pale, the
     confirmed front (the screened front without a confirmation) large and joined by a step
     line; the constraints on fps and area as dashed lines."""
-    plot = Plot(file_stem, f"{ex.name}: frame rate against chip area, energy as colour")
+    at = f" at {ex.nodes_text}" if ex.nodes_text else ""
+    plot = Plot(file_stem, f"{ex.name}{at}: frame rate against chip area, energy as colour")
     screen = ex.screen.dropna(subset=["fps", "area_mm2"])
     confirmed = not ex.confirm.empty
     front = ex.confirm if confirmed else ex.screen[ex.screen["front"] == 1]
@@ -248,7 +255,7 @@ def plot_explore(ex: Explore, directory: str, file_stem: str) -> Plot:
                 ax.axhline(float(c[bound]), color="C3", linestyle="--", linewidth=0.9)
     ax.set_xlabel("chip area [mm²]")
     ax.set_ylabel("predicted fps [frames/s] (weighted over the workloads)")
-    ax.set_title(f"What to build: {ex.name}")
+    ax.set_title(f"What to build: {ex.name}{at}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="x-small", loc="best")
     plot.file = f"{file_stem}.png"
@@ -376,6 +383,7 @@ def html_section(ex: Explore, plot: Plot) -> str:
            f"<h2>What to build: {e(ex.name)}</h2>",
            '<table class="summary">',
            f"<tr><th>explore file</th><td>{e(ex.file or '—')}</td></tr>",
+           f"<tr><th>technology node</th><td>{e(ex.nodes_text or '—')}</td></tr>",
            f"<tr><th>objectives</th><td>{e(objs)}</td></tr>",
            f"<tr><th>constraints</th><td>{e(cons)}</td></tr>",
            f"<tr><th>workloads</th><td>{e(loads)}</td></tr>",

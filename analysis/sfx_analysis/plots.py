@@ -82,6 +82,20 @@ def _context_caption(context: Dict[str, object]) -> str:
         else ""
 
 
+def _titled(plot: Plot, data: pd.DataFrame) -> str:
+    """The plot's title with the technology nodes of its points (hw.tech.node; tech.node_nm in
+    stores from before the node was a knob): "... (7nm)"."""
+    if "hw.tech.node" in data.columns:
+        nodes = sorted(data["hw.tech.node"].dropna().astype(str).unique())
+    elif "tech.node_nm" in data.columns:
+        nodes = [f"{_n(v)}nm" for v in sorted(data["tech.node_nm"].dropna().unique())]
+    else:
+        nodes = []
+    if nodes:
+        plot.title += f" ({', '.join(nodes)})"
+    return plot.title
+
+
 def _with(points: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
     if any(c not in points.columns for c in columns):
         return points.iloc[0:0]
@@ -115,7 +129,7 @@ def plot_fps_vs_width(store: Store, directory: str) -> Plot:
         ax.set_ylim(bottom=0)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = ("One panel per scene, one line per initial stream (tile) size." +
                     (" Error bars: the model's fps interval." if any_error else "") +
@@ -157,7 +171,7 @@ def plot_utilization_vs_width(store: Store, directory: str) -> Plot:
         ax.grid(True, alpha=0.3)
         if ax is axes[0]:  # the same stages in every panel: one legend
             ax.legend(fontsize="x-small")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = ("All rays. Solid: effective utilization (stalls issue nothing); dotted: the "
                     "ideal from the trace." + _context_caption(context))
@@ -197,7 +211,7 @@ def plot_stalls(store: Store, directory: str) -> Plot:
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="upper center", ncol=min(4, len(causes)),
                bbox_to_anchor=(0.5, -0.02), fontsize="small")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = ("Cycles per frame in which the SIMD unit issued nothing, stacked by cause." +
                     _context_caption(context))
@@ -261,7 +275,7 @@ def plot_fps_vs_buffer(store: Store, directory: str) -> Plot:
         ax.set_ylim(bottom=0)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="x-small", loc="lower right")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = (("One line per SIMD width and tile: what a bigger buffer buys at a fixed "
                      "stream size." if fixed_tile else
@@ -327,7 +341,7 @@ def plot_pareto(store: Store, directory: str) -> Plot:
         ax.set_ylim(0, 1.12 * d["fps"].max())  # room for the labels
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="x-small", loc="lower right")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = ("Ray-buffer capacity as an area proxy. Red: the designs no other design "
                     "beats with less or equal capacity; labels give SIMD width and tile." +
@@ -404,7 +418,7 @@ def _cost_front(store: Store, directory: str, plot: Plot, cost: str, cost_label:
         ax.margins(0.15)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="x-small", loc="best")
-    fig.suptitle(plot.title)
+    fig.suptitle(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     tech = ""
     if "tech.node_nm" in data.columns and data["tech.node_nm"].nunique() == 1:
@@ -485,7 +499,7 @@ def plot_error_vs_host_time(store: Store, directory: str) -> Plot:
     ax.set_ylim(-0.03 * top, top)  # exact (0 %) points stay visible
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")
-    ax.set_title(plot.title)
+    ax.set_title(_titled(plot, data))
     plot.file = _save(fig, directory, plot.name)
     plot.caption = (f"{data['config_id'].nunique()} configuration(s) run at several fidelities. "
                     "Filled: |fps − fps at full fidelity| / fps at full fidelity; hollow: the "

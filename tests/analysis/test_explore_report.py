@@ -142,3 +142,11 @@ def test_unreadable_spec_still_reports(tmp_path):
     report = write_report(path, str(tmp_path / "r"))
     page = open(report.index, encoding="utf-8").read()
     assert "What to build" in page and "not readable JSON" in page
+
+
+def test_front_names_its_node(tmp_path):
+    spec = dict(SPEC, nodes=["7nm"])
+    report = write_report(explore_store(tmp_path, spec=spec), str(tmp_path / "r"))
+    page = open(report.index, encoding="utf-8").read()
+    assert "<tr><th>technology node</th><td>7nm</td></tr>" in page
+    assert report.explore_plots[0].title.startswith("gr08-atrium at 7nm:")

@@ -123,3 +123,15 @@ def test_fronts_skip_stores_without_area(tmp_path):
     skipped = {p.name: p.skipped for p in report.plots if p.skipped}
     assert "area.total_mm2" in skipped["pareto_fps_vs_area"]
     assert "energy.total_per_frame_mj" in skipped["pareto_energy_vs_fps"]
+
+
+def test_plots_name_the_technology_node(tmp_path):
+    # A store of one node names it in every drawn plot's title; older stores (no hw.tech.node)
+    # fall back to tech.node_nm.
+    points = [dict(p, **{"hw.tech.node": "7nm", "tech.node_nm": 7.0})
+              for p in grid_points(kibs=(128.0, 512.0))]
+    report = write_report(write_store(str(tmp_path / "n.db"), points), str(tmp_path / "r"))
+    drawn = [p for p in report.plots if not p.skipped]
+    assert drawn and all(p.title.endswith("(7nm)") for p in drawn), [p.title for p in drawn]
+    old = write_report(write_store(str(tmp_path / "o.db"), grid_points()), str(tmp_path / "o"))
+    assert all(p.title.endswith("(90nm)") for p in old.plots if not p.skipped)

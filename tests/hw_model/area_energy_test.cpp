@@ -18,6 +18,7 @@ const char* k_test_table = R"(version: 1
 name: test
 node_nm: 90
 vdd_v: 1.2
+gate_delay_vs_90nm: 1
 sram:
   ref_kib: 16
   area_mm2: 0.25

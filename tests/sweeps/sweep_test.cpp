@@ -306,7 +306,8 @@ TEST_CASE("Every shipped sweep validates and expands", "[sweeps]") {
                                                     {"quickstart-buffer", 16},
                                                     {"paper-table6", 18},
                                                     {"buffer-size", 16},
-                                                    {"width-scan", 192}};
+                                                    {"width-scan", 192},
+                                                    {"nodes", 14}};
     size_t found = 0;
     for (const auto& entry : std::filesystem::directory_iterator(SFX_SOURCE_DIR "/sweeps")) {
         const std::string name = entry.path().filename().string();
