@@ -54,6 +54,23 @@ FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b) {
     return d;
 }
 
+void fit_stalls_to_cycles(FrameTiming& t, uint32_t units) {
+    double busy = 0.0;
+    for (const auto& by_stage : t.stages)
+        for (const StageTiming& s : by_stage) busy += double(s.busy_cycles);
+    const double stalled = double(t.stalls.total());
+    if (stalled <= 0.0) return;
+    const double f = std::max(0.0, double(units) * double(t.cycles) - busy) / stalled;
+    auto scale = [f](uint64_t& v) { v = uint64_t(std::llround(double(v) * f)); };
+    StallCycles::visit(t.stalls, t.stalls,
+                       [&](const CounterInfo&, uint64_t& v, const uint64_t&) { scale(v); });
+    for (auto& by_stage : t.stages)
+        for (StageTiming& s : by_stage) {
+            scale(s.stall_cycles);
+            scale(s.scene_memory_cycles);
+        }
+}
+
 double Prediction::frame_cycles() const {
     return double(timing.cycles) / double(std::max(1u, config.cores.count));
 }

@@ -148,6 +148,12 @@ struct FrameTiming {
 // What happened between two snapshots of the same model (b taken after a).
 FrameTiming timing_between(const FrameTiming& a, const FrameTiming& b);
 
+// Scales the stall causes, and each stage's stall cycles, by one factor so that busy and stall
+// unit-cycles add up to `units` x the cycles, as they do at cycle level by construction: a
+// closed form's (calibrated) cycles keep its work and its mix of causes. Unchanged when there
+// is no stall to scale.
+void fit_stalls_to_cycles(FrameTiming& t, uint32_t units);
+
 template <class A, class B, class F>
 void FrameTiming::visit(A& a, B& b, F&& f) {
     f(CounterInfo("cycles", "core-cycles", "cycles summed over passes"), a.cycles, b.cycles);

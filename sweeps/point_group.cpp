@@ -559,6 +559,8 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
             if (std::binary_search(calibrated.begin(), calibrated.end(), i))
                 p.sample_passes = calibration->sampled();
         }
+        // The closed form's causes, in proportion, fill the cycles its work leaves.
+        if (fidelity == Fidelity::analytic) fit_stalls_to_cycles(p.timing, configs[i].simd.units);
         // Full fidelity is the reference the other levels are measured against: no sampling
         // error. An uncalibrated analytic point's error is unknown (-1).
         if (fidelity == Fidelity::full) p.error_relative = 0.0;

@@ -476,12 +476,11 @@ TEST_CASE("The rate with every stall hidden is never below the prediction", "[hw
         CHECK(p.fps() > 0.0);
         CHECK(stall_free >= p.fps());
         CHECK(full_lanes >= stall_free);
-        // Busy cycles only: at cycle level, the frame's cycles less its stalls, per unit (the
-        // analytic level's calibrated cycles and its stalls do not sum so).
-        if (p.fidelity != Fidelity::full) continue;
+        // Busy cycles only: the frame's cycles less its stalls, per unit (at the analytic level
+        // too: its causes fill the calibrated cycles its work leaves).
         const double busy = p.frame_cycles() - double(p.timing.stalls.total()) /
                                                    double(p.config.simd.units * p.config.cores.count);
-        CHECK(stall_free == Approx(p.fps() * p.frame_cycles() / busy).epsilon(1e-9));
+        CHECK(stall_free == Approx(p.fps() * p.frame_cycles() / busy).epsilon(1e-3));  // causes rounded
     }
 }
 
