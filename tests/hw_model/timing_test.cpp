@@ -120,8 +120,8 @@ TEST_CASE("One group of one op on the cluster: II and schedule length, exact cyc
     // 63; the scratchpad by 64; the partition's compare ends the pass at 65.
     const HwConfig config = with_width(16);
     REQUIRE(config.datapath.issue == "cluster");
-    const OpProfile& p = OpCostTable(RayRecordLayout(triangle_shape(64).features),
-                                     config.datapath)[OpKind::box_test];
+    const OpCostTable table(RayRecordLayout(triangle_shape(64).features), config.datapath);
+    const OpProfile& p = table[OpKind::box_test];
     CHECK(p.schedule.ii == 1);
     CHECK(p.schedule.length == 7 * 7 + 2 * 1);
     const FrameTiming t =
