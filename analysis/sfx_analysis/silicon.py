@@ -165,7 +165,7 @@ def summary(df):
         out[f"{s}_mae"] = df[f"error.{s}"].abs().mean()
         out[f"{s}_worst"] = df[f"error.{s}"].abs().max()
     rank = ranking(df)
-    measurable = rank[rank["measurable"]]
+    measurable = rank[rank["measurable"].astype(bool)]
     out["ranking_right"] = int(measurable["right"].sum())
     out["ranking_cells"] = len(measurable)
     out["ranking_within_noise"] = len(rank) - len(measurable)
@@ -189,7 +189,7 @@ def width_summary(df):
         return None
     scenes = []
     for scene, g in rank.groupby("scene", sort=False):
-        m = g[g["measurable"]]
+        m = g[g["measurable"].astype(bool)]
         scenes.append({"scene": scene, "cells": len(m), "right": int(m["right"].sum()),
                        "pairs": int(m["pairs"].sum()), "pairs_right": int(m["pairs_right"].sum())})
     scenes = pd.DataFrame(scenes)

@@ -164,3 +164,22 @@ def test_self_consistency_flag(tmp_path):
     # An unconverged frame is not used to flag either.
     df.loc[df["scene"] == "b", "measured.converged"] = False
     assert "FLAGGED" not in silicon.consistency_text(df)
+
+
+def test_nothing_converged(tmp_path, capsys):
+    # A host that cannot be measured at all: every workload ran out of budget. The page is
+    # written, says so, and scores nothing.
+    rows = [row("a", 16, 110, 100), row("a", 32, 90, 130, res=(128, 128))]
+    for r in rows:
+        r["measured.converged"] = False
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    s = silicon.summary(df)
+    assert s["converged"] == 0 and s["ranking_cells"] == 0
+    text = silicon.all_summaries_text(df)
+    assert "of which 0 converged (0 %" in text
+    assert "target at least 90 % of workloads converge: MISSED" in text
+    header = tmp_path / "h.md"
+    header.write_text("")
+    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
