@@ -66,7 +66,7 @@ void add_calibrate_command(CLI::App& app) {
         std::string output = "host.hw.yaml";
         std::string check;
         std::string isa = "auto";
-        uint32_t repeats = 21;
+        uint32_t repeats = 41;
         uint32_t min_repeat = 7;
         uint32_t fastest = 3;
         std::string tolerance = "0.03";
