@@ -15,32 +15,26 @@ namespace {
 // uses those registers (Intel's frequency licences), while the count stays the scalar chain's.
 // A chain of the vector adds alone would be no ruler: their latency is 1 cycle on Haswell to
 // Zen 4 but 2 on Zen 5, where such a chain reads half the clock.
+// Eight adds of the ruler beside one link of each vector chain, in the registers R (ymm, zmm);
+// registers 2 and 3 hold 1.0f (so vmulps never meets a denormal), register 1 anything.
+#define SFX_VECTOR_CLOCK_LOOP(R)                                                                \
+    asm volatile("vbroadcastss %0, %%" R "2\n\tvbroadcastss %0, %%" R "3" ::"m"(k_one)          \
+                 : "xmm2", "xmm3");                                                             \
+    start = __rdtsc();                                                                          \
+    for (uint64_t i = 0; i < adds / 8; ++i)                                                     \
+        asm volatile("add $1, %0\n\tvpaddd %%" R "1, %%" R "0, %%" R "0\n\tadd $1, %0\n\t"        \
+                     "vmulps %%" R "3, %%" R "2, %%" R "2\n\tadd $1, %0\n\tadd $1, %0\n\t"       \
+                     "add $1, %0\n\tadd $1, %0\n\tadd $1, %0\n\tadd $1, %0"                      \
+                     : "+r"(x)::"xmm0", "xmm2")
+
 uint64_t chain_ticks(uint32_t lanes, uint64_t adds, uint64_t seed) {
     uint64_t x = seed;
     static const float k_one = 1.0f;
     uint64_t start = 0;
     if (lanes == 16) {
-        asm volatile("vpxord %%zmm1, %%zmm1, %%zmm1\n\tvbroadcastss %0, %%zmm2\n\t"
-                     "vbroadcastss %0, %%zmm3" ::"m"(k_one)
-                     : "xmm1", "xmm2", "xmm3");
-        start = __rdtsc();
-        for (uint64_t i = 0; i < adds / 8; ++i)
-            asm volatile(
-                "add $1, %0\n\tvpaddd %%zmm1, %%zmm0, %%zmm0\n\tadd $1, %0\n\t"
-                "vmulps %%zmm3, %%zmm2, %%zmm2\n\tadd $1, %0\n\tadd $1, %0\n\t"
-                "add $1, %0\n\tadd $1, %0\n\tadd $1, %0\n\tadd $1, %0"
-                : "+r"(x)::"xmm0", "xmm2");
+        SFX_VECTOR_CLOCK_LOOP("zmm");
     } else if (lanes == 8) {
-        asm volatile("vpxor %%ymm1, %%ymm1, %%ymm1\n\tvbroadcastss %0, %%ymm2\n\t"
-                     "vbroadcastss %0, %%ymm3" ::"m"(k_one)
-                     : "xmm1", "xmm2", "xmm3");
-        start = __rdtsc();
-        for (uint64_t i = 0; i < adds / 8; ++i)
-            asm volatile(
-                "add $1, %0\n\tvpaddd %%ymm1, %%ymm0, %%ymm0\n\tadd $1, %0\n\t"
-                "vmulps %%ymm3, %%ymm2, %%ymm2\n\tadd $1, %0\n\tadd $1, %0\n\t"
-                "add $1, %0\n\tadd $1, %0\n\tadd $1, %0\n\tadd $1, %0"
-                : "+r"(x)::"xmm0", "xmm2");
+        SFX_VECTOR_CLOCK_LOOP("ymm");
     } else {
         start = __rdtsc();
         for (uint64_t i = 0; i < adds / 4; ++i)
