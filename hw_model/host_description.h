@@ -61,7 +61,7 @@ struct HostDescription {
     uint32_t simd_width = 1;
     std::string isa;  // e.g. "avx512 (16 lanes)"
     double tsc_mhz = 0.0;
-    // The core's clock while measured, boost included, by a chain of the back end's own adds
+    // The core's clock while measured, boost included, under the back end's own instructions
     // (base/core_clock.h: the clock under AVX2 or AVX-512 code may be lower than under scalar).
     double core_mhz = 0.0;
     std::vector<HostCacheLevel> caches;

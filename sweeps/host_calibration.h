@@ -68,7 +68,7 @@ struct SiliconMeasurement {
     int64_t huge_page_kib_min = -1, huge_page_kib_max = -1;
     double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
     std::vector<double> frame_samples;       // every unclocked render's cycles
-    std::array<double, 3> measured_stage{};  // least interrupted split x measured_frame
+    std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame
     double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
 };
