@@ -314,6 +314,7 @@ void add_calibrate_command(CLI::App& app) {
                     row["measured.clock_mhz_after"] = m.clock_mhz_after;
                     row["measured.huge_page_kib_min"] = m.huge_page_kib_min;
                     row["measured.huge_page_kib_max"] = m.huge_page_kib_max;
+                    row["measured.neighbours_busy"] = m.neighbours_busy;
                     row["host.vendor"] = vendor_short_name(uarch.vendor);
                     row["host.family"] = uarch.signature.family;
                     row["host.model"] = uarch.signature.model;

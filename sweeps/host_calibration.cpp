@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "base/cpu_load.h"
 #include "base/cycle_source.h"
 #include "base/huge_pages.h"
 #include "hw_model/op_costs.h"
@@ -166,6 +167,8 @@ std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bv
     // of 0-64 KiB in 64-byte steps, held over the render, moves where the tracer's buffers land
     // relative to pages, cache sets and each other.
     std::mt19937_64 rng(seed);
+    std::vector<uint64_t> others_busy(n, 0), others_total(n, 0);
+    const int own_cpu = sched_getcpu();
     for (bool more = true; more;) {
         more = false;
         for (size_t v = 0; v < n; ++v) {
@@ -173,8 +176,15 @@ std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bv
             if (!needs_more_samples(m.frame_samples, convergence)) continue;
             more = true;
             std::vector<char> shift(64 * size_t(rng() % 1024));
+            const std::vector<CpuTimes> load_before = read_cpu_times();
             const auto [reading, ticks] = timed_render(scene, bvh, settings[v], false,
                                                        source_of(v), tsc_mhz, r, m.interrupted);
+            const std::vector<CpuTimes> load_after = read_cpu_times();
+            for (size_t c = 0; c < load_before.size() && c < load_after.size(); ++c)
+                if (int(c) != own_cpu) {
+                    others_busy[v] += load_after[c].busy - load_before[c].busy;
+                    others_total[v] += load_after[c].total - load_before[c].total;
+                }
             m.frame_samples.push_back(reading.cycles);
             readings[v].push_back(reading);
             tsc_samples[v].push_back(ticks);
@@ -200,6 +210,7 @@ std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bv
         m.clock_mhz_before = readings[v][fastest].clock_mhz_before;
         m.clock_mhz_after = readings[v][fastest].clock_mhz_after;
         m.measured_frame_tsc = median(tsc_samples[v]);
+        if (others_total[v] > 0) m.neighbours_busy = double(others_busy[v]) / double(others_total[v]);
         const double stages = stage_min[v][0] + stage_min[v][1] + stage_min[v][2];
         for (int s = 0; s < 3; ++s)
             m.measured_stage[size_t(s)] =

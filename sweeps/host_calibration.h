@@ -66,6 +66,9 @@ struct SiliconMeasurement {
     // Placement: KiB of the process in transparent huge pages after each render, least and
     // most (-1: unreadable); every render's buffers land after a heap block of random size.
     int64_t huge_page_kib_min = -1, huge_page_kib_max = -1;
+    // The other CPUs' busy share over its unclocked renders (base/cpu_load.h; -1: unknown): a
+    // neighbour's load biases a whole run, and no convergence rule sees it.
+    double neighbours_busy = -1.0;
     double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
     std::vector<double> frame_samples;       // every unclocked render's cycles
     std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame

@@ -328,6 +328,14 @@ def measurement_text(df):
         lo, hi = df["measured.huge_page_kib_min"].min(), df["measured.huge_page_kib_max"].max()
         lines.append(f"- transparent huge pages held by the process after each render: "
                      f"{lo / 1024:.0f}-{hi / 1024:.0f} MiB (AnonHugePages, /proc/self/smaps_rollup)")
+    if "measured.neighbours_busy" in df:
+        busy = df["measured.neighbours_busy"]
+        busy = busy[busy >= 0]
+        if len(busy):
+            lines.append(f"- the other CPUs were busy {100 * busy.mean():.0f} % of the time during "
+                         f"the renders (per workload {100 * busy.min():.0f}-{100 * busy.max():.0f} "
+                         f"%; /proc/stat): a neighbour's load biases a whole run alike, which no "
+                         f"convergence rule sees")
     return "\n".join(lines)
 
 

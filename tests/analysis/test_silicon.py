@@ -123,6 +123,7 @@ def test_unconverged_workloads_are_shown_not_scored(tmp_path):
         r["measured.renders"] = 7
         r["convergence_rule"] = "fastest 3 of 7-31 samples within 3 %"
         r["measured.cycle_source"] = "estimated: thread CPU time x ... (perf_event_open refused: ENOENT)"
+        r["measured.neighbours_busy"] = 0.5
     rows[2]["measured.converged"] = False  # the 25 % miss ran out of budget
     rows[2]["measured.renders"] = 31
     p = tmp_path / "rows.json"
@@ -141,6 +142,7 @@ def test_unconverged_workloads_are_shown_not_scored(tmp_path):
     assert "convergence rule: fastest 3 of 7-31 samples within 3 %" in text
     assert "cycles (avx512): estimated" in text and "ENOENT" in text
     assert "target at least 90 % of workloads converge: MISSED" in text
+    assert "the other CPUs were busy 50 % of the time" in text
 
 
 def test_self_consistency_flag(tmp_path):
