@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
@@ -261,95 +262,105 @@ void add_calibrate_command(CLI::App& app) {
         std::vector<std::pair<uint32_t, uint32_t>> resolutions;
         for (const std::string& r : split(o->res)) resolutions.push_back(parse_res(r));
         const std::vector<std::string> scenes = split(o->scenes);
-        Progress progress("calibrate --check", scenes.size() * resolutions.size(),
-                          "(scene, resolution) cells");
-        const Microarchitecture uarch = read_microarchitecture();
-        uint32_t workloads = 0, converged = 0;
-        std::string sources;
-        nlohmann::json rows = nlohmann::json::array();
+        // Every scene loaded first: the workloads of all scenes are measured in one
+        // interleaved run (predict_and_measure), so that each one's renders span the run.
+        std::vector<std::unique_ptr<Scene>> loaded;
+        std::vector<std::unique_ptr<Bvh>> bvhs;
+        Progress progress("calibrate --check", scenes.size(), "scenes loaded");
         for (const std::string& name : scenes) {
             progress.set_label(name + ": loading");
-            const Scene scene = load_scene(name);
-            const Bvh bvh(scene);
-            for (const auto& [w, h] : resolutions) {
-                progress.set_label(name + " " + std::to_string(w) + "x" + std::to_string(h));
-                // Every tile on every back end of the cell, measured in turn.
-                std::vector<SiliconVariant> variants;
+            loaded.push_back(std::make_unique<Scene>(load_scene(name)));
+            bvhs.push_back(std::make_unique<Bvh>(*loaded.back()));
+            progress.advance();
+        }
+        // Every tile on every back end of every (scene, resolution) cell.
+        std::vector<SiliconVariant> variants;
+        std::vector<std::string> variant_scene;
+        for (size_t sc = 0; sc < scenes.size(); ++sc)
+            for (const auto& [w, h] : resolutions)
                 for (size_t k = 0; k < hosts.size(); ++k)
                     for (uint32_t tile : tiles) {
                         SiliconVariant v;
+                        v.scene = loaded[sc].get();
+                        v.bvh = bvhs[sc].get();
                         v.settings.width = w;
                         v.settings.height = h;
                         v.settings.spp = o->spp;
                         v.settings.tile = tile;
-                        v.settings.max_depth = scene.max_depth;
+                        v.settings.max_depth = loaded[sc]->max_depth;
                         v.settings.isa = host_isas[k];
                         v.host = &hosts[k];
                         variants.push_back(v);
+                        variant_scene.push_back(scenes[sc]);
                     }
-                const std::vector<SiliconMeasurement> measured =
-                    predict_and_measure(scene, bvh, variants, render_rule);
-                for (size_t i = 0; i < variants.size(); ++i) {
-                    const SiliconMeasurement& m = measured[i];
-                    const RenderSettings& st = variants[i].settings;
-                    nlohmann::json row;
-                    row["scene"] = name;
-                    row["width"] = w;
-                    row["height"] = h;
-                    row["tile"] = st.tile;
-                    row["spp"] = o->spp;
-                    row["isa"] = isa_name(st.isa);
-                    row["simd_width"] = isa_width(st.isa);
-                    row["pinned"] = pinned;
-                    row["predicted.frame_cycles"] = m.predicted_frame;
-                    row["measured.frame_cycles"] = m.measured_frame;
-                    row["measured.frame_samples"] = m.frame_samples;
-                    row["measured.converged"] = m.convergence.converged;
-                    row["measured.spread"] = m.convergence.spread;
-                    row["measured.renders"] = m.convergence.samples;
-                    row["convergence_rule"] = describe(render_rule);
-                    row["measured.cycle_source"] = m.cycle_source;
-                    row["measured.cycles_counted"] = m.cycles_counted;
-                    row["measured.clock_mhz_before"] = m.clock_mhz_before;
-                    row["measured.clock_mhz_after"] = m.clock_mhz_after;
-                    row["measured.huge_page_kib_min"] = m.huge_page_kib_min;
-                    row["measured.huge_page_kib_max"] = m.huge_page_kib_max;
-                    row["measured.neighbours_busy"] = m.neighbours_busy;
-                    row["host.vendor"] = vendor_short_name(uarch.vendor);
-                    row["host.family"] = uarch.signature.family;
-                    row["host.model"] = uarch.signature.model;
-                    row["host.microarchitecture"] = describe(uarch);
-                    ++workloads;
-                    converged += m.convergence.converged;
-                    if (sources.find(m.cycle_source) == std::string::npos)
-                        sources += (sources.empty() ? "" : "; ") + m.cycle_source;
-                    row["stage_clock_overhead"] = m.stage_clock_overhead;
-                    row["measured.interrupted_renders"] = m.interrupted;
-                    row["measured.frame_tsc"] = m.measured_frame_tsc;
-                    for (int sg = 0; sg < 3; ++sg) {
-                        row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =
-                            m.predicted_stage[size_t(sg)];
-                        row[std::string("predicted.") + k_stage_names[sg] + "_memory_cycles"] =
-                            m.predicted_memory[size_t(sg)];
-                        row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
-                            m.measured_stage[size_t(sg)];
-                    }
-                    // The machine model's stall causes, as sfx simulate reports them.
-                    for (const Stat& stat : m.prediction.stats())
-                        if (stat.name.rfind("stall_cycles.", 0) == 0)
-                            row["predicted." + stat.name] = stat.value;
-                    rows.push_back(row);
-                    if (!o->json)
-                        progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) +
-                                     " tile " + std::to_string(st.tile) + " " +
-                                     isa_name(st.isa) + ": predicted " +
-                                     std::to_string(m.predicted_frame / 1e6) +
-                                     " Mcycles, measured " +
-                                     std::to_string(m.measured_frame / 1e6) +
-                                     (m.convergence.converged ? "" : " (NOT converged)"));
-                }
-                progress.advance();
+        const std::vector<SiliconMeasurement> measured = predict_and_measure(
+            variants, render_rule, 1, [&](const std::string& what, size_t done, size_t total) {
+                progress.set_label(what);
+                progress.set_total(total);
+                progress.set_done(done);
+            });
+        const Microarchitecture uarch = read_microarchitecture();
+        uint32_t workloads = 0, converged = 0;
+        std::string sources;
+        nlohmann::json rows = nlohmann::json::array();
+        for (size_t i = 0; i < variants.size(); ++i) {
+            const SiliconMeasurement& m = measured[i];
+            const RenderSettings& st = variants[i].settings;
+            const std::string& name = variant_scene[i];
+            const uint32_t w = st.width, h = st.height;
+            nlohmann::json row;
+            row["scene"] = name;
+            row["width"] = w;
+            row["height"] = h;
+            row["tile"] = st.tile;
+            row["spp"] = o->spp;
+            row["isa"] = isa_name(st.isa);
+            row["simd_width"] = isa_width(st.isa);
+            row["pinned"] = pinned;
+            row["predicted.frame_cycles"] = m.predicted_frame;
+            row["measured.frame_cycles"] = m.measured_frame;
+            row["measured.frame_samples"] = m.frame_samples;
+            row["measured.converged"] = m.convergence.converged;
+            row["measured.spread"] = m.convergence.spread;
+            row["measured.renders"] = m.convergence.samples;
+            row["convergence_rule"] = describe(render_rule);
+            row["measured.cycle_source"] = m.cycle_source;
+            row["measured.cycles_counted"] = m.cycles_counted;
+            row["measured.clock_mhz_before"] = m.clock_mhz_before;
+            row["measured.clock_mhz_after"] = m.clock_mhz_after;
+            row["measured.huge_page_kib_min"] = m.huge_page_kib_min;
+            row["measured.huge_page_kib_max"] = m.huge_page_kib_max;
+            row["measured.neighbours_busy"] = m.neighbours_busy;
+            row["host.vendor"] = vendor_short_name(uarch.vendor);
+            row["host.family"] = uarch.signature.family;
+            row["host.model"] = uarch.signature.model;
+            row["host.microarchitecture"] = describe(uarch);
+            ++workloads;
+            converged += m.convergence.converged;
+            if (sources.find(m.cycle_source) == std::string::npos)
+                sources += (sources.empty() ? "" : "; ") + m.cycle_source;
+            row["stage_clock_overhead"] = m.stage_clock_overhead;
+            row["measured.interrupted_renders"] = m.interrupted;
+            row["measured.frame_tsc"] = m.measured_frame_tsc;
+            for (int sg = 0; sg < 3; ++sg) {
+                row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =
+                    m.predicted_stage[size_t(sg)];
+                row[std::string("predicted.") + k_stage_names[sg] + "_memory_cycles"] =
+                    m.predicted_memory[size_t(sg)];
+                row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
+                    m.measured_stage[size_t(sg)];
             }
+            // The machine model's stall causes, as sfx simulate reports them.
+            for (const Stat& stat : m.prediction.stats())
+                if (stat.name.rfind("stall_cycles.", 0) == 0)
+                    row["predicted." + stat.name] = stat.value;
+            rows.push_back(row);
+            if (!o->json)
+                progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) + " tile " +
+                             std::to_string(st.tile) + " " + isa_name(st.isa) + ": predicted " +
+                             std::to_string(m.predicted_frame / 1e6) + " Mcycles, measured " +
+                             std::to_string(m.measured_frame / 1e6) +
+                             (m.convergence.converged ? "" : " (NOT converged)"));
         }
         progress.finish();
         std::fprintf(stderr, "calibrate --check: %u of %u workloads converged (%s); cycles %s\n",

@@ -124,17 +124,17 @@ std::pair<CycleReading, double> timed_render(const Scene& scene, const Bvh& bvh,
 
 }  // namespace
 
-std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bvh& bvh,
-                                                    const std::vector<SiliconVariant>& variants,
-                                                    const ConvergenceRule& convergence,
-                                                    uint64_t seed) {
+std::vector<SiliconMeasurement> predict_and_measure(
+    const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence, uint64_t seed,
+    const std::function<void(const std::string&, size_t, size_t)>& progress) {
     const size_t n = variants.size();
     std::vector<SiliconMeasurement> out(n);
     std::vector<RenderSettings> settings(n);
     for (size_t v = 0; v < n; ++v) {
+        if (progress) progress("predicting", v, n);
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
-        predict(scene, bvh, settings[v], *variants[v].host, out[v]);
+        predict(*variants[v].scene, *variants[v].bvh, settings[v], *variants[v].host, out[v]);
     }
     // One cycle source per back end: its clock chain is that back end's adds.
     const double tsc_mhz = measure_tsc_mhz();
@@ -159,22 +159,34 @@ std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bv
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
     std::vector<std::vector<CycleReading>> readings(n);
     RenderResult r;
-    for (size_t v = 0; v < n; ++v)  // warm: caches, page faults, the tracer's buffers
-        timed_render(scene, bvh, settings[v], false, source_of(v), tsc_mhz, r,
-                     out[v].interrupted);
-    for (size_t v = 0; v < n; ++v) out[v].interrupted = 0;
+    // Warm: the caches with the workload's scene, page faults, the tracer's buffers.
+    const Scene* warm_scene = nullptr;
+    auto warm = [&](size_t v) {
+        uint32_t ignored = 0;
+        timed_render(*variants[v].scene, *variants[v].bvh, settings[v], false, source_of(v),
+                     tsc_mhz, r, ignored);
+        warm_scene = variants[v].scene;
+    };
+    for (size_t v = 0; v < n; ++v) warm(v);
     // Placement varies from render to render (Stabilizer's idea, for the heap alone): a block
     // of 0-64 KiB in 64-byte steps, held over the render, moves where the tracer's buffers land
     // relative to pages, cache sets and each other.
     std::mt19937_64 rng(seed);
     std::vector<uint64_t> others_busy(n, 0), others_total(n, 0);
     const int own_cpu = sched_getcpu();
-    for (bool more = true; more;) {
-        more = false;
+    for (uint32_t round = 1;; ++round) {
+        size_t open = 0;
+        for (size_t v = 0; v < n; ++v) open += needs_more_samples(out[v].frame_samples, convergence);
+        if (open == 0) break;
+        if (progress)
+            progress("round " + std::to_string(round) + ": " + std::to_string(open) + " open",
+                     n - open, n);
         for (size_t v = 0; v < n; ++v) {
             SiliconMeasurement& m = out[v];
             if (!needs_more_samples(m.frame_samples, convergence)) continue;
-            more = true;
+            const Scene& scene = *variants[v].scene;
+            const Bvh& bvh = *variants[v].bvh;
+            if (warm_scene != &scene) warm(v);
             std::vector<char> shift(64 * size_t(rng() % 1024));
             const std::vector<CpuTimes> load_before = read_cpu_times();
             const auto [reading, ticks] = timed_render(scene, bvh, settings[v], false,

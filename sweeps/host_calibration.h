@@ -76,22 +76,27 @@ struct SiliconMeasurement {
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
 };
 
-// One workload of a silicon check: its render settings and the host configuration (whose SIMD
-// width is the back end's, settings.isa) that predicts it.
+// One workload of a silicon check: its scene, render settings and the host configuration (whose
+// SIMD width is the back end's, settings.isa) that predicts it.
 struct SiliconVariant {
+    const Scene* scene = nullptr;
+    const Bvh* bvh = nullptr;
     RenderSettings settings;
     const HwConfig* host = nullptr;
 };
 
-// The variants of one scene and resolution (tiles, back ends), each forced to one thread; every
-// host config must carry op_costs for every kind the scene uses. Each is predicted by the
-// machine model on the trace of its own render; then rounds render every variant that has not
-// converged in turn (trace off), once plain and once with the stage clock, so that the drift
-// of a shared machine touches all of them alike, until each has converged or spent its budget
-// (`convergence`). `seed` draws the heap offsets that vary placement.
-std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bvh& bvh,
-                                                    const std::vector<SiliconVariant>& variants,
-                                                    const ConvergenceRule& convergence,
-                                                    uint64_t seed = 1);
+// The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
+// every host config must carry op_costs for every kind its scene uses. Each is predicted by the
+// machine model on the trace of its own render; then rounds render every workload that has not
+// converged in turn (trace off), once plain and once with the stage clock, until each has
+// converged or spent its budget (`convergence`): every workload's renders span the whole run,
+// so that the drift of a shared machine touches all of them alike, and a slow spell shows as
+// disagreement instead of a bias. Consecutive workloads of one scene share its caches; where
+// the scene changes, an unmeasured render warms them first. `seed` draws the heap offsets that
+// vary placement. `progress(what, done, total)` as it goes.
+std::vector<SiliconMeasurement> predict_and_measure(
+    const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,
+    uint64_t seed = 1,
+    const std::function<void(const std::string&, size_t, size_t)>& progress = {});
 
 }  // namespace sfx

@@ -3,6 +3,7 @@
 
 #include "sweeps/host_calibration.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <map>
 
@@ -69,8 +70,21 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     rule.tolerance = 1.0;
     rule.min_samples = 2;
     rule.budget = 2;
-    const std::vector<SiliconMeasurement> cell = predict_and_measure(scene, bvh, {{s, &config}}, rule);
-    REQUIRE(cell.size() == 1);
+    // Two scenes in one interleaved run: each workload measured on its own scene.
+    const Scene furnace = load_scene("furnace");
+    const Bvh furnace_bvh(furnace);
+    RenderSettings f = s;
+    f.max_depth = furnace.max_depth;
+    std::vector<std::string> rounds;
+    const std::vector<SiliconMeasurement> cell = predict_and_measure(
+        {{&scene, &bvh, s, &config}, {&furnace, &furnace_bvh, f, &config}}, rule, 1,
+        [&](const std::string& what, size_t, size_t) { rounds.push_back(what); });
+    REQUIRE(cell.size() == 2);
+    CHECK(cell[1].frame_samples.size() == 2);
+    CHECK(cell[1].predicted_frame > 0);
+    CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
+    CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
+    CHECK(std::count(rounds.begin(), rounds.end(), "round 2: 2 open") == 1);
     const SiliconMeasurement& m = cell.front();
     CHECK(m.prediction.config.ray_buffer.storage == "l1d");  // the machine model's prediction
     CHECK(m.frame_samples.size() == 2);
