@@ -9,8 +9,10 @@ Only converged workloads are scored: `sfx calibrate --check` renders each worklo
 fastest renders agree (the rule, base/convergence.h, is in every row as `convergence_rule`) or
 its budget runs out; a workload that ran out is shown, marked, and left out of every error and
 ranking. A ranking is judged only where the measurement can tell: two converged variants count
-as measurably different when the ranges (min to max) of their measured renders do not overlap,
-and a ranking is right when the prediction orders every such pair as the measurement does.
+as measurably different when their measured ranges do not overlap, and a ranking is right when
+the prediction orders every such pair as the measurement does. A converged workload's range is
+what the rule vouches for: its fastest render to its k-th fastest (`measured.spread` above the
+fastest); rows without a spread (written before the rule) take their renders' min to max.
 
 Self-consistency: a scene's frame of 4x the pixels (128x128 against 64x64) must cost 3 to 5
 times as much (0.75 to 1.25 times the pixel ratio, for any pair of resolutions); a pair outside
@@ -53,6 +55,12 @@ def load_rows(path):
         lambda v: (max(v) - min(v)) / sorted(v)[len(v) // 2] if v else float("nan"))
     df["measured.lo"] = df["measured.frame_samples"].apply(min)
     df["measured.hi"] = df["measured.frame_samples"].apply(max)
+    if "measured.spread" in df:
+        # The range the convergence rule vouches for: the fastest to the k-th fastest render
+        # (an unconverged workload's spread may be null: infinite, never judged anyway).
+        spread = pd.to_numeric(df["measured.spread"], errors="coerce").fillna(float("inf"))
+        df["measured.lo"] = df["measured.frame_cycles"]
+        df["measured.hi"] = df["measured.frame_cycles"] * (1.0 + spread)
     # Rows written before the convergence rule carry no verdict: they are taken as they were.
     if "measured.converged" not in df:
         df["measured.converged"] = True
@@ -405,8 +413,9 @@ def write_page(df, page, plot_name, header):
         "before the budget ran out (the rule above), and how many renders it took; a workload "
         "marked NO is shown but scored nowhere.\n\n" + table_text(df),
         "## Per scene and stage\n\n" + stage_table_text(df),
-        "## Tile-size ranking\n\nJudged on the pairs of tiles whose measured renders' ranges "
-        "do not overlap.\n\n" + ranking_text(df),
+        "## Tile-size ranking\n\nJudged on the pairs of converged tiles whose measured ranges "
+        "(the fastest to the k-th fastest render, what the convergence rule vouches for) do "
+        "not overlap.\n\n" + ranking_text(df),
         "## SIMD-width ranking\n\nThe same workload on each back end, each predicted by its "
         "own host configuration (per-op costs from that back end's microbenchmarks); judged as "
         "the tiles are.\n\n" + width_ranking_text(df),

@@ -185,3 +185,23 @@ def test_nothing_converged(tmp_path, capsys):
     header = tmp_path / "h.md"
     header.write_text("")
     assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
+
+
+def test_rankings_judge_the_converged_range(tmp_path):
+    # Renders spread over a noisy run overlap from min to max, but the converged ranges (the
+    # fastest to the third fastest: frame x (1 + spread)) do not: the pair is judged.
+    rows = [row("a", 16, 100, 100), row("a", 32, 130, 120)]
+    rows[0]["measured.frame_samples"] = [100, 101, 102, 150]
+    rows[1]["measured.frame_samples"] = [120, 121, 123, 160]
+    rows[0]["measured.spread"], rows[1]["measured.spread"] = 0.02, 0.025
+    for r in rows:
+        r["measured.converged"] = True
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    assert df["measured.hi"].iloc[0] == pytest.approx(102)
+    rank = silicon.ranking(df)
+    assert list(rank["pairs"]) == [1] and list(rank["right"]) == [True]
+    # Ranges that overlap: not judged.
+    df.loc[0, "measured.hi"] = 125
+    assert list(silicon.ranking(df)["pairs"]) == [0]
