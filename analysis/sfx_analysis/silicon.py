@@ -329,6 +329,15 @@ def measurement_text(df):
                 lines.append(f"- cycles ({isa}): {src}")
     else:
         lines.append("- cycles: not recorded (rows written before the cycle source)")
+    if "measured.clock_mhz_before" in df and not df["measured.cycles_counted"].any():
+        for isa in isas(df):
+            g = df[df["isa"] == isa]
+            clocks = pd.concat([g["measured.clock_mhz_before"], g["measured.clock_mhz_after"]])
+            drift = (g["measured.clock_mhz_after"] / g["measured.clock_mhz_before"] - 1).abs()
+            lines.append(f"- core clock around the fastest renders ({isa}): "
+                         f"{clocks.min():.0f}-{clocks.max():.0f} MHz, before and after one render "
+                         f"apart by {100 * drift.median():.1f} % (median), "
+                         f"{100 * drift.max():.1f} % at most")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")

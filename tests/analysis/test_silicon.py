@@ -124,6 +124,8 @@ def test_unconverged_workloads_are_shown_not_scored(tmp_path):
         r["convergence_rule"] = "fastest 3 of 7-31 samples within 3 %"
         r["measured.cycle_source"] = "estimated: thread CPU time x ... (perf_event_open refused: ENOENT)"
         r["measured.neighbours_busy"] = 0.5
+        r["measured.cycles_counted"] = False
+        r["measured.clock_mhz_before"], r["measured.clock_mhz_after"] = 3000.0, 3030.0
     rows[2]["measured.converged"] = False  # the 25 % miss ran out of budget
     rows[2]["measured.renders"] = 31
     p = tmp_path / "rows.json"
@@ -143,6 +145,8 @@ def test_unconverged_workloads_are_shown_not_scored(tmp_path):
     assert "cycles (avx512): estimated" in text and "ENOENT" in text
     assert "target at least 90 % of workloads converge: MISSED" in text
     assert "the other CPUs were busy 50 % of the time" in text
+    assert ("core clock around the fastest renders (avx512): 3000-3030 MHz, before and after "
+            "one render apart by 1.0 % (median)") in text
 
 
 def test_self_consistency_flag(tmp_path):
