@@ -202,7 +202,8 @@ void add_calibrate_command(CLI::App& app) {
                 std::cout << j.dump(2) << "\n";
                 return;
             }
-            std::printf("host: %s, %s, TSC %.1f MHz, core %.1f MHz (%s chain), %zu cache levels%s\n",
+            std::printf("host: %s, %s, TSC %.1f MHz, core %.1f MHz (%s chain), %zu cache "
+                        "levels%s\n",
                         describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
                         cal.host.tsc_mhz, cal.host.core_mhz,
                         clock_chain_name(cal.host.simd_width), cal.host.caches.size(),

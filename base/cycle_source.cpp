@@ -23,14 +23,22 @@ double thread_cpu_seconds() {
 
 const char* errno_name(int e) {
     switch (e) {
-        case ENOENT: return "ENOENT";
-        case EOPNOTSUPP: return "EOPNOTSUPP";
-        case EACCES: return "EACCES";
-        case EPERM: return "EPERM";
-        case ENODEV: return "ENODEV";
-        case EINVAL: return "EINVAL";
-        case ENOSYS: return "ENOSYS";
-        default: return "errno";
+        case ENOENT:
+            return "ENOENT";
+        case EOPNOTSUPP:
+            return "EOPNOTSUPP";
+        case EACCES:
+            return "EACCES";
+        case EPERM:
+            return "EPERM";
+        case ENODEV:
+            return "ENODEV";
+        case EINVAL:
+            return "EINVAL";
+        case ENOSYS:
+            return "ENOSYS";
+        default:
+            return "errno";
     }
 }
 
@@ -83,8 +91,9 @@ CycleSource::CycleSource(uint32_t lanes, double tsc_mhz, const PerfEventOpener& 
     if (m_fd >= 0)
         m_description = "counted: perf_event_open, user-mode core cycles of the measured thread";
     else
-        m_description = std::string("estimated: thread CPU time x the core clock (a chain of "
-                                    "dependent ") +
+        m_description = std::string(
+                            "estimated: thread CPU time x the core clock (a chain of "
+                            "dependent ") +
                         clock_chain_name(lanes) +
                         ", one a cycle, against the TSC) measured before and after each render, "
                         "the mean taken (" +

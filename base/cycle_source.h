@@ -30,7 +30,7 @@ struct CycleReading {
 };
 
 class CycleSource {
-public:
+  public:
     // `lanes`: the back end timed (1 scalar, 8 AVX2, 16 AVX-512): its chain measures the clock
     // of the estimate. `tsc_mhz`: the TSC's rate (hw_model/host_description.h measures it).
     CycleSource(uint32_t lanes, double tsc_mhz, const PerfEventOpener& open = open_perf_event);
@@ -48,7 +48,7 @@ public:
     void start();
     CycleReading stop();
 
-private:
+  private:
     double clock_mhz() const;
     uint32_t m_lanes;
     double m_tsc_mhz;

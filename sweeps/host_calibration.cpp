@@ -136,7 +136,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
         settings[v].threads = 1;
         predict(*variants[v].scene, *variants[v].bvh, settings[v], *variants[v].host, out[v]);
     }
-    // One cycle source per back end: its clock chain is that back end's adds.
+    // One cycle source per back end: its clock is measured under that back end's instructions.
     const double tsc_mhz = measure_tsc_mhz();
     std::map<uint32_t, std::unique_ptr<CycleSource>> sources;
     for (size_t v = 0; v < n; ++v) {
@@ -176,7 +176,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
     const int own_cpu = sched_getcpu();
     for (uint32_t round = 1;; ++round) {
         size_t open = 0;
-        for (size_t v = 0; v < n; ++v) open += needs_more_samples(out[v].frame_samples, convergence);
+        for (size_t v = 0; v < n; ++v)
+            open += needs_more_samples(out[v].frame_samples, convergence);
         if (open == 0) break;
         if (progress)
             progress("round " + std::to_string(round) + ": " + std::to_string(open) + " open",
@@ -201,7 +202,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
             readings[v].push_back(reading);
             tsc_samples[v].push_back(ticks);
             const int64_t huge = anon_huge_page_kib();
-            m.huge_page_kib_min = m.huge_page_kib_min < 0 ? huge : std::min(m.huge_page_kib_min, huge);
+            m.huge_page_kib_min =
+                m.huge_page_kib_min < 0 ? huge : std::min(m.huge_page_kib_min, huge);
             m.huge_page_kib_max = std::max(m.huge_page_kib_max, huge);
             const CycleReading clocked = timed_render(scene, bvh, settings[v], true, source_of(v),
                                                       tsc_mhz, r, m.interrupted)
@@ -222,7 +224,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
         m.clock_mhz_before = readings[v][fastest].clock_mhz_before;
         m.clock_mhz_after = readings[v][fastest].clock_mhz_after;
         m.measured_frame_tsc = median(tsc_samples[v]);
-        if (others_total[v] > 0) m.neighbours_busy = double(others_busy[v]) / double(others_total[v]);
+        if (others_total[v] > 0)
+            m.neighbours_busy = double(others_busy[v]) / double(others_total[v]);
         const double stages = stage_min[v][0] + stage_min[v][1] + stage_min[v][2];
         for (int s = 0; s < 3; ++s)
             m.measured_stage[size_t(s)] =

@@ -344,7 +344,8 @@ def measurement_text(df):
     if "measured.huge_page_kib_min" in df:
         lo, hi = df["measured.huge_page_kib_min"].min(), df["measured.huge_page_kib_max"].max()
         lines.append(f"- transparent huge pages held by the process after each render: "
-                     f"{lo / 1024:.0f}-{hi / 1024:.0f} MiB (AnonHugePages, /proc/self/smaps_rollup)")
+                     f"{lo / 1024:.0f}-{hi / 1024:.0f} MiB "
+                     f"(AnonHugePages, /proc/self/smaps_rollup)")
     if "measured.neighbours_busy" in df:
         busy = df["measured.neighbours_busy"]
         busy = busy[busy >= 0]

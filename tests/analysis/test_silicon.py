@@ -122,7 +122,8 @@ def test_unconverged_workloads_are_shown_not_scored(tmp_path):
         r["measured.converged"] = True
         r["measured.renders"] = 7
         r["convergence_rule"] = "fastest 3 of 7-31 samples within 3 %"
-        r["measured.cycle_source"] = "estimated: thread CPU time x ... (perf_event_open refused: ENOENT)"
+        r["measured.cycle_source"] = ("estimated: thread CPU time x ... "
+                                      "(perf_event_open refused: ENOENT)")
         r["measured.neighbours_busy"] = 0.5
         r["measured.cycles_counted"] = False
         r["measured.clock_mhz_before"], r["measured.clock_mhz_after"] = 3000.0, 3030.0

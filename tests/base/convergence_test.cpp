@@ -33,7 +33,8 @@ std::vector<double> sample_until_done(const std::vector<double>& stream, const C
 
 }  // namespace
 
-TEST_CASE("Convergence: clean samples converge after the minimum, on their fastest", "[convergence]") {
+TEST_CASE("Convergence: clean samples converge after the minimum, on their fastest",
+          "[convergence]") {
     const ConvergenceRule r = rule(3, 0.03, 5, 31);
     const std::vector<double> clean = {101, 100.5, 102, 100, 101.5, 100.8, 101, 100.2};
     const std::vector<double> taken = sample_until_done(clean, r);
@@ -48,12 +49,13 @@ TEST_CASE("Convergence: clean samples converge after the minimum, on their faste
     CHECK(needs_more_samples({100, 100, 100}, r));
 }
 
-TEST_CASE("Convergence: bimodal samples converge only once the fast mode holds k samples", "[convergence]") {
+TEST_CASE("Convergence: bimodal samples converge only once the fast mode holds k samples",
+          "[convergence]") {
     const ConvergenceRule r = rule(3, 0.03, 5, 31);
     // The issue's Intel host: three fast samples far apart (241, 263, 282 Mcycles), then a slow
     // mode of 500-725. The fastest three disagree by 17 %: no verdict on the fast mode.
-    std::vector<double> bimodal = {241, 263, 282, 500, 725, 610, 540, 580, 700, 650, 520, 690,
-                                   560, 600, 710};
+    std::vector<double> bimodal = {241, 263, 282, 500, 725, 610, 540, 580,
+                                   700, 650, 520, 690, 560, 600, 710};
     Convergence c = judge_convergence(bimodal, r);
     CHECK_FALSE(c.converged);
     CHECK(c.fastest == 241);

@@ -45,8 +45,7 @@ TEST_CASE("Cycle source: a refused counter falls back to the estimate", "[cycles
             CHECK(asked);
             CHECK_FALSE(source.counted());
             CHECK(source.description().find("estimated") == 0);
-            CHECK(source.description().find(clock_chain_name(isa_width(isa))) !=
-                  std::string::npos);
+            CHECK(source.description().find(clock_chain_name(isa_width(isa))) != std::string::npos);
             CHECK(source.refusal().find(refusal == ENOENT       ? "ENOENT"
                                         : refusal == EOPNOTSUPP ? "EOPNOTSUPP"
                                                                 : "EACCES") != std::string::npos);
@@ -60,8 +59,8 @@ TEST_CASE("Cycle source: a refused counter falls back to the estimate", "[cycles
             CHECK(r.clock_mhz_before < 8000);
             CHECK(r.clock_mhz_after > 300);
             CHECK(r.clock_mhz_after < 8000);
-            CHECK(r.cycles == Approx(r.cpu_seconds * 0.5 *
-                                     (r.clock_mhz_before + r.clock_mhz_after) * 1e6));
+            CHECK(r.cycles ==
+                  Approx(r.cpu_seconds * 0.5 * (r.clock_mhz_before + r.clock_mhz_after) * 1e6));
         }
     }
 }
