@@ -267,7 +267,8 @@ void add_calibrate_command(CLI::App& app) {
         // interleaved run (predict_and_measure), so that each one's renders span the run.
         std::vector<std::unique_ptr<Scene>> loaded;
         std::vector<std::unique_ptr<Bvh>> bvhs;
-        Progress progress("calibrate --check", scenes.size(), "scenes loaded");
+        // Counted in scenes while loading, then in workloads (predicted, then converged).
+        Progress progress("calibrate --check", scenes.size(), "scenes, then workloads");
         for (const std::string& name : scenes) {
             progress.set_label(name + ": loading");
             loaded.push_back(std::make_unique<Scene>(load_scene(name)));

@@ -352,8 +352,8 @@ def measurement_text(df):
         if len(busy):
             lines.append(f"- the other CPUs were busy {100 * busy.mean():.0f} % of the time during "
                          f"the renders (per workload {100 * busy.min():.0f}-{100 * busy.max():.0f} "
-                         f"%; /proc/stat): a neighbour's load biases a whole run alike, which no "
-                         f"convergence rule sees")
+                         f"%; /proc/stat): a whole run can be slowed alike, which no convergence "
+                         f"rule sees")
     return "\n".join(lines)
 
 
