@@ -2,12 +2,15 @@
 //   --describe-host: describe the host (cpuid, caches, TSC, load latencies), microbenchmark the
 //     native filters on synthetic streams, fit the per-op costs, write host.hw.yaml.
 //   --check HOST.hw.yaml[,...]: for held-out workloads, the machine model's prediction from the
-//     trace against the native tracer's measured cycles (TSC, one pinned thread, trace off);
-//     one host file per back end (its SIMD width), all measured in turn per cell.
+//     trace against the native tracer's measured core cycles (counted or estimated:
+//     base/cycle_source.h; one pinned thread, trace off), each workload rendered until its
+//     fastest renders agree (base/convergence.h) or its budget runs out; one host file per back
+//     end (its SIMD width), all measured in turn per cell.
 
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
@@ -16,6 +19,7 @@
 #include "sweeps/host_calibration.h"
 #include "base/input_error.h"
 #include "workloads/scene_loader.h"
+#include "base/core_clock.h"
 #include "base/strict_number.h"
 #include "base/user_files.h"
 
@@ -63,12 +67,15 @@ void add_calibrate_command(CLI::App& app) {
         std::string output = "host.hw.yaml";
         std::string check;
         std::string isa = "auto";
-        uint32_t repeats = 21;
+        uint32_t repeats = 41;
+        uint32_t min_repeat = 7;
+        uint32_t fastest = 3;
+        std::string tolerance = "0.03";
         std::string scenes = "cornell,furnace,atrium,conference,temple";
         std::string tiles = "16,32,64";
         std::string res = "64x64,128x128";
         uint32_t spp = 1;
-        uint32_t repeat = 5;
+        uint32_t repeat = 31;
         bool json = false;
     };
     auto o = std::make_shared<Options>();
@@ -83,7 +90,16 @@ void add_calibrate_command(CLI::App& app) {
                   "per workload, each file on the back end of its SIMD width");
     c->add_option("--isa", o->isa, "auto, avx512, avx2 or scalar: the back end measured")
         ->capture_default_str();
-    c->add_option("--microbench-repeats", o->repeats, "repetitions per microbenchmark point")
+    c->add_option("--microbench-repeats", o->repeats,
+                  "most repetitions per microbenchmark point (it stops when converged)")
+        ->capture_default_str();
+    c->add_option("--fastest", o->fastest,
+                  "converged: the fastest K samples of a render or microbenchmark agree")
+        ->capture_default_str();
+    c->add_option("--tolerance", o->tolerance,
+                  "converged: the K-th fastest within (1 + this) x the fastest (0.03: 3 %)")
+        ->capture_default_str();
+    c->add_option("--min-repeat", o->min_repeat, "--check: renders per workload at least")
         ->capture_default_str();
     c->add_option("--scenes", o->scenes, "--check: comma-separated scenes")->capture_default_str();
     c->add_option("--tiles", o->tiles, "--check: comma-separated tile sizes")
@@ -91,7 +107,8 @@ void add_calibrate_command(CLI::App& app) {
     c->add_option("--res", o->res, "--check: comma-separated resolutions WxH")
         ->capture_default_str();
     c->add_option("--spp", o->spp, "--check: samples per pixel")->capture_default_str();
-    c->add_option("--repeat", o->repeat, "--check: measured renders per workload (median)")
+    c->add_option("--repeat", o->repeat,
+                  "--check: renders per workload at most (the budget; it stops when converged)")
         ->capture_default_str();
     c->add_flag("--json", o->json, "print one JSON document");
     c->callback([o] {
@@ -103,6 +120,24 @@ void add_calibrate_command(CLI::App& app) {
             throw InputError("command line", 0, "--microbench-repeats", "expected 1 to 1000");
         if (o->repeat < 1 || o->repeat > 1000)
             throw InputError("command line", 0, "--repeat", "expected 1 to 1000");
+        double tolerance = 0.0;
+        if (!parse_finite(o->tolerance, tolerance) || tolerance < 0.0 || tolerance > 1.0)
+            throw InputError("command line", 0, "--tolerance",
+                             "expected a fraction from 0 to 1 (0.03 is 3 %), got '" +
+                                 o->tolerance + "'");
+        if (o->fastest < 1 || o->fastest > o->repeat || (o->describe && o->fastest > o->repeats))
+            throw InputError("command line", 0, "--fastest",
+                             "expected 1 to the budget (--repeat, --microbench-repeats), got " +
+                                 std::to_string(o->fastest));
+        ConvergenceRule render_rule;
+        render_rule.fastest = o->fastest;
+        render_rule.tolerance = tolerance;
+        render_rule.min_samples = o->min_repeat;
+        render_rule.budget = o->repeat;
+        check_rule(render_rule, o->min_repeat > o->repeat ? "--min-repeat" : "--repeat");
+        ConvergenceRule bench_rule = microbench_rule(o->repeats);
+        bench_rule.fastest = std::min(o->fastest, o->repeats);
+        bench_rule.tolerance = tolerance;
         if (o->spp < 1 || o->spp > 4096)
             throw InputError("command line", 0, "--spp", "expected 1 to 4096");
         const bool pinned = pin_to_current_cpu();
@@ -111,7 +146,7 @@ void add_calibrate_command(CLI::App& app) {
             const std::string temp = outputs.add(o->output, "--output");
             Progress progress("calibrate", 15, "op kinds");
             const HostCalibration cal =
-                calibrate_host(isa, o->repeats, [&](uint32_t done, uint32_t total) {
+                calibrate_host(isa, bench_rule, [&](uint32_t done, uint32_t total) {
                     progress.set_total(total);
                     progress.set_done(done);
                 });
@@ -125,6 +160,10 @@ void add_calibrate_command(CLI::App& app) {
                 j["tsc_mhz"] = cal.host.tsc_mhz;
                 j["simd_width"] = cal.host.simd_width;
                 j["pinned"] = pinned;
+                j["microarchitecture"] = describe(cal.host.microarchitecture);
+                j["convergence_rule"] = describe(bench_rule);
+                j["converged_points"] = cal.converged_points;
+                j["points"] = cal.points;
                 for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                     const OpCostConfig& k = cal.op_costs[i];
                     j["op_costs"][k.op] = {{"per_op", k.per_op_cycles},
@@ -141,7 +180,9 @@ void add_calibrate_command(CLI::App& app) {
                                             {"slots", m.slots},
                                             {"lanes", m.lanes},
                                             {"passed", m.passed},
-                                            {"cycles", m.cycles}});
+                                            {"cycles", m.cycles},
+                                            {"converged", m.converged},
+                                            {"repetitions", m.repetitions}});
                 j["one_lane_fit_median_error"] = cal.one_lane_fit_error.first;
                 j["one_lane_fit_worst_error"] = cal.one_lane_fit_error.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {
@@ -149,7 +190,8 @@ void add_calibrate_command(CLI::App& app) {
                     for (uint32_t k = 0; k < k_op_kind_count; ++k)
                         if (s.ops[k]) ops[to_string(OpKind(k))] = s.ops[k];
                     j["one_ray_samples"].push_back(
-                        {{"rays", s.rays}, {"ops", ops}, {"cycles", s.cycles}});
+                        {{"rays", s.rays}, {"ops", ops}, {"cycles", s.cycles},
+                         {"converged", s.converged}, {"repetitions", s.repetitions}});
                 }
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
@@ -160,9 +202,14 @@ void add_calibrate_command(CLI::App& app) {
                 std::cout << j.dump(2) << "\n";
                 return;
             }
-            std::printf("host: %s, TSC %.1f MHz, %zu cache levels%s\n", cal.host.isa.c_str(),
-                        cal.host.tsc_mhz, cal.host.caches.size(),
+            std::printf("host: %s, %s, TSC %.1f MHz, core %.1f MHz (%s chain), %zu cache "
+                        "levels%s\n",
+                        describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
+                        cal.host.tsc_mhz, cal.host.core_mhz,
+                        clock_chain_name(cal.host.simd_width), cal.host.caches.size(),
                         pinned ? ", pinned" : ", NOT pinned");
+            std::printf("microbenchmarks: %u of %u points converged (%s)\n", cal.converged_points,
+                        cal.points, describe(bench_rule).c_str());
             std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s %9s\n", "op kind", "per_op", "per_group",
                         "per_lane", "per_pass", "beyondL1", "fit med", "fit max", "one_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
@@ -216,74 +263,110 @@ void add_calibrate_command(CLI::App& app) {
         std::vector<std::pair<uint32_t, uint32_t>> resolutions;
         for (const std::string& r : split(o->res)) resolutions.push_back(parse_res(r));
         const std::vector<std::string> scenes = split(o->scenes);
-        Progress progress("calibrate --check", scenes.size() * resolutions.size(),
-                          "(scene, resolution) cells");
-        nlohmann::json rows = nlohmann::json::array();
+        // Every scene loaded first: the workloads of all scenes are measured in one
+        // interleaved run (predict_and_measure), so that each one's renders span the run.
+        std::vector<std::unique_ptr<Scene>> loaded;
+        std::vector<std::unique_ptr<Bvh>> bvhs;
+        // Counted in scenes while loading, then in workloads (predicted, then converged).
+        Progress progress("calibrate --check", scenes.size(), "scenes, then workloads");
         for (const std::string& name : scenes) {
             progress.set_label(name + ": loading");
-            const Scene scene = load_scene(name);
-            const Bvh bvh(scene);
-            for (const auto& [w, h] : resolutions) {
-                progress.set_label(name + " " + std::to_string(w) + "x" + std::to_string(h));
-                // Every tile on every back end of the cell, measured in turn.
-                std::vector<SiliconVariant> variants;
+            loaded.push_back(std::make_unique<Scene>(load_scene(name)));
+            bvhs.push_back(std::make_unique<Bvh>(*loaded.back()));
+            progress.advance();
+        }
+        // Every tile on every back end of every (scene, resolution) cell.
+        std::vector<SiliconVariant> variants;
+        std::vector<std::string> variant_scene;
+        for (size_t sc = 0; sc < scenes.size(); ++sc)
+            for (const auto& [w, h] : resolutions)
                 for (size_t k = 0; k < hosts.size(); ++k)
                     for (uint32_t tile : tiles) {
                         SiliconVariant v;
+                        v.scene = loaded[sc].get();
+                        v.bvh = bvhs[sc].get();
                         v.settings.width = w;
                         v.settings.height = h;
                         v.settings.spp = o->spp;
                         v.settings.tile = tile;
-                        v.settings.max_depth = scene.max_depth;
+                        v.settings.max_depth = loaded[sc]->max_depth;
                         v.settings.isa = host_isas[k];
                         v.host = &hosts[k];
                         variants.push_back(v);
+                        variant_scene.push_back(scenes[sc]);
                     }
-                const std::vector<SiliconMeasurement> measured =
-                    predict_and_measure(scene, bvh, variants, o->repeat);
-                for (size_t i = 0; i < variants.size(); ++i) {
-                    const SiliconMeasurement& m = measured[i];
-                    const RenderSettings& st = variants[i].settings;
-                    nlohmann::json row;
-                    row["scene"] = name;
-                    row["width"] = w;
-                    row["height"] = h;
-                    row["tile"] = st.tile;
-                    row["spp"] = o->spp;
-                    row["isa"] = isa_name(st.isa);
-                    row["simd_width"] = isa_width(st.isa);
-                    row["pinned"] = pinned;
-                    row["predicted.frame_cycles"] = m.predicted_frame;
-                    row["measured.frame_cycles"] = m.measured_frame;
-                    row["measured.frame_samples"] = m.frame_samples;
-                    row["stage_clock_overhead"] = m.stage_clock_overhead;
-                    row["measured.interrupted_renders"] = m.interrupted;
-                    row["measured.frame_tsc"] = m.measured_frame_tsc;
-                    for (int sg = 0; sg < 3; ++sg) {
-                        row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =
-                            m.predicted_stage[size_t(sg)];
-                        row[std::string("predicted.") + k_stage_names[sg] + "_memory_cycles"] =
-                            m.predicted_memory[size_t(sg)];
-                        row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
-                            m.measured_stage[size_t(sg)];
-                    }
-                    // The machine model's stall causes, as sfx simulate reports them.
-                    for (const Stat& stat : m.prediction.stats())
-                        if (stat.name.rfind("stall_cycles.", 0) == 0)
-                            row["predicted." + stat.name] = stat.value;
-                    rows.push_back(row);
-                    if (!o->json)
-                        progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) +
-                                     " tile " + std::to_string(st.tile) + " " +
-                                     isa_name(st.isa) + ": predicted " +
-                                     std::to_string(m.predicted_frame / 1e6) +
-                                     " Mcycles, measured " +
-                                     std::to_string(m.measured_frame / 1e6));
-                }
-                progress.advance();
+        const std::vector<SiliconMeasurement> measured = predict_and_measure(
+            variants, render_rule, 1, [&](const std::string& what, size_t done, size_t total) {
+                progress.set_label(what);
+                progress.set_total(total);
+                progress.set_done(done);
+            });
+        const Microarchitecture uarch = read_microarchitecture();
+        uint32_t workloads = 0, converged = 0;
+        std::string sources;
+        nlohmann::json rows = nlohmann::json::array();
+        for (size_t i = 0; i < variants.size(); ++i) {
+            const SiliconMeasurement& m = measured[i];
+            const RenderSettings& st = variants[i].settings;
+            const std::string& name = variant_scene[i];
+            const uint32_t w = st.width, h = st.height;
+            nlohmann::json row;
+            row["scene"] = name;
+            row["width"] = w;
+            row["height"] = h;
+            row["tile"] = st.tile;
+            row["spp"] = o->spp;
+            row["isa"] = isa_name(st.isa);
+            row["simd_width"] = isa_width(st.isa);
+            row["pinned"] = pinned;
+            row["predicted.frame_cycles"] = m.predicted_frame;
+            row["measured.frame_cycles"] = m.measured_frame;
+            row["measured.frame_samples"] = m.frame_samples;
+            row["measured.converged"] = m.convergence.converged;
+            row["measured.spread"] = m.convergence.spread;
+            row["measured.renders"] = m.convergence.samples;
+            row["convergence_rule"] = describe(render_rule);
+            row["measured.cycle_source"] = m.cycle_source;
+            row["measured.cycles_counted"] = m.cycles_counted;
+            row["measured.clock_mhz_before"] = m.clock_mhz_before;
+            row["measured.clock_mhz_after"] = m.clock_mhz_after;
+            row["measured.huge_page_kib_min"] = m.huge_page_kib_min;
+            row["measured.huge_page_kib_max"] = m.huge_page_kib_max;
+            row["measured.neighbours_busy"] = m.neighbours_busy;
+            row["host.vendor"] = vendor_short_name(uarch.vendor);
+            row["host.family"] = uarch.signature.family;
+            row["host.model"] = uarch.signature.model;
+            row["host.microarchitecture"] = describe(uarch);
+            ++workloads;
+            converged += m.convergence.converged;
+            if (sources.find(m.cycle_source) == std::string::npos)
+                sources += (sources.empty() ? "" : "; ") + m.cycle_source;
+            row["stage_clock_overhead"] = m.stage_clock_overhead;
+            row["measured.interrupted_renders"] = m.interrupted;
+            row["measured.frame_tsc"] = m.measured_frame_tsc;
+            for (int sg = 0; sg < 3; ++sg) {
+                row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =
+                    m.predicted_stage[size_t(sg)];
+                row[std::string("predicted.") + k_stage_names[sg] + "_memory_cycles"] =
+                    m.predicted_memory[size_t(sg)];
+                row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
+                    m.measured_stage[size_t(sg)];
             }
+            // The machine model's stall causes, as sfx simulate reports them.
+            for (const Stat& stat : m.prediction.stats())
+                if (stat.name.rfind("stall_cycles.", 0) == 0)
+                    row["predicted." + stat.name] = stat.value;
+            rows.push_back(row);
+            if (!o->json)
+                progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) + " tile " +
+                             std::to_string(st.tile) + " " + isa_name(st.isa) + ": predicted " +
+                             std::to_string(m.predicted_frame / 1e6) + " Mcycles, measured " +
+                             std::to_string(m.measured_frame / 1e6) +
+                             (m.convergence.converged ? "" : " (NOT converged)"));
         }
         progress.finish();
+        std::fprintf(stderr, "calibrate --check: %u of %u workloads converged (%s); cycles %s\n",
+                     converged, workloads, describe(render_rule).c_str(), sources.c_str());
         std::cout << rows.dump(o->json ? 2 : -1) << "\n";
     });
 }

@@ -11,7 +11,10 @@
 #include <sys/mman.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
+#include <fstream>
+#include <string>
 #include <new>
 
 namespace sfx {
@@ -46,5 +49,28 @@ struct HugePageAllocator {
     friend bool operator==(const HugePageAllocator&, const HugePageAllocator&) { return true; }
     friend bool operator!=(const HugePageAllocator&, const HugePageAllocator&) { return false; }
 };
+
+// KiB of this process's anonymous memory in transparent huge pages now (AnonHugePages of
+// /proc/self/smaps_rollup, else the sum over /proc/self/smaps); -1 if neither can be read. What
+// `sfx calibrate --check` records per workload: whether the kernel granted the huge pages the
+// allocator above asked for is a placement effect that holds for a whole allocation.
+inline int64_t anon_huge_page_kib() {
+    for (const char* path : {"/proc/self/smaps_rollup", "/proc/self/smaps"}) {
+        std::ifstream in(path);
+        if (!in) continue;
+        int64_t total = 0;
+        std::string key;
+        while (in >> key) {
+            if (key == "AnonHugePages:") {
+                int64_t kib = 0;
+                in >> kib;
+                total += kib;
+            }
+            in.ignore(1 << 20, '\n');
+        }
+        return total;
+    }
+    return -1;
+}
 
 }  // namespace sfx

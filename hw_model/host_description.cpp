@@ -6,7 +6,9 @@
 #include <x86intrin.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <numeric>
@@ -147,6 +149,59 @@ std::vector<HostCacheLevel> read_host_caches() {
     return c;
 }
 
+CpuSignature decode_cpu_signature(uint32_t eax) {
+    CpuSignature s;
+    const uint32_t base_family = (eax >> 8) & 0xf, base_model = (eax >> 4) & 0xf;
+    s.stepping = eax & 0xf;
+    s.family = base_family == 0xf ? base_family + ((eax >> 20) & 0xff) : base_family;
+    s.model = base_family == 0x6 || base_family == 0xf ? base_model | (((eax >> 16) & 0xf) << 4)
+                                                       : base_model;
+    return s;
+}
+
+Microarchitecture read_microarchitecture() {
+    Microarchitecture m;
+    unsigned a, b, c, d;
+    __cpuid(0, a, b, c, d);
+    char vendor[13] = {};
+    std::memcpy(vendor, &b, 4);
+    std::memcpy(vendor + 4, &d, 4);
+    std::memcpy(vendor + 8, &c, 4);
+    m.vendor = vendor;
+    __cpuid(1, a, b, c, d);
+    m.signature = decode_cpu_signature(a);
+    __cpuid(0x80000000, a, b, c, d);
+    if (a >= 0x80000004) {
+        char brand[49] = {};
+        for (unsigned leaf = 0; leaf < 3; ++leaf) {
+            unsigned r[4];
+            __cpuid(0x80000002 + leaf, r[0], r[1], r[2], r[3]);
+            std::memcpy(brand + 16 * leaf, r, 16);
+        }
+        m.brand = brand;
+        while (!m.brand.empty() && m.brand.back() == ' ') m.brand.pop_back();
+        while (!m.brand.empty() && m.brand.front() == ' ') m.brand.erase(m.brand.begin());
+    }
+    return m;
+}
+
+std::string vendor_short_name(const std::string& vendor) {
+    if (vendor == "AuthenticAMD") return "amd";
+    if (vendor == "GenuineIntel") return "intel";
+    std::string out;
+    for (char ch : vendor)
+        if (std::isalnum(static_cast<unsigned char>(ch)))
+            out += char(std::tolower(static_cast<unsigned char>(ch)));
+    return out.empty() ? "unknown" : out;
+}
+
+std::string describe(const Microarchitecture& m) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s family 0x%X model 0x%X stepping %u", m.vendor.c_str(),
+                  m.signature.family, m.signature.model, m.signature.stepping);
+    return std::string(buf) + (m.brand.empty() ? "" : " (" + m.brand + ")");
+}
+
 uint64_t read_tsc() {
     return __rdtsc();
 }
@@ -196,10 +251,11 @@ constexpr uint64_t k_largest_chase = 256ull << 20;
 
 HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     HostDescription h;
+    h.microarchitecture = read_microarchitecture();
     h.simd_width = simd_width;
     h.isa = isa;
     h.tsc_mhz = measure_tsc_mhz();
-    h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21);
+    h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21, simd_width);
     h.caches = read_host_caches();
     for (const HostCacheLevel& c : h.caches) {
         // Half the level: it fits there, and not in the level before (which is smaller). At
@@ -255,9 +311,11 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "# One core running the native stream tracer (kernels/stream) single-threaded; timed by\n"
       << "# the same machine model as the paper's machine (hw_model/core_model.h): one SIMD unit,\n"
       << "# ray buffers behind the L1D, partition by compress, measured per-op costs.\n"
+      << "# Microarchitecture (cpuid): " << describe(h.microarchitecture) << "\n"
       << "version: 1\nname: host\nclock:\n"
       << "  core_mhz: " << fmt(c.clock.core_mhz, 3)
-      << "  # measured: a chain of dependent adds (one a core cycle) against the TSC ("
+      << "  # measured: a chain of dependent " << clock_chain_name(h.simd_width)
+      << " (one a core cycle, the back end's own) against the TSC ("
       << fmt(h.tsc_mhz, 3) << " MHz, over 0.2 s of the steady clock); op costs are core cycles\n"
       << "  interconnect_mhz: " << fmt(c.clock.core_mhz, 3)
       << "  # one clock (unused: storage l1d has no interconnect)\n"

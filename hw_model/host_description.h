@@ -37,11 +37,33 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz);
 // Reads the TSC (rdtsc): the clock the native tracer's cycles are counted in.
 uint64_t read_tsc();
 
+// The microarchitecture: cpuid's vendor string, display family and model (leaf 1: the base
+// family plus the extended family when the base is 0xF; the extended model above the base
+// model when the family is 6 or 0xF), stepping and brand string.
+struct CpuSignature {
+    uint32_t family = 0, model = 0, stepping = 0;
+};
+CpuSignature decode_cpu_signature(uint32_t leaf1_eax);
+
+struct Microarchitecture {
+    std::string vendor;  // "AuthenticAMD", "GenuineIntel", ...
+    CpuSignature signature;
+    std::string brand;  // "AMD EPYC 7B12" (leaf 0x80000002-4), empty if not given
+};
+Microarchitecture read_microarchitecture();
+// "amd", "intel" or the vendor string lower-cased: what names a host's silicon-check page.
+std::string vendor_short_name(const std::string& vendor);
+// "AuthenticAMD family 0x17 model 0x31 stepping 0 (AMD EPYC 7B12)".
+std::string describe(const Microarchitecture& m);
+
 struct HostDescription {
+    Microarchitecture microarchitecture;
     uint32_t simd_width = 1;
     std::string isa;  // e.g. "avx512 (16 lanes)"
     double tsc_mhz = 0.0;
-    double core_mhz = 0.0;  // the core's clock while measured (base/core_clock.h), boost included
+    // The core's clock while measured, boost included, under the back end's own instructions
+    // (base/core_clock.h: the clock under AVX2 or AVX-512 code may be lower than under scalar).
+    double core_mhz = 0.0;
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)

@@ -3,7 +3,9 @@
 // per-op costs on microbenchmarks of the native filters (never on frames), then, for a held-out
 // workload, predict the native stream tracer's single-thread cycles with the machine model on
 // the trace of the same render (run_point_group at full fidelity, as sfx simulate) and measure
-// them (TSC, trace off, one pinned thread).
+// them (trace off, one pinned thread): core cycles from base/cycle_source.h (counted, or
+// estimated with the back end's own clock), each workload rendered until its fastest renders
+// agree (base/convergence.h) or its budget runs out.
 
 #include <array>
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "base/convergence.h"
 #include "hw_model/host_description.h"
 #include "hw_model/op_cost_fit.h"
 #include "hw_model/prediction.h"
@@ -32,12 +35,14 @@ struct HostCalibration {
     // one_lane_cycles of the box, triangle and sphere tests).
     std::vector<OneRaySample> one_ray_samples;
     std::pair<double, double> one_lane_fit_error{};
+    // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
+    uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml
 };
 
-// Describes the host, runs the microbenchmarks (`repeats` per point) and fits. `isa`: the
-// back end measured (auto: the widest). `progress(done, total)` per op kind.
-HostCalibration calibrate_host(Isa isa, uint32_t repeats,
+// Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and
+// fits. `isa`: the back end measured (auto: the widest). `progress(done, total)` per op kind.
+HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {});
 
 // Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
@@ -48,31 +53,50 @@ struct SiliconMeasurement {
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses
     double predicted_frame = 0.0;
-    // Core cycles: process CPU time at the core's clock measured just before each render (the
-    // TSC alone counts the neighbours' time on a shared machine, and the core's clock moves);
-    // the fastest of the unclocked renders (the microbenchmarks take their fastest too).
+    // Core cycles (base/cycle_source.h: counted by perf_event_open, else the thread's CPU time
+    // at the back end's clock measured before and after the render; the TSC alone counts the
+    // neighbours' time on a shared machine, and the core's clock moves): the fastest of the
+    // unclocked renders (the microbenchmarks take their fastest too), which counts only if
+    // `convergence` says the fastest of them agree.
     double measured_frame = 0.0;
+    Convergence convergence;
+    std::string cycle_source;  // CycleSource::description() of the back end's source
+    bool cycles_counted = false;
+    double clock_mhz_before = 0.0, clock_mhz_after = 0.0;  // around the fastest render
+    // Placement: KiB of the process in transparent huge pages after each render, least and
+    // most (-1: unreadable); every render's buffers land after a heap block of random size.
+    int64_t huge_page_kib_min = -1, huge_page_kib_max = -1;
+    // The other CPUs' busy share over its unclocked renders (base/cpu_load.h; -1: unknown): a
+    // neighbour's load biases a whole run, and no convergence rule sees it.
+    double neighbours_busy = -1.0;
     double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
     std::vector<double> frame_samples;       // every unclocked render's cycles
-    std::array<double, 3> measured_stage{};  // least interrupted split x measured_frame
+    std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame
     double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
 };
 
-// One workload of a silicon check: its render settings and the host configuration (whose SIMD
-// width is the back end's, settings.isa) that predicts it.
+// One workload of a silicon check: its scene, render settings and the host configuration (whose
+// SIMD width is the back end's, settings.isa) that predicts it.
 struct SiliconVariant {
+    const Scene* scene = nullptr;
+    const Bvh* bvh = nullptr;
     RenderSettings settings;
     const HwConfig* host = nullptr;
 };
 
-// The variants of one scene and resolution (tiles, back ends), each forced to one thread; every
-// host config must carry op_costs for every kind the scene uses. Each is predicted by the
-// machine model on the trace of its own render; then `repeats` rounds render every variant in
-// turn (trace off), once plain and once with the stage clock, so that the drift of a shared
-// machine touches all of them alike.
-std::vector<SiliconMeasurement> predict_and_measure(const Scene& scene, const Bvh& bvh,
-                                                    const std::vector<SiliconVariant>& variants,
-                                                    uint32_t repeats);
+// The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
+// every host config must carry op_costs for every kind its scene uses. Each is predicted by the
+// machine model on the trace of its own render; then rounds render every workload that has not
+// converged in turn (trace off), once plain and once with the stage clock, until each has
+// converged or spent its budget (`convergence`): every workload's renders span the whole run,
+// so that the drift of a shared machine touches all of them alike, and a slow spell shows as
+// disagreement instead of a bias. Consecutive workloads of one scene share its caches; where
+// the scene changes, an unmeasured render warms them first. `seed` draws the heap offsets that
+// vary placement. `progress(what, done, total)` as it goes.
+std::vector<SiliconMeasurement> predict_and_measure(
+    const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,
+    uint64_t seed = 1,
+    const std::function<void(const std::string&, size_t, size_t)>& progress = {});
 
 }  // namespace sfx

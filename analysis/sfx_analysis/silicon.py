@@ -5,9 +5,18 @@ worst relative error of frame cycles, the same per stage, the tile-size ranking 
 resolution; across back ends, the SIMD-width ranking; a predicted-against-measured scatter plot
 with the y = x line, and the Markdown page `docs/silicon-check-*.md`.
 
-A ranking is judged only where the measurement can tell: two variants count as measurably
-different when the ranges (min to max) of their measured renders do not overlap, and a ranking
-is right when the prediction orders every such pair as the measurement does."""
+Only converged workloads are scored: `sfx calibrate --check` renders each workload until its
+fastest renders agree (the rule, base/convergence.h, is in every row as `convergence_rule`) or
+its budget runs out; a workload that ran out is shown, marked, and left out of every error and
+ranking. A ranking is judged only where the measurement can tell: two converged variants count
+as measurably different when their measured ranges do not overlap, and a ranking is right when
+the prediction orders every such pair as the measurement does. A converged workload's range is
+what the rule vouches for: its fastest render to its k-th fastest (`measured.spread` above the
+fastest); rows without a spread (written before the rule) take their renders' min to max.
+
+Self-consistency: a scene's frame of 4x the pixels (128x128 against 64x64) must cost 3 to 5
+times as much (0.75 to 1.25 times the pixel ratio, for any pair of resolutions); a pair outside
+flags the host's measurement, not the model."""
 
 import html
 import itertools
@@ -22,7 +31,9 @@ import pandas as pd  # noqa: E402
 
 STAGES = ("traversal", "intersection", "shading")
 # Issue targets, on held-out workloads: frame MAE and worst, each stage's MAE.
-TARGETS = {"frame_mae": 0.10, "frame_worst": 0.20, "stage_mae": 0.20}
+TARGETS = {"frame_mae": 0.10, "frame_worst": 0.20, "stage_mae": 0.20, "converged": 0.90}
+# A frame of r times the pixels costs between these multiples of r.
+CONSISTENT = (0.75, 1.25)
 WIDTHS = {"scalar": 1, "avx2": 8, "avx512": 16}
 
 
@@ -44,7 +55,66 @@ def load_rows(path):
         lambda v: (max(v) - min(v)) / sorted(v)[len(v) // 2] if v else float("nan"))
     df["measured.lo"] = df["measured.frame_samples"].apply(min)
     df["measured.hi"] = df["measured.frame_samples"].apply(max)
+    if "measured.spread" in df:
+        # The range the convergence rule vouches for: the fastest to the k-th fastest render
+        # (an unconverged workload's spread may be null: infinite, never judged anyway).
+        spread = pd.to_numeric(df["measured.spread"], errors="coerce").fillna(float("inf"))
+        df["measured.lo"] = df["measured.frame_cycles"]
+        df["measured.hi"] = df["measured.frame_cycles"] * (1.0 + spread)
+    # Rows written before the convergence rule carry no verdict: they are taken as they were.
+    if "measured.converged" not in df:
+        df["measured.converged"] = True
+    df["measured.converged"] = df["measured.converged"].fillna(False).astype(bool)
+    if "measured.renders" not in df:
+        df["measured.renders"] = df["measured.frame_samples"].apply(len)
     return df
+
+
+def scored(df):
+    """The rows that count: converged workloads only."""
+    return df[df["measured.converged"]]
+
+
+def self_consistency(df):
+    """Per back end, scene and tile, each pair of resolutions measured (converged rows): the
+    measured cost ratio against the pixel ratio, and whether it lies within CONSISTENT."""
+    rows = []
+    g_df = scored(df).assign(pixels=lambda d: d["width"] * d["height"])
+    for (isa, scene, tile), g in g_df.groupby(["isa", "scene", "tile"], sort=False):
+        g = g.sort_values("pixels")
+        for (_, a), (_, b) in zip(g.iloc[:-1].iterrows(), g.iloc[1:].iterrows()):
+            if a["pixels"] == b["pixels"]:
+                continue
+            pixel_ratio = b["pixels"] / a["pixels"]
+            ratio = b["measured.frame_cycles"] / a["measured.frame_cycles"]
+            lo, hi = CONSISTENT[0] * pixel_ratio, CONSISTENT[1] * pixel_ratio
+            rows.append({"isa": isa, "scene": scene, "tile": tile, "small": a["res"],
+                         "large": b["res"], "ratio": ratio, "lo": lo, "hi": hi,
+                         "consistent": bool(lo <= ratio <= hi)})
+    return pd.DataFrame(rows, columns=["isa", "scene", "tile", "small", "large", "ratio", "lo",
+                                       "hi", "consistent"])
+
+
+def consistency_text(df):
+    """One line per back end: how many resolution pairs are consistent, and the ones that are
+    not (the host's measurement is flagged by them)."""
+    c = self_consistency(df)
+    if c.empty:
+        return "- self-consistency: no scene measured (converged) at two resolutions"
+    lines = []
+    for isa in isas(df):
+        g = c[c["isa"] == isa]
+        if g.empty:
+            continue
+        bad = g[~g["consistent"]]
+        lo, hi = g["lo"].iloc[0], g["hi"].iloc[0]
+        verdict = "consistent" if bad.empty else "FLAGGED: this host's measurement is suspect"
+        lines.append(f"- self-consistency ({isa}): {len(g) - len(bad)} of {len(g)} "
+                     f"(scene, tile) frames cost {lo:g}-{hi:g}x at {g['large'].iloc[0]} what "
+                     f"they cost at {g['small'].iloc[0]}: {verdict}")
+        for _, r in bad.iterrows():
+            lines.append(f"  - {r['scene']} tile {r['tile']}: {r['ratio']:.2f}x")
+    return "\n".join(lines)
 
 
 def isas(df):
@@ -69,18 +139,20 @@ def judged_ranking(g, key):
 
 
 def ranking(df):
-    """Per back end, scene and resolution: tiles fastest first, predicted and measured."""
+    """Per back end, scene and resolution: tiles fastest first, predicted and measured (the
+    converged workloads)."""
     rows = []
-    for (isa, scene, res), g in df.groupby(["isa", "scene", "res"], sort=False):
+    for (isa, scene, res), g in scored(df).groupby(["isa", "scene", "res"], sort=False):
         rows.append({"isa": isa, "scene": scene, "res": res, **judged_ranking(g, "tile")})
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=["isa", "scene", "res", "predicted", "measured", "pairs",
+                                       "pairs_right", "measurable", "right"])
 
 
 def width_ranking(df):
     """Per scene, resolution and tile (with more than one back end): SIMD widths fastest
     first, predicted and measured."""
     rows = []
-    for (scene, res, tile), g in df.groupby(["scene", "res", "tile"], sort=False):
+    for (scene, res, tile), g in scored(df).groupby(["scene", "res", "tile"], sort=False):
         if g["isa"].nunique() < 2:
             continue
         rows.append({"scene": scene, "res": res, "tile": tile,
@@ -89,20 +161,25 @@ def width_ranking(df):
 
 
 def summary(df):
-    """For one back end's rows: MAE and worst |error| of frame cycles, per stage, the tile
-    ranking, and whether the targets hold."""
-    out = {"workloads": len(df),
+    """For one back end's rows: how many converged; over the converged ones, MAE and worst
+    |error| of frame cycles, per stage, the tile ranking; and whether the targets hold."""
+    all_rows = df
+    df = scored(df)
+    out = {"workloads": len(all_rows), "converged": len(df),
+           "converged_share": len(df) / len(all_rows) if len(all_rows) else 0.0,
            "frame_mae": df["error.frame"].abs().mean(),
            "frame_worst": df["error.frame"].abs().max()}
     for s in STAGES:
         out[f"{s}_mae"] = df[f"error.{s}"].abs().mean()
         out[f"{s}_worst"] = df[f"error.{s}"].abs().max()
     rank = ranking(df)
-    measurable = rank[rank["measurable"]]
+    measurable = rank[rank["measurable"].astype(bool)]
     out["ranking_right"] = int(measurable["right"].sum())
     out["ranking_cells"] = len(measurable)
     out["ranking_within_noise"] = len(rank) - len(measurable)
     out["targets"] = {
+        "at least 90 % of workloads converge":
+            bool(out["converged_share"] >= TARGETS["converged"]),
         "frame MAE <= 10 %": bool(out["frame_mae"] <= TARGETS["frame_mae"]),
         "frame worst <= 20 %": bool(out["frame_worst"] <= TARGETS["frame_worst"]),
         "each stage's MAE <= 20 %": all(bool(out[f"{s}_mae"] <= TARGETS["stage_mae"])
@@ -120,7 +197,7 @@ def width_summary(df):
         return None
     scenes = []
     for scene, g in rank.groupby("scene", sort=False):
-        m = g[g["measurable"]]
+        m = g[g["measurable"].astype(bool)]
         scenes.append({"scene": scene, "cells": len(m), "right": int(m["right"].sum()),
                        "pairs": int(m["pairs"].sum()), "pairs_right": int(m["pairs_right"].sum())})
     scenes = pd.DataFrame(scenes)
@@ -134,17 +211,22 @@ def pct(x):
     return f"{100 * x:+.1f} %"
 
 
+def converged_text(r):
+    """'yes (9)' or 'NO (31)': the verdict and the renders it took."""
+    return f"{'yes' if r['measured.converged'] else 'NO'} ({r['measured.renders']})"
+
+
 def table_text(df):
     lines = ["| back end | scene | res | tile | predicted Mcyc | measured Mcyc | error | trav err | "
-             "isect err | shade err | noise |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "isect err | shade err | noise | converged (renders) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in df.iterrows():
         lines.append(
             f"| {r['isa']} | {r['scene']} | {r['res']} | {r['tile']} | "
             f"{r['predicted.frame_cycles'] / 1e6:.2f} | "
             f"{r['measured.frame_cycles'] / 1e6:.2f} | {pct(r['error.frame'])} | "
             f"{pct(r['error.traversal'])} | {pct(r['error.intersection'])} | "
-            f"{pct(r['error.shading'])} | {100 * r['noise']:.0f} % |")
+            f"{pct(r['error.shading'])} | {100 * r['noise']:.0f} % | {converged_text(r)} |")
     return "\n".join(lines)
 
 
@@ -152,7 +234,7 @@ def stage_table_text(df):
     lines = ["| back end | scene | stage | predicted Mcyc (sum) | measured Mcyc (sum) | "
              "error of sum | mean abs error | of which scene-data stalls (predicted) |",
              "|---|---|---|---|---|---|---|---|"]
-    for (isa, scene), g in df.groupby(["isa", "scene"], sort=False):
+    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
         for s in STAGES:
             p = g[f"predicted.{s}_cycles"].sum()
             m = g[f"measured.{s}_cycles"].sum()
@@ -197,7 +279,7 @@ def misses_text(df):
     prediction is scene-data stalls - where to look first."""
     lines = ["| back end | stage | predicted Mcyc | measured Mcyc | error of sum | "
              "predicted scene-data stalls | error without them |", "|---|---|---|---|---|---|---|"]
-    for isa, g in df.groupby("isa", sort=False):
+    for isa, g in scored(df).groupby("isa", sort=False):
         for s in STAGES:
             p = g[f"predicted.{s}_cycles"].sum()
             m = g[f"measured.{s}_cycles"].sum()
@@ -209,7 +291,8 @@ def misses_text(df):
 
 def summary_text(s, isa=None):
     at = f" ({isa})" if isa else ""
-    lines = [f"- workloads{at}: {s['workloads']}",
+    lines = [f"- workloads{at}: {s['workloads']}, of which {s['converged']} converged "
+             f"({100 * s['converged_share']:.0f} %; only these are scored)",
              f"- frame cycles: MAE {100 * s['frame_mae']:.1f} %, worst {100 * s['frame_worst']:.1f} %"]
     for st in STAGES:
         lines.append(f"- {st}: MAE {100 * s[f'{st}_mae']:.1f} %, worst {100 * s[f'{st}_worst']:.1f} %")
@@ -233,12 +316,58 @@ def width_summary_text(w):
     return "\n".join(lines)
 
 
+def measurement_text(df):
+    """How the rows were measured: the convergence rule, the cycle source of each back end,
+    the host's microarchitecture, the huge pages the process held."""
+    lines = []
+    if "convergence_rule" in df:
+        for rule in df["convergence_rule"].dropna().unique():
+            lines.append(f"- convergence rule: {rule}")
+    if "measured.cycle_source" in df:
+        for isa in isas(df):
+            for src in df[df["isa"] == isa]["measured.cycle_source"].dropna().unique():
+                lines.append(f"- cycles ({isa}): {src}")
+    else:
+        lines.append("- cycles: not recorded (rows written before the cycle source)")
+    if "measured.clock_mhz_before" in df and not df["measured.cycles_counted"].any():
+        for isa in isas(df):
+            g = df[df["isa"] == isa]
+            clocks = pd.concat([g["measured.clock_mhz_before"], g["measured.clock_mhz_after"]])
+            drift = (g["measured.clock_mhz_after"] / g["measured.clock_mhz_before"] - 1).abs()
+            lines.append(f"- core clock around the fastest renders ({isa}): "
+                         f"{clocks.min():.0f}-{clocks.max():.0f} MHz, before and after one render "
+                         f"apart by {100 * drift.median():.1f} % (median), "
+                         f"{100 * drift.max():.1f} % at most")
+    if "host.microarchitecture" in df:
+        for m in df["host.microarchitecture"].dropna().unique():
+            lines.append(f"- microarchitecture: {m}")
+    if "measured.huge_page_kib_min" in df:
+        lo, hi = df["measured.huge_page_kib_min"].min(), df["measured.huge_page_kib_max"].max()
+        lines.append(f"- transparent huge pages held by the process after each render: "
+                     f"{lo / 1024:.0f}-{hi / 1024:.0f} MiB "
+                     f"(AnonHugePages, /proc/self/smaps_rollup)")
+    if "measured.neighbours_busy" in df:
+        busy = df["measured.neighbours_busy"]
+        busy = busy[busy >= 0]
+        if len(busy):
+            lines.append(f"- the other CPUs were busy {100 * busy.mean():.0f} % of the time during "
+                         f"the renders (per workload {100 * busy.min():.0f}-{100 * busy.max():.0f} "
+                         f"%; /proc/stat): a whole run can be slowed alike, which no convergence "
+                         f"rule sees")
+    return "\n".join(lines)
+
+
 def all_summaries_text(df):
-    """The summary of every back end, then the width ranking's."""
+    """How it was measured, the summary of every back end, the width ranking's, and the
+    self-consistency flags."""
     parts = []
+    head = measurement_text(df)
+    if head:
+        parts.append(head)
     for isa in isas(df):
         parts.append(summary_text(summary(df[df["isa"] == isa]), isa))
     parts.append(width_summary_text(width_summary(df)))
+    parts.append(consistency_text(df))
     return "\n".join(parts)
 
 
@@ -246,6 +375,7 @@ def scatter_plot(df, path):
     fig, axes = plt.subplots(1, 2, figsize=(11, 5))
     ax = axes[0]
     markers = {"scalar": "x", "avx2": "o", "avx512": "s"}
+    df = scored(df) if scored(df).shape[0] else df
     for (scene, isa), g in df.groupby(["scene", "isa"], sort=False):
         ax.scatter(g["measured.frame_cycles"] / 1e6, g["predicted.frame_cycles"] / 1e6,
                    label=f"{scene} {isa}", marker=markers.get(isa, "o"), s=28)
@@ -289,10 +419,13 @@ def write_page(df, page, plot_name, header):
         "## Summary\n\n" + all_summaries_text(df),
         f"![predicted against measured]({plot_name})",
         "## Per workload\n\nError = predicted / measured - 1. Noise = (max - min) / median of the "
-        "measured renders of that workload.\n\n" + table_text(df),
+        "measured renders of that workload. Converged: whether its fastest renders agreed "
+        "before the budget ran out (the rule above), and how many renders it took; a workload "
+        "marked NO is shown but scored nowhere.\n\n" + table_text(df),
         "## Per scene and stage\n\n" + stage_table_text(df),
-        "## Tile-size ranking\n\nJudged on the pairs of tiles whose measured renders' ranges "
-        "do not overlap.\n\n" + ranking_text(df),
+        "## Tile-size ranking\n\nJudged on the pairs of converged tiles whose measured ranges "
+        "(the fastest to the k-th fastest render, what the convergence rule vouches for) do "
+        "not overlap.\n\n" + ranking_text(df),
         "## SIMD-width ranking\n\nThe same workload on each back end, each predicted by its "
         "own host configuration (per-op costs from that back end's microbenchmarks); judged as "
         "the tiles are.\n\n" + width_ranking_text(df),
@@ -314,14 +447,14 @@ def html_section(df, directory, plot_name="silicon-check.png"):
     items = "".join(f"<li>{e(line.strip()[2:])}</li>"
                     for line in all_summaries_text(df).splitlines())
     head = ["back end", "scene", "res", "tile", "predicted Mcyc", "measured Mcyc", "error", "trav err",
-            "isect err", "shade err", "noise"]
+            "isect err", "shade err", "noise", "converged (renders)"]
     rows = []
     for _, r in df.iterrows():
         cells = [r["isa"], r["scene"], r["res"], r["tile"],
                  f"{r['predicted.frame_cycles'] / 1e6:.2f}",
                  f"{r['measured.frame_cycles'] / 1e6:.2f}", pct(r["error.frame"]),
                  pct(r["error.traversal"]), pct(r["error.intersection"]),
-                 pct(r["error.shading"]), f"{100 * r['noise']:.0f} %"]
+                 pct(r["error.shading"]), f"{100 * r['noise']:.0f} %", converged_text(r)]
         rows.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in cells) + "</tr>")
     return "\n".join([
         "<h2>The timing model on silicon</h2>",

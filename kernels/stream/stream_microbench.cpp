@@ -231,14 +231,15 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 if (n > slots) continue;
                 std::vector<double> times;
                 uint32_t passed = 0;
-                const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
+                const double ticks_per_cycle =
+                    tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(options.isa)));
                 const uint32_t box_node = box_nodes[box_sample++ % box_nodes.size()];
                 // Short streams run several times in the timed region (the TSC ticks in steps
                 // of tens of cycles here), each time on another stream.
                 const uint32_t inner = std::max(1u, 256u / n);
                 const uint32_t stride = n + k_stream_padding;
                 streams.assign(size_t(inner) * stride, 0u);
-                for (uint32_t rep = 0; rep < options.repeats; ++rep) {
+                while (needs_more_samples(times, options.convergence)) {
                     // Fresh random streams: n slots of the buffer each, in increasing order, as
                     // the tracer's streams are (the camera's, and every stable partition of
                     // one), with the rays dealt anew; the whole buffer touched in random order
@@ -435,8 +436,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     const uint64_t end = __rdtsc();
                     times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
                 }
-                out.push_back({kind, slots, n, passed,
-                               *std::min_element(times.begin(), times.end()) / ticks_per_cycle});
+                const Convergence c = judge_convergence(times, options.convergence);
+                out.push_back({kind, slots, n, passed, c.fastest / ticks_per_cycle, c.converged,
+                               c.samples});
             }
         }
         if (progress) progress(++done, uint32_t(kinds.size()));
@@ -444,7 +446,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     return out;
 }
 
-std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats, uint64_t seed) {
+std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
+                                                      uint64_t seed) {
     const Scene scene = synthetic_scene(true);
     const Bvh bvh(scene);
     const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
@@ -487,14 +490,17 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats,
                 sample.ops[k] = counts.kind_ops(OpKind(k));
             job.sink = nullptr;
             std::vector<double> times;
-            const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
-            for (uint32_t rep = 0; rep < repeats; ++rep) {
+            const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
+            while (needs_more_samples(times, convergence)) {
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
                 times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
             }
-            sample.cycles = *std::min_element(times.begin(), times.end()) / ticks_per_cycle;
+            const Convergence c = judge_convergence(times, convergence);
+            sample.cycles = c.fastest / ticks_per_cycle;
+            sample.converged = c.converged;
+            sample.repetitions = c.samples;
             out.push_back(sample);
         }
     return out;
@@ -535,7 +541,8 @@ std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t re
                     e = __rdtsc();
                     compress_t.push_back((double(e - s) - overhead) / n);
                 }
-                const double ticks_per_cycle = tsc_ticks_per_core_cycle(3);
+                const double ticks_per_cycle =
+                    tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
                 out.push_back({"field read (box kernel, 7 fields)", slots, n, scattered,
                                median(gather_t) / ticks_per_cycle});
                 out.push_back({"compress partition", slots, n, scattered,

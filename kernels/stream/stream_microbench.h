@@ -5,18 +5,21 @@
 // run with the trace off on streams of a chosen length whose ids are a random subset, in
 // increasing order (as the tracer's stable partitions keep them), of a ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
 // glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
-// the fastest of several repetitions (a shared machine only ever adds time), in core cycles
-// (the TSC over base/core_clock.h's ticks per core cycle, taken just before). An op is timed with all the per-ray work the tracer does for
+// the fastest of repetitions that go on until their fastest k agree or a budget runs out
+// (base/convergence.h: a shared machine only ever adds time), in core cycles (the TSC over
+// base/core_clock.h's ticks per core cycle of the back end's own chain, taken just before). An op is timed with all the per-ray work the tracer does for
 // it: the emission filter computes the hits' surfaces (surface_at), and the camera and every
 // shader that makes a ray set it up for the next generation's traversal (set_up_ray, the
 // tracer's load_rays). `sfx calibrate --describe-host` fits the host's per-op costs to these
 // samples (hw_model/op_cost_fit.h), never to frames.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
+#include "base/convergence.h"
 #include "kernels/simd/isa.h"
 #include "kernels/trace.h"
 
@@ -32,7 +35,19 @@ struct MicrobenchSample {
     uint32_t lanes = 0;   // stream length
     uint32_t passed = 0;  // lanes that passed (the filter's result)
     double cycles = 0.0;  // core cycles per call (base/core_clock.h), fastest repetition
+    bool converged = false;  // its fastest repetitions agreed (base/convergence.h)
+    uint32_t repetitions = 0;
 };
+
+// The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.
+inline ConvergenceRule microbench_rule(uint32_t budget = 9) {
+    ConvergenceRule r;
+    r.fastest = std::min<uint32_t>(3, budget);
+    r.tolerance = 0.03;
+    r.min_samples = std::min<uint32_t>(5, budget);
+    r.budget = budget;
+    return r;
+}
 
 struct MicrobenchOptions {
     Isa isa = Isa::automatic;
@@ -40,7 +55,7 @@ struct MicrobenchOptions {
     // 16^2, 32^2 and 64^2 ray buffers.
     std::vector<uint32_t> buffer_slots = {64, 256, 1024, 4096};
     std::vector<uint32_t> lengths = {1, 8, 16, 24, 48, 96, 200, 512, 1024, 4096};
-    uint32_t repeats = 9;
+    ConvergenceRule convergence = microbench_rule();  // repetitions per point
     uint64_t seed = 1;
 };
 
@@ -58,14 +73,16 @@ struct OneRaySample {
     uint32_t rays = 0;
     std::array<uint64_t, k_op_kind_count> ops{};  // per kind, counted by the same traversals
     double cycles = 0.0;                          // core cycles, fastest repetition
+    bool converged = false;
+    uint32_t repetitions = 0;
 };
 // Batches of 1 to 32 random rays (several batches of each size).
-std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, uint32_t repeats = 9,
-                                                      uint64_t seed = 1);
+std::vector<OneRaySample> run_one_ray_microbenchmarks(
+    Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1);
 
 // The field-read and compress rates by themselves: TSC ticks per lane of the box kernel's read
 // of 7 fields for `lanes` ids over `slots` records (contiguous or random slots) with a box every
-// ray passes, and of the compress partition.
+// ray passes, and of the compress partition (the median of `repeats`: reported, not fitted).
 struct KernelRate {
     const char* what;
     uint32_t slots, lanes;

@@ -114,3 +114,99 @@ def test_report_bad_rows(tmp_path):
     p.write_text("{}")
     assert main(["report", accuracy_store(tmp_path), "-o", str(tmp_path / "r"),
                  "--silicon", str(p)]) == 2
+
+
+def test_unconverged_workloads_are_shown_not_scored(tmp_path):
+    rows = [row("a", 16, 110, 100), row("a", 32, 90, 100.5), row("a", 64, 150, 120)]
+    for r in rows:
+        r["measured.converged"] = True
+        r["measured.renders"] = 7
+        r["convergence_rule"] = "fastest 3 of 7-31 samples within 3 %"
+        r["measured.cycle_source"] = ("estimated: thread CPU time x ... "
+                                      "(perf_event_open refused: ENOENT)")
+        r["measured.neighbours_busy"] = 0.5
+        r["measured.cycles_counted"] = False
+        r["measured.clock_mhz_before"], r["measured.clock_mhz_after"] = 3000.0, 3030.0
+    rows[2]["measured.converged"] = False  # the 25 % miss ran out of budget
+    rows[2]["measured.renders"] = 31
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    s = silicon.summary(df)
+    assert s["workloads"] == 3 and s["converged"] == 2
+    assert s["converged_share"] == pytest.approx(2 / 3)
+    assert s["frame_worst"] == pytest.approx(1 - 90 / 100.5)  # the unconverged 25 % is not
+    assert s["targets"]["at least 90 % of workloads converge"] is False
+    assert s["ranking_cells"] == 0  # tiles 16 and 32 overlap; 64 is not judged
+    table = silicon.table_text(df)
+    assert "| NO (31) |" in table and "| yes (7) |" in table
+    text = silicon.all_summaries_text(df)
+    assert "of which 2 converged (67 %; only these are scored)" in text
+    assert "convergence rule: fastest 3 of 7-31 samples within 3 %" in text
+    assert "cycles (avx512): estimated" in text and "ENOENT" in text
+    assert "target at least 90 % of workloads converge: MISSED" in text
+    assert "the other CPUs were busy 50 % of the time" in text
+    assert ("core clock around the fastest renders (avx512): 3000-3030 MHz, before and after "
+            "one render apart by 1.0 % (median)") in text
+
+
+def test_self_consistency_flag(tmp_path):
+    # Scene a: 128x128 costs 4x its 64x64 (consistent); scene b: 1.5x (the Intel host's
+    # atrium: the small frame slower than it can be): flagged. Scene c at one resolution.
+    rows = [row("a", 64, 100, 100), row("a", 64, 400, 410, res=(128, 128)),
+            row("b", 64, 100, 146.9), row("b", 64, 400, 220, res=(128, 128)),
+            row("c", 64, 100, 100)]
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    c = silicon.self_consistency(df)
+    assert list(c["scene"]) == ["a", "b"]
+    assert list(c["consistent"]) == [True, False]
+    assert c["lo"].iloc[0] == pytest.approx(3) and c["hi"].iloc[0] == pytest.approx(5)
+    text = silicon.consistency_text(df)
+    assert "1 of 2 (scene, tile) frames cost 3-5x at 128x128" in text
+    assert "FLAGGED" in text and "b tile 64: 1.50x" in text
+    # Consistent everywhere: not flagged.
+    assert "FLAGGED" not in silicon.consistency_text(df[df["scene"] == "a"])
+    # An unconverged frame is not used to flag either.
+    df.loc[df["scene"] == "b", "measured.converged"] = False
+    assert "FLAGGED" not in silicon.consistency_text(df)
+
+
+def test_nothing_converged(tmp_path, capsys):
+    # A host that cannot be measured at all: every workload ran out of budget. The page is
+    # written, says so, and scores nothing.
+    rows = [row("a", 16, 110, 100), row("a", 32, 90, 130, res=(128, 128))]
+    for r in rows:
+        r["measured.converged"] = False
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    s = silicon.summary(df)
+    assert s["converged"] == 0 and s["ranking_cells"] == 0
+    text = silicon.all_summaries_text(df)
+    assert "of which 0 converged (0 %" in text
+    assert "target at least 90 % of workloads converge: MISSED" in text
+    header = tmp_path / "h.md"
+    header.write_text("")
+    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
+
+
+def test_rankings_judge_the_converged_range(tmp_path):
+    # Renders spread over a noisy run overlap from min to max, but the converged ranges (the
+    # fastest to the third fastest: frame x (1 + spread)) do not: the pair is judged.
+    rows = [row("a", 16, 100, 100), row("a", 32, 130, 120)]
+    rows[0]["measured.frame_samples"] = [100, 101, 102, 150]
+    rows[1]["measured.frame_samples"] = [120, 121, 123, 160]
+    rows[0]["measured.spread"], rows[1]["measured.spread"] = 0.02, 0.025
+    for r in rows:
+        r["measured.converged"] = True
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    assert df["measured.hi"].iloc[0] == pytest.approx(102)
+    rank = silicon.ranking(df)
+    assert list(rank["pairs"]) == [1] and list(rank["right"]) == [True]
+    # Ranges that overlap: not judged.
+    df.loc[0, "measured.hi"] = 125
+    assert list(silicon.ranking(df)["pairs"]) == [0]

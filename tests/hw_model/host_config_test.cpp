@@ -254,3 +254,33 @@ TEST_CASE("The host's caches and clock are read from the CPU", "[host]") {
     CHECK(mhz > 100.0);
     CHECK(mhz < 10000.0);
 }
+
+TEST_CASE("The host's microarchitecture: vendor, family and model from cpuid", "[host]") {
+    // Known leaf-1 signatures: AMD EPYC 7B12 (Zen 2, family 0x17 model 0x31), an Intel Xeon
+    // Skylake-SP (family 6 model 0x55), an Ice Lake-SP (family 6 model 0x6A), Zen 4 (0x19 0x11).
+    CpuSignature s = decode_cpu_signature(0x00830F10);
+    CHECK(s.family == 0x17);
+    CHECK(s.model == 0x31);
+    CHECK(s.stepping == 0);
+    s = decode_cpu_signature(0x00050654);
+    CHECK(s.family == 6);
+    CHECK(s.model == 0x55);
+    CHECK(s.stepping == 4);
+    s = decode_cpu_signature(0x000606A6);
+    CHECK(s.family == 6);
+    CHECK(s.model == 0x6A);
+    s = decode_cpu_signature(0x00A10F11);
+    CHECK(s.family == 0x19);
+    CHECK(s.model == 0x11);
+    CHECK(vendor_short_name("AuthenticAMD") == "amd");
+    CHECK(vendor_short_name("GenuineIntel") == "intel");
+    CHECK(vendor_short_name("Hygon Genuine") == "hygongenuine");
+    // This CPU: a vendor every x86-64 CPU gives, and the host file names it.
+    const Microarchitecture m = read_microarchitecture();
+    CHECK(m.vendor.size() == 12);
+    CHECK(m.signature.family > 0);
+    HostDescription h = small_host();
+    h.microarchitecture = m;
+    CHECK_THAT(host_hw_yaml(h, {}, "test"),
+               Catch::Contains("# Microarchitecture (cpuid): " + m.vendor + " family 0x"));
+}

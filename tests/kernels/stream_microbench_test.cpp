@@ -37,7 +37,7 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     MicrobenchOptions o;
     o.buffer_slots = {64};
     o.lengths = {1, 16, 64, 128};  // 128 > 64 slots: skipped
-    o.repeats = 1;
+    o.convergence = microbench_rule(1);
     const std::vector<MicrobenchSample> samples = run_stream_microbenchmarks(o);
     std::set<OpKind> kinds;
     for (const MicrobenchSample& m : samples) {

@@ -3,6 +3,7 @@
 
 #include "sweeps/host_calibration.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <map>
 
@@ -21,14 +22,14 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     o.isa = isa;
     o.buffer_slots = {64, 256};
     o.lengths = {1, 16, 64, 256};
-    o.repeats = 3;
+    o.convergence = microbench_rule(3);
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     for (const MicrobenchSample& s : run_stream_microbenchmarks(o))
         by_kind[s.kind].push_back(
             {s.lanes, s.passed,
              beyond_l1_fraction(s.slots, stream_slot_bytes(), host.caches.front().kib), s.cycles});
     // One-ray traversals: only the traversal's kinds, each made, and their fitted cost.
-    const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, 3);
+    const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, microbench_rule(3));
     std::vector<OneLaneSample> one_lane;
     std::map<OpKind, uint64_t> made;
     double one_ray_cycles = 0;
@@ -63,11 +64,35 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     s.tile = 8;
     s.max_depth = scene.max_depth;
     s.isa = isa;
-    const std::vector<SiliconMeasurement> cell = predict_and_measure(scene, bvh, {{s, &config}}, 1);
-    REQUIRE(cell.size() == 1);
+    // Two renders at most; converged when the fastest two agree within 100 %.
+    ConvergenceRule rule;
+    rule.fastest = 2;
+    rule.tolerance = 1.0;
+    rule.min_samples = 2;
+    rule.budget = 2;
+    // Two scenes in one interleaved run: each workload measured on its own scene.
+    const Scene furnace = load_scene("furnace");
+    const Bvh furnace_bvh(furnace);
+    RenderSettings f = s;
+    f.max_depth = furnace.max_depth;
+    std::vector<std::string> rounds;
+    const std::vector<SiliconMeasurement> cell = predict_and_measure(
+        {{&scene, &bvh, s, &config}, {&furnace, &furnace_bvh, f, &config}}, rule, 1,
+        [&](const std::string& what, size_t, size_t) { rounds.push_back(what); });
+    REQUIRE(cell.size() == 2);
+    CHECK(cell[1].frame_samples.size() == 2);
+    CHECK(cell[1].predicted_frame > 0);
+    CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
+    CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
+    CHECK(std::count(rounds.begin(), rounds.end(), "round 2: 2 open") == 1);
     const SiliconMeasurement& m = cell.front();
     CHECK(m.prediction.config.ray_buffer.storage == "l1d");  // the machine model's prediction
-    CHECK(m.frame_samples.size() == 1);
+    CHECK(m.frame_samples.size() == 2);
+    CHECK(m.convergence.samples == 2);
+    CHECK(m.measured_frame == Approx(std::min(m.frame_samples[0], m.frame_samples[1])));
+    // Where the cycles came from, said either way.
+    CHECK((m.cycle_source.find("counted") == 0 || m.cycle_source.find("estimated") == 0));
+    CHECK(m.clock_mhz_before > 0);
     CHECK(m.measured_frame > 0);
     CHECK(m.predicted_frame > 0);
     for (int i = 0; i < 3; ++i) {
