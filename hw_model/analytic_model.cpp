@@ -160,6 +160,36 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
            previous_miss * (double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer);
 }
 
+// Expected cycles until the slowest of `lanes` reads of each lane's hit primitive arrives. The
+// hit's lines were fetched by the intersection op that found it in this pass, so a read is a
+// re-touch: it hits a level if the pass's working set fits (in proportion, if not). Fills
+// `global_misses` (per level, one read's) when given.
+double expected_hit_read_cycles(const SceneMemoryConfig& memory, double core_mhz,
+                                const TraceProfile& profile, double lanes,
+                                std::vector<double>* global_misses = nullptr) {
+    const TraceProfile::Footprint& f = profile.footprint();
+    const double pass_bytes = TraceProfile::k_line_bytes * double(f.pass_distinct) /
+                              double(std::max<uint64_t>(1, profile.passes()));
+    double previous_miss = 1.0, previous_latency = 0.0, cycles = 0.0;
+    auto beyond = [&](double miss, double latency) {
+        // P(some lane reaches this level) x its extra latency over the nearer level's.
+        cycles += (1.0 - std::pow(1.0 - previous_miss, lanes)) * (latency - previous_latency);
+        previous_latency = latency;
+        previous_miss = miss;
+    };
+    for (const CacheLevelConfig& level : memory.caches) {
+        const double retouch_miss =
+            pass_bytes > 0 ? 1.0 - std::min(1.0, double(level.kib) * 1024.0 / pass_bytes) : 0.0;
+        const double global_miss = std::min(previous_miss, retouch_miss);  // inclusive
+        beyond(global_miss, double(ns_to_cycles(level.hit_latency_ns, core_mhz)));
+        if (global_misses) global_misses->push_back(global_miss);
+    }
+    const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
+    const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
+    beyond(0.0, double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer);
+    return cycles;
+}
+
 }  // namespace
 
 FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
@@ -174,9 +204,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const uint32_t n = c.simd.width;
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
     std::vector<double> global_misses;  // per cache level, for the action counts
+    const TraceProfile& lines = footprint ? *footprint : profile;  // whose scene lines
     const double fetch_cycles = std::max(
-        0.0, expected_fetch_cycles(c.scene_memory, c.clock.core_mhz,
-                                   footprint ? *footprint : profile, &global_misses) -
+        0.0, expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, lines, &global_misses) -
                  double(scene_latency_in_costs(c)));
     const double beyond_l1 =
         slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()));
@@ -206,7 +236,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     StallCounts<double> stalls;
     // Expected action counts, summed fractionally and rounded once at the end (as the stalls).
     double bank_reads = 0, bank_writes = 0, addresses = 0, compares = 0, moved = 0,
-           scratch_words = 0, word_hops = 0, fetches = 0, busy_units[k_hw_unit_count] = {};
+           scratch_words = 0, word_hops = 0, fetches = 0, busy_units[k_hw_unit_count] = {},
+           lane_reads = 0;
     double simd_instructions[k_op_kind_count] = {}, simd_lane_ops[k_op_kind_count] = {};
     const double units = double(std::max(1u, c.simd.units));
     const double agu_rate = double(c.agu.count) * c.agu.addresses_per_cycle;
@@ -290,11 +321,22 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         // fetch and the earlier ops do not cover shows.
         const double ahead =
             double(c.scene_memory.prefetch_depth) + (c.scene_memory.prefetch_children ? 1.0 : 0.0);
-        const double memory_stall =
+        const double fetch_stall =
             p.scene_bytes
                 ? std::max(0.0, fetch_cycles - first_fetch - ahead * (exec + bubble)) *
                       double(bucket.fetches) / ops
                 : 0.0;
+        // Each lane's hit primitive (lane_scene_reads), requested at dispatch: the first
+        // group waits for its slowest lane beyond its ray data; later groups find theirs.
+        double lane_stall = 0.0;
+        if (p.lane_scene_reads && !l1d) {
+            lane_stall = std::max(
+                0.0, expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines,
+                                              double(std::min<uint32_t>(n, length))) -
+                         first_fetch);
+            lane_reads += ops * double(length);
+        }
+        const double memory_stall = fetch_stall + lane_stall;
         const double op_cycles = exec + bubble + memory_stall;
 
         total_cycles += ops * op_cycles;
@@ -342,6 +384,19 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         t.mix.compute += uint64_t(ops * double(groups) * p.compute_instructions);
         t.mix.scatter_gather += uint64_t(std::llround(ops * accesses));
         t.mix.partition += uint64_t(ops * compare);
+        if (p.partitions) {
+            // G&R Fig. 5's mask store, for groups with a passing lane (independent lanes).
+            double stored = 0.0;
+            for (uint64_t g = 0; g < groups; ++g)
+                stored += 1.0 - std::pow(1.0 - pass_rate,
+                                         double(std::min<uint32_t>(n, length - uint32_t(g * n))));
+            t.mix.store += uint64_t(ops * stored);
+        }
+        if (p.lane_scene_reads) {
+            t.mix.load += uint64_t(ops * double(groups * p.lane_scene_words));
+            t.mix.scatter_gather += uint64_t(ops * double(groups * p.lane_scene_words));
+            addresses += ops * double(length) * p.lane_scene_words;
+        }
         t.mix.store += uint64_t(ops * moves + ops * scatter_addresses);
         if (p.pushes_rays) t.mix.store += uint64_t(std::ceil(double(bucket.passed) / n));
         if (is_option_kind(kind)) t.mix.option += t.mix.total() - mix_before;
@@ -363,12 +418,17 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     a.partition_moves = count(moved);
     a.scratchpad_accesses = count(scratch_words);
     a.interconnect_word_hops = count(word_hops);
-    // One line per fetch: level i is looked up by the fetches every nearer level missed.
-    double reaching = fetches;
+    // One line per fetch: level i is looked up by the fetches every nearer level missed; so
+    // with the lanes' hit reads (one line each, at their re-touch misses).
+    std::vector<double> lane_misses;
+    if (lane_reads > 0)
+        expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines, 1.0, &lane_misses);
+    double reaching = fetches + lane_reads;
     for (size_t i = 0; i < global_misses.size() && i < ActionCounts::k_max_cache_levels; ++i) {
+        const double lane_missed = i < lane_misses.size() ? lane_reads * lane_misses[i] : 0.0;
         a.cache_accesses[i] = count(reaching);
-        a.cache_fills[i] = count(fetches * global_misses[i]);
-        reaching = fetches * global_misses[i];
+        a.cache_fills[i] = count(fetches * global_misses[i] + lane_missed);
+        reaching = fetches * global_misses[i] + lane_missed;
     }
     const uint32_t dram_line =
         c.scene_memory.caches.empty() ? 64 : c.scene_memory.caches.back().line_bytes;

@@ -57,6 +57,8 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     const size_t n = pass->size();
     m_scene_ready.assign(n, 0);
     m_scene_requested.assign(n, 0);
+    m_group_scene_offset.assign(n, k_none);
+    m_group_scene_ready.clear();
     m_groups_left.assign(n, 0);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
@@ -96,6 +98,21 @@ void CoreModel::dispatch_op(uint32_t index) {
         act.bank_reads += part.moved_ids;
         act.bank_writes += part.moved_ids;
     }
+    if (p.partitions) {
+        // G&R Fig. 5: a group's mask is stored when any lane passed (`if (anytrue(mask))
+        // store(mask_end, mask)`), for the partition to read.
+        for (uint32_t first = 0; first < op.length; first += n) {
+            const uint32_t lanes = std::min(n, op.length - first);
+            mix.store += std::any_of(op.passed + first, op.passed + first + lanes,
+                                     [](uint8_t v) { return v != 0; });
+        }
+    }
+    if (p.lane_scene_reads && op.length > 0) {
+        // Each lane's hit primitive, gathered from the scene: an address vector per word.
+        mix.load += groups * p.lane_scene_words;
+        mix.scatter_gather += groups * p.lane_scene_words;
+        act.agu_addresses += uint64_t(op.length) * p.lane_scene_words;  // ACTIONS
+    }
     if (p.pushes_rays) mix.store += (uint64_t(op.pass_count) + n - 1) / n;
     if (p.pushes_rays) act.bank_writes += op.pass_count;  // ACTIONS: next generation's ids
     if (is_option_kind(op.kind)) mix.option += mix.total() - mix_before;
@@ -106,6 +123,22 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
     m_scene_requested[index] = 1;
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
+    const uint32_t* hits = m_pass->lane_hits(index);
+    if (p.lane_scene_reads && hits && !m_l1d && op.length > 0) {
+        // Every lane's hit primitive, requested with the op (the address units run ahead of
+        // the SIMD units, G&R 4.1; assumed: as soon as the op is dispatched); a group waits
+        // for its slowest lane. A CPU core's measured cost holds these reads.
+        const uint32_t n = width();
+        m_group_scene_offset[index] = m_group_scene_ready.size();
+        for (uint32_t first = 0; first < op.length; first += n) {
+            uint64_t ready = now;
+            for (uint32_t i = first; i < std::min(op.length, first + n); ++i)
+                if (hits[i] != k_no_object)
+                    ready = std::max(ready, m_scene_memory->read(m_core, m_map.hit_address(hits[i]),
+                                                                 m_map.hit_bytes(hits[i]), now));
+            m_group_scene_ready.push_back(ready);
+        }
+    }
     if (!p.scene_bytes || op.object == k_no_object || op.length == 0) {
         m_scene_ready[index] = 0;
         return;
@@ -204,13 +237,22 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
     return std::max(issue_done, ids_done);
 }
 
+uint64_t CoreModel::scene_ready(const GroupToken& t) const {
+    const StreamOp op = m_pass->at(t.op);
+    const OpProfile& p = m_costs[op.kind];
+    uint64_t ready = p.scene_bytes && op.object != k_no_object ? m_scene_ready[t.op] : 0;
+    if (m_group_scene_offset[t.op] != k_none)
+        ready = std::max(ready, m_group_scene_ready[m_group_scene_offset[t.op] + t.first / width()]);
+    return ready;
+}
+
 CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint64_t now) {
     const StreamOp op = m_pass->at(t.op);
     const OpProfile& p = m_costs[op.kind];
     StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
     Executed e;
     e.start = std::max(now, t.data_ready);
-    if (p.scene_bytes && op.object != k_no_object) e.start = std::max(e.start, m_scene_ready[t.op]);
+    e.start = std::max(e.start, scene_ready(t));
     charge_idle(m_unit_free[unit], e.start, t, stage);
 
     uint32_t passed = 0;
@@ -301,7 +343,7 @@ void CoreModel::charge_idle(uint64_t from, uint64_t start, const GroupToken& t,
         s.unit_idle += before;
     rest -= before;
     // 3. Scene data later than the ray data.
-    const uint64_t ready = m_scene_ready[t.op];
+    const uint64_t ready = scene_ready(t);
     const uint64_t data_or_idle = std::max(released, t.data_ready);
     const uint64_t scene = ready > data_or_idle ? std::min(rest, ready - data_or_idle) : 0;
     s.scene_memory += scene;

@@ -112,6 +112,13 @@ class CoreModel {
     uint64_t m_pass_start = 0;
     std::vector<uint64_t> m_scene_ready;    // per op
     std::vector<uint8_t> m_scene_requested;  // per op: its scene data was requested
+    // Per op that reads each lane's hit primitive: where its groups' entries start in
+    // m_group_scene_ready (k_none otherwise); per such group, when its lanes' reads arrived.
+    std::vector<size_t> m_group_scene_offset;
+    std::vector<uint64_t> m_group_scene_ready;
+    static constexpr size_t k_none = ~size_t(0);
+    // When the scene data a group waits for (its op's, its lanes') has arrived.
+    uint64_t scene_ready(const GroupToken& t) const;
     std::vector<uint32_t> m_groups_left;    // per op
     std::vector<uint64_t> m_op_completion;  // per op: latest group completion so far
     std::vector<uint64_t> m_unit_free;      // per SIMD unit

@@ -9,7 +9,7 @@
 
 namespace sfx {
 
-RayRecordLayout::RayRecordLayout(const FeatureSet& features) {
+RayRecordLayout::RayRecordLayout(const FeatureSet& features) : m_features(features) {
     for (const RayField& f : ray_record_fields(features)) {
         std::vector<uint32_t> words;
         for (uint32_t i = 0; i < (f.bytes + 3) / 4; ++i) words.push_back(m_words++);
@@ -58,6 +58,10 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
         p.scene_bytes = scene_bytes;
         p.partitions = op_info(k).partitions;
         p.pushes_rays = op_info(k).pushes_rays;
+        // Per lane: a triangle's three vertices (9 words) or a sphere (4): the larger present.
+        p.lane_scene_reads = op_info(k).reads_hit_primitive;
+        p.lane_scene_words =
+            p.lane_scene_reads ? (l.features().triangles ? 9u : l.features().spheres ? 4u : 0u) : 0u;
     };
     // Classes (issue: cluster; Mathew 9.3's function units): float add, subtract, multiply,
     // compare, min/max and convert, and (assumed, one instruction each: the perception
@@ -92,8 +96,48 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
         {3, 2, 0}, {1, 1, 0}, 0);
     set(OpKind::miss_filter, {"hit_primitive", "throughput", "radiance"}, {"radiance"}, {3, 2, 0},
         {1, 1, 0}, 0);
-    set(OpKind::emission_filter, {"hit_primitive", "hit_material", "state", "throughput"},
-        {"radiance"}, {3, 3, 0}, {1, 2, 0}, 64);
+    // The emission filter first computes the hits' surfaces (kernels/intersect.h surface_at:
+    // the stream tracer does it just before this op, and the microbenchmark times it inside
+    // it), reading each lane's hit primitive from the scene: a gather whose address differs
+    // per lane. A triangle: w (2), the barycentric point (9 mul, 6 add), its error bound (the
+    // same products' 9 abs on ALUs, 6 add, 3 mul), the normal (6 sub, a cross product of 6 mul
+    // and 3 sub, a normalize of 3 mul, 2 add, sqrt, divide, 3 mul), the facing test (3 mul,
+    // 2 add, a compare) and the facing normal (3 negates and 3 selects on ALUs): {57, 15, 0},
+    // chain sub, mul, sub, mul, add, add, sqrt, divide, mul, then mul, add, add, compare, and
+    // the select: {13, 1, 0}. A sphere: the hit point (3 mul, 3 add), its offset (3 sub), a
+    // divide and 3 mul by the radius, the normalize (10), the re-projected point (3 mul, 3 add),
+    // the error bound (6 abs, 3 add, 3 mul) and the facing as for a triangle: {41, 12, 0}, chain
+    // {14, 1, 0}. The emission test beside it: {3, 3, 0}, chain {1, 2, 0}. A scene with both
+    // runs both bodies under masks.
+    {
+        const FeatureSet& f = l.features();
+        UnitClassCounts body{3, 3, 0}, chain{1, 2, 0};
+        std::vector<const char*> gather = {"hit_primitive", "hit_material", "state",
+                                           "throughput"};
+        if (f.triangles) {
+            body = {body.fpu + 57, body.alu + 15, 0};
+            chain = {13, 1, 0};
+            gather.insert(gather.end(), {"direction", "hit_barycentrics"});
+        }
+        if (f.spheres) {
+            body = {body.fpu + 41, body.alu + 12, 0};
+            chain = {14, 1, 0};
+            gather.insert(gather.end(), {"origin", "direction", "hit_t"});
+        }
+        std::sort(gather.begin(), gather.end(), [](const char* a, const char* b) {
+            return std::string_view(a) < std::string_view(b);
+        });
+        gather.erase(std::unique(gather.begin(), gather.end(),
+                                 [](const char* a, const char* b) {
+                                     return std::string_view(a) == std::string_view(b);
+                                 }),
+                     gather.end());
+        set(OpKind::emission_filter, {}, {"radiance"}, body, chain, 64);
+        OpProfile& p = m_profiles[size_t(OpKind::emission_filter)];
+        for (const char* name : gather)
+            for (uint32_t w : l.field(name)) p.gather_words.push_back(w);
+        std::sort(p.gather_words.begin(), p.gather_words.end());
+    }
     set(OpKind::depth_filter, {"state"}, {}, {0, 2, 0}, {0, 1, 0}, 0);
     set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, {0, 2, 0}, {0, 1, 0}, 64);
     set(OpKind::ambient, {"throughput", "radiance"}, {"radiance"}, {6, 0, 0}, {2, 0, 0}, 64);

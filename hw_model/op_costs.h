@@ -23,12 +23,14 @@ namespace sfx {
 class RayRecordLayout {
   public:
     explicit RayRecordLayout(const FeatureSet& features);
+    const FeatureSet& features() const { return m_features; }
     uint32_t words() const { return m_words; }
     uint32_t bytes() const { return m_words * 4; }
     // Word offsets of a named field (empty when the scene has no such field).
     const std::vector<uint32_t>& field(const std::string& name) const;
 
   private:
+    FeatureSet m_features;
     uint32_t m_words = 0;
     std::vector<std::pair<std::string, std::vector<uint32_t>>> m_fields;
     std::vector<uint32_t> m_none;
@@ -67,6 +69,10 @@ struct OpProfile {
     UnitClassCounts body, chain, recurrence;
     ModuloSchedule schedule;
     uint32_t scene_bytes = 0;             // scene data fetched once per op (broadcast operand)
+    // Scene data gathered per lane (op table: reads_hit_primitive): each lane's hit primitive,
+    // `lane_scene_words` words of it (a triangle's vertices, or a sphere) per lane group.
+    bool lane_scene_reads = false;
+    uint32_t lane_scene_words = 0;
     bool partitions = false;              // the mask partitions the stream in place (op table)
     bool pushes_rays = false;             // passing lanes write the next generation (op table)
     // A CPU core's fitted cost of this kind (HwConfig::op_costs): it replaces the instruction
@@ -111,6 +117,13 @@ struct SceneDataMap {
     uint64_t nodes = 0, triangles = 0, spheres = 0;
 
     uint64_t address(OpKind kind, uint32_t object) const;
+    // Where a hit primitive (a global primitive id: triangles, then spheres) lives, and its size.
+    uint64_t hit_address(uint32_t prim) const {
+        return address(prim < triangles ? OpKind::triangle_test : OpKind::sphere_test, prim);
+    }
+    uint32_t hit_bytes(uint32_t prim) const {
+        return uint32_t(prim < triangles ? triangle_bytes : sphere_bytes);
+    }
 };
 // The scene data of a workload laid out as SceneDataMap says.
 SceneDataMap scene_data_map(const WorkloadShape& shape);

@@ -24,6 +24,9 @@ public:
         m_streams.clear();
         m_consumers.clear();
         m_consumer_start.clear();
+        m_hit.assign(p.slot_count, k_no_object);
+        m_lane_hits.clear();
+        m_lane_hit_offset.clear();
     }
     void op(const StreamOp& op) override {
         StreamOp copy = op;
@@ -41,6 +44,20 @@ public:
         if (op_info(op.kind).partitions && op.length > 0)  // an empty op is never dispatched
             m_streams[stream_key(op.slots, op.passed, op.length, true)] =
                 uint32_t(m_ops.size() - 1);
+        // Each slot's hit so far: an intersection op's passing lanes took a closer hit; a
+        // pushed ray (the slot's next generation) has none yet.
+        const bool hits = op.kind == OpKind::triangle_test || op.kind == OpKind::sphere_test;
+        if (hits || op_info(op.kind).pushes_rays)
+            for (uint32_t i = 0; i < op.length; ++i)
+                if (op.passed[i] && op.slots[i] < m_hit.size())
+                    m_hit[op.slots[i]] = hits ? op.object : k_no_object;
+        m_lane_hit_offset.push_back(k_no_lane_hits);
+        if (op_info(op.kind).reads_hit_primitive) {
+            m_lane_hit_offset.back() = m_lane_hits.size();
+            for (uint32_t i = 0; i < op.length; ++i)
+                m_lane_hits.push_back(op.slots[i] < m_hit.size() ? m_hit[op.slots[i]]
+                                                                 : k_no_object);
+        }
     }
     void end_pass(const TilePass& p) override {
         m_pass = p;
@@ -67,6 +84,14 @@ public:
     }
     const uint32_t* consumers_end(size_t i) const {
         return m_consumers.data() + m_consumer_start[i + 1];
+    }
+    // For an op that reads each lane's hit primitive (OpKindInfo::reads_hit_primitive): the
+    // primitive each lane's ray had hit when the op ran (k_no_object: none), in stream order;
+    // nullptr for other ops. The trace carries it implicitly: the last intersection op a slot
+    // passed in is its hit.
+    const uint32_t* lane_hits(size_t i) const {
+        return m_lane_hit_offset[i] == k_no_lane_hits ? nullptr
+                                                      : m_lane_hits.data() + m_lane_hit_offset[i];
     }
     size_t size() const { return m_ops.size(); }
     // The op with its views pointing into this buffer.
@@ -100,6 +125,10 @@ private:
     std::vector<int32_t> m_producer;
     std::vector<uint32_t> m_consumers, m_consumer_start;
     std::unordered_map<uint64_t, uint32_t> m_streams;  // passing-stream key -> latest op
+    static constexpr size_t k_no_lane_hits = ~size_t(0);
+    std::vector<uint32_t> m_hit;        // per slot: the primitive its ray hit so far
+    std::vector<uint32_t> m_lane_hits;  // lane_hits() of the ops that read them, concatenated
+    std::vector<size_t> m_lane_hit_offset;  // per op: into m_lane_hits, or k_no_lane_hits
 };
 
 }  // namespace sfx

@@ -29,7 +29,7 @@ enum class OpKind : uint8_t {
     sphere_test,      // intersection: ray/sphere test (object: global primitive id)
     shadow_filter,    // shading: extract shadow rays (passed); each adds its light unless occluded
     miss_filter,      // shading: extract rays that left the scene; passed = miss
-    emission_filter,  // shading: light hits; passed = the hit surface is emissive
+    emission_filter,  // shading: the hits' surfaces, then light hits; passed = emissive
     depth_filter,     // shading: passed = the path may scatter (bounce < max depth)
     material_filter,  // shading: passed = the hit material is `object` (material id)
     ambient,          // shading: add the constant ambient term; all pass
@@ -78,6 +78,9 @@ struct OpKindInfo {
     bool partitions;   // the filter's mask partitions the stream in place (G&R 3.1)
     bool pushes_rays;  // passing lanes write a ray (and its id) to the next-generation buffer
     OpFeature feature;
+    // Reads, per lane, the scene data of the primitive its ray hit (the hit's surface: its
+    // triangle's vertices or its sphere), at an address that differs from lane to lane.
+    bool reads_hit_primitive = false;
 };
 inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
     {"camera", OpStage::shading, false, true, OpFeature::always},
@@ -86,7 +89,7 @@ inline constexpr OpKindInfo k_op_kinds[k_op_kind_count] = {
     {"sphere_test", OpStage::intersection, false, false, OpFeature::spheres},
     {"shadow_filter", OpStage::shading, true, false, OpFeature::lights},
     {"miss_filter", OpStage::shading, true, false, OpFeature::always},
-    {"emission_filter", OpStage::shading, true, false, OpFeature::always},
+    {"emission_filter", OpStage::shading, true, false, OpFeature::always, true},
     {"depth_filter", OpStage::shading, true, false, OpFeature::always},
     {"material_filter", OpStage::shading, true, false, OpFeature::always},
     {"ambient", OpStage::shading, false, false, OpFeature::ambient},

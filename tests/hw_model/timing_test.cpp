@@ -336,6 +336,80 @@ TEST_CASE("Partition and scene-memory stalls are charged where they occur", "[hw
     CHECK(i.mix.scatter_gather == 2 * 7 + 2 * 5);
 }
 
+TEST_CASE("The pass buffer knows each lane's hit primitive where an op reads it",
+          "[hw_model]") {
+    // Slots 0..15 hit triangle 7; slots 0..7 then hit triangle 50 closer; slot 3's ray is then
+    // replaced by a pushed one (no hit yet). The emission filter reads its lanes' hits; a depth
+    // filter does not.
+    PassBuffer buffer;
+    TilePass pass;
+    pass.slot_count = 64;
+    buffer.begin_pass(pass);
+    const std::vector<CraftedOp> ops = {
+        {OpKind::triangle_test, consecutive(16), std::vector<uint8_t>(16, 1), 7},
+        {OpKind::triangle_test, consecutive(8), std::vector<uint8_t>(8, 1), 50},
+        {OpKind::lambertian_indirect, {3}, {1}, 0},
+        {OpKind::emission_filter, consecutive(16), std::vector<uint8_t>(16, 0)},
+        {OpKind::depth_filter, consecutive(16), std::vector<uint8_t>(16, 0)}};
+    for (const CraftedOp& c : ops) buffer.op(to_stream_op(c));
+    buffer.end_pass(pass);
+    REQUIRE(buffer.lane_hits(3) != nullptr);
+    CHECK(buffer.lane_hits(4) == nullptr);
+    CHECK(buffer.lane_hits(0) == nullptr);
+    for (uint32_t i = 0; i < 16; ++i) {
+        INFO("lane " << i);
+        CHECK(buffer.lane_hits(3)[i] == (i == 3 ? k_no_object : i < 8 ? 50u : 7u));
+    }
+}
+
+TEST_CASE("A surface group waits for its slowest lane's hit primitive", "[hw_model][systemc]") {
+    // No caches: every scene read goes to DRAM. A triangle test (the hits), a miss filter whose
+    // partition the emission filter waits for, then the emission filter over the 16 hits. Its
+    // one group waits for its lanes' vertices beyond its ray data, on DRAM alone: 50 ns more
+    // DRAM latency adds exactly 25 cycles (500 MHz) to that wait.
+    auto config = [](double dram_ns) {
+        HwConfig c = with_width(16);
+        c.scene_memory.caches.clear();
+        c.scene_memory.dram_latency_ns = dram_ns;
+        return c;
+    };
+    const std::vector<CraftedOp> ops = {
+        {OpKind::triangle_test, consecutive(16), std::vector<uint8_t>(16, 1), 7},
+        {OpKind::miss_filter, consecutive(16), std::vector<uint8_t>(16, 0)},
+        {OpKind::emission_filter, consecutive(16), std::vector<uint8_t>(16, 0)}};
+    const FrameTiming near = time_passes(config(200), {ops});
+    const FrameTiming far = time_passes(config(250), {ops});
+    const uint64_t shading_near = near.stages[1][uint32_t(OpStage::shading)].scene_memory_cycles;
+    const uint64_t shading_far = far.stages[1][uint32_t(OpStage::shading)].scene_memory_cycles;
+    INFO("shading scene-memory stall " << shading_near << " / " << shading_far);
+    CHECK(shading_near > 0);
+    CHECK(shading_far == shading_near + 25);
+    // The op mix: one group gathers the triangle's 9 vertex words (an address vector each).
+    const FrameTiming depth_only = time_passes(
+        config(200), {{ops[0], ops[1], {OpKind::depth_filter, consecutive(16),
+                                        std::vector<uint8_t>(16, 0)}}});
+    CHECK(depth_only.stages[1][uint32_t(OpStage::shading)].scene_memory_cycles == 0);
+    // The op mix: the emission filter's one group gathers its ray words and the triangle's 9
+    // vertex words (an address vector each); the depth filter's gathers its ray words.
+    const OpCostTable table(RayRecordLayout(triangle_shape(64).features), config(200));
+    REQUIRE(table[OpKind::emission_filter].lane_scene_words == 9);
+    CHECK(near.mix.scatter_gather - depth_only.mix.scatter_gather ==
+          table[OpKind::emission_filter].gather_words.size() + 9 -
+              table[OpKind::depth_filter].gather_words.size());
+}
+
+TEST_CASE("A group's mask is stored when any lane passed (G&R Fig. 5)", "[hw_model][systemc]") {
+    // A box test of 48 lanes at width 16: the first group passes none, the second one lane,
+    // the third all. Two mask stores; the stable partition moves the 17 passing ids forward
+    // and the first group's 16 failing ones back (33 ids: 3 move cycles).
+    std::vector<uint8_t> passed(48, 0);
+    passed[20] = 1;
+    for (uint32_t i = 32; i < 48; ++i) passed[i] = 1;
+    const FrameTiming t = time_one(with_width(16), OpKind::box_test, consecutive(48), passed);
+    const uint32_t moved = stable_partition_moves(passed.data(), 48);
+    CHECK(t.mix.store == 2 + (moved + 15) / 16);
+}
+
 // A parent box test on 32 rays (node 1), 16 passing; its front child on those 16 (node 20;
 // half pass, so its own passing stream is a new one); the back child on the parent's 16 again
 // (node 40): the back child's stream comes from the parent, not from the front child.
