@@ -83,9 +83,19 @@ std::vector<Priced> price(const HwConfig& c, const ActionCounts& n, const TechTa
         cores, double(n.agu_addresses) * l.int32_add_pj, HwUnit::agu));
     uint64_t lane_ops = 0;
     for (uint64_t v : n.simd_lane_ops) lane_ops += v;
-    p.push_back(logic("simd", double(c.simd.width) * (l.fp32_add_um2 + l.fp32_mul_um2),
-                      cores * c.simd.units, double(lane_ops) * (l.fp32_add_pj + l.fp32_mul_pj),
-                      HwUnit::simd));
+    // A lane's datapath: one FPU (an adder and a multiplier) issuing an instruction a cycle;
+    // on a cluster (datapath.issue: cluster, Mathew 9.3's classes) every function unit of
+    // every class, each as wide as the SIMD unit: an FPU as above, an ALU as an integer
+    // adder, a multiplier as an integer multiplier. Energy stays per instruction, each priced
+    // as an FPU's add and multiply (an upper bound for ALU and multiplier instructions).
+    const DatapathConfig& d = c.datapath;
+    const double fpu_um2 = l.fp32_add_um2 + l.fp32_mul_um2;
+    const double lane_um2 =
+        d.issue == "cluster" ? double(d.fpu_units) * fpu_um2 + double(d.alu_units) * l.int32_add_um2 +
+                                   double(d.mul_units) * l.int32_mul_um2
+                             : fpu_um2;
+    p.push_back(logic("simd", double(c.simd.width) * lane_um2, cores * c.simd.units,
+                      double(lane_ops) * (l.fp32_add_pj + l.fp32_mul_pj), HwUnit::simd));
     p.push_back(logic("partition",
                       double(c.simd.width) * c.partition.comparators_per_lane * l.compare32_um2,
                       cores, double(n.partition_compares) * l.compare32_pj, HwUnit::partition));

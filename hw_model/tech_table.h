@@ -80,6 +80,7 @@ struct LogicTech {
     double fp32_add_pj = 0, fp32_add_um2 = 0;
     double fp32_mul_pj = 0, fp32_mul_um2 = 0;
     double int32_add_pj = 0, int32_add_um2 = 0;
+    double int32_mul_pj = 0, int32_mul_um2 = 0;
     double compare32_pj = 0, compare32_um2 = 0;
     double register32_pj = 0, register32_um2 = 0;  // a 32-bit pipeline register
     double leakage_mw_per_mm2 = 0;                 // of logic area
@@ -92,6 +93,8 @@ struct LogicTech {
         v.param("fp32_mul_um2", fp32_mul_um2, "um2", "32-bit floating-point multiplier", 0.0, 1e7);
         v.param("int32_add_pj", int32_add_pj, "pJ", "32-bit integer add", 0.0, 1e4);
         v.param("int32_add_um2", int32_add_um2, "um2", "32-bit integer adder", 0.0, 1e7);
+        v.param("int32_mul_pj", int32_mul_pj, "pJ", "32-bit integer multiply", 0.0, 1e4);
+        v.param("int32_mul_um2", int32_mul_um2, "um2", "32-bit integer multiplier", 0.0, 1e7);
         v.param("compare32_pj", compare32_pj, "pJ", "32-bit comparison", 0.0, 1e4);
         v.param("compare32_um2", compare32_um2, "um2", "32-bit comparator", 0.0, 1e7);
         v.param("register32_pj", register32_pj, "pJ", "32-bit register write and read", 0.0, 1e4);

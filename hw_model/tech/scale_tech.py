@@ -209,7 +209,7 @@ def table_text(node, base):
     group("cache", rows(ca, {"area_mm2": "cell", "lookup_pj": "energy", "fill_pj": "energy",
                              "leakage_mw": "energy"}))
     logic = []
-    for key in ["fp32_add", "fp32_mul", "int32_add", "compare32", "register32"]:
+    for key in ["fp32_add", "fp32_mul", "int32_add", "int32_mul", "compare32", "register32"]:
         logic.append((key + "_pj", sig(lo[key + "_pj"] * e), f"{lo[key + '_pj']} x {ef} [SB17]"))
         logic.append((key + "_um2", sig(lo[key + "_um2"] * a), f"{lo[key + '_um2']} x {af} [SB17]"))
     logic.append(

@@ -49,6 +49,8 @@ logic:
   fp32_mul_um2: 2000
   int32_add_pj: 0.5
   int32_add_um2: 100
+  int32_mul_pj: 2
+  int32_mul_um2: 1500
   compare32_pj: 0.25
   compare32_um2: 50
   register32_pj: 0.5
@@ -249,6 +251,7 @@ TEST_CASE("A small machine's area and energy equal a hand computation", "[hw_mod
     c.agu.addresses_per_cycle = 1;
     c.simd.width = 4;
     c.simd.units = 1;
+    c.datapath.issue = "programmable";  // an instruction a cycle: one FPU per lane
     c.cores.count = 1;
     c.partition.comparators_per_lane = 1;  // 4 comparators
     c.scratchpad.kib = 64;                 // 4x the reference, two ports
@@ -307,6 +310,20 @@ TEST_CASE("A small machine's area and energy equal a hand computation", "[hw_mod
     CHECK(unit(r, "dram").leakage_mj == 0);
     CHECK(r.leakage_mj() == Approx(5.34094e-5));
     CHECK(r.total_energy_mj() == Approx(2.2925e-5 + 5.34094e-5));
+
+    // A cluster (datapath.issue: cluster): every function unit as wide as the SIMD unit; an
+    // FPU an adder and a multiplier, an ALU an integer adder, a multiplier an integer one.
+    HwConfig cluster = c;
+    cluster.datapath.issue = "cluster";
+    cluster.datapath.fpu_units = 3;
+    cluster.datapath.alu_units = 2;
+    cluster.datapath.mul_units = 1;
+    const AreaEnergy rc = evaluate_area_energy(cluster, n, 1000, t);
+    CHECK(unit(rc, "simd").area_mm2 == Approx(4 * (3 * (1000 + 2000) + 2 * 100 + 1 * 1500) * 1e-6));
+    CHECK(unit(rc, "simd").dynamic_mj == Approx(unit(r, "simd").dynamic_mj));
+    cluster.datapath.alu_units = 3;
+    CHECK(unit(evaluate_area_energy(cluster, n, 1000, t), "simd").area_mm2 >
+          unit(rc, "simd").area_mm2);
 
     // Two cores: every unit twice but a shared cache level; the same work over twice the
     // capacity leaks more idle cycles.

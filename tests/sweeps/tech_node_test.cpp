@@ -185,7 +185,7 @@ TEST_CASE("The node is a sweep axis: each point's clocks follow its node", "[tec
 TEST_CASE("The shipped 7 nm explore is built at 7 nm, at the node's clocks", "[tech][explore]") {
     const ExploreSpec e = load_explore(SFX_SOURCE_DIR "/sweeps/explore-7nm.yaml");
     CHECK(e.nodes() == std::vector<std::string>{"7nm"});
-    CHECK(e.configurations() == 192);
+    CHECK(e.configurations() == 192 * 27);
     const SweepPoint p = e.point(0, 0, e.screen);
     CHECK(p.hw.clock.core_mhz == Approx(500 / tech_table_for("7nm").gate_delay_vs_90nm));
     CHECK(e.space.warnings.empty());
