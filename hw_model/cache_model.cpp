@@ -88,6 +88,9 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     if (a.cores.count != 1 || b.cores.count != 1 || x.caches.size() != y.caches.size() ||
         x.prefetch_depth != y.prefetch_depth || x.prefetch_children != y.prefetch_children)
         return false;
+    // A CPU core's (storage l1d) measured costs hold its lanes' hit-primitive reads; a machine
+    // priced from instructions looks them up (CoreModel::request_scene).
+    if ((a.ray_buffer.storage == "l1d") != (b.ray_buffer.storage == "l1d")) return false;
     for (size_t i = 0; i < x.caches.size(); ++i)
         if (x.caches[i].kib != y.caches[i].kib ||
             x.caches[i].line_bytes != y.caches[i].line_bytes ||

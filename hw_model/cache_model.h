@@ -50,7 +50,8 @@ uint64_t scene_latency_in_costs(const HwConfig& config);
 // of the same geometry, so that every lookup finds its line at the same level: one core each
 // (several cores take passes in an order their timing decides), equal cache sizes, lines and
 // ways (latencies may differ) and equal prefetch (which decides when an op's data is looked
-// up). The trace decides the rest: ops are dispatched in order on every machine.
+// up), and the same storage (an l1d core does not look up its lanes' hit primitives). The trace
+// decides the rest: ops are dispatched in order on every machine.
 bool same_cache_lookups(const HwConfig& a, const HwConfig& b);
 
 // The lookups of one cache hierarchy shared by configurations with same_cache_lookups: the

@@ -88,6 +88,9 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     other = a;
     other.cores.count = 2;  // passes go to cores as their timing decides
     CHECK_FALSE(same_cache_lookups(a, other));
+    other = a;
+    other.ray_buffer.storage = "l1d";  // a CPU core looks up no lane's hit primitive
+    CHECK_FALSE(same_cache_lookups(a, other));
 
     auto shared = std::make_shared<SharedCacheLookups>(a.scene_memory.caches);
     SceneMemoryModel own_a(a.scene_memory, 500.0), own_b(b.scene_memory, 500.0);
