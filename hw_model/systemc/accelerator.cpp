@@ -42,6 +42,8 @@ void Accelerator::warm(const PassBuffer& pass) {
     for (size_t i = 0; i < pass.size(); ++i) {
         const StreamOp op = pass.at(i);
         const OpProfile& p = m_costs[op.kind];
+        // The lanes' hit-primitive reads (CoreModel::request_scene) need no warming of their
+        // own: each is a line the intersection op that found the hit fetched.
         if (p.scene_bytes && op.object != k_no_object && op.length)
             m_scene_memory->warm(0, m_map.address(op.kind, op.object), p.scene_bytes);
     }
