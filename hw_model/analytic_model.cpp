@@ -128,15 +128,26 @@ namespace {
 // line already fetched in this pass hits if the pass's working set fits (in proportion, if
 // not); a first touch in the pass hits if the line survived from earlier passes, in
 // proportion to how much of the frame's working set fits; the frame's first touches miss.
+// The scene data a pass touches, on average (distinct lines).
+double mean_pass_bytes(const TraceProfile& profile) {
+    return TraceProfile::k_line_bytes * double(profile.footprint().pass_distinct) /
+           double(std::max<uint64_t>(1, profile.passes()));
+}
+
+// Cycles of a line read from DRAM: its latency and its transfer at the channel's bandwidth.
+double dram_read_cycles(const SceneMemoryConfig& memory, double core_mhz) {
+    const double transfer =
+        double(dram_line_bytes(memory)) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
+    return double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer;
+}
+
 double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
                              const TraceProfile& profile,
                              std::vector<double>* global_misses = nullptr) {
     const TraceProfile::Footprint& f = profile.footprint();
     const double fetches = double(f.fetches);
-    const double line = TraceProfile::k_line_bytes;
-    const double pass_bytes =
-        line * double(f.pass_distinct) / double(std::max<uint64_t>(1, profile.passes()));
-    const double frame_bytes = line * double(f.frame_distinct);
+    const double pass_bytes = mean_pass_bytes(profile);
+    const double frame_bytes = TraceProfile::k_line_bytes * double(f.frame_distinct);
     const double first_in_pass = double(f.pass_distinct), first_in_frame = double(f.frame_distinct);
     if (fetches == 0) return 0.0;
     const double compulsory = first_in_frame / fetches;
@@ -154,10 +165,7 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
         previous_miss = global_miss;
         if (global_misses) global_misses->push_back(global_miss);
     }
-    const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
-    const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
-    return cycles +
-           previous_miss * (double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer);
+    return cycles + previous_miss * dram_read_cycles(memory, core_mhz);
 }
 
 // Expected cycles until the slowest of `lanes` reads of each lane's hit primitive arrives. The
@@ -167,9 +175,7 @@ double expected_fetch_cycles(const SceneMemoryConfig& memory, double core_mhz,
 double expected_hit_read_cycles(const SceneMemoryConfig& memory, double core_mhz,
                                 const TraceProfile& profile, double lanes,
                                 std::vector<double>* global_misses = nullptr) {
-    const TraceProfile::Footprint& f = profile.footprint();
-    const double pass_bytes = TraceProfile::k_line_bytes * double(f.pass_distinct) /
-                              double(std::max<uint64_t>(1, profile.passes()));
+    const double pass_bytes = mean_pass_bytes(profile);
     double previous_miss = 1.0, previous_latency = 0.0, cycles = 0.0;
     auto beyond = [&](double miss, double latency) {
         // P(some lane reaches this level) x its extra latency over the nearer level's.
@@ -184,9 +190,7 @@ double expected_hit_read_cycles(const SceneMemoryConfig& memory, double core_mhz
         beyond(global_miss, double(ns_to_cycles(level.hit_latency_ns, core_mhz)));
         if (global_misses) global_misses->push_back(global_miss);
     }
-    const uint32_t dram_line = memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
-    const double transfer = double(dram_line) / (memory.dram_bandwidth_gbps * 1000.0 / core_mhz);
-    beyond(0.0, double(ns_to_cycles(memory.dram_latency_ns, core_mhz)) + transfer);
+    beyond(0.0, dram_read_cycles(memory, core_mhz));
     return cycles;
 }
 
@@ -430,9 +434,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         a.cache_fills[i] = count(fetches * global_misses[i] + lane_missed);
         reaching = fetches * global_misses[i] + lane_missed;
     }
-    const uint32_t dram_line =
-        c.scene_memory.caches.empty() ? 64 : c.scene_memory.caches.back().line_bytes;
-    a.dram_bytes = count(reaching * dram_line);
+    a.dram_bytes = count(reaching * dram_line_bytes(c.scene_memory));
     for (uint32_t u = 0; u < k_hw_unit_count; ++u) a.busy_cycles[u] = count(busy_units[u]);
     t.cycles = uint64_t(std::llround(total_cycles));
     return t;

@@ -164,7 +164,7 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
                                   SetAssociativeCache(level));
         m_latency.push_back(ns_to_cycles(level.hit_latency_ns, core_mhz));
     }
-    m_line_bytes = config.caches.empty() ? 64 : config.caches.back().line_bytes;
+    m_line_bytes = dram_line_bytes(config);
 }
 
 SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {

@@ -37,6 +37,11 @@ class SetAssociativeCache {
     uint64_t m_hits = 0, m_misses = 0;
 };
 
+// The line DRAM transfers: the last cache level's (64 bytes without caches).
+inline uint32_t dram_line_bytes(const SceneMemoryConfig& memory) {
+    return memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
+}
+
 // Whole core cycles for a latency in nanoseconds at a clock in MHz (rounded up: a result is
 // usable from the first clock edge after it arrives).
 uint64_t ns_to_cycles(double ns, double mhz);

@@ -238,9 +238,7 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
 }
 
 uint64_t CoreModel::scene_ready(const GroupToken& t) const {
-    const StreamOp op = m_pass->at(t.op);
-    const OpProfile& p = m_costs[op.kind];
-    uint64_t ready = p.scene_bytes && op.object != k_no_object ? m_scene_ready[t.op] : 0;
+    uint64_t ready = m_scene_ready[t.op];  // 0 for an op without scene data (request_scene)
     if (m_group_scene_offset[t.op] != k_none)
         ready = std::max(ready, m_group_scene_ready[m_group_scene_offset[t.op] + t.first / width()]);
     return ready;

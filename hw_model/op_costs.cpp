@@ -26,7 +26,7 @@ const std::vector<uint32_t>& RayRecordLayout::field(const std::string& name) con
 namespace {
 
 std::vector<uint32_t> words_of(const RayRecordLayout& layout,
-                               std::initializer_list<const char*> names) {
+                               const std::vector<const char*>& names) {
     std::vector<uint32_t> out;
     for (const char* n : names)
         for (uint32_t w : layout.field(n)) out.push_back(w);
@@ -42,8 +42,8 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     // select operations of kernels/intersect.h's scalar code per lane (the box test is G&R
     // Fig. 5's slab test; the triangle test is watertight, with its plane distance in double).
     // Shading counts are estimates from kernels/materials.h and kernels/path.h, not exact.
-    auto set = [&](OpKind k, std::initializer_list<const char*> gather,
-                   std::initializer_list<const char*> scatter, UnitClassCounts body,
+    auto set = [&](OpKind k, const std::vector<const char*>& gather,
+                   const std::vector<const char*>& scatter, UnitClassCounts body,
                    UnitClassCounts chain, uint32_t scene_bytes, UnitClassCounts recurrence = {}) {
         OpProfile& p = m_profiles[size_t(k)];
         p.gather_words = words_of(l, gather);
@@ -58,10 +58,15 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
         p.scene_bytes = scene_bytes;
         p.partitions = op_info(k).partitions;
         p.pushes_rays = op_info(k).pushes_rays;
-        // Per lane: a triangle's three vertices (9 words) or a sphere (4): the larger present.
+        // Per lane: a triangle's vertices or a sphere (SceneDataMap's records), the larger
+        // present, in words.
+        const SceneDataMap records;
         p.lane_scene_reads = op_info(k).reads_hit_primitive;
-        p.lane_scene_words =
-            p.lane_scene_reads ? (l.features().triangles ? 9u : l.features().spheres ? 4u : 0u) : 0u;
+        if (p.lane_scene_reads)
+            p.lane_scene_words = uint32_t((l.features().triangles ? records.triangle_bytes
+                                           : l.features().spheres ? records.sphere_bytes
+                                                                  : 0) /
+                                          4);
     };
     // Classes (issue: cluster; Mathew 9.3's function units): float add, subtract, multiply,
     // compare, min/max and convert, and (assumed, one instruction each: the perception
@@ -112,31 +117,24 @@ OpCostTable::OpCostTable(const RayRecordLayout& l, const DatapathConfig& d) {
     {
         const FeatureSet& f = l.features();
         UnitClassCounts body{3, 3, 0}, chain{1, 2, 0};
-        std::vector<const char*> gather = {"hit_primitive", "hit_material", "state",
-                                           "throughput"};
         if (f.triangles) {
             body = {body.fpu + 57, body.alu + 15, 0};
             chain = {13, 1, 0};
-            gather.insert(gather.end(), {"direction", "hit_barycentrics"});
         }
         if (f.spheres) {
             body = {body.fpu + 41, body.alu + 12, 0};
             chain = {14, 1, 0};
-            gather.insert(gather.end(), {"origin", "direction", "hit_t"});
         }
-        std::sort(gather.begin(), gather.end(), [](const char* a, const char* b) {
-            return std::string_view(a) < std::string_view(b);
-        });
-        gather.erase(std::unique(gather.begin(), gather.end(),
-                                 [](const char* a, const char* b) {
-                                     return std::string_view(a) == std::string_view(b);
-                                 }),
-                     gather.end());
-        set(OpKind::emission_filter, {}, {"radiance"}, body, chain, 64);
-        OpProfile& p = m_profiles[size_t(OpKind::emission_filter)];
-        for (const char* name : gather)
-            for (uint32_t w : l.field(name)) p.gather_words.push_back(w);
-        std::sort(p.gather_words.begin(), p.gather_words.end());
+        // What surface_at reads (a sphere also the origin and t, a triangle the barycentrics)
+        // and the emission test, in the record's field order (workloads/ray_layout.cpp).
+        std::vector<const char*> gather;
+        if (f.spheres) gather.push_back("origin");
+        if (f.triangles || f.spheres) gather.push_back("direction");
+        gather.push_back("hit_primitive");
+        if (f.spheres) gather.push_back("hit_t");
+        if (f.triangles) gather.push_back("hit_barycentrics");
+        gather.insert(gather.end(), {"hit_material", "throughput", "state"});
+        set(OpKind::emission_filter, gather, {"radiance"}, body, chain, 64);
     }
     set(OpKind::depth_filter, {"state"}, {}, {0, 2, 0}, {0, 1, 0}, 0);
     set(OpKind::material_filter, {"hit_primitive", "hit_material"}, {}, {0, 2, 0}, {0, 1, 0}, 64);

@@ -66,8 +66,7 @@ FrameTiming Accelerator::timing() const {
         t.actions.cache_accesses[level] = m_scene_memory->hits(level) + m_scene_memory->misses(level);
         t.actions.cache_fills[level] = m_scene_memory->misses(level);
     }
-    const auto& caches = m_config.scene_memory.caches;
-    t.actions.dram_bytes = m_scene_memory->dram_reads() * (caches.empty() ? 64 : caches.back().line_bytes);
+    t.actions.dram_bytes = m_scene_memory->dram_reads() * dram_line_bytes(m_config.scene_memory);
     return t;
 }
 
