@@ -21,25 +21,10 @@ double thread_cpu_seconds() {
     return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+// The error's symbolic name (glibc's strerrorname_np), or "errno" for a code it does not name.
 const char* errno_name(int e) {
-    switch (e) {
-        case ENOENT:
-            return "ENOENT";
-        case EOPNOTSUPP:
-            return "EOPNOTSUPP";
-        case EACCES:
-            return "EACCES";
-        case EPERM:
-            return "EPERM";
-        case ENODEV:
-            return "ENODEV";
-        case EINVAL:
-            return "EINVAL";
-        case ENOSYS:
-            return "ENOSYS";
-        default:
-            return "errno";
-    }
+    const char* name = strerrorname_np(e);
+    return name ? name : "errno";
 }
 
 // The counter's value, scaled up if the kernel multiplexed it; false if unreadable.
