@@ -193,6 +193,20 @@ void add_calibrate_command(CLI::App& app) {
                         {{"rays", s.rays}, {"ops", ops}, {"cycles", s.cycles},
                          {"converged", s.converged}, {"repetitions", s.repetitions}});
                 }
+                j["hit_read_exposed_share"] = cal.hit_read_fit.share;
+                j["hit_read_fit_median_error"] = cal.hit_read_fit.error.first;
+                j["hit_read_fit_worst_error"] = cal.hit_read_fit.error.second;
+                for (size_t i = 0; i < cal.surface_read_samples.size(); ++i) {
+                    const SurfaceReadSample& s = cal.surface_read_samples[i];
+                    j["surface_read_samples"].push_back(
+                        {{"triangles", s.triangles},
+                         {"lanes", s.lanes},
+                         {"cycles", s.cycles},
+                         {"resident_cycles", s.resident_cycles},
+                         {"modeled_beyond_l1_cycles", cal.hit_read_fit.modeled[i]},
+                         {"converged", s.converged},
+                         {"repetitions", s.repetitions}});
+                }
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
                                           {"slots", r.slots},
@@ -225,6 +239,18 @@ void add_calibrate_command(CLI::App& app) {
                 "%.1f%%, worst %.1f%%\n",
                 cal.one_ray_samples.size(), 100 * cal.one_lane_fit_error.first,
                 100 * cal.one_lane_fit_error.second);
+            std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
+                        "latency, fit error median %.1f%%, worst %.1f%%\n",
+                        cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,
+                        100 * cal.hit_read_fit.error.second);
+            std::printf("%-10s %9s %12s %12s %14s %6s\n", "triangles", "lanes", "cycles/lane",
+                        "resident", "modelled extra", "conv");
+            for (size_t i = 0; i < cal.surface_read_samples.size(); ++i) {
+                const SurfaceReadSample& s = cal.surface_read_samples[i];
+                std::printf("%-10u %9u %12.1f %12.1f %14.1f %6s\n", s.triangles, s.lanes,
+                            s.cycles / s.lanes, s.resident_cycles / s.lanes,
+                            cal.hit_read_fit.modeled[i] / s.lanes, s.converged ? "yes" : "NO");
+            }
             std::printf("\n%-30s %6s %6s %9s %12s\n", "kernel", "slots", "lanes", "slots are",
                         "cycles/lane");
             for (const KernelRate& r : cal.rates)

@@ -339,6 +339,18 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                                               double(std::min<uint32_t>(n, length))) -
                          first_fetch);
             lane_reads += ops * double(length);
+        } else if (p.lane_scene_reads) {
+            // A CPU core works through its lanes in turn and leaves the measured share of each
+            // read's latency beyond an L1D hit exposed (CoreModel::request_scene). Taken as
+            // re-touches in the pass, as above, whichever array hit_reads names; a triangle's
+            // mesh record and its vertices are two reads.
+            const double reads = c.scene_memory.hit_reads == "mesh" && shape.triangles ? 2.0 : 1.0;
+            const double beyond =
+                std::max(0.0, expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines,
+                                                       1.0) -
+                                  double(scene_latency_in_costs(c)));
+            lane_stall = p.cost.hit_read_exposed_share * double(length) * reads * beyond;
+            lane_reads += ops * double(length) * reads;
         }
         const double memory_stall = fetch_stall + lane_stall;
         const double op_cycles = exec + bubble + memory_stall;

@@ -88,9 +88,9 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     if (a.cores.count != 1 || b.cores.count != 1 || x.caches.size() != y.caches.size() ||
         x.prefetch_depth != y.prefetch_depth || x.prefetch_children != y.prefetch_children)
         return false;
-    // A CPU core's (storage l1d) measured costs hold its lanes' hit-primitive reads; a machine
-    // priced from instructions looks them up (CoreModel::request_scene).
-    if ((a.ray_buffer.storage == "l1d") != (b.ray_buffer.storage == "l1d")) return false;
+    // Every machine looks its lanes' hit primitives up (CoreModel::request_scene), where
+    // hit_reads says.
+    if (x.hit_reads != y.hit_reads) return false;
     for (size_t i = 0; i < x.caches.size(); ++i)
         if (x.caches[i].kib != y.caches[i].kib ||
             x.caches[i].line_bytes != y.caches[i].line_bytes ||
@@ -192,25 +192,38 @@ void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {
         look_up(core, line);
 }
 
-uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now) {
+uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
+                                uint64_t* unloaded) {
     ++m_requests;
+    if (unloaded) *unloaded = 0;
     if (bytes == 0) return now;
     const uint64_t first = address / m_line_bytes, last = (address + bytes - 1) / m_line_bytes;
     uint64_t arrival = now;
     for (uint64_t line = first; line <= last; ++line) {
         const uint32_t level = look_up(core, line);
-        uint64_t ready = 0;
+        uint64_t ready = 0, latency = 0;
         if (level < level_count()) {
-            ready = now + m_latency[level];
+            latency = m_latency[level];
+            ready = now + latency;
         } else {
             ++m_dram_reads;
             // The line leaves DRAM after its latency, then occupies the channel for its transfer.
+            const double transfer = double(m_line_bytes) / m_dram.per_cycle();
             const double start = m_dram.serve(double(now + m_dram_latency), double(m_line_bytes));
-            ready = uint64_t(std::ceil(start + double(m_line_bytes) / m_dram.per_cycle() - 1e-9));
+            ready = uint64_t(std::ceil(start + transfer - 1e-9));
+            latency = m_dram_latency + uint64_t(std::ceil(transfer - 1e-9));
         }
         arrival = std::max(arrival, ready);
+        if (unloaded) *unloaded = std::max(*unloaded, latency);
     }
     return arrival;
+}
+
+uint64_t SceneMemoryModel::latency_beyond(uint32_t core, uint64_t address, uint32_t bytes,
+                                          uint64_t now, uint64_t hidden) {
+    uint64_t latency = 0;
+    read(core, address, bytes, now, &latency);
+    return latency - std::min(latency, hidden);
 }
 
 }  // namespace sfx

@@ -59,6 +59,7 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_scene_requested.assign(n, 0);
     m_group_scene_offset.assign(n, k_none);
     m_group_scene_ready.clear();
+    m_group_lane_stall.clear();
     m_groups_left.assign(n, 0);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
@@ -124,19 +125,35 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
     const uint32_t* hits = m_pass->lane_hits(index);
-    if (p.lane_scene_reads && hits && !m_l1d && op.length > 0) {
+    if (p.lane_scene_reads && hits && op.length > 0) {
         // Every lane's hit primitive, requested with the op (the address units run ahead of
         // the SIMD units, G&R 4.1; assumed: as soon as the op is dispatched); a group waits
-        // for its slowest lane. A CPU core's measured cost holds these reads.
+        // for its slowest lane. A CPU core works through its lanes one after another and
+        // overlaps a measured share of their latency beyond an L1D hit (its cost holds the
+        // hit): that share of their sum is what a group adds.
         const uint32_t n = width();
-        m_group_scene_offset[index] = m_group_scene_ready.size();
+        const bool mesh = m_config.scene_memory.hit_reads == "mesh";
+        const double share = p.cost.hit_read_exposed_share;
+        m_group_scene_offset[index] =
+            m_l1d ? m_group_lane_stall.size() : m_group_scene_ready.size();
+        SceneDataMap::Read reads[2];
         for (uint32_t first = 0; first < op.length; first += n) {
-            uint64_t ready = now;
-            for (uint32_t i = first; i < std::min(op.length, first + n); ++i)
-                if (hits[i] != k_no_object)
-                    ready = std::max(ready, m_scene_memory->read(m_core, m_map.hit_address(hits[i]),
-                                                                 m_map.hit_bytes(hits[i]), now));
-            m_group_scene_ready.push_back(ready);
+            uint64_t ready = now, beyond_l1 = 0;
+            for (uint32_t i = first; i < std::min(op.length, first + n); ++i) {
+                if (hits[i] == k_no_object) continue;
+                const uint32_t count = m_map.hit_reads(hits[i], mesh, reads);
+                for (uint32_t r = 0; r < count; ++r)
+                    if (m_l1d)
+                        beyond_l1 += m_scene_memory->latency_beyond(
+                            m_core, reads[r].address, reads[r].bytes, now, m_scene_hidden);
+                    else
+                        ready = std::max(ready, m_scene_memory->read(m_core, reads[r].address,
+                                                                     reads[r].bytes, now));
+            }
+            if (m_l1d)
+                m_group_lane_stall.push_back(uint64_t(std::llround(share * double(beyond_l1))));
+            else
+                m_group_scene_ready.push_back(ready);
         }
     }
     if (!p.scene_bytes || op.object == k_no_object || op.length == 0) {
@@ -239,7 +256,7 @@ uint64_t CoreModel::fetch(GroupToken& t, uint64_t now) {
 
 uint64_t CoreModel::scene_ready(const GroupToken& t) const {
     uint64_t ready = m_scene_ready[t.op];  // 0 for an op without scene data (request_scene)
-    if (m_group_scene_offset[t.op] != k_none)
+    if (m_group_scene_offset[t.op] != k_none && !m_l1d)
         ready = std::max(ready, m_group_scene_ready[m_group_scene_offset[t.op] + t.first / width()]);
     return ready;
 }
@@ -252,6 +269,15 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     e.start = std::max(now, t.data_ready);
     e.start = std::max(e.start, scene_ready(t));
     charge_idle(m_unit_free[unit], e.start, t, stage);
+    if (m_l1d && m_group_scene_offset[t.op] != k_none) {
+        // A CPU core's exposed share of its lanes' hit-primitive reads (request_scene).
+        const uint64_t lanes_stall =
+            m_group_lane_stall[m_group_scene_offset[t.op] + t.first / width()];
+        m_timing.stalls.scene_memory += lanes_stall;
+        stage.scene_memory_cycles += lanes_stall;
+        stage.stall_cycles += lanes_stall;
+        e.start += lanes_stall;
+    }
 
     uint32_t passed = 0;
     if (p.measured)

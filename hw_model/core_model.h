@@ -113,9 +113,12 @@ class CoreModel {
     std::vector<uint64_t> m_scene_ready;    // per op
     std::vector<uint8_t> m_scene_requested;  // per op: its scene data was requested
     // Per op that reads each lane's hit primitive: where its groups' entries start in
-    // m_group_scene_ready (k_none otherwise); per such group, when its lanes' reads arrived.
+    // m_group_scene_ready, or m_group_lane_stall on a CPU core (k_none otherwise); per such
+    // group, when its lanes' reads arrived.
     std::vector<size_t> m_group_scene_offset;
     std::vector<uint64_t> m_group_scene_ready;
+    // A CPU core (m_l1d) instead: per such group, the cycles its lanes' reads add.
+    std::vector<uint64_t> m_group_lane_stall;
     static constexpr size_t k_none = ~size_t(0);
     // When the scene data a group waits for (its op's, its lanes') has arrived.
     uint64_t scene_ready(const GroupToken& t) const;

@@ -299,6 +299,8 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     // node (prefetch_below in kernels/stream/stream_kernels_impl.h), and nothing else.
     c.scene_memory.prefetch_depth = 0;
     c.scene_memory.prefetch_children = true;
+    // Its surface_at reads the mesh's triangle and vertex arrays, not the leaves' copies.
+    c.scene_memory.hit_reads = "mesh";
     c.op_costs = op_costs;
     return c;
 }
@@ -348,7 +350,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  # assumed: not measured; DRAM lines queue for it\n"
       << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
       << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) as it\n"
-      << "                           # tests the node (prefetch_below, kernels/stream)\n";
+      << "                           # tests the node (prefetch_below, kernels/stream)\n"
+      << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
+      << "                   # copies its leaf tests read (kernels/intersect.h)\n";
     y << "# Fitted: " << fit_note << "\n";
     if (op_costs.empty()) {
         y << "op_costs: []\n";
@@ -360,7 +364,11 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", per_lane_cycles: " << fmt(o.per_lane_cycles, 2)
               << ", per_pass_cycles: " << fmt(o.per_pass_cycles, 2)
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
-              << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2) << "}\n";
+              << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
+              << (o.hit_read_exposed_share > 0
+                      ? ", hit_read_exposed_share: " + fmt(o.hit_read_exposed_share, 3)
+                      : std::string())
+              << "}\n";
     }
     return y.str();
 }

@@ -241,6 +241,12 @@ struct SceneMemoryConfig {
     // ops whose streams its partition produces (a node's children, a leaf's primitives) is
     // requested too.
     bool prefetch_children = false;
+    // Where a lane's hit primitive is read from when its surface is computed (the emission
+    // filter, OpKindInfo::reads_hit_primitive). Assumed "primitives": G&R's scene memory holds
+    // one copy of each primitive, the one its intersection test fetched. "mesh": the native
+    // tracer's surface_at reads the mesh's own arrays (a 16-byte triangle record indexed by
+    // primitive, then its vertices), not the copies its leaf tests read in BVH order.
+    std::string hit_reads = "primitives";
 
     template <class V>
     void visit(V& v) {
@@ -255,6 +261,10 @@ struct SceneMemoryConfig {
         v.param("prefetch_children", prefetch_children, "",
                 "request the scene data of the ops an op's partition feeds (a node's children, "
                 "a leaf's primitives) when it is dispatched");
+        v.choice("hit_reads", hit_reads, {"primitives", "mesh"},
+                 "where a lane's hit primitive is read when its surface is computed: "
+                 "primitives (the record its intersection test fetched) or mesh (separate "
+                 "triangle and vertex arrays, as the native tracer's surface_at reads)");
     }
 };
 
@@ -338,6 +348,12 @@ struct OpCostConfig {
     double per_pass_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
+    // An op that reads each lane's hit primitive (the emission filter): the share of those
+    // reads' latency beyond an L1D hit that the core does not overlap with other work, fitted
+    // on the surface-read microbenchmark (scene arrays beyond the caches) through the same
+    // cache model that prices the frames. 0: not measured (the reads cost what the
+    // cache-resident microbenchmark saw).
+    double hit_read_exposed_share = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -358,6 +374,10 @@ struct OpCostConfig {
                 "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "
                 "formula above applies)",
                 0.0, 1e9);
+        v.param("hit_read_exposed_share", hit_read_exposed_share, "",
+                "share of each lane's hit-primitive read latency beyond an L1D hit that is not "
+                "overlapped (0: not measured)",
+                0.0, 100.0);
     }
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hw_model/cache_model.h"
 #include "hw_model/op_costs.h"
 
 namespace sfx {
@@ -182,6 +183,54 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};
+}
+
+double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample) {
+    SceneMemoryConfig memory = host.scene_memory;
+    memory.hit_reads = "mesh";
+    SceneMemoryModel scene(memory, host.clock.core_mhz);
+    SceneDataMap map;
+    map.triangles = sample.triangles;
+    SceneDataMap::Read reads[2];
+    auto warm = [&](uint32_t prim) {
+        const uint32_t n = map.hit_reads(prim, true, reads);
+        for (uint32_t r = 0; r < n; ++r) scene.warm(0, reads[r].address, reads[r].bytes);
+    };
+    // The mesh as its construction wrote it, in order, then the earlier repetitions' hits.
+    for (uint32_t prim = 0; prim < sample.triangles; ++prim) warm(prim);
+    for (uint32_t prim : sample.warm_prims) warm(prim);
+    const uint64_t hidden = scene_latency_in_costs(host);
+    double beyond = 0.0;
+    for (uint32_t prim : sample.timed_prims) {
+        const uint32_t n = map.hit_reads(prim, true, reads);
+        for (uint32_t r = 0; r < n; ++r)
+            beyond += double(scene.latency_beyond(0, reads[r].address, reads[r].bytes, 0, hidden));
+    }
+    return beyond;
+}
+
+HitReadFit fit_hit_read_exposed_share(const HwConfig& host,
+                                      const std::vector<HitReadSample>& samples) {
+    if (samples.empty()) throw std::invalid_argument("no surface-read samples to fit");
+    HitReadFit fit;
+    double num = 0.0, den = 0.0;
+    std::vector<double> floor;
+    for (const HitReadSample& s : samples) {
+        fit.modeled.push_back(modeled_hit_read_cycles(host, s));
+        // Minimises sum ((share m - e) / f)^2, f the floored extra.
+        const double f = std::max(s.extra_cycles, double(s.timed_prims.size()));
+        floor.push_back(f);
+        num += fit.modeled.back() * s.extra_cycles / (f * f);
+        den += fit.modeled.back() * fit.modeled.back() / (f * f);
+    }
+    fit.share = den > 0 ? std::max(0.0, num / den) : 0.0;
+    std::vector<double> errors;
+    for (size_t i = 0; i < samples.size(); ++i)
+        errors.push_back(std::abs(fit.share * fit.modeled[i] - samples[i].extra_cycles) /
+                         floor[i]);
+    std::sort(errors.begin(), errors.end());
+    fit.error = {errors[errors.size() / 2], errors.back()};
+    return fit;
 }
 
 }  // namespace sfx

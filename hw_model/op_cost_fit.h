@@ -53,4 +53,30 @@ std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLan
 std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
                                              const std::vector<OneLaneSample>& samples);
 
+// The surface-read microbenchmark (kernels/stream/stream_microbench.h) as the fit sees it: a
+// stream of hits on a mesh of `triangles` (the hit primitives of the repetitions before, then of
+// the timed one), and the cycles it took beyond the same stream on a cache-resident mesh.
+struct HitReadSample {
+    uint32_t triangles = 0;
+    std::vector<uint32_t> warm_prims, timed_prims;
+    double extra_cycles = 0.0;
+};
+
+// The cache model's latency beyond an L1D hit of a sample's timed reads, summed, on `host`
+// (its scene_memory with hit_reads mesh): the reads as CoreModel::request_scene makes them, one
+// op's lanes requested together, after the mesh (written in order when it was built) and the
+// earlier repetitions' reads warmed the caches.
+double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample);
+
+// OpCostConfig::hit_read_exposed_share: the share s with s x modeled = extra, least squares on
+// relative error over the samples (a sample's extra floored at one cycle a lane), not below 0;
+// with its (median, worst) relative error. Throws std::invalid_argument on no samples.
+struct HitReadFit {
+    double share = 0.0;
+    std::pair<double, double> error{};
+    std::vector<double> modeled;  // per sample
+};
+HitReadFit fit_hit_read_exposed_share(const HwConfig& host,
+                                      const std::vector<HitReadSample>& samples);
+
 }  // namespace sfx

@@ -293,4 +293,23 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
     }
 }
 
+uint32_t SceneDataMap::hit_reads(uint32_t prim, bool mesh, Read out[2]) const {
+    if (prim >= triangles) {
+        out[0] = {address(OpKind::sphere_test, prim), uint32_t(sphere_bytes)};
+        return 1;
+    }
+    if (!mesh) {
+        out[0] = {address(OpKind::triangle_test, prim), uint32_t(triangle_bytes)};
+        return 1;
+    }
+    // Far beyond the materials (room for every 32-bit material id), so no region overlaps.
+    const uint64_t materials_base =
+        nodes * node_bytes + triangles * triangle_bytes + spheres * sphere_bytes;
+    const uint64_t mesh_base = materials_base + (uint64_t(1) << 32) * material_bytes;
+    const uint64_t vertices_base = mesh_base + triangles * mesh_triangle_bytes;
+    out[0] = {mesh_base + uint64_t(prim) * mesh_triangle_bytes, uint32_t(mesh_triangle_bytes)};
+    out[1] = {vertices_base + uint64_t(prim) * triangle_bytes, uint32_t(triangle_bytes)};
+    return 2;
+}
+
 }  // namespace sfx

@@ -111,19 +111,25 @@ class OpCostTable {
 };
 
 // Where the scene data of an op's object lives (a flat layout: nodes, then triangles' vertex
-// triples, then spheres, then materials), for the cache model.
+// triples, then spheres, then materials; far beyond them, for scene_memory.hit_reads mesh, the
+// mesh's triangle records and vertices), for the cache model.
 struct SceneDataMap {
     uint64_t node_bytes = 32, triangle_bytes = 36, sphere_bytes = 16, material_bytes = 64;
+    // The mesh's own arrays (workloads/scene.h): a triangle's record (three vertex ids and a
+    // material), and its vertices, taken as its own three (36 bytes) in triangle order.
+    uint64_t mesh_triangle_bytes = 16;
     uint64_t nodes = 0, triangles = 0, spheres = 0;
 
     uint64_t address(OpKind kind, uint32_t object) const;
-    // Where a hit primitive (a global primitive id: triangles, then spheres) lives, and its size.
-    uint64_t hit_address(uint32_t prim) const {
-        return address(prim < triangles ? OpKind::triangle_test : OpKind::sphere_test, prim);
-    }
-    uint32_t hit_bytes(uint32_t prim) const {
-        return uint32_t(prim < triangles ? triangle_bytes : sphere_bytes);
-    }
+
+    // The reads of a hit primitive's surface (a global primitive id: triangles, then spheres):
+    // its record as its intersection test fetched it, or (`mesh`) the mesh's triangle record
+    // and then its vertices; a sphere's record either way. Returns how many (1 or 2).
+    struct Read {
+        uint64_t address = 0;
+        uint32_t bytes = 0;
+    };
+    uint32_t hit_reads(uint32_t prim, bool mesh, Read out[2]) const;
 };
 // The scene data of a workload laid out as SceneDataMap says.
 SceneDataMap scene_data_map(const WorkloadShape& shape);

@@ -419,6 +419,19 @@ inline SurfaceHit surface_at(const Scene& scene, const Ray& ray, const Hit& hit)
     return s;
 }
 
+// The surfaces of a stream's hits (every id's hit valid), as the stream tracer computes them
+// before its emission filter: the scene's arrays are read at random, so each hit's triangle is
+// fetched 16 rays ahead and its vertices 8 ahead (the stream is known in advance, unlike one
+// ray at a time). The surface-read microbenchmark times this same loop.
+inline void compute_surfaces(const Scene& scene, const Ray* rays, const Hit* hits,
+                             const uint32_t* ids, uint32_t len, SurfaceHit* surf) {
+    for (uint32_t i = 0; i < len; ++i) {
+        if (i + 16 < len) prefetch_surface_triangle(scene, hits[ids[i + 16]].prim);
+        if (i + 8 < len) prefetch_surface_vertices(scene, hits[ids[i + 8]].prim);
+        surf[ids[i]] = surface_at(scene, rays[ids[i]], hits[ids[i]]);
+    }
+}
+
 // A spawned ray's origin on the side of s that n points to (s.normal: the side the incoming
 // ray came from; -s.normal: through the surface).
 inline Vec3 offset_ray_origin(const SurfaceHit& s, const Vec3& n) {

@@ -35,6 +35,10 @@ struct HostCalibration {
     // one_lane_cycles of the box, triangle and sphere tests).
     std::vector<OneRaySample> one_ray_samples;
     std::pair<double, double> one_lane_fit_error{};
+    // The hits' surfaces read beyond the caches, and the fitted share of their modelled latency
+    // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
+    std::vector<SurfaceReadSample> surface_read_samples;
+    HitReadFit hit_read_fit;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml

@@ -42,10 +42,21 @@ void Accelerator::warm(const PassBuffer& pass) {
     for (size_t i = 0; i < pass.size(); ++i) {
         const StreamOp op = pass.at(i);
         const OpProfile& p = m_costs[op.kind];
-        // The lanes' hit-primitive reads (CoreModel::request_scene) need no warming of their
-        // own: each is a line the intersection op that found the hit fetched.
         if (p.scene_bytes && op.object != k_no_object && op.length)
             m_scene_memory->warm(0, m_map.address(op.kind, op.object), p.scene_bytes);
+        // The lanes' hit-primitive reads (CoreModel::request_scene) need warming of their own
+        // only from the mesh's arrays: otherwise each is a line the intersection op that found
+        // the hit fetched.
+        const uint32_t* hits = pass.lane_hits(i);
+        if (p.lane_scene_reads && hits && m_config.scene_memory.hit_reads == "mesh") {
+            SceneDataMap::Read reads[2];
+            for (uint32_t lane = 0; lane < op.length; ++lane) {
+                if (hits[lane] == k_no_object) continue;
+                const uint32_t n = m_map.hit_reads(hits[lane], true, reads);
+                for (uint32_t r = 0; r < n; ++r)
+                    m_scene_memory->warm(0, reads[r].address, reads[r].bytes);
+            }
+        }
     }
 }
 

@@ -553,4 +553,96 @@ std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t re
     return out;
 }
 
+namespace {
+
+// A mesh of `triangles` triangles, each with its own three vertices in triangle order, spread
+// over a unit box (what surface_at computes does not depend on where they are).
+Scene surface_read_mesh(uint32_t triangles, std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    Scene s;
+    s.name = "surface-reads";
+    s.materials.resize(1);
+    s.positions.resize(size_t(triangles) * 3);
+    s.triangles.resize(triangles);
+    for (uint32_t i = 0; i < triangles; ++i) {
+        const Vec3 base(u(rng), u(rng), u(rng));
+        s.positions[3 * size_t(i)] = base;
+        s.positions[3 * size_t(i) + 1] = base + Vec3(0.01f, 0.f, 0.f);
+        s.positions[3 * size_t(i) + 2] = base + Vec3(0.f, 0.01f, 0.f);
+        s.triangles[i].v0 = 3 * i;
+        s.triangles[i].v1 = 3 * i + 1;
+        s.triangles[i].v2 = 3 * i + 2;
+    }
+    return s;
+}
+
+}  // namespace
+
+std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_t repetition) {
+    std::mt19937 rng(uint32_t(sample.seed * 7919 + repetition));
+    std::uniform_int_distribution<uint32_t> pick(0, sample.triangles - 1);
+    std::vector<uint32_t> prims(sample.lanes);
+    for (uint32_t& p : prims) p = pick(rng);
+    return prims;
+}
+
+std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
+                                                                const ConvergenceRule& convergence,
+                                                                uint64_t seed) {
+    constexpr uint32_t k_lanes = 4096, k_resident = 64;
+    std::mt19937 rng{uint32_t(seed)};
+    const double overhead = tsc_overhead();
+    const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
+    std::vector<Ray> rays(k_lanes);
+    std::vector<Hit> hits(k_lanes);
+    std::vector<SurfaceHit> surf(k_lanes);
+    std::vector<uint32_t> ids(k_lanes);
+    std::iota(ids.begin(), ids.end(), 0u);
+    std::uniform_real_distribution<float> u(0.f, 0.5f);
+    for (uint32_t i = 0; i < k_lanes; ++i) {
+        rays[i].dir = Vec3(0.f, 0.f, 1.f);
+        hits[i].t = 1.f;
+        hits[i].u = u(rng);
+        hits[i].v = u(rng);
+    }
+    const Scene resident = surface_read_mesh(k_resident, rng);
+    std::vector<SurfaceReadSample> out;
+    uint64_t stream_seed = seed;
+    for (uint32_t triangles : {1u << 13, 1u << 17, 1u << 20}) {
+        const Scene mesh = surface_read_mesh(triangles, rng);
+        SurfaceReadSample sample;
+        sample.triangles = triangles;
+        sample.lanes = k_lanes;
+        sample.seed = ++stream_seed;
+        // Interleaved: the mesh's stream, then the resident one, each time anew.
+        std::vector<double> times, resident_times;
+        float sink = 0.f;
+        for (uint32_t rep = 0; needs_more_samples(times, convergence) ||
+                               needs_more_samples(resident_times, convergence);
+             ++rep) {
+            const std::vector<uint32_t> prims = surface_read_hits(sample, rep);
+            for (uint32_t i = 0; i < k_lanes; ++i) hits[i].prim = prims[i];
+            uint64_t start = __rdtsc();
+            compute_surfaces(mesh, rays.data(), hits.data(), ids.data(), k_lanes, surf.data());
+            times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+            sink += surf[k_lanes / 2].position.x;
+            for (uint32_t i = 0; i < k_lanes; ++i) hits[i].prim = prims[i] % k_resident;
+            start = __rdtsc();
+            compute_surfaces(resident, rays.data(), hits.data(), ids.data(), k_lanes,
+                             surf.data());
+            resident_times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+            sink += surf[k_lanes / 2].position.x;
+        }
+        if (sink == 12345.f) out.clear();  // keeps the surfaces computed
+        const Convergence c = judge_convergence(times, convergence);
+        const Convergence r = judge_convergence(resident_times, convergence);
+        sample.cycles = c.fastest / ticks_per_cycle;
+        sample.resident_cycles = r.fastest / ticks_per_cycle;
+        sample.converged = c.converged && r.converged;
+        sample.repetitions = uint32_t(times.size());
+        out.push_back(sample);
+    }
+    return out;
+}
+
 }  // namespace sfx

@@ -91,4 +91,25 @@ struct KernelRate {
 };
 std::vector<KernelRate> run_gather_compress_microbenchmarks(Isa isa, uint32_t repeats = 9);
 
+// The hits' surfaces read from scene arrays beyond the caches: the stream tracer's own loop
+// (compute_surfaces, kernels/intersect.h, with its prefetches) over a stream of `lanes` hits
+// on triangles drawn at random from a mesh of `triangles` (each with its own three vertices, in
+// triangle order: 52 bytes of triangle record and vertices each), against the same loop on a
+// cache-resident mesh of 64 triangles. What the first costs beyond the second is the latency
+// of those reads that the core does not overlap; `sfx calibrate --describe-host` fits the share
+// of the cache model's latency that this is (hw_model/op_cost_fit.h), never on frames.
+struct SurfaceReadSample {
+    uint32_t triangles = 0, lanes = 0;
+    double cycles = 0.0;           // per stream, fastest repetition
+    double resident_cycles = 0.0;  // the same stream length on the resident mesh
+    bool converged = false;        // both agreed (base/convergence.h)
+    uint32_t repetitions = 0;
+    uint64_t seed = 0;  // of the hits' draw (surface_read_hits replays it)
+};
+// Meshes of 2^13, 2^17 and 2^20 triangles (416 KiB, 6.5 MiB, 52 MiB), streams of 4096 hits.
+std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(
+    Isa isa, const ConvergenceRule& convergence, uint64_t seed = 5);
+// The triangles hit by repetition `repetition` of a sample's stream, in stream order.
+std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_t repetition);
+
 }  // namespace sfx

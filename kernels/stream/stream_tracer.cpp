@@ -527,16 +527,10 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             });
         s += misses;
         len -= misses;
-        // The hits' surfaces, for the emission filter and the stack below: the scene's arrays
-        // are read at random, so each hit's triangle is fetched 16 rays ahead and its vertices
-        // 8 ahead (the stream is known in advance, unlike one ray at a time). Timing models
+        // The hits' surfaces, for the emission filter and the stack below. Timing models
         // price this as part of the emission filter (OpKindInfo::reads_hit_primitive), as the
-        // microbenchmark times it.
-        for (uint32_t i = 0; i < len; ++i) {
-            if (i + 16 < len) prefetch_surface_triangle(scene, hit[s[i + 16]].prim);
-            if (i + 8 < len) prefetch_surface_vertices(scene, hit[s[i + 8]].prim);
-            b.surf[s[i]] = surface_at(scene, rays[s[i]], hit[s[i]]);
-        }
+        // microbenchmarks time it.
+        compute_surfaces(scene, rays, hit, s, len, b.surf.data());
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
             const Material& m = scene.materials[surf[id].material];
             if (!m.emissive()) return false;

@@ -89,8 +89,11 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     other.cores.count = 2;  // passes go to cores as their timing decides
     CHECK_FALSE(same_cache_lookups(a, other));
     other = a;
-    other.ray_buffer.storage = "l1d";  // a CPU core looks up no lane's hit primitive
+    other.scene_memory.hit_reads = "mesh";  // the lanes' hit primitives read elsewhere
     CHECK_FALSE(same_cache_lookups(a, other));
+    other = a;
+    other.ray_buffer.storage = "l1d";  // a CPU core looks its lanes' hit primitives up too
+    CHECK(same_cache_lookups(a, other));
 
     auto shared = std::make_shared<SharedCacheLookups>(a.scene_memory.caches);
     SceneMemoryModel own_a(a.scene_memory, 500.0), own_b(b.scene_memory, 500.0);

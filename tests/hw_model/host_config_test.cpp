@@ -64,7 +64,111 @@ FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes,
     return timing.timing(0);
 }
 
+// A triangle test (hits on triangle `prim` for 16 lanes, slots 0..15), then the emission
+// filter over those lanes, in one pass of 64 slots, timed by the machine model.
+FrameTiming time_surfaces(const HwConfig& config, uint32_t prim = 7) {
+    SystemcTiming timing({config}, shape());
+    std::vector<uint32_t> ids(16);
+    for (uint32_t i = 0; i < 16; ++i) ids[i] = i;
+    const std::vector<uint8_t> all(16, 1), none(16, 0);
+    TilePass pass;
+    pass.slot_count = 64;
+    timing.begin_pass(pass);
+    StreamOp op;
+    op.kind = OpKind::triangle_test;
+    op.stage = OpStage::intersection;
+    op.object = prim;
+    op.length = 16;
+    op.pass_count = 16;
+    op.slots = ids.data();
+    op.passed = all.data();
+    timing.op(op);
+    op.kind = OpKind::emission_filter;
+    op.stage = OpStage::shading;
+    op.object = k_no_object;
+    op.pass_count = 0;
+    op.passed = none.data();
+    timing.op(op);
+    timing.end_pass(pass);
+    return timing.timing(0);
+}
+
+HwConfig with_hit_share(HwConfig c, double share) {
+    for (OpCostConfig& k : c.op_costs)
+        if (k.op == "emission_filter") k.hit_read_exposed_share = share;
+    return c;
+}
+
 }  // namespace
+
+TEST_CASE("A CPU core leaves the measured share of its lanes' hit reads exposed",
+          "[host][systemc]") {
+    // The host reads a hit's surface from the mesh's arrays (host_hw_config: hit_reads mesh):
+    // the triangle's 16-byte record, then its vertices, neither fetched by the triangle test.
+    const HwConfig host = host_with({});
+    REQUIRE(host.scene_memory.hit_reads == "mesh");
+    SceneDataMap map = scene_data_map(shape());
+    SceneDataMap::Read reads[2];
+    REQUIRE(map.hit_reads(7, true, reads) == 2);
+    CHECK(reads[0].bytes == 16);
+    CHECK(reads[1].bytes == 36);
+    CHECK(reads[1].address == reads[0].address + (map.triangles - 7) * 16 + 7 * 36);
+    CHECK(reads[0].address > map.address(OpKind::material_filter, ~0u - 1));  // no overlap
+    REQUIRE(map.hit_reads(7, false, reads) == 1);
+    CHECK(reads[0].address == map.address(OpKind::triangle_test, 7));
+    REQUIRE(map.hit_reads(uint32_t(map.triangles), true, reads) == 1);  // a sphere: its record
+    CHECK(reads[0].bytes == 16);
+
+    // The first lane finds both reads in DRAM (81 ns at 1 GHz, then a 64-byte line at 25.6
+    // B/cycle: 84 cycles, the L1D hit inside the measured cost taken off: 83 each, a vertex
+    // read across two lines waiting for the later); the other 15 find them in the L1D. Half
+    // of 2 x 83 is exposed, as a scene-memory stall of the shading stage; none at share 0.
+    const FrameTiming free = time_surfaces(host);
+    const FrameTiming half = time_surfaces(with_hit_share(host, 0.5));
+    CHECK(half.cycles - free.cycles == 83);
+    CHECK(half.stalls.scene_memory - free.stalls.scene_memory == 83);
+    CHECK(half.stages[0][size_t(OpStage::shading)].scene_memory_cycles -
+              free.stages[0][size_t(OpStage::shading)].scene_memory_cycles ==
+          83);
+    // Read where the triangle test fetched it, the hit is an L1D hit: nothing exposed.
+    HwConfig primitives = with_hit_share(host, 0.5);
+    primitives.scene_memory.hit_reads = "primitives";
+    CHECK(time_surfaces(primitives).cycles == free.cycles);
+    // The reads are looked up whatever the share: the caches see them.
+    CHECK(free.dram_reads == half.dram_reads);
+    CHECK(free.dram_reads > time_surfaces(primitives).dram_reads);
+}
+
+TEST_CASE("The exposed share of hit reads is fitted through the cache model", "[host]") {
+    const HwConfig host = host_with({});
+    // 16-byte records and 36-byte vertices of a mesh of 2^15 triangles (1.6 MiB, beyond the
+    // 256 KiB L2) and of 64 (inside the L1D).
+    auto sample = [](uint32_t triangles, uint32_t seed) {
+        HitReadSample s;
+        s.triangles = triangles;
+        for (uint32_t i = 0; i < 512; ++i) s.timed_prims.push_back((i * 7919u + seed) % triangles);
+        return s;
+    };
+    const HitReadSample resident = sample(64, 1);
+    CHECK(modeled_hit_read_cycles(host, resident) == 0.0);  // warmed into the L1D
+    HitReadSample big = sample(1u << 15, 3), mid = sample(1u << 12, 5);
+    const double modeled_big = modeled_hit_read_cycles(host, big);
+    const double modeled_mid = modeled_hit_read_cycles(host, mid);
+    // The big mesh's reads mostly come from DRAM (83 beyond the L1D each, two a lane).
+    CHECK(modeled_big > 512 * 2 * 40);
+    CHECK(modeled_big <= 512 * 2 * 83);
+    CHECK(modeled_mid < modeled_big);
+    big.extra_cycles = 0.3 * modeled_big;
+    mid.extra_cycles = 0.3 * modeled_mid;
+    const HitReadFit fit = fit_hit_read_exposed_share(host, {big, mid});
+    CHECK(fit.share == Approx(0.3));
+    CHECK(fit.error.second < 1e-9);
+    mid.extra_cycles *= 2;  // a sample the one share cannot follow shows in the error
+    CHECK(fit_hit_read_exposed_share(host, {big, mid}).error.second > 0.2);
+    big.extra_cycles = mid.extra_cycles = 0;  // nothing measured: not negative
+    CHECK(fit_hit_read_exposed_share(host, {big, mid}).share == 0.0);
+    CHECK_THROWS_AS(fit_hit_read_exposed_share(host, {}), std::invalid_argument);
+}
 
 TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]") {
     const OpCostConfig c = cost("box_test", 10, 4, 0.5, 2, 8);

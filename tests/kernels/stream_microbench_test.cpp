@@ -65,3 +65,51 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     CHECK(passed < lanes);
     CHECK(stream_slot_bytes() > 64);
 }
+
+TEST_CASE("The surface reads beyond the caches are timed on the tracer's own loop",
+          "[stream][host]") {
+    // compute_surfaces (the tracer's loop, with its prefetches) gives every id surface_at's
+    // surface, bit for bit.
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    std::vector<Ray> rays;
+    std::vector<Hit> hits;
+    std::vector<uint32_t> ids;
+    for (uint32_t i = 0; i < 64; ++i) {
+        Ray r;
+        r.org = scene.camera.eye;
+        const Vec3 ahead = normalize(scene.camera.look_at - scene.camera.eye);
+        r.dir = normalize(ahead + Vec3(float(i % 8) - 3.5f, float(i / 8) - 3.5f, 0.f) * 0.05f);
+        rays.push_back(r);
+        hits.push_back(bvh.intersect(r));
+        if (hits.back().valid() && i % 3 != 1) ids.push_back(i);  // a sparse stream of hits
+    }
+    REQUIRE(ids.size() > 20);
+    std::vector<SurfaceHit> surf(64);
+    compute_surfaces(scene, rays.data(), hits.data(), ids.data(), uint32_t(ids.size()),
+                     surf.data());
+    for (uint32_t id : ids) {
+        const SurfaceHit s = surface_at(scene, rays[id], hits[id]);
+        CHECK(std::memcmp(&s.position, &surf[id].position, sizeof(Vec3)) == 0);
+        CHECK(std::memcmp(&s.normal, &surf[id].normal, sizeof(Vec3)) == 0);
+        CHECK(s.material == surf[id].material);
+    }
+
+    const std::vector<SurfaceReadSample> samples =
+        run_surface_read_microbenchmarks(Isa::automatic, microbench_rule(1));
+    REQUIRE(samples.size() == 3);
+    for (const SurfaceReadSample& s : samples) {
+        CHECK(s.lanes == 4096);
+        CHECK(s.cycles > 0.0);
+        CHECK(s.resident_cycles > 0.0);
+        CHECK(s.repetitions == 1);
+        // The draw replays: the same hits for the same repetition, others for the next, all
+        // inside the mesh.
+        const std::vector<uint32_t> a = surface_read_hits(s, 0);
+        CHECK(a == surface_read_hits(s, 0));
+        CHECK(a != surface_read_hits(s, 1));
+        CHECK(*std::max_element(a.begin(), a.end()) < s.triangles);
+    }
+    CHECK(samples[0].triangles == 1u << 13);
+    CHECK(samples[2].triangles == 1u << 20);
+}
