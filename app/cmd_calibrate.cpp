@@ -359,6 +359,8 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.huge_page_kib_min"] = m.huge_page_kib_min;
             row["measured.huge_page_kib_max"] = m.huge_page_kib_max;
             row["measured.neighbours_busy"] = m.neighbours_busy;
+            row["measured.speed_probe_before"] = m.probe_before;
+            row["measured.speed_probe_after"] = m.probe_after;
             row["host.vendor"] = vendor_short_name(uarch.vendor);
             row["host.family"] = uarch.signature.family;
             row["host.model"] = uarch.signature.model;

@@ -302,6 +302,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     // Its surface_at reads the mesh's triangle and vertex arrays, not the leaves' copies.
     c.scene_memory.hit_reads = "mesh";
     c.op_costs = op_costs;
+    c.speed_probe_cycles = h.speed_probe_cycles;
     return c;
 }
 
@@ -353,6 +354,10 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "                           # tests the node (prefetch_below, kernels/stream)\n"
       << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";
+    if (h.speed_probe_cycles > 0)
+        y << "speed_probe_cycles: " << fmt(h.speed_probe_cycles, 0)
+          << "  # measured: the speed probe's microbenchmark points at calibration (fastest of "
+             "repetitions, sweeps/host_calibration.h)\n";
     y << "# Fitted: " << fit_note << "\n";
     if (op_costs.empty()) {
         y << "op_costs: []\n";

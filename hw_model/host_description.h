@@ -67,6 +67,7 @@ struct HostDescription {
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
+    double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
 };
 
 // Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).

@@ -396,6 +396,9 @@ struct HwConfig {
     SceneMemoryConfig scene_memory;
     DatapathConfig datapath;
     std::vector<OpCostConfig> op_costs;  // measured per-op costs of a CPU core (host only)
+    // Host only: the speed probe's cycles when the host was calibrated (sweeps/host_calibration.h
+    // speed_probe_cycles), for a silicon check to see whether the machine still runs as then.
+    double speed_probe_cycles = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -415,6 +418,10 @@ struct HwConfig {
         v.list("op_costs", op_costs,
                "measured per-op costs of a CPU core (sfx calibrate --describe-host); empty: "
                "priced from instruction counts");
+        v.param("speed_probe_cycles", speed_probe_cycles, "cycles",
+                "host only: the speed probe's microbenchmark cycles at calibration (0: not "
+                "measured); a silicon check re-runs the probe against it",
+                0.0, 1e15);
     }
 };
 

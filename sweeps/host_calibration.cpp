@@ -3,6 +3,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <random>
@@ -80,6 +81,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.converged_points += s.converged;
     }
     c.points += uint32_t(c.surface_read_samples.size());
+    c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
     for (OpCostConfig& cost : c.op_costs)
@@ -152,6 +154,19 @@ std::pair<CycleReading, double> timed_render(const Scene& scene, const Bvh& bvh,
 
 }  // namespace
 
+double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence) {
+    MicrobenchOptions options;
+    options.isa = isa;
+    options.convergence = convergence;
+    options.kinds = {OpKind::box_test, OpKind::triangle_test, OpKind::emission_filter,
+                     OpKind::lambertian_indirect};
+    options.buffer_slots = {1024};
+    options.lengths = {512, 1024};
+    double cycles = 0.0;
+    for (const MicrobenchSample& s : run_stream_microbenchmarks(options)) cycles += s.cycles;
+    return cycles;
+}
+
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence, uint64_t seed,
     const std::function<void(const std::string&, size_t, size_t)>& progress) {
@@ -196,6 +211,21 @@ std::vector<SiliconMeasurement> predict_and_measure(
         warm_scene = variants[v].scene;
     };
     for (size_t v = 0; v < n; ++v) warm(v);
+    // The machine's speed against calibration, per back end, before the renders and after.
+    std::map<uint32_t, double> probe_before, probe_after;
+    auto probe_all = [&](std::map<uint32_t, double>& probes) {
+        for (size_t v = 0; v < n; ++v) {
+            const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
+            const double at_calibration = variants[v].host->speed_probe_cycles;
+            if (!probes.count(lanes))
+                probes[lanes] = at_calibration > 0 ? speed_probe_cycles(settings[v].isa,
+                                                                        microbench_rule()) /
+                                                             at_calibration -
+                                                         1.0
+                                                   : std::nan("");
+        }
+    };
+    probe_all(probe_before);
     // Placement varies from render to render (Stabilizer's idea, for the heap alone): a block
     // of 0-64 KiB in 64-byte steps, held over the render, moves where the tracer's buffers land
     // relative to pages, cache sets and each other.
@@ -242,8 +272,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
             clocked_totals[v].push_back(clocked.cycles);
         }
     }
+    probe_all(probe_after);
     for (size_t v = 0; v < n; ++v) {
         SiliconMeasurement& m = out[v];
+        const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
+        m.probe_before = probe_before[lanes];
+        m.probe_after = probe_after[lanes];
         m.convergence = judge_convergence(m.frame_samples, convergence);
         m.measured_frame = m.convergence.fastest;
         const size_t fastest = size_t(

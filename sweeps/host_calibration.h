@@ -78,7 +78,18 @@ struct SiliconMeasurement {
     std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame
     double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
+    // The machine's speed during the renders against calibration: the speed probe re-run just
+    // before the first render and just after the last, over its cycles at calibration, less 1
+    // (NaN: the host file has none). The same for every workload of a back end; a probe beyond
+    // +-10 % flags a run slowed (or sped) alike.
+    double probe_before = 0.0, probe_after = 0.0;
 };
+
+// The speed probe: microbenchmark points of a traversal, an intersection and two shading
+// filters (box, triangle, emission, Lambertian indirect; streams of 512 and 1024 of 1024
+// slots), their fastest cycles summed. Measured at calibration (HwConfig::speed_probe_cycles)
+// and around a check's renders: their ratio says whether the machine runs as calibrated.
+double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence);
 
 // One workload of a silicon check: its scene, render settings and the host configuration (whose
 // SIMD width is the back end's, settings.isa) that predicts it.

@@ -35,6 +35,9 @@ TARGETS = {"frame_mae": 0.10, "frame_worst": 0.20, "stage_mae": 0.20, "converged
 # A frame of r times the pixels costs between these multiples of r.
 CONSISTENT = (0.75, 1.25)
 WIDTHS = {"scalar": 1, "avx2": 8, "avx512": 16}
+# A speed probe (the same microbenchmark points re-run around the renders) this far from the
+# host's fitted costs says the machine ran faster or slower than when it was calibrated.
+SPEED_PROBE_LIMIT = 0.10
 
 
 def load_rows(path):
@@ -354,6 +357,20 @@ def measurement_text(df):
                          f"the renders (per workload {100 * busy.min():.0f}-{100 * busy.max():.0f} "
                          f"%; /proc/stat): a whole run can be slowed alike, which no convergence "
                          f"rule sees")
+    if "measured.speed_probe_before" in df:
+        for isa, g in df.groupby("isa", sort=False):
+            before = g["measured.speed_probe_before"].iloc[0]
+            after = g["measured.speed_probe_after"].iloc[0]
+            what = (f"- speed probe ({isa}): box, triangle, emission and Lambertian filter "
+                    f"microbenchmarks re-run just before the first render and after the last, "
+                    f"against their cycles at calibration")
+            if pd.isna(before) or pd.isna(after):
+                lines.append(f"{what}: not measured at calibration (an older host file)")
+                continue
+            flag = (f"SLOWED OR SPED ALIKE (beyond +-{100 * SPEED_PROBE_LIMIT:.0f} %): the run's "
+                    f"measurements are not the calibrated machine's"
+                    if max(abs(before), abs(after)) > SPEED_PROBE_LIMIT else "as calibrated")
+            lines.append(f"{what}: {100 * before:+.1f} % / {100 * after:+.1f} %: {flag}")
     return "\n".join(lines)
 
 

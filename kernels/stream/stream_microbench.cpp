@@ -220,6 +220,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     uint32_t box_sample = 0;
 
     for (OpKind kind : kinds) {
+        if (!options.kinds.empty() &&
+            std::find(options.kinds.begin(), options.kinds.end(), kind) == options.kinds.end())
+            continue;
         for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
             const uint32_t slots = options.buffer_slots[bi];
             Buffers& b = buffers[bi];

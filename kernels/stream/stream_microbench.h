@@ -57,6 +57,7 @@ struct MicrobenchOptions {
     std::vector<uint32_t> lengths = {1, 8, 16, 24, 48, 96, 200, 512, 1024, 4096};
     ConvergenceRule convergence = microbench_rule();  // repetitions per point
     uint64_t seed = 1;
+    std::vector<OpKind> kinds;  // empty: every kind the native tracer has
 };
 
 // Every op kind the native tracer has, at every (buffer, length <= buffer). `progress(done,

@@ -210,3 +210,21 @@ def test_rankings_judge_the_converged_range(tmp_path):
     # Ranges that overlap: not judged.
     df.loc[0, "measured.hi"] = 125
     assert list(silicon.ranking(df)["pairs"]) == [0]
+
+
+def test_speed_probe_flags_a_run_unlike_calibration(tmp_path):
+    # avx2's machine ran as calibrated; avx512's ran 30 % slower after its renders.
+    # scalar's host file predates the probe (null).
+    rows = [row("a", 16, 100, 100, isa="avx2"), row("a", 16, 100, 130, isa="avx512"),
+            row("a", 16, 100, 300, isa="scalar")]
+    rows[0].update({"measured.speed_probe_before": 0.02, "measured.speed_probe_after": -0.03})
+    rows[1].update({"measured.speed_probe_before": 0.01, "measured.speed_probe_after": 0.30})
+    rows[2].update({"measured.speed_probe_before": None, "measured.speed_probe_after": None})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    text = silicon.measurement_text(silicon.load_rows(p))
+    lines = [line for line in text.splitlines() if "speed probe" in line]
+    assert len(lines) == 3
+    assert "(scalar)" in lines[2] and "not measured at calibration" in lines[2]
+    assert "(avx2)" in lines[0] and "+2.0 % / -3.0 %: as calibrated" in lines[0]
+    assert "(avx512)" in lines[1] and "+30.0 %" in lines[1] and "SLOWED OR SPED ALIKE" in lines[1]

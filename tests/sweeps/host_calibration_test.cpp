@@ -4,6 +4,7 @@
 #include "sweeps/host_calibration.h"
 
 #include <algorithm>
+#include <cmath>
 #include <catch2/catch.hpp>
 #include <map>
 
@@ -102,4 +103,27 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     // Within a factor of 20 either way: only a broken flow (units, a lost stage) misses that.
     CHECK(m.predicted_frame / m.measured_frame > 0.05);
     CHECK(m.predicted_frame / m.measured_frame < 20);
+    // No probe at calibration in this host file: the probe is unknown (NaN), not 0.
+    CHECK(std::isnan(m.probe_before));
+    CHECK(std::isnan(m.probe_after));
+    // With one, the probe is re-run once per back end before the renders and once after, the
+    // same for both workloads: against a probe a thousand times its cycles it reads the
+    // machine as about a thousand times faster than at calibration.
+    const double probe = speed_probe_cycles(isa, microbench_rule(3));
+    CHECK(probe > 0);
+    HwConfig probed = config;
+    probed.speed_probe_cycles = 1000 * probe;
+    const std::vector<SiliconMeasurement> again =
+        predict_and_measure({{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}},
+                            rule, 1);
+    CHECK(again[0].probe_before == again[1].probe_before);
+    CHECK(again[0].probe_after == again[1].probe_after);
+    CHECK(again[0].probe_before < -0.95);
+    CHECK(again[0].probe_after < -0.95);
+    CHECK(again[0].probe_before > -1.0);
+    // The host file keeps it.
+    HostDescription probed_host = host;
+    probed_host.speed_probe_cycles = 12345;
+    CHECK(parse_hw_config(host_hw_yaml(probed_host, costs, "test"), "host.hw.yaml")
+              .speed_probe_cycles == Approx(12345));
 }
