@@ -219,11 +219,4 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
     return arrival;
 }
 
-uint64_t SceneMemoryModel::latency_beyond(uint32_t core, uint64_t address, uint32_t bytes,
-                                          uint64_t now, uint64_t hidden) {
-    uint64_t latency = 0;
-    read(core, address, bytes, now, &latency);
-    return latency - std::min(latency, hidden);
-}
-
 }  // namespace sfx

@@ -91,16 +91,11 @@ class SceneMemoryModel {
     // Cycle at which `bytes` at `address`, requested by `core` at cycle `now`, have arrived:
     // each line comes from the nearest level holding it (lines of one request overlap: the
     // request waits for its slowest line); lines from DRAM queue for its bandwidth.
-    // `unloaded`: the slowest line's latency had DRAM been idle.
+    // `unloaded`: the slowest line's latency had DRAM been idle (a CPU core working through its
+    // lanes in turn overlaps a share of each, hit_latency_beyond in hw_model/op_costs.h; the
+    // queue of one op's reads all issued at once is the accelerator's).
     uint64_t read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
                   uint64_t* unloaded = nullptr);
-    // A CPU core's read of a lane's scene data: looked up, counted and booked as read() does;
-    // returns its latency beyond `hidden` cycles (an L1D hit, inside measured costs) as if DRAM
-    // were idle. A core that works through its lanes in turn overlaps a share of each lane's
-    // latency (OpCostConfig::hit_read_exposed_share); the queue of one op's reads all issued at
-    // once is the accelerator's.
-    uint64_t latency_beyond(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
-                            uint64_t hidden);
     // Touches the lines of a read in the caches only (cache warming: no time, no DRAM traffic).
     void warm(uint32_t core, uint64_t address, uint32_t bytes);
     // The same read issued at cycle 0 (for code that keeps no time).

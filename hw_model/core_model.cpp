@@ -30,6 +30,7 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_map(map),
       m_core(core_index),
       m_l1d(config.ray_buffer.storage == "l1d"),
+      m_mesh_hits(config.scene_memory.hit_reads == "mesh"),
       m_record_bytes(record_words * 4),
       m_scene_hidden(scene_latency_in_costs(config)),
       m_layout(config.ray_buffer, record_words, slot_capacity),
@@ -132,7 +133,6 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
         // overlaps a measured share of their latency beyond an L1D hit (its cost holds the
         // hit): that share of their sum is what a group adds.
         const uint32_t n = width();
-        const bool mesh = m_config.scene_memory.hit_reads == "mesh";
         const double share = p.cost.hit_read_exposed_share;
         m_group_scene_offset[index] =
             m_l1d ? m_group_lane_stall.size() : m_group_scene_ready.size();
@@ -141,14 +141,15 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
             uint64_t ready = now, beyond_l1 = 0;
             for (uint32_t i = first; i < std::min(op.length, first + n); ++i) {
                 if (hits[i] == k_no_object) continue;
-                const uint32_t count = m_map.hit_reads(hits[i], mesh, reads);
+                if (m_l1d) {
+                    beyond_l1 += hit_latency_beyond(*m_scene_memory, m_map, m_core, hits[i],
+                                                    m_mesh_hits, now, m_scene_hidden);
+                    continue;
+                }
+                const uint32_t count = m_map.hit_reads(hits[i], m_mesh_hits, reads);
                 for (uint32_t r = 0; r < count; ++r)
-                    if (m_l1d)
-                        beyond_l1 += m_scene_memory->latency_beyond(
-                            m_core, reads[r].address, reads[r].bytes, now, m_scene_hidden);
-                    else
-                        ready = std::max(ready, m_scene_memory->read(m_core, reads[r].address,
-                                                                     reads[r].bytes, now));
+                    ready = std::max(ready, m_scene_memory->read(m_core, reads[r].address,
+                                                                 reads[r].bytes, now));
             }
             if (m_l1d)
                 m_group_lane_stall.push_back(uint64_t(std::llround(share * double(beyond_l1))));

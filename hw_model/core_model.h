@@ -99,6 +99,7 @@ class CoreModel {
     SceneDataMap m_map;
     uint32_t m_core;
     bool m_l1d;               // a CPU core: ray buffers behind its L1D, measured op costs
+    bool m_mesh_hits;         // scene_memory.hit_reads mesh
     uint32_t m_record_bytes;  // the scene's ray record (a slot, unless ray_buffer.slot_bytes)
     uint64_t m_scene_hidden;  // scene-data latency already inside measured costs (L1D hit)
     double m_beyond_l1 = 0.0; // the current pass's share of slots beyond an l1d buffer

@@ -186,26 +186,16 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
 }
 
 double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample) {
-    SceneMemoryConfig memory = host.scene_memory;
-    memory.hit_reads = "mesh";
-    SceneMemoryModel scene(memory, host.clock.core_mhz);
+    SceneMemoryModel scene(host.scene_memory, host.clock.core_mhz);
     SceneDataMap map;
     map.triangles = sample.triangles;
-    SceneDataMap::Read reads[2];
-    auto warm = [&](uint32_t prim) {
-        const uint32_t n = map.hit_reads(prim, true, reads);
-        for (uint32_t r = 0; r < n; ++r) scene.warm(0, reads[r].address, reads[r].bytes);
-    };
     // The mesh as its construction wrote it, in order, then the earlier repetitions' hits.
-    for (uint32_t prim = 0; prim < sample.triangles; ++prim) warm(prim);
-    for (uint32_t prim : sample.warm_prims) warm(prim);
+    for (uint32_t prim = 0; prim < sample.triangles; ++prim) warm_hit(scene, map, 0, prim, true);
+    for (uint32_t prim : sample.warm_prims) warm_hit(scene, map, 0, prim, true);
     const uint64_t hidden = scene_latency_in_costs(host);
     double beyond = 0.0;
-    for (uint32_t prim : sample.timed_prims) {
-        const uint32_t n = map.hit_reads(prim, true, reads);
-        for (uint32_t r = 0; r < n; ++r)
-            beyond += double(scene.latency_beyond(0, reads[r].address, reads[r].bytes, 0, hidden));
-    }
+    for (uint32_t prim : sample.timed_prims)
+        beyond += double(hit_latency_beyond(scene, map, 0, prim, true, 0, hidden));
     return beyond;
 }
 

@@ -312,4 +312,24 @@ uint32_t SceneDataMap::hit_reads(uint32_t prim, bool mesh, Read out[2]) const {
     return 2;
 }
 
+uint64_t hit_latency_beyond(SceneMemoryModel& memory, const SceneDataMap& map, uint32_t core,
+                            uint32_t prim, bool mesh, uint64_t now, uint64_t hidden) {
+    SceneDataMap::Read reads[2];
+    const uint32_t n = map.hit_reads(prim, mesh, reads);
+    uint64_t beyond = 0;
+    for (uint32_t r = 0; r < n; ++r) {
+        uint64_t latency = 0;
+        memory.read(core, reads[r].address, reads[r].bytes, now, &latency);
+        beyond += latency - std::min(latency, hidden);
+    }
+    return beyond;
+}
+
+void warm_hit(SceneMemoryModel& memory, const SceneDataMap& map, uint32_t core, uint32_t prim,
+              bool mesh) {
+    SceneDataMap::Read reads[2];
+    const uint32_t n = map.hit_reads(prim, mesh, reads);
+    for (uint32_t r = 0; r < n; ++r) memory.warm(core, reads[r].address, reads[r].bytes);
+}
+
 }  // namespace sfx

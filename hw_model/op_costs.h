@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "hw_model/cache_model.h"
 #include "hw_model/hw_config.h"
 #include "hw_model/workload_shape.h"
 #include "kernels/trace.h"
@@ -133,5 +134,15 @@ struct SceneDataMap {
 };
 // The scene data of a workload laid out as SceneDataMap says.
 SceneDataMap scene_data_map(const WorkloadShape& shape);
+
+// A CPU core's lane: the reads of its hit primitive `prim` (SceneDataMap::hit_reads) looked up
+// in `memory` at `now`, their latencies beyond `hidden` cycles (an L1D hit, inside measured
+// costs) summed, DRAM taken as idle. CoreModel::request_scene prices a group's lanes with it,
+// and the exposed-share fit (hw_model/op_cost_fit.h) models its microbenchmark with it.
+uint64_t hit_latency_beyond(SceneMemoryModel& memory, const SceneDataMap& map, uint32_t core,
+                            uint32_t prim, bool mesh, uint64_t now, uint64_t hidden);
+// The same reads touched in the caches only (warming).
+void warm_hit(SceneMemoryModel& memory, const SceneDataMap& map, uint32_t core, uint32_t prim,
+              bool mesh);
 
 }  // namespace sfx

@@ -69,6 +69,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.surface_read_samples = run_surface_read_microbenchmarks(resolved, convergence);
     std::vector<HitReadSample> hit_reads;
     for (const SurfaceReadSample& s : c.surface_read_samples) {
+        // Replayed: the third repetition's hits after the first two's, which warmed the caches
+        // as the repetitions before any measured one did (which repetition was fastest is not
+        // kept; every repetition draws its hits alike).
         HitReadSample h;
         h.triangles = s.triangles;
         for (uint32_t rep = 0; rep + 1 < std::min(s.repetitions, 3u); ++rep) {

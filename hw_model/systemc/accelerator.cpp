@@ -48,15 +48,10 @@ void Accelerator::warm(const PassBuffer& pass) {
         // only from the mesh's arrays: otherwise each is a line the intersection op that found
         // the hit fetched.
         const uint32_t* hits = pass.lane_hits(i);
-        if (p.lane_scene_reads && hits && m_config.scene_memory.hit_reads == "mesh") {
-            SceneDataMap::Read reads[2];
-            for (uint32_t lane = 0; lane < op.length; ++lane) {
-                if (hits[lane] == k_no_object) continue;
-                const uint32_t n = m_map.hit_reads(hits[lane], true, reads);
-                for (uint32_t r = 0; r < n; ++r)
-                    m_scene_memory->warm(0, reads[r].address, reads[r].bytes);
-            }
-        }
+        if (p.lane_scene_reads && hits && m_config.scene_memory.hit_reads == "mesh")
+            for (uint32_t lane = 0; lane < op.length; ++lane)
+                if (hits[lane] != k_no_object)
+                    warm_hit(*m_scene_memory, m_map, 0, hits[lane], true);
     }
 }
 
