@@ -117,7 +117,8 @@ class OpCostTable {
 struct SceneDataMap {
     uint64_t node_bytes = 32, triangle_bytes = 36, sphere_bytes = 16, material_bytes = 64;
     // The mesh's own arrays (workloads/scene.h): a triangle's record (three vertex ids and a
-    // material), and its vertices, taken as its own three (36 bytes) in triangle order.
+    // material: 16 bytes, Triangle), and its vertices, assumed its own three (36 bytes) in
+    // triangle order (a mesh shares vertices; the trace names no vertex ids).
     uint64_t mesh_triangle_bytes = 16;
     uint64_t nodes = 0, triangles = 0, spheres = 0;
 
