@@ -43,6 +43,7 @@ struct SamplingFlags {
     std::string target_error;  // empty: sample `fraction` of the passes
     std::string confidence = "99.7%";
     uint32_t warmup_passes = 1;
+    uint32_t warm_frames = 0;
     uint32_t strata = 8;
     std::string calibration = "2%";  // analytic fidelity: passes also timed at cycle level
 

@@ -99,6 +99,10 @@ void SamplingFlags::add_to(CLI::App* c) {
         ->capture_default_str();
     c->add_option("--warmup-passes", warmup_passes, "sampled fidelity: passes replayed into the caches first")
         ->capture_default_str();
+    c->add_option("--warm-frames", warm_frames,
+                  "full fidelity: renders of the same workload into the scene caches before the "
+                  "timed frame (0: it starts from empty caches)")
+        ->capture_default_str();
     c->add_option("--strata", strata, "sampled fidelity: strata of tiles")->capture_default_str();
     c->add_option("--calibration", calibration,
                   "analytic fidelity: share of passes also timed at cycle level to calibrate it "
@@ -117,6 +121,7 @@ SamplingOptions SamplingFlags::resolve(uint64_t seed) const {
                                  ? 0.0
                                  : parse_fraction(calibration, "--calibration");
     o.warmup_passes = warmup_passes;
+    o.warm_frames = warm_frames;
     o.strata = strata;
     o.seed = seed + 1;
     return o;

@@ -124,7 +124,12 @@ namespace {
 void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
              SiliconMeasurement& m) {
     settings.stage_clock = false;
-    const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full);
+    // Every measured render follows a render of its scene (predict_and_measure: its own warming
+    // render, or the workload before it), so the prediction starts from the caches a render of
+    // this workload leaves, not from empty ones.
+    SamplingOptions warm;
+    warm.warm_frames = 1;
+    const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full, warm);
     m.prediction = r.predictions.front();
     const FrameTiming& t = m.prediction.timing;
     for (int s = 0; s < 3; ++s)

@@ -19,6 +19,10 @@ struct SamplingOptions {
     double confidence = 0.997;   // two-sided level of the interval
     uint32_t strata = 8;
     uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
+    // Full fidelity: frames of the same workload rendered into the scene caches (no time, no
+    // counts) before the timed one; 0: the timed frame starts from empty caches. 1 predicts a
+    // frame that follows a render of its scene, as the silicon check's measured renders do.
+    uint32_t warm_frames = 0;
     uint32_t pilot_min_spp = 8;  // stratify by a pilot cost estimate from this spp on
     uint64_t seed = 1;
     // Analytic fidelity: share of tile passes also timed at cycle level to calibrate the

@@ -306,3 +306,30 @@ TEST_CASE("Configurations left out of the calibration take their stratum's ratio
         uncalibrated_ratios(knobs, calibrated, {1.0, 1.0, 1.0, 1.0}, {0.01, -1.0, 0.01, 0.01}, 0.997);
     CHECK(unknown[1].second < 0.0);
 }
+
+TEST_CASE("Full fidelity after warm frames: the timed frame finds its scene in the caches, and "
+          "counts only its own lookups",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings settings = small_settings(scene);
+    settings.width = settings.height = 32;
+    settings.spp = 1;
+    settings.tile = 16;
+    const std::vector<HwConfig> configs = {HwConfig{}};
+    const Prediction cold = run_point_group(scene, bvh, settings, configs, Fidelity::full).predictions[0];
+    SamplingOptions warm_options;
+    warm_options.warm_frames = 1;
+    const Prediction warm =
+        run_point_group(scene, bvh, settings, configs, Fidelity::full, warm_options).predictions[0];
+    // Cornell fits in gr08's scene caches: the warm frame took every compulsory miss.
+    CHECK(cold.timing.dram_reads > 0);
+    CHECK(warm.timing.dram_reads == 0);
+    CHECK(warm.timing.cycles < cold.timing.cycles);
+    // The same frame's lookups, the warm frame's excluded.
+    REQUIRE(warm.timing.cache_hits.size() == cold.timing.cache_hits.size());
+    CHECK(warm.timing.cache_hits[0] + warm.timing.cache_misses[0] ==
+          cold.timing.cache_hits[0] + cold.timing.cache_misses[0]);
+    CHECK(warm.timing.cache_misses[0] < cold.timing.cache_misses[0]);
+    CHECK(warm.total_passes == cold.total_passes);
+}
