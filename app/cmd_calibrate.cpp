@@ -172,6 +172,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"per_pass", k.per_pass_cycles},
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                                            {"one_lane", k.one_lane_cycles},
+                                           {"few_lane", k.few_lane_cycles},
                                            {"fit_median_error", cal.fit_errors[i].first},
                                            {"fit_worst_error", cal.fit_errors[i].second}};
                 }
@@ -186,11 +187,19 @@ void add_calibrate_command(CLI::App& app) {
                 j["one_lane_fit_median_error"] = cal.one_lane_fit_error.first;
                 j["one_lane_fit_worst_error"] = cal.one_lane_fit_error.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {
-                    nlohmann::json ops;
-                    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                    nlohmann::json ops, few_ops, stream_ops = nlohmann::json::array();
+                    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
                         if (s.ops[k]) ops[to_string(OpKind(k))] = s.ops[k];
+                        if (s.few_ops[k]) few_ops[to_string(OpKind(k))] = s.few_ops[k];
+                    }
+                    for (const OpsOfLength& o : s.stream_ops)
+                        stream_ops.push_back({{"op", to_string(o.kind)},
+                                              {"lanes", o.lanes},
+                                              {"count", o.count},
+                                              {"passed", o.passed}});
                     j["one_ray_samples"].push_back(
-                        {{"rays", s.rays}, {"ops", ops}, {"cycles", s.cycles},
+                        {{"rays", s.rays}, {"streams", s.streams}, {"ops", ops},
+                         {"few_ops", few_ops}, {"stream_ops", stream_ops}, {"cycles", s.cycles},
                          {"converged", s.converged}, {"repetitions", s.repetitions}});
                 }
                 j["hit_read_exposed_share"] = cal.hit_read_fit.share;
@@ -224,18 +233,19 @@ void add_calibrate_command(CLI::App& app) {
                         pinned ? ", pinned" : ", NOT pinned");
             std::printf("microbenchmarks: %u of %u points converged (%s)\n", cal.converged_points,
                         cal.points, describe(bench_rule).c_str());
-            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s %9s\n", "op kind", "per_op", "per_group",
-                        "per_lane", "per_pass", "beyondL1", "fit med", "fit max", "one_lane");
+            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
+                        "per_group", "per_lane", "per_pass", "beyondL1", "fit med", "fit max",
+                        "one_lane", "few_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
-                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f\n",
+                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f %9.1f\n",
                             k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
                             k.per_pass_cycles, k.beyond_l1_per_lane_cycles,
                             100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
-                            k.one_lane_cycles);
+                            k.one_lane_cycles, k.few_lane_cycles);
             }
             std::printf(
-                "one-lane costs: %zu batches of one-ray traversals, fit error median "
+                "one- and few-lane costs: %zu batches of short-stream traversals, fit error median "
                 "%.1f%%, worst %.1f%%\n",
                 cal.one_ray_samples.size(), 100 * cal.one_lane_fit_error.first,
                 100 * cal.one_lane_fit_error.second);

@@ -338,7 +338,10 @@ struct DatapathConfig {
 // except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each, fitted on
-// one-ray traversals of the same synthetic scene.
+// one-ray traversals of the same synthetic scene; and a box test of 2 to k_few_ray_lanes lanes
+// when few_lane_cycles is set: on a back end of k_few_ray_min_width lanes or more the tracer runs
+// such a stream in its few-ray loop (traverse_few, kernels/trace.h), not the stream loop, so its
+// box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene.
 // Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
@@ -348,6 +351,7 @@ struct OpCostConfig {
     double per_pass_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
+    double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L1D hit that the core does not overlap with other work, fitted
     // on the surface-read microbenchmark (scene arrays beyond the caches) through the same
@@ -373,6 +377,10 @@ struct OpCostConfig {
         v.param("one_lane_cycles", one_lane_cycles, "cycles",
                 "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "
                 "formula above applies)",
+                0.0, 1e9);
+        v.param("few_lane_cycles", few_lane_cycles, "cycles",
+                "cost of an op of 2 to 4 lanes in the few-ray traversal loop (0: not measured; "
+                "the formula above applies)",
                 0.0, 1e9);
         v.param("hit_read_exposed_share", hit_read_exposed_share, "",
                 "share of each lane's hit-primitive read latency beyond an L1D hit that is not "

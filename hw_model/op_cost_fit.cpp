@@ -117,11 +117,22 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
     return x;
 }
 
-// The one-lane kinds' counts of a sample, as a row of the fit.
-std::array<double, k_op_kind_count> one_lane_row(const OneLaneSample& s) {
-    std::array<double, k_op_kind_count> row{};
-    for (size_t k = 0; k < k_op_kind_count; ++k) row[k] = double(s.ops[k]);
+// A sample's one-lane counts, then its few-lane counts, as a row of the fit.
+constexpr size_t k_short_terms = 2 * k_op_kind_count;
+std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
+    std::array<double, k_short_terms> row{};
+    for (size_t k = 0; k < k_op_kind_count; ++k) {
+        row[k] = double(s.ops[k]);
+        row[k_op_kind_count + k] = double(s.few_ops[k]);
+    }
     return row;
+}
+
+double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s) {
+    double cycles = s.stream_op_cycles;
+    for (size_t k = 0; k < k_op_kind_count; ++k)
+        cycles += double(s.ops[k]) * costs.one_lane[k] + double(s.few_ops[k]) * costs.few_lane[k];
+    return cycles;
 }
 
 }  // namespace
@@ -146,28 +157,33 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     return from_coefficients(op, fit_nonnegative(rows, cycles, active));
 }
 
-std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLaneSample>& samples) {
-    if (samples.empty()) throw std::invalid_argument("no one-ray traversal samples");
-    std::array<bool, k_op_kind_count> active{};
-    std::vector<std::array<double, k_op_kind_count>> rows;
+ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples) {
+    if (samples.empty()) throw std::invalid_argument("no short-stream traversal samples");
+    std::array<bool, k_short_terms> active{};
+    std::vector<std::array<double, k_short_terms>> rows;
     std::vector<double> cycles;
     for (const OneLaneSample& s : samples) {
-        for (size_t k = 0; k < k_op_kind_count; ++k) active[k] = active[k] || s.ops[k] > 0;
-        rows.push_back(one_lane_row(s));
-        cycles.push_back(s.cycles);
+        const std::array<double, k_short_terms> row = short_stream_row(s);
+        for (size_t k = 0; k < k_short_terms; ++k) active[k] = active[k] || row[k] > 0;
+        rows.push_back(row);
+        // What the one-ray and few-ray loops' ops took: the rest is priced by the formula.
+        cycles.push_back(std::max(s.cycles - s.stream_op_cycles, 1.0));
     }
-    return fit_nonnegative(rows, cycles, active);
+    const std::array<double, k_short_terms> x = fit_nonnegative(rows, cycles, active);
+    ShortStreamCosts costs;
+    for (size_t k = 0; k < k_op_kind_count; ++k) {
+        costs.one_lane[k] = x[k];
+        costs.few_lane[k] = x[k_op_kind_count + k];
+    }
+    return costs;
 }
 
-std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
-                                             const std::vector<OneLaneSample>& samples) {
+std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
+                                                 const std::vector<OneLaneSample>& samples) {
     std::vector<double> e;
-    for (const OneLaneSample& s : samples) {
-        const std::array<double, k_op_kind_count> row = one_lane_row(s);
-        double predicted = 0.0;
-        for (size_t k = 0; k < k_op_kind_count; ++k) predicted += row[k] * cycles[k];
-        e.push_back(std::abs(predicted - s.cycles) / std::max(s.cycles, k_resolution));
-    }
+    for (const OneLaneSample& s : samples)
+        e.push_back(std::abs(short_stream_cycles(costs, s) - s.cycles) /
+                    std::max(s.cycles, k_resolution));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};

@@ -37,21 +37,29 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples);
 
-// One-ray traversals timed together (kernels/stream/stream_microbench.h): how many one-lane ops
-// of each kind they made, and the cycles they took.
+// Short-stream traversals timed together (kernels/stream/stream_microbench.h): how many ops
+// each kind made in the one-ray loop (one lane) and in the few-ray loop (a wide back end's box
+// tests of 2 to k_few_ray_lanes lanes), the cycles of their other ops as the stream formula
+// prices them (OpProfile::issue_cycles with the fitted per-op costs), and the cycles they took.
 struct OneLaneSample {
     std::array<uint64_t, k_op_kind_count> ops{};
     double cycles = 0.0;
+    std::array<uint64_t, k_op_kind_count> few_ops{};
+    double stream_op_cycles = 0.0;
 };
 
-// The one-lane cost of every kind the samples make (OpCostConfig::one_lane_cycles; 0 for the
-// rest): least squares on relative error, non-negative as in fit_op_cost. Throws
+// The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
+// one_lane_cycles, few_lane_cycles; 0 for the rest): least squares on relative error of the
+// cycles beyond the stream-priced ops', non-negative as in fit_op_cost. Throws
 // std::invalid_argument on no samples.
-std::array<double, k_op_kind_count> fit_one_lane_cycles(const std::vector<OneLaneSample>& samples);
+struct ShortStreamCosts {
+    std::array<double, k_op_kind_count> one_lane{}, few_lane{};
+};
+ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
 
-// That fit's (median, worst) relative error on its own samples.
-std::pair<double, double> one_lane_fit_error(const std::array<double, k_op_kind_count>& cycles,
-                                             const std::vector<OneLaneSample>& samples);
+// That fit's (median, worst) relative error on its own samples (of their whole cycles).
+std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
+                                                 const std::vector<OneLaneSample>& samples);
 
 // The surface-read microbenchmark (kernels/stream/stream_microbench.h) as the fit sees it: a
 // stream of hits on a mesh of `triangles` (the hit primitives of the repetitions before, then of

@@ -254,6 +254,9 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
     }
     // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
     if (length == 1 && cost.one_lane_cycles > 0) return cost.one_lane_cycles;
+    // A stream of a few rays runs in the few-ray loop (traverse_few): one group, one cost.
+    if (length >= 2 && length <= k_few_ray_lanes && cost.few_lane_cycles > 0)
+        return first ? cost.few_lane_cycles : 0.0;
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
            cost.per_lane_cycles * lanes + cost.per_pass_cycles * passed +
            cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes;

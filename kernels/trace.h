@@ -124,6 +124,14 @@ inline bool is_option_kind(OpKind kind) {
 
 constexpr uint32_t k_no_object = 0xffffffffu;
 
+// The native tracer's loops by stream length: a stream of one ray runs its whole subtree in the
+// one-ray loop (traverse_one), and, on back ends of k_few_ray_min_width lanes or more, a stream
+// of 2 to k_few_ray_lanes rays in the few-ray loop (traverse_few: the rays' box fields in one
+// register of k_few_ray_lanes lanes, each stream a mask of them, no ids partitioned), whose box
+// tests are not the stream loop's. Neither changes an op, its order or a bit of the trace.
+constexpr uint32_t k_few_ray_lanes = 4;
+constexpr uint32_t k_few_ray_min_width = 8;
+
 // One stream operation. `slots` and `passed` are views valid only during the sink call.
 // Built by aggregate initialization in field order, so an emitter names every field it sets in
 // one expression (and the kernels' copies stay inline).

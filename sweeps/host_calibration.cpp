@@ -28,6 +28,39 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
+                                                   const std::vector<OpCostConfig>& costs,
+                                                   uint32_t width, uint32_t l1d_kib) {
+    auto cost_of = [&](OpKind kind) -> const OpCostConfig* {
+        for (const OpCostConfig& o : costs)
+            if (o.op == to_string(kind)) return &o;
+        return nullptr;
+    };
+    std::vector<OneLaneSample> out;
+    for (const OneRaySample& s : samples) {
+        OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0};
+        const double beyond = beyond_l1_fraction(s.slots, stream_slot_bytes(), l1d_kib);
+        for (const OpsOfLength& o : s.stream_ops)
+            if (const OpCostConfig* cost = cost_of(o.kind))
+                sample.stream_op_cycles +=
+                    double(o.count) *
+                    measured_op_cycles(*cost, width, o.lanes,
+                                       uint32_t(std::lround(double(o.passed) / double(o.count))),
+                                       beyond);
+        out.push_back(sample);
+    }
+    return out;
+}
+
+void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs) {
+    for (OpCostConfig& o : costs)
+        for (uint32_t k = 0; k < k_op_kind_count; ++k)
+            if (o.op == to_string(OpKind(k))) {
+                o.one_lane_cycles = fit.one_lane[k];
+                o.few_lane_cycles = fit.few_lane[k];
+            }
+}
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress) {
     HostCalibration c;
@@ -47,23 +80,23 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     for (const MicrobenchSample& s : c.samples)
         by_kind[s.kind].push_back(
             {s.lanes, s.passed, beyond_l1_fraction(s.slots, slot_bytes, l1d), s.cycles});
-    // One-lane ops run in the one-ray loop, not the filters above: their own fit.
-    c.one_ray_samples = run_one_ray_microbenchmarks(resolved, convergence);
-    std::vector<OneLaneSample> one_lane;
-    for (const OneRaySample& s : c.one_ray_samples) {
-        one_lane.push_back({s.ops, s.cycles});
-        c.converged_points += s.converged;
-    }
-    c.points += uint32_t(c.one_ray_samples.size());
-    const std::array<double, k_op_kind_count> one_lane_cycles = fit_one_lane_cycles(one_lane);
-    c.one_lane_fit_error = one_lane_fit_error(one_lane_cycles, one_lane);
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
-        c.op_costs.back().one_lane_cycles = one_lane_cycles[size_t(kind)];
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size();
     }
+    // Ops of one lane run in the one-ray loop, and a wide back end's box tests of a few lanes in
+    // the few-ray loop, not the filters above: their own fit, of what the samples' other ops
+    // (their leaves' tests) leave when the formula above prices them.
+    c.one_ray_samples = run_one_ray_microbenchmarks(resolved, convergence);
+    for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
+    c.points += uint32_t(c.one_ray_samples.size());
+    const std::vector<OneLaneSample> short_streams =
+        short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d);
+    const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
+    c.one_lane_fit_error = short_stream_fit_error(short_costs, short_streams);
+    set_short_stream_costs(short_costs, c.op_costs);
     // The hits' surfaces read beyond the caches: the share of the cache model's latency the
     // core leaves exposed, for the op that reads them (the emission filter).
     c.surface_read_samples = run_surface_read_microbenchmarks(resolved, convergence);
@@ -97,9 +130,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "64/256/1024/4096 slots of " << slot_bytes << " bytes, the fastest of repetitions "
          << "until " << describe(convergence) << " (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
-         << "error; one-lane "
+         << "error; one-lane and (" << k_few_ray_min_width << "+ lanes) few-lane box "
          << "costs from " << c.one_ray_samples.size()
-         << " batches of 1-32 one-ray traversals of the same scene; the hit reads' exposed "
+         << " batches of 1-32 short-stream traversals (1 to " << k_few_ray_lanes
+         << " rays a stream) of the same scene; the hit reads' exposed "
          << "share from " << c.surface_read_samples.size()
          << " streams of 4096 hits on meshes of 416 KiB-52 MiB against a resident one, "
          << "through the cache model (relative error median "

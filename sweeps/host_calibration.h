@@ -31,8 +31,9 @@ struct HostCalibration {
     std::vector<KernelRate> rates;  // field read and compress by themselves (reported, not fitted)
     // Per fitted kind: the fit's (median, worst) relative error on its own samples.
     std::vector<std::pair<double, double>> fit_errors;
-    // One-ray traversals, and the one-lane costs' fit error on them (OpCostConfig::
-    // one_lane_cycles of the box, triangle and sphere tests).
+    // Short-stream traversals, and the one- and few-lane costs' fit error on them
+    // (OpCostConfig::one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of
+    // a wide back end's box test).
     std::vector<OneRaySample> one_ray_samples;
     std::pair<double, double> one_lane_fit_error{};
     // The hits' surfaces read beyond the caches, and the fitted share of their modelled latency
@@ -43,6 +44,16 @@ struct HostCalibration {
     uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml
 };
+
+// The short-stream traversals as the one- and few-lane fit sees them (fit_short_stream_cycles):
+// each sample's other ops (its leaves' tests) priced by `costs`, the stream formula of a back
+// end of `width` lanes, over the sample's buffer (its slots, the native slot size) beside an
+// L1D of `l1d_kib`.
+std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
+                                                   const std::vector<OpCostConfig>& costs,
+                                                   uint32_t width, uint32_t l1d_kib);
+// The fitted one- and few-lane costs into each kind's OpCostConfig.
+void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);
 
 // Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and
 // fits. `isa`: the back end measured (auto: the widest). `progress(done, total)` per op kind.

@@ -541,7 +541,7 @@ template <int Width, TraceDetail Detail, class Report>
 SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint32_t len,
                                    Report& report_op) {
     static_assert(Detail != TraceDetail::lanes, "a lanes trace lists each op's slots");
-    constexpr int W = 4;
+    constexpr int W = int(k_few_ray_lanes);
     namespace f = traversal_field;
     uint32_t lane_ids[W];
     for (uint32_t l = 0; l < uint32_t(W); ++l) lane_ids[l] = job.ids[l < len ? l : 0];
@@ -613,8 +613,8 @@ void traverse(const TraversalJob& job) {
             traverse_one<Detail>(job, node_index, report);
             continue;
         }
-        if constexpr (Width >= 8 && Detail != TraceDetail::lanes) {
-            if (len <= 4) {
+        if constexpr (Width >= int(k_few_ray_min_width) && Detail != TraceDetail::lanes) {
+            if (len <= k_few_ray_lanes) {
                 traverse_few<Width, Detail>(job, node_index, len, report);
                 continue;
             }

@@ -3,6 +3,7 @@
 #include <x86intrin.h>
 
 #include <algorithm>
+#include <map>
 #include <numeric>
 #include <random>
 
@@ -449,51 +450,93 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     return out;
 }
 
+// Tallies a traversal's ops by kind and stream length (the tracer sends them by length when the
+// trace is counts only).
+class OpLengthTally : public TraceSink {
+public:
+    void op(const StreamOp& o) override { ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count); }
+    void ops_of_length(OpKind kind, OpStage, uint16_t, uint32_t length, uint32_t count,
+                       uint32_t passed) override {
+        auto& t = m_tally[{kind, length}];
+        t.first += count;
+        t.second += passed;
+    }
+    bool counts_only() const override { return true; }
+    // Into a sample: one-lane ops, the few-ray loop's box tests (a wide back end's), the rest.
+    void fill(OneRaySample& s, uint32_t width) const {
+        for (const auto& [key, t] : m_tally) {
+            const auto [kind, length] = key;
+            if (length == 1)
+                s.ops[size_t(kind)] += t.first;
+            else if (kind == OpKind::box_test && length <= k_few_ray_lanes &&
+                     width >= k_few_ray_min_width)
+                s.few_ops[size_t(kind)] += t.first;
+            else
+                s.stream_ops.push_back({kind, length, t.first, t.second});
+        }
+    }
+
+private:
+    std::map<std::pair<OpKind, uint32_t>, std::pair<uint64_t, uint64_t>> m_tally;
+};
+
 std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
                                                       uint64_t seed) {
     const Scene scene = synthetic_scene(true);
     const Bvh bvh(scene);
-    const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
+    const Isa resolved = resolve_isa(isa);
+    const StreamKernels& kernels = stream_kernels(resolved);
     std::mt19937 rng{uint32_t(seed)};
     const double overhead = tsc_overhead();
     constexpr uint32_t k_slots = 256;
     Buffers b = make_buffers(scene, bvh, k_slots, rng);
     TraversalJob job = traversal_job(bvh, b);
-    job.n = 1;
     std::vector<uint32_t> order(k_slots);
     std::iota(order.begin(), order.end(), 0u);
+    // Every stream its own ids with the kernels' padding: the traversal partitions them in place.
+    std::vector<uint32_t> stream_ids;
     std::vector<OneRaySample> out;
-    for (uint32_t rays : {1u, 2u, 4u, 8u, 16u, 32u})
+    std::vector<std::pair<uint32_t, uint32_t>> shapes;  // (rays per stream, streams)
+    for (uint32_t streams : {1u, 2u, 4u, 8u, 16u, 32u}) shapes.push_back({1, streams});
+    for (uint32_t rays = 2; rays <= k_few_ray_lanes; ++rays)
+        for (uint32_t streams : {4u, 8u, 16u, 32u}) shapes.push_back({rays, streams});
+    for (const auto& [rays, streams] : shapes)
         for (uint32_t batch = 0; batch < 8; ++batch) {
             std::shuffle(order.begin(), order.end(), rng);
-            std::copy(order.begin(), order.begin() + rays, b.ids.begin());
-            // Each traversal starts from no hit and the ray's full t, as after load_rays.
+            const uint32_t stride = rays + k_stream_padding;
+            stream_ids.assign(size_t(streams) * stride, 0u);
+            // Each traversal starts from no hit and the ray's full t, as after load_rays, with
+            // its stream's ids in increasing order, as the tracer's are.
             auto reset = [&] {
-                for (uint32_t i = 0; i < rays; ++i) {
-                    const uint32_t id = b.ids[i];
-                    b.trav.set(id, b.pre[id], b.ray[id].t_max);
-                    b.hit[id] = Hit{};
+                for (uint32_t s = 0; s < streams; ++s) {
+                    uint32_t* ids = stream_ids.data() + size_t(s) * stride;
+                    std::copy(order.begin() + s * rays, order.begin() + (s + 1) * rays, ids);
+                    std::sort(ids, ids + rays);
+                    for (uint32_t i = 0; i < rays; ++i) {
+                        b.trav.set(ids[i], b.pre[ids[i]], b.ray[ids[i]].t_max);
+                        b.hit[ids[i]] = Hit{};
+                    }
                 }
             };
             auto run = [&](TraceDetail detail) {
-                for (uint32_t i = 0; i < rays; ++i) {
-                    job.ids = b.ids.data() + i;  // a one-ray stream: only ids[0] is read
+                job.n = rays;
+                for (uint32_t s = 0; s < streams; ++s) {
+                    job.ids = stream_ids.data() + size_t(s) * stride;
                     kernels.traverse[int(detail)](job);
                 }
             };
             OneRaySample sample;
             sample.rays = rays;
-            CountingSink counts({1});
-            counts.begin_pass(TilePass{});
-            job.sink = &counts;
+            sample.streams = streams;
+            sample.slots = k_slots;
+            OpLengthTally tally;
+            job.sink = &tally;
             reset();
             run(TraceDetail::counts);
-            counts.end_pass(TilePass{});
-            for (uint32_t k = 0; k < k_op_kind_count; ++k)
-                sample.ops[k] = counts.kind_ops(OpKind(k));
+            tally.fill(sample, isa_width(resolved));
             job.sink = nullptr;
             std::vector<double> times;
-            const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
+            const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
             while (needs_more_samples(times, convergence)) {
                 reset();
                 const uint64_t start = __rdtsc();

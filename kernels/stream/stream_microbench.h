@@ -65,19 +65,35 @@ struct MicrobenchOptions {
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
 
-// One-ray traversals: StreamKernels::traverse (trace off) of `rays` one-ray streams from the
-// root, one after another, in the synthetic scene with its floor cut into 16 x 16 quads and 16
-// small spheres on it (so a traversal tests as many boxes as a secondary ray's one-ray subtree
-// does, and spheres often enough to fit their cost). Every op of
-// a one-ray stream has one lane and runs in the one-ray loop (traverse_one), whatever the width.
+// Short-stream traversals: StreamKernels::traverse (trace off) of one-ray streams, and of
+// streams of 2 to k_few_ray_lanes rays (kernels/trace.h), from the root, one after another, in
+// the synthetic scene with its floor cut into 16 x 16 quads and 16 small spheres on it (so a
+// traversal tests as many boxes as a secondary ray's short-stream subtree does, and spheres
+// often enough to fit their cost). Every op of a one-ray stream has one lane and runs in the
+// one-ray loop (traverse_one), whatever the width; a few-ray stream's box tests run in the
+// few-ray loop on a back end of k_few_ray_min_width lanes or more (the stream loop otherwise),
+// its leaves' tests in the stream loop's leaf code, and its one-ray subtrees in the one-ray loop.
+struct OpsOfLength {
+    OpKind kind = OpKind::box_test;
+    uint32_t lanes = 0;
+    uint64_t count = 0, passed = 0;  // ops, and passing lanes summed over them
+};
 struct OneRaySample {
-    uint32_t rays = 0;
-    std::array<uint64_t, k_op_kind_count> ops{};  // per kind, counted by the same traversals
-    double cycles = 0.0;                          // core cycles, fastest repetition
+    uint32_t rays = 0;         // per stream
+    uint32_t streams = 0;      // traversed one after another
+    uint32_t slots = 0;        // of the ray buffer the streams' ids are drawn from
+    // Counted by the same traversals: per kind, its one-lane ops (the one-ray loop's) and its
+    // few-ray loop's ops (box tests of 2 to k_few_ray_lanes lanes on a wide back end); every
+    // other op by kind and length (priced by the stream formula).
+    std::array<uint64_t, k_op_kind_count> ops{};
+    std::array<uint64_t, k_op_kind_count> few_ops{};
+    std::vector<OpsOfLength> stream_ops;
+    double cycles = 0.0;  // core cycles, fastest repetition
     bool converged = false;
     uint32_t repetitions = 0;
 };
-// Batches of 1 to 32 random rays (several batches of each size).
+// Batches of 1 to 32 one-ray streams and of 4 to 32 streams of 2, 3 and 4 rays (several
+// batches of each).
 std::vector<OneRaySample> run_one_ray_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1);
 

@@ -29,32 +29,47 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         by_kind[s.kind].push_back(
             {s.lanes, s.passed,
              beyond_l1_fraction(s.slots, stream_slot_bytes(), host.caches.front().kib), s.cycles});
-    // One-ray traversals: only the traversal's kinds, each made, and their fitted cost.
+    std::vector<OpCostConfig> costs;
+    for (const auto& [kind, samples] : by_kind)
+        costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
+    // Short-stream traversals: only the traversal's kinds, each made, and their fitted cost.
     const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, microbench_rule(3));
-    std::vector<OneLaneSample> one_lane;
-    std::map<OpKind, uint64_t> made;
+    std::map<OpKind, uint64_t> made, few, streamed;
     double one_ray_cycles = 0;
     for (const OneRaySample& s : one_ray) {
         // A batch of one ray that misses the root costs about what reading the TSC does, so
         // its cycles can be 0 (after the overhead); the batches together cannot.
         CHECK(s.cycles >= 0);
         one_ray_cycles += s.cycles;
-        one_lane.push_back({s.ops, s.cycles});
-        for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        for (uint32_t k = 0; k < k_op_kind_count; ++k) {
             if (s.ops[k]) made[OpKind(k)] += s.ops[k];
+            if (s.few_ops[k]) few[OpKind(k)] += s.few_ops[k];
+        }
+        for (const OpsOfLength& o : s.stream_ops) {
+            CHECK(o.lanes >= 2);
+            CHECK(o.lanes <= s.rays);
+            streamed[o.kind] += o.count;
+        }
+        if (s.rays == 1) CHECK(s.stream_ops.empty());
     }
     CHECK(one_ray_cycles > 0);
     CHECK(made.size() == 3);
     CHECK(made[OpKind::box_test] > 10 * one_ray.size());  // deep enough to be a loop
     CHECK(made[OpKind::triangle_test] > 0);
     CHECK(made[OpKind::sphere_test] > 0);
-    const auto one_lane_cycles = fit_one_lane_cycles(one_lane);
-    CHECK(one_lane_cycles[size_t(OpKind::box_test)] > 0);
-    std::vector<OpCostConfig> costs;
-    for (const auto& [kind, samples] : by_kind) {
-        costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
-        costs.back().one_lane_cycles = one_lane_cycles[size_t(kind)];
-    }
+    // The few-ray loop's box tests on a wide back end; its leaves' tests by the stream formula.
+    const bool wide = isa_width(isa) >= k_few_ray_min_width;
+    CHECK(few.size() == (wide ? 1u : 0u));
+    CHECK(streamed[OpKind::triangle_test] > 0);
+    CHECK(streamed.count(OpKind::box_test) == (wide ? 0u : 1u));
+    const std::vector<OneLaneSample> short_streams =
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib);
+    for (size_t i = 0; i < one_ray.size(); ++i)
+        CHECK((short_streams[i].stream_op_cycles > 0) == !one_ray[i].stream_ops.empty());
+    const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
+    CHECK(short_costs.one_lane[size_t(OpKind::box_test)] > 0);
+    CHECK((short_costs.few_lane[size_t(OpKind::box_test)] > 0) == wide);
+    set_short_stream_costs(short_costs, costs);
     const HwConfig config = parse_hw_config(host_hw_yaml(host, costs, "test"), "host.hw.yaml");
 
     const Scene scene = load_scene("cornell");
