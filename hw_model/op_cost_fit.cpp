@@ -79,11 +79,13 @@ std::vector<double> solve(std::vector<std::vector<double>> a, std::vector<double
 }
 
 // Least squares on relative error of rows[s] . x = cycles[s] over the active columns, every
-// coefficient non-negative: the most negative one is dropped and the rest refitted.
+// coefficient non-negative: the most negative one is dropped and the rest refitted. The error
+// is relative to `relative_to[s]` when given (a sample whose cycles are partly known).
 template <size_t Terms>
 std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, Terms>>& rows,
                                           const std::vector<double>& cycles,
-                                          std::array<bool, Terms> active) {
+                                          std::array<bool, Terms> active,
+                                          const std::vector<double>* relative_to = nullptr) {
     std::array<double, Terms> x{};
     for (size_t round = 0; round < Terms; ++round) {
         std::vector<size_t> cols;
@@ -94,7 +96,8 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
         std::vector<double> atb(m, 0.0);
         for (size_t s = 0; s < rows.size(); ++s) {
             // Relative error; below k_resolution cycles the clock's steps dominate a sample.
-            const double w = 1.0 / std::max(cycles[s], k_resolution);
+            const double w =
+                1.0 / std::max(relative_to ? (*relative_to)[s] : cycles[s], k_resolution);
             for (size_t i = 0; i < m; ++i) {
                 atb[i] += rows[s][cols[i]] * w * cycles[s] * w;
                 for (size_t j = 0; j < m; ++j)
@@ -161,15 +164,17 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
     if (samples.empty()) throw std::invalid_argument("no short-stream traversal samples");
     std::array<bool, k_short_terms> active{};
     std::vector<std::array<double, k_short_terms>> rows;
-    std::vector<double> cycles;
+    std::vector<double> loops, whole;
     for (const OneLaneSample& s : samples) {
         const std::array<double, k_short_terms> row = short_stream_row(s);
         for (size_t k = 0; k < k_short_terms; ++k) active[k] = active[k] || row[k] > 0;
         rows.push_back(row);
-        // What the one-ray and few-ray loops' ops took: the rest is priced by the formula.
-        cycles.push_back(std::max(s.cycles - s.stream_op_cycles, 1.0));
+        // What the one-ray and few-ray loops' ops took (the rest is priced by the formula),
+        // its error relative to the whole sample's cycles, as short_stream_fit_error judges it.
+        loops.push_back(s.cycles - s.stream_op_cycles);
+        whole.push_back(s.cycles);
     }
-    const std::array<double, k_short_terms> x = fit_nonnegative(rows, cycles, active);
+    const std::array<double, k_short_terms> x = fit_nonnegative(rows, loops, active, &whole);
     ShortStreamCosts costs;
     for (size_t k = 0; k < k_op_kind_count; ++k) {
         costs.one_lane[k] = x[k];

@@ -92,8 +92,8 @@ struct OneRaySample {
     bool converged = false;
     uint32_t repetitions = 0;
 };
-// Batches of 1 to 32 one-ray streams and of 4 to 32 streams of 2, 3 and 4 rays (several
-// batches of each).
+// Batches of 1 to 32 one-ray streams and, on a back end of k_few_ray_min_width lanes or more,
+// of 4 to 32 streams of 2, 3 and 4 rays (several batches of each).
 std::vector<OneRaySample> run_one_ray_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1);
 
