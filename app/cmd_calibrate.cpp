@@ -7,6 +7,7 @@
 //     fastest renders agree (base/convergence.h) or its budget runs out; one host file per back
 //     end (its SIMD width), all measured in turn per cell.
 
+#include <sched.h>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -141,6 +142,7 @@ void add_calibrate_command(CLI::App& app) {
         if (o->spp < 1 || o->spp > 4096)
             throw InputError("command line", 0, "--spp", "expected 1 to 4096");
         const bool pinned = pin_to_current_cpu();
+        const int cpu = sched_getcpu();  // the rows say where they were measured
         if (o->describe) {
             OutputFiles outputs;
             const std::string temp = outputs.add(o->output, "--output");
@@ -355,6 +357,7 @@ void add_calibrate_command(CLI::App& app) {
             row["isa"] = isa_name(st.isa);
             row["simd_width"] = isa_width(st.isa);
             row["pinned"] = pinned;
+            row["cpu"] = cpu;
             row["predicted.frame_cycles"] = m.predicted_frame;
             row["measured.frame_cycles"] = m.measured_frame;
             row["measured.frame_samples"] = m.frame_samples;

@@ -3,6 +3,7 @@
 #include "base/core_clock.h"
 
 #include <cpuid.h>
+#include <sched.h>
 #include <x86intrin.h>
 
 #include <algorithm>
@@ -254,6 +255,7 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     h.microarchitecture = read_microarchitecture();
     h.simd_width = simd_width;
     h.isa = isa;
+    h.cpu = sched_getcpu();
     h.tsc_mhz = measure_tsc_mhz();
     h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21, simd_width);
     h.caches = read_host_caches();
@@ -315,6 +317,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "# the same machine model as the paper's machine (hw_model/core_model.h): one SIMD unit,\n"
       << "# ray buffers behind the L1D, partition by compress, measured per-op costs.\n"
       << "# Microarchitecture (cpuid): " << describe(h.microarchitecture) << "\n"
+      << "# Measured on CPU " << h.cpu << " (sched_getcpu): check it pinned to the same CPU\n"
       << "version: 1\nname: host\nclock:\n"
       << "  core_mhz: " << fmt(c.clock.core_mhz, 3)
       << "  # measured: a chain of dependent " << clock_chain_name(h.simd_width)

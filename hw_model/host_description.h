@@ -68,6 +68,10 @@ struct HostDescription {
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
+    // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine
+    // one CPU's L3 may not be another's (a neighbour's load on its physical core): the check
+    // runs pinned where its host was described (scripts/silicon-check --cpu).
+    int cpu = -1;
 };
 
 // Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).
