@@ -503,8 +503,10 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
     if (isa_width(resolved) >= k_few_ray_min_width)
         for (uint32_t rays = 2; rays <= k_few_ray_lanes; ++rays)
             for (uint32_t streams : {4u, 8u, 16u, 32u}) shapes.push_back({rays, streams});
-    for (const auto& [rays, streams] : shapes)
+    for (const std::pair<uint32_t, uint32_t>& shape : shapes)
         for (uint32_t batch = 0; batch < 8; ++batch) {
+            // Plain copies: C++17 lambdas cannot capture structured bindings (clang rejects it).
+            const uint32_t rays = shape.first, streams = shape.second;
             std::shuffle(order.begin(), order.end(), rng);
             const uint32_t stride = rays + k_stream_padding;
             stream_ids.assign(size_t(streams) * stride, 0u);
