@@ -186,8 +186,8 @@ void add_calibrate_command(CLI::App& app) {
                                             {"cycles", m.cycles},
                                             {"converged", m.converged},
                                             {"repetitions", m.repetitions}});
-                j["one_lane_fit_median_error"] = cal.one_lane_fit_error.first;
-                j["one_lane_fit_worst_error"] = cal.one_lane_fit_error.second;
+                j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
+                j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {
                     nlohmann::json ops, few_ops, stream_ops = nlohmann::json::array();
                     for (uint32_t k = 0; k < k_op_kind_count; ++k) {
@@ -249,8 +249,8 @@ void add_calibrate_command(CLI::App& app) {
             std::printf(
                 "one- and few-lane costs: %zu batches of short-stream traversals, fit error median "
                 "%.1f%%, worst %.1f%%\n",
-                cal.one_ray_samples.size(), 100 * cal.one_lane_fit_error.first,
-                100 * cal.one_lane_fit_error.second);
+                cal.one_ray_samples.size(), 100 * cal.short_stream_fit_errors.first,
+                100 * cal.short_stream_fit_errors.second);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,

@@ -198,7 +198,7 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
             p.schedule = modulo_schedule(p.body, p.chain, p.recurrence, config.datapath);
         }
         for (const OpCostConfig& c : config.op_costs)
-            if (c.op == k_op_kinds[k].name) {
+            if (op_kind_named(c.op) == OpKind(k)) {
                 p.measured = true;
                 p.cost = c;
             }

@@ -115,6 +115,12 @@ inline const char* to_string(OpKind kind) {
 inline OpStage stage_of(OpKind kind) {
     return op_info(kind).stage;
 }
+// The kind called `name` (k_op_kinds), or OpKind::count if there is none.
+inline OpKind op_kind_named(const std::string& name) {
+    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        if (name == k_op_kinds[k].name) return OpKind(k);
+    return OpKind::count;
+}
 // The kind exists because of a workload option (a seed paper's alternative), not the scene.
 inline bool is_option_kind(OpKind kind) {
     const OpFeature f = op_info(kind).feature;
@@ -131,6 +137,12 @@ constexpr uint32_t k_no_object = 0xffffffffu;
 // tests are not the stream loop's. Neither changes an op, its order or a bit of the trace.
 constexpr uint32_t k_few_ray_lanes = 4;
 constexpr uint32_t k_few_ray_min_width = 8;
+// An op the few-ray loop runs itself on a back end of `width` lanes: a box test of 2 to
+// k_few_ray_lanes lanes (its leaves' tests are the stream loop's leaf code).
+inline bool runs_in_few_ray_loop(OpKind kind, uint32_t length, uint32_t width) {
+    return kind == OpKind::box_test && length >= 2 && length <= k_few_ray_lanes &&
+           width >= k_few_ray_min_width;
+}
 
 // One stream operation. `slots` and `passed` are views valid only during the sink call.
 // Built by aggregate initialization in field order, so an emitter names every field it sets in

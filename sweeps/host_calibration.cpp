@@ -31,17 +31,15 @@ double median(std::vector<double> v) {
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                    const std::vector<OpCostConfig>& costs,
                                                    uint32_t width, uint32_t l1d_kib) {
-    auto cost_of = [&](OpKind kind) -> const OpCostConfig* {
-        for (const OpCostConfig& o : costs)
-            if (o.op == to_string(kind)) return &o;
-        return nullptr;
-    };
+    std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
+    for (const OpCostConfig& o : costs)
+        if (op_kind_named(o.op) != OpKind::count) cost_of[size_t(op_kind_named(o.op))] = &o;
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0};
         const double beyond = beyond_l1_fraction(s.slots, stream_slot_bytes(), l1d_kib);
         for (const OpsOfLength& o : s.stream_ops)
-            if (const OpCostConfig* cost = cost_of(o.kind))
+            if (const OpCostConfig* cost = cost_of[size_t(o.kind)])
                 sample.stream_op_cycles +=
                     double(o.count) *
                     measured_op_cycles(*cost, width, o.lanes,
@@ -53,12 +51,12 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
 }
 
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs) {
-    for (OpCostConfig& o : costs)
-        for (uint32_t k = 0; k < k_op_kind_count; ++k)
-            if (o.op == to_string(OpKind(k))) {
-                o.one_lane_cycles = fit.one_lane[k];
-                o.few_lane_cycles = fit.few_lane[k];
-            }
+    for (OpCostConfig& o : costs) {
+        const OpKind kind = op_kind_named(o.op);
+        if (kind == OpKind::count) continue;
+        o.one_lane_cycles = fit.one_lane[size_t(kind)];
+        o.few_lane_cycles = fit.few_lane[size_t(kind)];
+    }
 }
 
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
@@ -95,7 +93,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     const std::vector<OneLaneSample> short_streams =
         short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d);
     const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
-    c.one_lane_fit_error = short_stream_fit_error(short_costs, short_streams);
+    c.short_stream_fit_errors = short_stream_fit_error(short_costs, short_streams);
     set_short_stream_costs(short_costs, c.op_costs);
     // The hits' surfaces read beyond the caches: the share of the cache model's latency the
     // core leaves exposed, for the op that reads them (the emission filter).
@@ -120,10 +118,11 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
-    for (OpCostConfig& cost : c.op_costs)
-        for (uint32_t k = 0; k < k_op_kind_count; ++k)
-            if (op_info(OpKind(k)).reads_hit_primitive && cost.op == to_string(OpKind(k)))
-                cost.hit_read_exposed_share = c.hit_read_fit.share;
+    for (OpCostConfig& cost : c.op_costs) {
+        const OpKind kind = op_kind_named(cost.op);
+        if (kind != OpKind::count && op_info(kind).reads_hit_primitive)
+            cost.hit_read_exposed_share = c.hit_read_fit.share;
+    }
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "

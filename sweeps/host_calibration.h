@@ -35,7 +35,7 @@ struct HostCalibration {
     // (OpCostConfig::one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of
     // a wide back end's box test).
     std::vector<OneRaySample> one_ray_samples;
-    std::pair<double, double> one_lane_fit_error{};
+    std::pair<double, double> short_stream_fit_errors{};
     // The hits' surfaces read beyond the caches, and the fitted share of their modelled latency
     // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
     std::vector<SurfaceReadSample> surface_read_samples;

@@ -454,7 +454,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
 // trace is counts only).
 class OpLengthTally : public TraceSink {
 public:
-    void op(const StreamOp& o) override { ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count); }
+    void op(const StreamOp& o) override {
+        ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count);
+    }
     void ops_of_length(OpKind kind, OpStage, uint16_t, uint32_t length, uint32_t count,
                        uint32_t passed) override {
         auto& t = m_tally[{kind, length}];
@@ -468,8 +470,7 @@ public:
             const auto [kind, length] = key;
             if (length == 1)
                 s.ops[size_t(kind)] += t.first;
-            else if (kind == OpKind::box_test && length <= k_few_ray_lanes &&
-                     width >= k_few_ray_min_width)
+            else if (runs_in_few_ray_loop(kind, length, width))
                 s.few_ops[size_t(kind)] += t.first;
             else
                 s.stream_ops.push_back({kind, length, t.first, t.second});
