@@ -175,6 +175,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                                            {"one_lane", k.one_lane_cycles},
                                            {"few_lane", k.few_lane_cycles},
+                                           {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                                            {"fit_median_error", cal.fit_errors[i].first},
                                            {"fit_worst_error", cal.fit_errors[i].second}};
                 }
@@ -247,10 +248,16 @@ void add_calibrate_command(CLI::App& app) {
                             k.one_lane_cycles, k.few_lane_cycles);
             }
             std::printf(
-                "one- and few-lane costs: %zu batches of short-stream traversals, fit error median "
-                "%.1f%%, worst %.1f%%\n",
+                "one- and few-lane costs, and the stream loop's per-op box cost: %zu batches of "
+                "traversals, fit error median %.1f%%, worst %.1f%%\n",
                 cal.one_ray_samples.size(), 100 * cal.short_stream_fit_errors.first,
                 100 * cal.short_stream_fit_errors.second);
+            for (size_t i = 0; i < cal.op_costs.size(); ++i)
+                if (cal.op_costs[i].per_op_cycles != cal.filter_costs[i].per_op_cycles)
+                    std::printf("  %s per_op: %.1f in a traversal (above), %.1f in the filter "
+                                "microbenchmarks' independent calls (their fit error)\n",
+                                cal.op_costs[i].op.c_str(), cal.op_costs[i].per_op_cycles,
+                                cal.filter_costs[i].per_op_cycles);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,

@@ -341,7 +341,10 @@ struct DatapathConfig {
 // one-ray traversals of the same synthetic scene; and a box test of 2 to k_few_ray_lanes lanes
 // when few_lane_cycles is set: on a back end of k_few_ray_min_width lanes or more the tracer runs
 // such a stream in its few-ray loop (traverse_few, kernels/trace.h), not the stream loop, so its
-// box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene.
+// box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene. The box
+// test's per_op is fitted on traversals of longer streams too (a stream-loop op waits for the
+// one before's output; the filter microbenchmarks' calls are independent, and a core overlaps
+// them), its other terms on the filter microbenchmarks.
 // Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)

@@ -120,13 +120,15 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
     return x;
 }
 
-// A sample's one-lane counts, then its few-lane counts, as a row of the fit.
-constexpr size_t k_short_terms = 2 * k_op_kind_count;
+// A sample's one-lane counts, its few-lane counts and its stream-loop counts, as a row of the
+// fit.
+constexpr size_t k_short_terms = 3 * k_op_kind_count;
 std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
     std::array<double, k_short_terms> row{};
     for (size_t k = 0; k < k_op_kind_count; ++k) {
         row[k] = double(s.ops[k]);
         row[k_op_kind_count + k] = double(s.few_ops[k]);
+        row[2 * k_op_kind_count + k] = double(s.stream_ops[k]);
     }
     return row;
 }
@@ -134,7 +136,8 @@ std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
 double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s) {
     double cycles = s.stream_op_cycles;
     for (size_t k = 0; k < k_op_kind_count; ++k)
-        cycles += double(s.ops[k]) * costs.one_lane[k] + double(s.few_ops[k]) * costs.few_lane[k];
+        cycles += double(s.ops[k]) * costs.one_lane[k] + double(s.few_ops[k]) * costs.few_lane[k] +
+                  double(s.stream_ops[k]) * costs.stream_per_op[k];
     return cycles;
 }
 
@@ -179,6 +182,8 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
     for (size_t k = 0; k < k_op_kind_count; ++k) {
         costs.one_lane[k] = x[k];
         costs.few_lane[k] = x[k_op_kind_count + k];
+        costs.stream_per_op[k] = x[2 * k_op_kind_count + k];
+        costs.stream_measured[k] = active[2 * k_op_kind_count + k];
     }
     return costs;
 }

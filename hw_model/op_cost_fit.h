@@ -37,23 +37,29 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples);
 
-// Short-stream traversals timed together (kernels/stream/stream_microbench.h): how many ops
-// each kind made in the one-ray loop (one lane) and in the few-ray loop (a wide back end's box
-// tests of 2 to k_few_ray_lanes lanes), the cycles of their other ops as the stream formula
-// prices them (OpProfile::issue_cycles with the fitted per-op costs), and the cycles they took.
+// Traversals timed together (kernels/stream/stream_microbench.h): how many ops each kind made
+// in the one-ray loop (one lane), in the few-ray loop (a wide back end's box tests of 2 to
+// k_few_ray_lanes lanes) and in the stream loop (the rest); the cycles of the stream loop's ops
+// beyond their per-op costs (their groups and lanes) as the stream formula prices them
+// (OpProfile::issue_cycles with the fitted per-op costs); and the cycles they took.
 struct OneLaneSample {
     std::array<uint64_t, k_op_kind_count> ops{};
     double cycles = 0.0;
     std::array<uint64_t, k_op_kind_count> few_ops{};
     double stream_op_cycles = 0.0;
+    std::array<uint64_t, k_op_kind_count> stream_ops{};
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
-// one_lane_cycles, few_lane_cycles; 0 for the rest): least squares on relative error of the
-// cycles beyond the stream-priced ops', non-negative as in fit_op_cost. Throws
-// std::invalid_argument on no samples.
+// one_lane_cycles, few_lane_cycles; 0 for the rest) and the per-op cost in a traversal of every
+// kind the samples' stream loops make (OpCostConfig::per_op_cycles): there each op waits for
+// the one before's output, where the filter microbenchmarks time independent calls, which a
+// core overlaps (an op's groups are independent in both, so their cost stays the filters').
+// Least squares on relative error of the cycles beyond the stream-priced groups and lanes,
+// non-negative as in fit_op_cost. Throws std::invalid_argument on no samples.
 struct ShortStreamCosts {
-    std::array<double, k_op_kind_count> one_lane{}, few_lane{};
+    std::array<double, k_op_kind_count> one_lane{}, few_lane{}, stream_per_op{};
+    std::array<bool, k_op_kind_count> stream_measured{};  // the samples' stream loops made it
 };
 ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
 

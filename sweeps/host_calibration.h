@@ -29,11 +29,14 @@ struct HostCalibration {
     std::vector<OpCostConfig> op_costs;
     std::vector<MicrobenchSample> samples;
     std::vector<KernelRate> rates;  // field read and compress by themselves (reported, not fitted)
-    // Per fitted kind: the fit's (median, worst) relative error on its own samples.
+    // Per fitted kind: the fit's (median, worst) relative error on its own samples, and its
+    // costs as the filter microbenchmarks alone fitted them (op_costs then takes the
+    // traversals' per-op box cost: set_short_stream_costs).
     std::vector<std::pair<double, double>> fit_errors;
-    // Short-stream traversals, and the one- and few-lane costs' fit error on them
-    // (OpCostConfig::one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of
-    // a wide back end's box test).
+    std::vector<OpCostConfig> filter_costs;
+    // Traversals, and the one- and few-lane costs' fit error on them (OpCostConfig::
+    // one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of a wide back
+    // end's box test, and the box test's per_op_cycles in the stream loop).
     std::vector<OneRaySample> one_ray_samples;
     std::pair<double, double> short_stream_fit_errors{};
     // The hits' surfaces read beyond the caches, and the fitted share of their modelled latency
@@ -45,14 +48,15 @@ struct HostCalibration {
     std::string yaml;  // host.hw.yaml
 };
 
-// The short-stream traversals as the one- and few-lane fit sees them (fit_short_stream_cycles):
-// each sample's other ops (its leaves' tests) priced by `costs`, the stream formula of a back
-// end of `width` lanes, over the sample's buffer (its slots, the native slot size) beside an
-// L1D of `l1d_kib`.
+// The traversal samples as the one- and few-lane fit sees them (fit_short_stream_cycles): each
+// sample's other ops (its leaves' tests, and its stream-loop box tests' lanes) priced by
+// `costs`, the stream formula of a back end of `width` lanes, over the sample's buffer (its
+// slots, the native slot size) beside an L1D of `l1d_kib`.
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                    const std::vector<OpCostConfig>& costs,
                                                    uint32_t width, uint32_t l1d_kib);
-// The fitted one- and few-lane costs into each kind's OpCostConfig.
+// The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
+// and per-group costs where the traversals measured them (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);
 
 // Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and

@@ -489,28 +489,54 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
     const StreamKernels& kernels = stream_kernels(resolved);
     std::mt19937 rng{uint32_t(seed)};
     const double overhead = tsc_overhead();
-    constexpr uint32_t k_slots = 256;
+    // Rays enough that the other rays' traversals between a batch's repetitions (below) are
+    // many more than a branch predictor can learn.
+    constexpr uint32_t k_slots = 4096;
     Buffers b = make_buffers(scene, bvh, k_slots, rng);
     TraversalJob job = traversal_job(bvh, b);
     std::vector<uint32_t> order(k_slots);
     std::iota(order.begin(), order.end(), 0u);
     // Every stream its own ids with the kernels' padding: the traversal partitions them in place.
-    std::vector<uint32_t> stream_ids;
+    std::vector<uint32_t> stream_ids, other_ids;
     std::vector<OneRaySample> out;
-    std::vector<std::pair<uint32_t, uint32_t>> shapes;  // (rays per stream, streams)
-    for (uint32_t streams : {1u, 2u, 4u, 8u, 16u, 32u}) shapes.push_back({1, streams});
+    struct Shape {
+        uint32_t rays, streams;  // rays per stream, streams one after another
+        bool bundle;             // each stream a bundle (below), or rays drawn at random
+    };
+    std::vector<Shape> shapes;
+    for (uint32_t streams : {1u, 2u, 4u, 8u, 16u, 32u}) shapes.push_back({1, streams, false});
     // Few-ray streams where the few-ray loop runs them: elsewhere the stream loop does, whose
     // costs the filter microbenchmarks measure.
     if (isa_width(resolved) >= k_few_ray_min_width)
         for (uint32_t rays = 2; rays <= k_few_ray_lanes; ++rays)
-            for (uint32_t streams : {4u, 8u, 16u, 32u}) shapes.push_back({rays, streams});
-    for (const std::pair<uint32_t, uint32_t>& shape : shapes)
+            for (uint32_t streams : {4u, 8u, 16u, 32u}) shapes.push_back({rays, streams, false});
+    // Streams the stream loop starts (every back end): its box tests in a traversal, where each
+    // op's stream is the one before's output, not the filter microbenchmarks' independent calls;
+    // bundles that stay together, as a tile's camera rays do, and rays that part at once, as
+    // bounces do.
+    for (bool bundle : {true, false})
+        for (uint32_t rays : {8u, 16u, 32u, 64u, 128u})
+            for (uint32_t streams : {1u, 4u}) shapes.push_back({rays, streams, bundle});
+    for (const Shape& shape : shapes)
         for (uint32_t batch = 0; batch < 8; ++batch) {
-            // Plain copies: C++17 lambdas cannot capture structured bindings (clang rejects it).
-            const uint32_t rays = shape.first, streams = shape.second;
+            const uint32_t rays = shape.rays, streams = shape.streams;
             std::shuffle(order.begin(), order.end(), rng);
             const uint32_t stride = rays + k_stream_padding;
             stream_ids.assign(size_t(streams) * stride, 0u);
+            // A bundle: one origin, targets within a cell of the floor, so that it stays one
+            // stream for several levels (its rays restored after the batch).
+            if (shape.bundle)
+                for (uint32_t s = 0; s < streams; ++s) {
+                    std::uniform_real_distribution<float> u(-1.f, 1.f);
+                    const Vec3 org(3 * u(rng), 5.f + u(rng), 6.f + u(rng));
+                    const Vec3 centre(4.f * u(rng), 0.2f, 4.f * u(rng));
+                    for (uint32_t i = s * rays; i < (s + 1) * rays; ++i) {
+                        Ray& r = b.ray[order[i]];
+                        r.org = org;
+                        r.dir = normalize(centre + Vec3(0.5f * u(rng), 0.f, 0.5f * u(rng)) - org);
+                        b.pre[order[i]] = RayPrecomp(r);
+                    }
+                }
             // Each traversal starts from no hit and the ray's full t, as after load_rays, with
             // its stream's ids in increasing order, as the tracer's are.
             auto reset = [&] {
@@ -528,13 +554,37 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                 job.n = rays;
                 for (uint32_t s = 0; s < streams; ++s) {
                     job.ids = stream_ids.data() + size_t(s) * stride;
+                    job.shared_origin = shared_origin(job.rays, job.ids, rays);  // as the tracer
                     kernels.traverse[int(detail)](job);
+                }
+            };
+            // Before each repetition, every other ray's traversal, in streams of as many rays, in
+            // a new order: a branch predictor learns a batch of a few traversals that repeats
+            // (a one-ray box test in cornell costs 14-16 cycles in a batch of 32-256 repeated
+            // traversals and 29-31 in one of 8192-32768, on an AMD Zen 5 VM, 2026-11-27), and a
+            // frame's traversals do not repeat.
+            const uint32_t batch_rays = rays * streams;
+            auto displace_predictor = [&] {
+                std::shuffle(order.begin() + batch_rays, order.end(), rng);
+                job.n = rays;
+                for (uint32_t first = batch_rays; first + rays <= k_slots; first += rays) {
+                    other_ids.assign(order.begin() + first, order.begin() + first + rays);
+                    std::sort(other_ids.begin(), other_ids.end());
+                    other_ids.resize(stride, 0u);
+                    for (uint32_t i = 0; i < rays; ++i) {
+                        const uint32_t id = other_ids[i];
+                        b.trav.set(id, b.pre[id], b.ray[id].t_max);
+                        b.hit[id] = Hit{};
+                    }
+                    job.ids = other_ids.data();
+                    job.shared_origin = shared_origin(job.rays, job.ids, rays);
+                    kernels.traverse[int(TraceDetail::none)](job);
                 }
             };
             OneRaySample sample;
             sample.rays = rays;
             sample.streams = streams;
-            sample.slots = k_slots;
+            sample.slots = batch_rays;
             OpLengthTally tally;
             job.sink = &tally;
             reset();
@@ -544,6 +594,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
             while (needs_more_samples(times, convergence)) {
+                displace_predictor();
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
@@ -554,6 +605,11 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             sample.converged = c.converged;
             sample.repetitions = c.samples;
             out.push_back(sample);
+            if (shape.bundle)
+                for (uint32_t i = 0; i < batch_rays; ++i) {
+                    b.ray[order[i]] = b.saved_ray[order[i]];
+                    b.pre[order[i]] = b.saved_pre[order[i]];
+                }
         }
     return out;
 }

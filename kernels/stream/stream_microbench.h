@@ -65,14 +65,15 @@ struct MicrobenchOptions {
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
 
-// Short-stream traversals: StreamKernels::traverse (trace off) of one-ray streams, and of
-// streams of 2 to k_few_ray_lanes rays (kernels/trace.h), from the root, one after another, in
+// Traversals: StreamKernels::traverse (trace off) of one-ray streams, of streams of 2 to
+// k_few_ray_lanes rays (kernels/trace.h) and of longer ones, from the root, one after another, in
 // the synthetic scene with its floor cut into 16 x 16 quads and 16 small spheres on it (so a
 // traversal tests as many boxes as a secondary ray's short-stream subtree does, and spheres
 // often enough to fit their cost). Every op of a one-ray stream has one lane and runs in the
 // one-ray loop (traverse_one), whatever the width; a few-ray stream's box tests run in the
 // few-ray loop on a back end of k_few_ray_min_width lanes or more (the stream loop otherwise),
-// its leaves' tests in the stream loop's leaf code, and its one-ray subtrees in the one-ray loop.
+// its leaves' tests in the stream loop's leaf code, and its one-ray subtrees in the one-ray loop;
+// a longer stream's box tests run in the stream loop until its streams narrow to those.
 struct OpsOfLength {
     OpKind kind = OpKind::box_test;
     uint32_t lanes = 0;
@@ -81,7 +82,7 @@ struct OpsOfLength {
 struct OneRaySample {
     uint32_t rays = 0;         // per stream
     uint32_t streams = 0;      // traversed one after another
-    uint32_t slots = 0;        // of the ray buffer the streams' ids are drawn from
+    uint32_t slots = 0;        // of the ray buffer the batch's rays occupy (its footprint)
     // Counted by the same traversals: per kind, its one-lane ops (the one-ray loop's) and its
     // few-ray loop's ops (box tests of 2 to k_few_ray_lanes lanes on a wide back end); every
     // other op by kind and length (priced by the stream formula).
@@ -92,8 +93,11 @@ struct OneRaySample {
     bool converged = false;
     uint32_t repetitions = 0;
 };
-// Batches of 1 to 32 one-ray streams and, on a back end of k_few_ray_min_width lanes or more,
-// of 4 to 32 streams of 2, 3 and 4 rays (several batches of each).
+// Batches of 1 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
+// 32 streams of 2, 3 and 4 rays; and of 1 and 4 streams of 8 to 128 rays, whose first ops run
+// in the stream loop (several batches of each shape), drawn from 4096 rays; before
+// each repetition of a batch the other rays are traversed in a new order, so that a branch
+// predictor meets the batch as a frame's traversals, which never repeat.
 std::vector<OneRaySample> run_one_ray_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1);
 

@@ -228,41 +228,53 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK_THROWS_AS(fit_op_cost("box_test", 16, {}), std::invalid_argument);
 }
 
-TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost from traversals "
-          "that mix them, beyond what their stream-priced ops take",
+TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and the stream "
+          "loop's per-op box cost from traversals that mix them, beyond what their "
+          "stream-priced groups and lanes take",
           "[host]") {
     auto sample = [](uint64_t boxes, uint64_t triangles, uint64_t spheres, uint64_t few_boxes,
-                     double stream_cycles) {
+                     uint64_t stream_boxes, double stream_cycles) {
         OneLaneSample s;
         s.ops[size_t(OpKind::box_test)] = boxes;
         s.ops[size_t(OpKind::triangle_test)] = triangles;
         s.ops[size_t(OpKind::sphere_test)] = spheres;
         s.few_ops[size_t(OpKind::box_test)] = few_boxes;
+        s.stream_ops[size_t(OpKind::box_test)] = stream_boxes;
         s.stream_op_cycles = stream_cycles;
         s.cycles = 30.0 * boxes + 90.0 * triangles + 40.0 * spheres + 55.0 * few_boxes +
-                   stream_cycles;
+                   140.0 * stream_boxes + stream_cycles;
         return s;
     };
     std::vector<OneLaneSample> samples;
     for (uint64_t b : {7u, 23u, 130u})
         for (uint64_t t : {0u, 2u, 12u})
             for (uint64_t s : {0u, 1u, 5u})
-                for (uint64_t f : {0u, 3u, 40u}) samples.push_back(sample(b, t, s, f, f * 70.0));
+                for (uint64_t f : {0u, 3u, 40u})
+                    for (uint64_t w : {0u, 4u, 19u})
+                        samples.push_back(sample(b, t, s, f, w, f * 70.0 + w * 300.0));
     const ShortStreamCosts fit = fit_short_stream_cycles(samples);
     CHECK(fit.one_lane[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
     CHECK(fit.one_lane[size_t(OpKind::triangle_test)] == Approx(90).epsilon(1e-6));
     CHECK(fit.one_lane[size_t(OpKind::sphere_test)] == Approx(40).epsilon(1e-6));
     CHECK(fit.few_lane[size_t(OpKind::box_test)] == Approx(55).epsilon(1e-6));
+    CHECK(fit.stream_per_op[size_t(OpKind::box_test)] == Approx(140).epsilon(1e-6));
+    CHECK(fit.stream_measured[size_t(OpKind::box_test)]);
+    CHECK_FALSE(fit.stream_measured[size_t(OpKind::triangle_test)]);  // none in the samples
     CHECK(fit.one_lane[size_t(OpKind::camera)] == 0.0);  // never made: no cost
     CHECK(fit.few_lane[size_t(OpKind::triangle_test)] == 0.0);
     CHECK(short_stream_fit_error(fit, samples).second < 1e-9);
-    // A wrong cost shows in the error: 10 % off on the boxes, or on the few-ray loop's.
+    // A wrong cost shows in the error: 10 % off on the boxes, 20 % on the few-ray loop's or the
+    // stream loop's.
     ShortStreamCosts off = fit;
     off.one_lane[size_t(OpKind::box_test)] *= 1.1;
     CHECK(short_stream_fit_error(off, samples).second > 0.05);
     off = fit;
     off.few_lane[size_t(OpKind::box_test)] *= 1.2;
     CHECK(short_stream_fit_error(off, samples).second > 0.05);
+    off = fit;
+    off.stream_per_op[size_t(OpKind::box_test)] *= 1.2;
+    CHECK(short_stream_fit_error(off, samples).second > 0.05);
+
     // The stream-priced ops are not the loops' to carry: ignoring them fits other costs.
     std::vector<OneLaneSample> unpriced = samples;
     for (OneLaneSample& s : unpriced) s.stream_op_cycles = 0;

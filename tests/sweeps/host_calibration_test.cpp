@@ -32,15 +32,17 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     std::vector<OpCostConfig> costs;
     for (const auto& [kind, samples] : by_kind)
         costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
-    // Short-stream traversals: only the traversal's kinds, each made, and their fitted cost.
+    // Traversals: only the traversal's kinds, each made, and their fitted cost.
     const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, microbench_rule(3));
-    std::map<OpKind, uint64_t> made, few, streamed;
+    const bool wide = isa_width(isa) >= k_few_ray_min_width;
+    std::map<OpKind, uint64_t> made, few, streamed, streamed_short;
     double one_ray_cycles = 0;
     for (const OneRaySample& s : one_ray) {
         // A batch of one ray that misses the root costs about what reading the TSC does, so
         // its cycles can be 0 (after the overhead); the batches together cannot.
         CHECK(s.cycles >= 0);
         one_ray_cycles += s.cycles;
+        CHECK(s.slots == s.rays * s.streams);  // the batch's footprint
         for (uint32_t k = 0; k < k_op_kind_count; ++k) {
             if (s.ops[k]) made[OpKind(k)] += s.ops[k];
             if (s.few_ops[k]) few[OpKind(k)] += s.few_ops[k];
@@ -49,6 +51,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
             CHECK(o.lanes >= 2);
             CHECK(o.lanes <= s.rays);
             streamed[o.kind] += o.count;
+            if (s.rays <= k_few_ray_lanes) streamed_short[o.kind] += o.count;
         }
         if (s.rays == 1) CHECK(s.stream_ops.empty());
     }
@@ -58,20 +61,26 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(made[OpKind::triangle_test] > 0);
     CHECK(made[OpKind::sphere_test] > 0);
     // The few-ray loop's box tests on a wide back end; its leaves' tests by the stream formula.
-    const bool wide = isa_width(isa) >= k_few_ray_min_width;
     CHECK(few.size() == (wide ? 1u : 0u));
+    CHECK((streamed_short[OpKind::triangle_test] > 0) == wide);
+    CHECK(streamed_short.count(OpKind::box_test) == 0u);
     // A narrow back end has no few-ray loop, and no few-ray samples.
-    CHECK((streamed[OpKind::triangle_test] > 0) == wide);
-    CHECK(streamed.count(OpKind::box_test) == 0u);
-    CHECK(std::all_of(one_ray.begin(), one_ray.end(),
-                      [&](const OneRaySample& s) { return wide || s.rays == 1; }));
+    CHECK(std::all_of(one_ray.begin(), one_ray.end(), [&](const OneRaySample& s) {
+        return wide || s.rays == 1 || s.rays > k_few_ray_lanes;
+    }));
+    // Longer streams start in the stream loop, on every back end.
+    CHECK(streamed[OpKind::box_test] > 0);
     const std::vector<OneLaneSample> short_streams =
         short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib);
-    for (size_t i = 0; i < one_ray.size(); ++i)
+    for (size_t i = 0; i < one_ray.size(); ++i) {
         CHECK((short_streams[i].stream_op_cycles > 0) == !one_ray[i].stream_ops.empty());
+        // The stream loop's box tests counted for the fit of their per-op cost, the leaves' not.
+        CHECK(short_streams[i].stream_ops[size_t(OpKind::triangle_test)] == 0u);
+    }
     const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
     CHECK(short_costs.one_lane[size_t(OpKind::box_test)] > 0);
     CHECK((short_costs.few_lane[size_t(OpKind::box_test)] > 0) == wide);
+    CHECK(short_costs.stream_measured[size_t(OpKind::box_test)]);
     set_short_stream_costs(short_costs, costs);
     const HwConfig config = parse_hw_config(host_hw_yaml(host, costs, "test"), "host.hw.yaml");
 
@@ -144,4 +153,31 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     probed_host.speed_probe_cycles = 12345;
     CHECK(parse_hw_config(host_hw_yaml(probed_host, costs, "test"), "host.hw.yaml")
               .speed_probe_cycles == Approx(12345));
+}
+
+TEST_CASE("The traversals' fit sets the box test's per-op cost, and each kind's one- and "
+          "few-lane costs",
+          "[host]") {
+    ShortStreamCosts fit;
+    fit.one_lane[size_t(OpKind::box_test)] = 30;
+    fit.one_lane[size_t(OpKind::triangle_test)] = 90;
+    fit.few_lane[size_t(OpKind::box_test)] = 55;
+    fit.stream_per_op[size_t(OpKind::box_test)] = 140;
+    fit.stream_measured[size_t(OpKind::box_test)] = true;
+    std::vector<OpCostConfig> costs(2);
+    costs[0].op = "box_test";
+    costs[0].per_op_cycles = 37;
+    costs[1].op = "triangle_test";
+    costs[1].per_op_cycles = 120;
+    set_short_stream_costs(fit, costs);
+    CHECK(costs[0].per_op_cycles == 140);
+    CHECK(costs[0].one_lane_cycles == 30);
+    CHECK(costs[0].few_lane_cycles == 55);
+    CHECK(costs[1].per_op_cycles == 120);  // not measured in the stream loop: its own
+    CHECK(costs[1].one_lane_cycles == 90);
+    // Not measured at all (no stream-loop box test in the samples): the filters' cost stays.
+    fit.stream_measured[size_t(OpKind::box_test)] = false;
+    costs[0].per_op_cycles = 37;
+    set_short_stream_costs(fit, costs);
+    CHECK(costs[0].per_op_cycles == 37);
 }
