@@ -276,7 +276,8 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
     for (size_t i = 0; i < c.op_costs.size(); ++i) {
         const std::string& op = c.op_costs[i].op;
         const std::string key = "op_costs[" + std::to_string(i) + "].op";
-        if (op_kind_named(op) == OpKind::count) fail(key, "'" + op + "' is not an op kind (kernels/trace.h)");
+        if (op_kind_named(op) == OpKind::count)
+            fail(key, "'" + op + "' is not an op kind (kernels/trace.h)");
         if (!ops.insert(op).second) fail(key, "'" + op + "' has two cost entries");
     }
     const std::string unknown = unknown_tech_reason(c.tech.node);

@@ -40,7 +40,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                    uint32_t width, uint32_t l1d_kib) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
-        if (op_kind_named(o.op) != OpKind::count) cost_of[size_t(op_kind_named(o.op))] = &o;
+        if (const OpKind kind = op_kind_named(o.op); kind != OpKind::count)
+            cost_of[size_t(kind)] = &o;
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}};

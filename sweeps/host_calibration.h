@@ -56,7 +56,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                    const std::vector<OpCostConfig>& costs,
                                                    uint32_t width, uint32_t l1d_kib);
 // The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
-// and per-group costs where the traversals measured them (its stream loop's, in a traversal).
+// cost where the traversals measured it (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);
 
 // Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and

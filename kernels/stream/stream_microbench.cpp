@@ -537,26 +537,29 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                         b.pre[order[i]] = RayPrecomp(r);
                     }
                 }
-            // Each traversal starts from no hit and the ray's full t, as after load_rays, with
-            // its stream's ids in increasing order, as the tracer's are.
-            auto reset = [&] {
-                for (uint32_t s = 0; s < streams; ++s) {
-                    uint32_t* ids = stream_ids.data() + size_t(s) * stride;
-                    std::copy(order.begin() + s * rays, order.begin() + (s + 1) * rays, ids);
-                    std::sort(ids, ids + rays);
-                    for (uint32_t i = 0; i < rays; ++i) {
-                        b.trav.set(ids[i], b.pre[ids[i]], b.ray[ids[i]].t_max);
-                        b.hit[ids[i]] = Hit{};
-                    }
+            // The stream of the rays order[first, first + rays) into `ids`: in increasing order,
+            // as the tracer's are, each from no hit and its full t, as after load_rays.
+            auto load_stream = [&](uint32_t first, uint32_t* ids) {
+                std::copy(order.begin() + first, order.begin() + first + rays, ids);
+                std::sort(ids, ids + rays);
+                for (uint32_t i = 0; i < rays; ++i) {
+                    b.trav.set(ids[i], b.pre[ids[i]], b.ray[ids[i]].t_max);
+                    b.hit[ids[i]] = Hit{};
                 }
             };
-            auto run = [&](TraceDetail detail) {
+            auto traverse = [&](uint32_t* ids, TraceDetail detail) {
                 job.n = rays;
-                for (uint32_t s = 0; s < streams; ++s) {
-                    job.ids = stream_ids.data() + size_t(s) * stride;
-                    job.shared_origin = shared_origin(job.rays, job.ids, rays);  // as the tracer
-                    kernels.traverse[int(detail)](job);
-                }
+                job.ids = ids;
+                job.shared_origin = shared_origin(job.rays, ids, rays);  // as the tracer
+                kernels.traverse[int(detail)](job);
+            };
+            auto reset = [&] {
+                for (uint32_t s = 0; s < streams; ++s)
+                    load_stream(s * rays, stream_ids.data() + size_t(s) * stride);
+            };
+            auto run = [&](TraceDetail detail) {
+                for (uint32_t s = 0; s < streams; ++s)
+                    traverse(stream_ids.data() + size_t(s) * stride, detail);
             };
             // Before each repetition, every other ray's traversal, in streams of as many rays, in
             // a new order: a branch predictor learns a batch of a few traversals that repeats
@@ -566,19 +569,10 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             const uint32_t batch_rays = rays * streams;
             auto displace_predictor = [&] {
                 std::shuffle(order.begin() + batch_rays, order.end(), rng);
-                job.n = rays;
+                other_ids.assign(stride, 0u);
                 for (uint32_t first = batch_rays; first + rays <= k_slots; first += rays) {
-                    other_ids.assign(order.begin() + first, order.begin() + first + rays);
-                    std::sort(other_ids.begin(), other_ids.end());
-                    other_ids.resize(stride, 0u);
-                    for (uint32_t i = 0; i < rays; ++i) {
-                        const uint32_t id = other_ids[i];
-                        b.trav.set(id, b.pre[id], b.ray[id].t_max);
-                        b.hit[id] = Hit{};
-                    }
-                    job.ids = other_ids.data();
-                    job.shared_origin = shared_origin(job.rays, job.ids, rays);
-                    kernels.traverse[int(TraceDetail::none)](job);
+                    load_stream(first, other_ids.data());
+                    traverse(other_ids.data(), TraceDetail::none);
                 }
             };
             OneRaySample sample;
