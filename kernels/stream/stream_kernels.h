@@ -187,6 +187,12 @@ struct StreamKernels {
     uint32_t (*sphere_filter)(TraversalView rays, const RayPrecomp* pre, const Sphere& sphere,
                               const uint32_t* ids, uint32_t n, uint8_t* mask, float* t);
 
+    // The traversal's leaf code (trace off) on the leaf primitives [first, first + count) for
+    // job.ids[0, k): each primitive's test, its hits taken if closer (t tightened). Returns the
+    // lanes that took a hit, summed over the primitives. The microbenchmarks time the triangle
+    // and sphere tests through it, so that their costs are those of the code a frame runs.
+    uint32_t (*leaf_tests)(const TraversalJob& job, uint32_t first, uint32_t count, uint32_t k);
+
     // Stable partition of ids[0, n) by mask[i] != 0, passing first, by compress; returns the
     // passing count; writes nothing past ids[n). `scratch` holds n + k_stream_padding ids.
     uint32_t (*partition)(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scratch);

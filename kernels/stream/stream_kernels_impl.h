@@ -471,6 +471,21 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
     }
 }
 
+// traverse_leaf (trace off) on the leaf primitives [first, first + count) for job.ids[0, k):
+// the microbenchmarks time the leaf tests through the tracer's own leaf code. Returns the lanes
+// that took a hit, summed over the primitives.
+template <int Width>
+uint32_t leaf_tests(const TraversalJob& job, uint32_t first, uint32_t count, uint32_t k) {
+    BvhNode leaf;
+    leaf.first = first;
+    leaf.count = uint16_t(count);
+    uint32_t passed = 0;
+    auto add_passed = [&](OpKind, OpStage, uint32_t, const uint32_t*, uint32_t, const uint8_t*,
+                          uint32_t op_passed) { passed += op_passed; };
+    traverse_leaf<Width, TraceDetail::none>(job, leaf, k, add_passed);
+    return passed;
+}
+
 // traverse_leaf, its TSC ticks added to job.leaf_tsc when the caller asks for the stage clock.
 template <int Width, TraceDetail Detail, class Report>
 SFX_LANES_INLINE void timed_leaf(const TraversalJob& job, const BvhNode& node, uint32_t k,
@@ -663,6 +678,7 @@ StreamKernels make_kernels(Isa isa) {
     k.triangle_candidates = &triangle_candidates<Width>;
     k.leaf_candidates = &leaf_candidates<Width>;
     k.sphere_filter = &sphere_filter<Width>;
+    k.leaf_tests = &leaf_tests<Width>;
     k.partition = &partition<Width>;
     k.traverse[int(TraceDetail::none)] = &traverse<Width, TraceDetail::none>;
     k.traverse[int(TraceDetail::counts)] = &traverse<Width, TraceDetail::counts>;

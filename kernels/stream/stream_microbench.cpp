@@ -73,7 +73,6 @@ struct Buffers {
     std::vector<uint8_t> any_hit, mask, saved_any_hit;
     std::vector<SurfaceHit> surf, saved_surf;
     std::vector<uint32_t> ids, scratch, scratch2, positions;
-    std::vector<float> sphere_t;     // the sphere filter's distances
     std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
     // Where a made ray is set up for the next generation's traversal (set_up_ray): arrays of
     // their own, so a repeated call finds its inputs as they were.
@@ -107,7 +106,6 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     b.scratch.resize(padded);
     b.scratch2.resize(padded);
     b.positions.resize(padded);
-    b.sphere_t.resize(padded);
     b.mask.resize(padded);
     b.op_tally.assign(op_tally_size(slots), 0);
     for (uint32_t i = 0; i < slots; ++i) {
@@ -204,10 +202,14 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     std::vector<Buffers> buffers;
     for (uint32_t slots : options.buffer_slots)
         buffers.push_back(make_buffers(scene, bvh, slots, rng));
-    // The triangle test's floor triangle (primitive 0) at its leaf position, as the tracer's
-    // leaves test it.
-    const uint32_t floor_leaf = uint32_t(
-        std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), 0u) - bvh.prim_ids().begin());
+    // The triangle test's floor triangle (primitive 0) at its leaf position.
+    auto leaf_position = [&](uint32_t prim) {
+        return uint32_t(std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), prim) -
+                        bvh.prim_ids().begin());
+    };
+    const uint32_t floor_leaf = leaf_position(0);
+    // The sphere test's sphere (the scene's first, the large one) likewise.
+    const uint32_t sphere_leaf = leaf_position(scene.triangle_count());
     // The box test's nodes: the root (every ray passes) and the nodes below it, breadth first
     // (a share of the rays passes, as in a frame, where a stream's lanes pass and fail: the
     // filter's per-lane branches and compress see both); the samples take them in turn.
@@ -227,6 +229,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
             const uint32_t slots = options.buffer_slots[bi];
             Buffers& b = buffers[bi];
+            TraversalJob job = traversal_job(bvh, b);  // the leaf tests' buffers
             std::vector<uint32_t> order(slots), deal(slots);
             std::iota(order.begin(), order.end(), 0u);
             std::iota(deal.begin(), deal.end(), 0u);
@@ -305,43 +308,21 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 std::copy(scratch, scratch + (n - passed), ids + passed);
                                 break;
                             }
-                            case OpKind::triangle_test: {
-                                // A floor triangle: about half the rays. The tracer's leaf
-                                // test: the float stage, then the full test of each candidate
-                                // with the plane normal computed once for the op.
-                                const LeafPrimitive& tri = bvh.leaf_primitives()[floor_leaf];
-                                uint32_t* positions = b.positions.data();
-                                const uint32_t candidates = kernels.triangle_candidates(
-                                    b.trav.view(), tri.p0, tri.p1, tri.p2, ids, n, positions);
-                                const TriangleNormal normal =
-                                    candidates != 0 ? triangle_normal(tri.p0, tri.p1, tri.p2)
-                                                    : TriangleNormal{};
-                                passed = 0;
-                                for (uint32_t j = 0; j < candidates; ++j) {
-                                    const uint32_t id = ids[positions[j]];
-                                    float& t = b.trav.t(id);
-                                    if (!bvh.intersect_leaf_triangle(b.pre[id], floor_leaf, normal,
-                                                                     t, b.hit[id]))
-                                        continue;
-                                    t = b.any_hit[id] ? -1.f : b.hit[id].t;
-                                    ++passed;
-                                }
+                            case OpKind::triangle_test:
+                                // A floor triangle (about half the rays) as a leaf of its own,
+                                // by the tracer's leaf code: the float stage, then the full
+                                // test of each candidate, the hits taken if closer.
+                                job.ids = ids;
+                                job.n = n;
+                                passed = kernels.leaf_tests(job, floor_leaf, 1, n);
                                 break;
-                            }
-                            case OpKind::sphere_test: {
-                                // The tracer's sphere filter: the kernel's hits, then each one
-                                // taken if closer.
-                                const uint32_t prim = scene.triangle_count();
-                                float* t = b.sphere_t.data();
-                                kernels.sphere_filter(b.trav.view(), b.pre.data(),
-                                                      scene.sphere(prim), ids, n, mask, t);
-                                passed = 0;
-                                for (uint32_t j = 0; j < n; ++j)
-                                    passed += mask[j] &&
-                                              take_closer_hit(t[j], prim, b.hit[ids[j]],
-                                                              b.trav.t(ids[j]), b.any_hit[ids[j]]);
+                            case OpKind::sphere_test:
+                                // The large glass sphere as a leaf of its own, likewise: the
+                                // test of each group, then its hits taken if closer.
+                                job.ids = ids;
+                                job.n = n;
+                                passed = kernels.leaf_tests(job, sphere_leaf, 1, n);
                                 break;
-                            }
                             case OpKind::shadow_filter:
                                 passed = run_filter([&](uint32_t id) {
                                     if (!b.any_hit[id]) return false;

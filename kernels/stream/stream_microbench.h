@@ -1,17 +1,18 @@
 #pragma once
-// Microbenchmarks of the stream tracer's native filters on synthetic streams: each op kind's
-// filter (the box kernel, the triangle test's SIMD float stage and its exact stage, the sphere
-// test, the camera and every shading filter of Fig. 4 with the same per-ray steps of path.h)
-// run with the trace off on streams of a chosen length whose ids are a random subset, in
-// increasing order (as the tracer's stable partitions keep them), of a ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy panel, a
-// glass sphere, a light: no shipped scene). Time is the time-stamp counter around one call,
-// the fastest of repetitions that go on until their fastest k agree or a budget runs out
+// Microbenchmarks of the stream tracer's native filters on synthetic streams: each op kind's filter
+// (the box kernel; the triangle and sphere tests by the traversal's own leaf code,
+// StreamKernels::leaf_tests, on a leaf of one primitive; the camera and every shading filter of
+// Fig. 4 with the same per-ray steps of path.h) run with the trace off on streams of a chosen
+// length whose ids are a random subset, in increasing order (as the tracer's stable partitions keep
+// them), of a ray buffer of a chosen size, against a small synthetic scene (a floor, a glossy
+// panel, a glass sphere, a light: no shipped scene). Time is the time-stamp counter around one
+// call, the fastest of repetitions that go on until their fastest k agree or a budget runs out
 // (base/convergence.h: a shared machine only ever adds time), in core cycles (the TSC over
-// base/core_clock.h's ticks per core cycle of the back end's own chain, taken just before). An op is timed with all the per-ray work the tracer does for
-// it: the emission filter computes the hits' surfaces (surface_at), and the camera and every
-// shader that makes a ray set it up for the next generation's traversal (set_up_ray, the
-// tracer's load_rays). `sfx calibrate --describe-host` fits the host's per-op costs to these
-// samples (hw_model/op_cost_fit.h), never to frames.
+// base/core_clock.h's ticks per core cycle of the back end's own chain, taken just before). An op
+// is timed with all the per-ray work the tracer does for it: the emission filter computes the hits'
+// surfaces (surface_at), and the camera and every shader that makes a ray set it up for the next
+// generation's traversal (set_up_ray, the tracer's load_rays). `sfx calibrate --describe-host` fits
+// the host's per-op costs to these samples (hw_model/op_cost_fit.h), never to frames.
 
 #include <algorithm>
 #include <array>
