@@ -172,6 +172,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"per_group", k.per_group_cycles},
                                            {"per_lane", k.per_lane_cycles},
                                            {"per_pass", k.per_pass_cycles},
+                                           {"per_minority_lane", k.per_minority_lane_cycles},
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                                            {"one_lane", k.one_lane_cycles},
                                            {"few_lane", k.few_lane_cycles},
@@ -228,24 +229,25 @@ void add_calibrate_command(CLI::App& app) {
                 std::cout << j.dump(2) << "\n";
                 return;
             }
-            std::printf("host: %s, %s, TSC %.1f MHz, core %.1f MHz (%s chain), %zu cache "
-                        "levels%s\n",
-                        describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
-                        cal.host.tsc_mhz, cal.host.core_mhz,
-                        clock_chain_name(cal.host.simd_width), cal.host.caches.size(),
-                        pinned ? ", pinned" : ", NOT pinned");
+            std::printf(
+                "host: %s, %s, TSC %.1f MHz, core %.1f MHz (%s chain), %zu cache "
+                "levels%s\n",
+                describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
+                cal.host.tsc_mhz, cal.host.core_mhz, clock_chain_name(cal.host.simd_width),
+                cal.host.caches.size(), pinned ? ", pinned" : ", NOT pinned");
             std::printf("microbenchmarks: %u of %u points converged (%s)\n", cal.converged_points,
                         cal.points, describe(bench_rule).c_str());
-            std::printf("%-20s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
-                        "per_group", "per_lane", "per_pass", "beyondL1", "fit med", "fit max",
-                        "one_lane", "few_lane");
+            std::printf("%-20s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
+                        "per_group", "per_lane", "per_pass", "minority", "beyondL1", "fit med",
+                        "fit max", "one_lane", "few_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
-                std::printf("%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f %9.1f\n",
-                            k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
-                            k.per_pass_cycles, k.beyond_l1_per_lane_cycles,
-                            100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
-                            k.one_lane_cycles, k.few_lane_cycles);
+                std::printf(
+                    "%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f %9.1f\n",
+                    k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
+                    k.per_pass_cycles, k.per_minority_lane_cycles, k.beyond_l1_per_lane_cycles,
+                    100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
+                    k.one_lane_cycles, k.few_lane_cycles);
             }
             std::printf(
                 "one- and few-lane costs, and the stream loop's per-op box cost: %zu batches of "

@@ -268,9 +268,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         double busy_sum = 0.0;  // the op's issue cycles, all groups
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
-            const double busy = p.issue_cycles(c.datapath, length, lanes,
-                                               uint32_t(std::lround(pass_rate * lanes)), g == 0,
-                                               beyond_l1);
+            const double busy = p.issue_cycles(
+                c.datapath, length, uint32_t(std::lround(pass_rate * length)), lanes,
+                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

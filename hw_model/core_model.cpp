@@ -284,8 +284,9 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     if (p.measured)
         for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
     // Fractional measured cycles: the unit carries the remainder to its next group.
-    const double exact = m_unit_carry[unit] + p.issue_cycles(m_config.datapath, op.length, t.lanes,
-                                                             passed, t.first == 0, m_beyond_l1);
+    const double exact =
+        m_unit_carry[unit] + p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes,
+                                            passed, t.first == 0, m_beyond_l1);
     const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact)));
     m_unit_carry[unit] = exact - double(busy);
     e.issue_end = e.start + busy;

@@ -334,7 +334,11 @@ struct DatapathConfig {
 // by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
 // streams, never on frames. An op of n lanes in g = ceil(n / simd.width) groups, p passing,
 // whose ray buffer is a fraction f beyond the L1D costs
-//   per_op + per_group * g + per_lane * n + per_pass * p + beyond_l1_per_lane * f * n cycles,
+//   per_op + per_group * g + per_lane * n + per_pass * p + per_minority_lane * min(p, n - p)
+//   + beyond_l1_per_lane * f * n cycles
+// (the minority term: a filter that branches on each lane's outcome pays the branch
+// predictor's misses, which on outcomes in no order are the lanes of the rarer outcome; the
+// microbenchmarks time streams of mixed outcomes, and of every lane passing and of none),
 // except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each, fitted on
@@ -352,6 +356,7 @@ struct OpCostConfig {
     double per_group_cycles = 0.0;
     double per_lane_cycles = 0.0;
     double per_pass_cycles = 0.0;
+    double per_minority_lane_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
     double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
@@ -373,6 +378,10 @@ struct OpCostConfig {
                 "cost per lane (per-ray scalar work)", 0.0, 1e9);
         v.param("per_pass_cycles", per_pass_cycles, "cycles",
                 "cost per passing lane (work only passing rays do)", 0.0, 1e9);
+        v.param("per_minority_lane_cycles", per_minority_lane_cycles, "cycles",
+                "cost per lane of the op's rarer outcome (passing or failing): branch "
+                "mispredictions on each lane's outcome",
+                0.0, 1e9);
         v.param("beyond_l1_per_lane_cycles", beyond_l1_per_lane_cycles, "cycles",
                 "extra cost per lane when the ray buffer is wholly beyond the L1D (scaled by "
                 "the fraction beyond)",

@@ -22,7 +22,7 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
         const uint32_t n = std::min(width, lanes - first);
         const uint32_t pass = std::min(n, left);
         left -= pass;
-        cycles += p.issue_cycles(datapath, lanes, n, pass, first == 0, beyond_l1);
+        cycles += p.issue_cycles(datapath, lanes, passed, n, pass, first == 0, beyond_l1);
     }
     return cycles;
 }
@@ -33,10 +33,16 @@ namespace {
 // (it steps by tens of ticks on some machines) and counts as this many in relative errors.
 constexpr double k_resolution = 100.0;
 
-// Columns of the cost formula for one sample (per op, group, lane, passing lane, beyond L1).
-constexpr int k_terms = 5;
+// Columns of the cost formula for one sample (per op, group, lane, passing lane, minority
+// lane, beyond L1).
+constexpr int k_terms = 6;
 std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
-    return {1.0, double((s.lanes + width - 1) / width), double(s.lanes), double(s.passed),
+    const uint32_t passed = std::min(s.passed, s.lanes);
+    return {1.0,
+            double((s.lanes + width - 1) / width),
+            double(s.lanes),
+            double(passed),
+            double(std::min(passed, s.lanes - passed)),
             s.beyond_l1 * s.lanes};
 }
 
@@ -47,7 +53,8 @@ OpCostConfig from_coefficients(const std::string& op, const std::array<double, k
     c.per_group_cycles = x[1];
     c.per_lane_cycles = x[2];
     c.per_pass_cycles = x[3];
-    c.beyond_l1_per_lane_cycles = x[4];
+    c.per_minority_lane_cycles = x[4];
+    c.beyond_l1_per_lane_cycles = x[5];
     return c;
 }
 
@@ -148,17 +155,24 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     if (samples.empty()) throw std::invalid_argument("no microbenchmark samples for " + op);
     std::array<bool, k_terms> active;
     active.fill(true);
-    // A column that never varies apart from the constant carries no information.
-    bool any_beyond = false, any_passed = false;
+    // A column that never varies apart from the constant carries no information. The minority
+    // column is told from the lane and pass columns only by streams of many lanes that all
+    // pass and that none pass beside mixed ones (the shading filters' microbenchmarks).
+    bool any_beyond = false, any_passed = false, all_pass = false, none_pass = false,
+         mixed = false;
     std::vector<std::array<double, k_terms>> rows;
     std::vector<double> cycles;
     for (const OpCostSample& s : samples) {
         any_beyond |= s.beyond_l1 > 0;
         any_passed |= s.passed > 0;
+        all_pass |= s.lanes >= 8 && s.passed == s.lanes;
+        none_pass |= s.lanes >= 8 && s.passed == 0;
+        mixed |= s.passed > 0 && s.passed < s.lanes;
         rows.push_back(terms(s, width));
         cycles.push_back(s.cycles);
     }
-    active[4] = any_beyond;
+    active[5] = any_beyond;
+    active[4] = all_pass && none_pass && mixed;
     active[3] = any_passed;
     return from_coefficients(op, fit_nonnegative(rows, cycles, active));
 }

@@ -179,8 +179,19 @@ TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]
     OpProfile p;
     p.measured = true;
     p.cost = c;
-    CHECK(p.issue_cycles(DatapathConfig{}, 40, 16, 3, true, 0.0) == Approx(10 + 4 + 8 + 6));
-    CHECK(p.issue_cycles(DatapathConfig{}, 40, 8, 0, false, 0.5) == Approx(4 + 4 + 32));
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 16, 3, true, 0.0) == Approx(10 + 4 + 8 + 6));
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 8, 0, false, 0.5) == Approx(4 + 4 + 32));
+    // The op's rarer outcome (10 of 40 pass) costs per minority lane, shared by lanes.
+    p.cost.per_minority_lane_cycles = 3;
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 16, 3, true, 0.0) ==
+          Approx(10 + 4 + 8 + 6 + 3 * 10 * 16 / 40.0));
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 30, 8, 8, false, 0.0) ==
+          Approx(4 + 4 + 16 + 3 * 10 * 8 / 40.0));
+    OpCostConfig mixed = c;
+    mixed.per_minority_lane_cycles = 3;
+    CHECK(measured_op_cycles(mixed, 16, 40, 10, 0.0) == Approx(10 + 12 + 20 + 20 + 30));
+    CHECK(measured_op_cycles(mixed, 16, 40, 40, 0.0) == Approx(10 + 12 + 20 + 80));
+    CHECK(measured_op_cycles(mixed, 16, 40, 0, 0.0) == Approx(10 + 12 + 20));
     CHECK(p.result_cycles(DatapathConfig{}, 12.5) == 12.5);
     CHECK(beyond_l1_fraction(256, 64, 32) == 0.0);   // 16 KiB in 32 KiB
     CHECK(beyond_l1_fraction(1024, 64, 32) == 0.5);  // 64 KiB
@@ -217,7 +228,22 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK(fit.per_lane_cycles == Approx(0).margin(1e-6));
     CHECK(fit.per_pass_cycles == Approx(40).epsilon(1e-6));
     CHECK(fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
+    CHECK(fit.per_minority_lane_cycles == 0.0);  // no stream of many lanes all passed
     CHECK(fit_error(fit, 16, samples).second < 1e-9);
+
+    // Streams that all pass and that none pass, beside mixed ones, tell a minority lane's cost
+    // (a branch predictor's misses) from a lane's and a passing lane's.
+    OpCostConfig branchy = cost("lambertian_choice", 12, 0, 8, 2, 0);
+    branchy.per_minority_lane_cycles = 25;
+    std::vector<OpCostSample> dealt;
+    for (uint32_t lanes : {8u, 16u, 48u, 200u, 1024u})
+        for (uint32_t passed : {lanes / 2, lanes, 0u, lanes / 5})
+            dealt.push_back({lanes, passed, 0.0,
+                             measured_op_cycles(branchy, 1, lanes, passed, 0.0)});
+    const OpCostConfig branchy_fit = fit_op_cost("lambertian_choice", 1, dealt);
+    CHECK(branchy_fit.per_minority_lane_cycles == Approx(25).epsilon(1e-6));
+    CHECK(branchy_fit.per_pass_cycles == Approx(2).epsilon(1e-6));
+    CHECK(fit_error(branchy_fit, 1, dealt).second < 1e-9);
 
     // Cycles that fall with length cannot be fitted by non-negative costs: the fit clamps.
     std::vector<OpCostSample> falling = {{1, 0, 0, 100}, {16, 0, 0, 50}, {256, 0, 0, 10}};

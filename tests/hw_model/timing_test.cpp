@@ -168,7 +168,7 @@ TEST_CASE("Modulo schedule: the resource bound and the recurrence bound, exactly
     const OpProfile& tri = table[OpKind::triangle_test];
     CHECK(tri.body.total() == tri.compute_instructions);
     CHECK(tri.chain.total() == tri.chain_steps);
-    CHECK(tri.issue_cycles(gr08, 16, 16, 0, true, 0.0) == double(tri.schedule.ii));
+    CHECK(tri.issue_cycles(gr08, 16, 0, 16, 0, true, 0.0) == double(tri.schedule.ii));
     CHECK(tri.result_cycles(gr08, 1.0) == double(tri.schedule.length));
 }
 

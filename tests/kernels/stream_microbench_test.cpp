@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include "kernels/bvh.h"
@@ -52,7 +53,24 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     uint32_t plain_kinds = 0;
     for (uint32_t k = 0; k < k_op_kind_count; ++k) plain_kinds += !is_option_kind(OpKind(k));
     CHECK(kinds.size() == plain_kinds);
-    CHECK(samples.size() == 3 * plain_kinds);
+    // Three lengths each; a shading op whose buffer has rays it passes and rays it fails also
+    // on streams that all pass and streams that none pass.
+    std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
+    for (const MicrobenchSample& m : samples) by_kind[m.kind].push_back(&m);
+    for (const auto& [kind, of_kind] : by_kind) {
+        INFO(to_string(kind));
+        if (of_kind.size() == 3) continue;
+        REQUIRE(of_kind.size() == 9);
+        CHECK(stage_of(kind) == OpStage::shading);
+        for (int i = 0; i < 3; ++i) {
+            CHECK(of_kind[3 + i]->passed == of_kind[3 + i]->lanes);
+            CHECK(of_kind[6 + i]->passed == 0);
+        }
+    }
+    REQUIRE(by_kind[OpKind::lambertian_direct].size() == 9);
+    const MicrobenchSample& mixed = *by_kind[OpKind::lambertian_direct][2];
+    CHECK(mixed.passed > 0);
+    CHECK(mixed.passed < mixed.lanes);
     for (OpKind k : kinds) CHECK_FALSE(is_option_kind(k));
     // Some pass and some fail: the synthetic streams exercise both sides of the filters.
     uint64_t lanes = 0, passed = 0;
