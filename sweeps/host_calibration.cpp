@@ -147,7 +147,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
-         << "64/256/1024/4096 slots of " << slot_bytes << " bytes, the fastest of repetitions "
+         << "64/256/1024/4096 slots of " << slot_bytes << " bytes (a shading op's streams "
+         << "also with every lane passing and with none, for its minority-lane cost), the "
+         << "triangle and sphere tests through the traversal's leaf code, the fastest of "
+         << "repetitions "
          << "until " << describe(convergence) << " (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
          << "error; one-lane and (" << k_few_ray_min_width << "+ lanes) few-lane box "
