@@ -341,8 +341,9 @@ struct DatapathConfig {
 // microbenchmarks time streams of mixed outcomes, and of every lane passing and of none),
 // except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
-// partition), so its box, triangle and sphere tests cost one_lane_cycles each, fitted on
-// one-ray traversals of the same synthetic scene; and a box test of 2 to k_few_ray_lanes lanes
+// partition), so its box, triangle and sphere tests cost one_lane_cycles each (the box test's
+// fitted on one-ray traversals of the same synthetic scene, the leaf tests' timed on one lane
+// by the one-ray loop's leaf code); and a box test of 2 to k_few_ray_lanes lanes
 // when few_lane_cycles is set: on a back end of k_few_ray_min_width lanes or more the tracer runs
 // such a stream in its few-ray loop (traverse_few, kernels/trace.h), not the stream loop, so its
 // box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene. The box

@@ -39,9 +39,11 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
 
 // Traversals timed together (kernels/stream/stream_microbench.h): how many ops each kind made
 // in the one-ray loop (one lane), in the few-ray loop (a wide back end's box tests of 2 to
-// k_few_ray_lanes lanes) and in the stream loop (the rest); the cycles of the stream loop's ops
-// beyond their per-op costs (their groups and lanes) as the stream formula prices them
-// (OpProfile::issue_cycles with the fitted per-op costs); and the cycles they took.
+// k_few_ray_lanes lanes) and in the stream loop (the rest); the cycles priced before the fit
+// (stream_op_cycles: the stream loop's ops beyond their per-op costs, their groups and lanes, as
+// the stream formula prices them (OpProfile::issue_cycles with the fitted per-op costs), and
+// one-lane ops whose cost was timed directly, which `ops` then leaves out); and the cycles they
+// took.
 struct OneLaneSample {
     std::array<uint64_t, k_op_kind_count> ops{};
     double cycles = 0.0;

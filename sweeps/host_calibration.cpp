@@ -33,11 +33,20 @@ double median(std::vector<double> v) {
 // microbenchmarks'.
 bool per_op_from_traversals(OpKind kind) { return kind == OpKind::box_test; }
 
+// Whose one-lane cost the filter microbenchmarks time directly (StreamKernels::leaf_tests of
+// one lane runs the one-ray loop's leaf code): the leaf tests'. Fitted on the traversals
+// beside the one-lane box test, whose ops come with theirs in fixed ratios, they were not
+// determined (on an AMD Zen 5 VM on 2026-11-27 six fits gave the sphere test 4.9-99.9 cycles,
+// the triangle test 90-165).
+bool one_lane_from_filters(OpKind kind) {
+    return kind == OpKind::triangle_test || kind == OpKind::sphere_test;
+}
+
 }  // namespace
 
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
-                                                   const std::vector<OpCostConfig>& costs,
-                                                   uint32_t width, uint32_t l1d_kib) {
+                                                    const std::vector<OpCostConfig>& costs,
+                                                    uint32_t width, uint32_t l1d_kib) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
         if (const OpKind kind = op_kind_named(o.op); kind != OpKind::count)
@@ -46,6 +55,12 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}};
         const double beyond = beyond_l1_fraction(s.slots, stream_slot_bytes(), l1d_kib);
+        // One-lane leaf tests at their directly timed cost.
+        for (size_t k = 0; k < k_op_kind_count; ++k)
+            if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
+                sample.stream_op_cycles += double(sample.ops[k]) * cost_of[k]->one_lane_cycles;
+                sample.ops[k] = 0;
+            }
         // The stream loop's ops priced by the formula; the box tests' per-op cost left to the
         // fit (a group's cost stays the filter microbenchmarks' throughput: an op's groups are
         // independent).
@@ -73,7 +88,8 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
     for (OpCostConfig& o : costs) {
         const OpKind kind = op_kind_named(o.op);
         if (kind == OpKind::count) continue;
-        o.one_lane_cycles = fit.one_lane[size_t(kind)];
+        if (!one_lane_from_filters(kind) || o.one_lane_cycles == 0.0)
+            o.one_lane_cycles = fit.one_lane[size_t(kind)];
         o.few_lane_cycles = fit.few_lane[size_t(kind)];
         if (fit.stream_measured[size_t(kind)]) o.per_op_cycles = fit.stream_per_op[size_t(kind)];
     }
@@ -95,14 +111,21 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     const uint32_t l1d = c.host.caches.empty() ? 32 : c.host.caches.front().kib;
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
-    for (const MicrobenchSample& s : c.samples)
+    std::map<OpKind, std::vector<double>> one_lane;  // a leaf test's one-lane samples
+    for (const MicrobenchSample& s : c.samples) {
+        if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
+            one_lane[s.kind].push_back(s.cycles);
+            continue;
+        }
         by_kind[s.kind].push_back(
             {s.lanes, s.passed, beyond_l1_fraction(s.slots, slot_bytes, l1d), s.cycles});
+    }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
+        c.op_costs.back().one_lane_cycles = median(one_lane[kind]);
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
-        points += samples.size();
+        points += samples.size() + one_lane[kind].size();
     }
     // Ops of one lane run in the one-ray loop, and a wide back end's box tests of a few lanes in
     // the few-ray loop, not the filters above: their own fit, of what the samples' other ops
@@ -153,7 +176,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "repetitions "
          << "until " << describe(convergence) << " (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
-         << "error; one-lane and (" << k_few_ray_min_width << "+ lanes) few-lane box "
+         << "error; the triangle and sphere tests' one-lane costs their one-lane points' "
+         << "median (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
+         << "+ lanes) few-lane box "
          << "costs, and the stream loop's per-op box cost, from " << c.one_ray_samples.size()
          << " batches of traversals (1-32 streams of 1 to " << k_few_ray_lanes
          << " rays, 1 and 4 of 8 to 128) of the same scene, other rays' traversals between "

@@ -189,8 +189,9 @@ struct StreamKernels {
 
     // The traversal's leaf code (trace off) on the leaf primitives [first, first + count) for
     // job.ids[0, k): each primitive's test, its hits taken if closer (t tightened). Returns the
-    // lanes that took a hit, summed over the primitives. The microbenchmarks time the triangle
-    // and sphere tests through it, so that their costs are those of the code a frame runs.
+    // lanes that took a hit, summed over the primitives; one lane (k = 1) by the one-ray loop's
+    // leaf code. The microbenchmarks time the triangle and sphere tests through it, so that
+    // their costs are those of the code a frame runs.
     uint32_t (*leaf_tests)(const TraversalJob& job, uint32_t first, uint32_t count, uint32_t k);
 
     // Stable partition of ids[0, n) by mask[i] != 0, passing first, by compress; returns the

@@ -472,8 +472,10 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
 }
 
 // traverse_leaf (trace off) on the leaf primitives [first, first + count) for job.ids[0, k):
-// the microbenchmarks time the leaf tests through the tracer's own leaf code. Returns the lanes
-// that took a hit, summed over the primitives.
+// the microbenchmarks time the leaf tests through the tracer's own leaf code, a one-lane
+// stream's in the one-ray loop's (Width 1, as traverse_one calls it; the machine model prices
+// a one-lane op by its one_lane_cycles). Returns the lanes that took a hit, summed over the
+// primitives.
 template <int Width>
 uint32_t leaf_tests(const TraversalJob& job, uint32_t first, uint32_t count, uint32_t k) {
     BvhNode leaf;
@@ -482,7 +484,10 @@ uint32_t leaf_tests(const TraversalJob& job, uint32_t first, uint32_t count, uin
     uint32_t passed = 0;
     auto add_passed = [&](OpKind, OpStage, uint32_t, const uint32_t*, uint32_t, const uint8_t*,
                           uint32_t op_passed) { passed += op_passed; };
-    traverse_leaf<Width, TraceDetail::none>(job, leaf, k, add_passed);
+    if (k == 1)
+        traverse_leaf<1, TraceDetail::none>(job, leaf, 1, add_passed);
+    else
+        traverse_leaf<Width, TraceDetail::none>(job, leaf, k, add_passed);
     return passed;
 }
 

@@ -77,6 +77,20 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         // The stream loop's box tests counted for the fit of their per-op cost, the leaves' not.
         CHECK(short_streams[i].stream_ops[size_t(OpKind::triangle_test)] == 0u);
     }
+    // A leaf test's one-lane cost timed directly prices its one-lane ops before the fit.
+    std::vector<OpCostConfig> direct = costs;
+    for (OpCostConfig& o : direct)
+        if (o.op == "triangle_test") o.one_lane_cycles = 131;
+    const std::vector<OneLaneSample> priced =
+        short_stream_fit_samples(one_ray, direct, host.simd_width, host.caches.front().kib);
+    for (size_t i = 0; i < one_ray.size(); ++i) {
+        const size_t tri = size_t(OpKind::triangle_test);
+        CHECK(priced[i].ops[tri] == 0u);
+        CHECK(priced[i].ops[size_t(OpKind::box_test)] ==
+              short_streams[i].ops[size_t(OpKind::box_test)]);
+        CHECK(priced[i].stream_op_cycles == Approx(short_streams[i].stream_op_cycles +
+                                                   131.0 * double(short_streams[i].ops[tri])));
+    }
     const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
     CHECK(short_costs.one_lane[size_t(OpKind::box_test)] > 0);
     CHECK((short_costs.few_lane[size_t(OpKind::box_test)] > 0) == wide);
@@ -175,6 +189,10 @@ TEST_CASE("The traversals' fit sets the box test's per-op cost, and each kind's 
     CHECK(costs[0].few_lane_cycles == 55);
     CHECK(costs[1].per_op_cycles == 120);  // not measured in the stream loop: its own
     CHECK(costs[1].one_lane_cycles == 90);
+    // A leaf test's one-lane cost timed directly (its one-lane filter points) stays.
+    costs[1].one_lane_cycles = 131;
+    set_short_stream_costs(fit, costs);
+    CHECK(costs[1].one_lane_cycles == 131);
     // Not measured at all (no stream-loop box test in the samples): the filters' cost stays.
     fit.stream_measured[size_t(OpKind::box_test)] = false;
     costs[0].per_op_cycles = 37;
