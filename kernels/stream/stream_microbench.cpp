@@ -467,7 +467,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                           fail_slots.begin() + f + (n - stream_passing),
                                           stream + stream_passing);
                             } else {
-                                const auto first = order.begin() + (size_t(j) * n) % slots;
+                                // inner * n <= slots: the streams are disjoint.
+                                const auto first = order.begin() + size_t(j) * n;
                                 std::copy(first, first + n, stream);
                             }
                             std::sort(stream, stream + n);
