@@ -266,6 +266,10 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
             std::min<uint64_t>(uint64_t(c.kib) * 1024 / 2, k_largest_chase / 32), h.tsc_mhz));
     }
     h.latency_ns.push_back(measure_load_latency_ns(k_largest_chase, h.tsc_mhz));
+    if (!h.caches.empty() && h.caches.back().kib > 16384)
+        for (uint32_t kib : {4096u, 8192u, 16384u})
+            h.last_level_chases.push_back(
+                {kib, measure_load_latency_ns(uint64_t(kib) * 1024, h.tsc_mhz)});
     return h;
 }
 
@@ -346,7 +350,15 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
           << ", ways: " << l.ways << ", hit_latency_ns: " << fmt(l.hit_latency_ns, 2)
           << ", shared: " << (l.shared ? "true" : "false") << "}  # " << h.caches[i].source
           << "; latency measured (pointer chase over "
-          << std::min<uint64_t>(h.caches[i].kib / 2, 8192) << " KiB)\n";
+          << std::min<uint64_t>(h.caches[i].kib / 2, 8192) << " KiB)";
+        if (i + 1 == c.scene_memory.caches.size() && !h.last_level_chases.empty()) {
+            y << "; chases over";
+            for (const auto& [kib, ns] : h.last_level_chases)
+                y << " " << kib / 1024 << " MiB " << fmt(ns, 1) << " ns"
+                  << (kib == h.last_level_chases.back().first ? "" : ",");
+            y << " (a jump between two: the L3 this core sees ends there)";
+        }
+        y << "\n";
     }
     y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2)
       << "  # measured: pointer chase over 256 MiB\n"

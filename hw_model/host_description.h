@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hw_model/hw_config.h"
@@ -66,6 +67,10 @@ struct HostDescription {
     double core_mhz = 0.0;
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
+    // Chases over 4, 8 and 16 MiB (KiB, ns) when the last level reports more than 16 MiB: on a
+    // virtual machine the L3 a core sees can end well short of what cpuid reports, and its
+    // latency (the 8 MiB chase) is then a draw on that knee. Reported, not used.
+    std::vector<std::pair<uint32_t, double>> last_level_chases;
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
     // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine

@@ -374,7 +374,12 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
     box.one_lane_cycles = 6;
     box.few_lane_cycles = 4.5;
-    const std::string yaml = host_hw_yaml(small_host(), {box}, "test samples");
+    box.per_minority_lane_cycles = 7;
+    HostDescription host = small_host();
+    host.last_level_chases = {{4096, 15.5}, {8192, 98.4}, {16384, 130.5}};
+    const std::string yaml = host_hw_yaml(host, {box}, "test samples");
+    CHECK(yaml.find("chases over 4 MiB 15.5 ns, 8 MiB 98.4 ns, 16 MiB 130.5 ns") !=
+          std::string::npos);
     const HwConfig c = parse_hw_config(yaml, "host.hw.yaml");
     CHECK(c.ray_buffer.storage == "l1d");
     CHECK(c.ray_buffer.kib == 32);
@@ -389,6 +394,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
     CHECK(c.op_costs[0].few_lane_cycles == Approx(4.5));
+    CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
     // A host file written before one-lane costs were measured: the formula for every op.
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
                           "old.hw.yaml")
