@@ -266,10 +266,12 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
             std::min<uint64_t>(uint64_t(c.kib) * 1024 / 2, k_largest_chase / 32), h.tsc_mhz));
     }
     h.latency_ns.push_back(measure_load_latency_ns(k_largest_chase, h.tsc_mhz));
+    // Around the last level's chase (over 8 MiB when it reports more than 16 MiB), the same
+    // sample as its latency, not a second one.
     if (!h.caches.empty() && h.caches.back().kib > 16384)
-        for (uint32_t kib : {4096u, 8192u, 16384u})
-            h.last_level_chases.push_back(
-                {kib, measure_load_latency_ns(uint64_t(kib) * 1024, h.tsc_mhz)});
+        h.last_level_chases = {{4096u, measure_load_latency_ns(4096ull << 10, h.tsc_mhz)},
+                               {8192u, h.latency_ns[h.caches.size() - 1]},
+                               {16384u, measure_load_latency_ns(16384ull << 10, h.tsc_mhz)}};
     return h;
 }
 

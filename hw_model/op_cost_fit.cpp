@@ -37,12 +37,11 @@ constexpr double k_resolution = 100.0;
 // lane, beyond L1).
 constexpr int k_terms = 6;
 std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
-    const uint32_t passed = std::min(s.passed, s.lanes);
     return {1.0,
             double((s.lanes + width - 1) / width),
             double(s.lanes),
-            double(passed),
-            double(std::min(passed, s.lanes - passed)),
+            double(s.passed),
+            double(minority_lanes(s.passed, s.lanes)),
             s.beyond_l1 * s.lanes};
 }
 

@@ -258,10 +258,10 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
     // A stream of a few rays runs in the few-ray loop (traverse_few): one group, one cost.
     if (length >= 2 && length <= k_few_ray_lanes && cost.few_lane_cycles > 0)
         return first ? cost.few_lane_cycles : 0.0;
-    const double minority = double(std::min(op_passed, length - std::min(op_passed, length)));
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
            cost.per_lane_cycles * lanes + cost.per_pass_cycles * passed +
-           cost.per_minority_lane_cycles * minority * lanes / double(length) +
+           cost.per_minority_lane_cycles * minority_lanes(op_passed, length) * lanes /
+               double(length) +
            cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
 }
 

@@ -6,6 +6,7 @@
 // cost (HwConfig::op_costs). This is the one place a lane group's issue cycles are priced
 // (OpProfile::issue_cycles); the models decide when a group issues and what it waits for.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -58,6 +59,13 @@ struct ModuloSchedule {
 };
 ModuloSchedule modulo_schedule(const UnitClassCounts& body, const UnitClassCounts& chain,
                                const UnitClassCounts& recurrence, const DatapathConfig& datapath);
+
+// The lanes of an op's rarer outcome, passing or failing (`passed` of `lanes`): what a
+// branch predictor misses on outcomes in no order (OpCostConfig::per_minority_lane_cycles).
+inline uint32_t minority_lanes(uint32_t passed, uint32_t lanes) {
+    passed = std::min(passed, lanes);
+    return std::min(passed, lanes - passed);
+}
 
 struct OpProfile {
     std::vector<uint32_t> gather_words;   // gathered for every lane
