@@ -402,6 +402,13 @@ void add_calibrate_command(CLI::App& app) {
                 row[std::string("measured.") + k_stage_names[sg] + "_cycles"] =
                     m.measured_stage[size_t(sg)];
             }
+            const char* loops[3] = {"one_ray", "few_ray", "stream"};
+            for (int l = 0; l < 3; ++l) {
+                row[std::string("predicted.traversal_") + loops[l] + "_loop_cycles"] =
+                    m.predicted_loop[size_t(l)];
+                row[std::string("measured.traversal_") + loops[l] + "_loop_cycles"] =
+                    m.measured_loop[size_t(l)];
+            }
             // The machine model's stall causes, as sfx simulate reports them.
             for (const Stat& stat : m.prediction.stats())
                 if (stat.name.rfind("stall_cycles.", 0) == 0)

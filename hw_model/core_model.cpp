@@ -67,6 +67,14 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_partition_free = std::max(m_partition_free, now);
     m_timing = FrameTiming();
     m_timing.passes = 1;
+    m_loop.assign(n, TraversalLoop::stream);
+    for (uint32_t i = 0; i < n; ++i) {
+        const StreamOp op = pass->at(i);
+        if (op.kind != OpKind::box_test) continue;
+        const int32_t producer = pass->producer(i);
+        m_loop[i] = traversal_loop(op.length, width(),
+                                   producer < 0 ? TraversalLoop::stream : m_loop[producer]);
+    }
     m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
 
@@ -267,6 +275,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     const OpProfile& p = m_costs[op.kind];
     StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
     Executed e;
+    const uint64_t stage_before = stage.busy_cycles + stage.stall_cycles;
     e.start = std::max(now, t.data_ready);
     e.start = std::max(e.start, scene_ready(t));
     charge_idle(m_unit_free[unit], e.start, t, stage);
@@ -293,6 +302,9 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     const uint64_t result =
         e.start + ceil_cycle(p.result_cycles(m_config.datapath, double(busy)));
     stage.busy_cycles += busy;
+    if (op.kind == OpKind::box_test)
+        m_timing.traversal_loop_cycles[size_t(m_loop[t.op])] +=
+            stage.busy_cycles + stage.stall_cycles - stage_before;
     m_unit_free[unit] = e.issue_end;
     // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
     ActionCounts& act = m_timing.actions;

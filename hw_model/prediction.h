@@ -135,6 +135,10 @@ struct FrameTiming {
     uint64_t dram_reads = 0;
     uint64_t passes = 0;
     ActionCounts actions;  // what each unit did, for area_energy's costing
+    // The box tests' unit-cycles (busy and stalled) by the native tracer's loop that runs them
+    // (TraversalLoop, kernels/trace.h): what the tracer's stage clock splits the traversal
+    // into (RenderStats::short_loop_tsc). Cycle-level models only.
+    uint64_t traversal_loop_cycles[3] = {0, 0, 0};
 
     // Every counter of a and b in step (b's cache levels are made a's first if a has fewer).
     template <class A, class B, class F>
@@ -189,6 +193,12 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
     f(CounterInfo("dram_reads", "lines", "scene-data lines read from DRAM"), a.dram_reads,
       b.dram_reads);
     f(CounterInfo("passes", "passes", "tile passes"), a.passes, b.passes);
+    const char* loops[3] = {"one_ray", "few_ray", "stream"};
+    for (int l = 0; l < 3; ++l)
+        f(CounterInfo(loops[l], "cycles",
+                      "box tests' unit-cycles in the tracer's loop of that name")
+              .under("traversal_loop_cycles"),
+          a.traversal_loop_cycles[l], b.traversal_loop_cycles[l]);
     ActionCounts::visit(a.actions, b.actions, [&](const CounterInfo& c, auto& x, auto& y) {
         f(c.under("actions"), x, y);
     });

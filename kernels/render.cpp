@@ -28,6 +28,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     shadow_rays += o.shadow_rays;
     nonfinite_paths += o.nonfinite_paths;
     for (int i = 0; i < 3; ++i) stage_tsc[i] += o.stage_tsc[i];
+    for (int i = 0; i < 2; ++i) short_loop_tsc[i] += o.short_loop_tsc[i];
     entry_searches += o.entry_searches;
     entry_depth_sum += o.entry_depth_sum;
     batch_queues += o.batch_queues;

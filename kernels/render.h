@@ -58,6 +58,10 @@ struct RenderStats {
     // intersection, shading] as kernels/trace.h's OpStage; shading is the rest of each pass
     // (camera, ray set-up, the shading filter stack).
     uint64_t stage_tsc[3] = {0, 0, 0};
+    // Of stage_tsc[0] (stream tracer, stage clock): the ticks of the one-ray loop ([0]) and
+    // of the few-ray loop ([1]) run from the stream loop (kernels/stream), their leaves' not
+    // included: where a traversal's short streams go (kernels/trace.h).
+    uint64_t short_loop_tsc[2] = {0, 0};
 
     uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
     RenderStats& operator+=(const RenderStats& o);

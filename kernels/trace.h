@@ -144,6 +144,18 @@ inline bool runs_in_few_ray_loop(OpKind kind, uint32_t length, uint32_t width) {
            width >= k_few_ray_min_width;
 }
 
+// The native tracer's loop that runs a box test: a stream of one ray runs its subtree in the
+// one-ray loop, one of 2 to k_few_ray_lanes rays (a wide back end) in the few-ray loop, and every
+// op below either is that loop's; `producer` is the loop of the op whose partition produced the
+// stream (stream for a traversal's first op). Indexes RenderStats::short_loop_tsc.
+enum class TraversalLoop : uint8_t { one_ray, few_ray, stream };
+inline TraversalLoop traversal_loop(uint32_t length, uint32_t width, TraversalLoop producer) {
+    if (producer != TraversalLoop::stream) return producer;
+    if (length == 1) return TraversalLoop::one_ray;
+    if (runs_in_few_ray_loop(OpKind::box_test, length, width)) return TraversalLoop::few_ray;
+    return TraversalLoop::stream;
+}
+
 // One stream operation. `slots` and `passed` are views valid only during the sink call.
 // Built by aggregate initialization in field order, so an emitter names every field it sets in
 // one expression (and the kernels' copies stay inline).

@@ -71,6 +71,10 @@ struct SiliconMeasurement {
     Prediction prediction;                     // the machine model's, whole
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses
+    // The traversal by the tracer's loop that runs its box tests (TraversalLoop: one-ray,
+    // few-ray, stream loop), predicted and measured (the stage clock's short-loop ticks,
+    // RenderStats::short_loop_tsc, split as the stages are; the stream loop the rest).
+    std::array<double, 3> predicted_loop{}, measured_loop{};
     double predicted_frame = 0.0;
     // Core cycles (base/cycle_source.h: counted by perf_event_open, else the thread's CPU time
     // at the back end's clock measured before and after the render; the TSC alone counts the

@@ -292,6 +292,28 @@ def misses_text(df):
     return "\n".join(lines)
 
 
+LOOPS = (("one_ray", "one-ray loop"), ("few_ray", "few-ray loop"), ("stream", "stream loop"))
+
+
+def loops_text(df):
+    """Per back end and scene, the traversal by the tracer's loop that runs its box tests (the
+    stage clock's short-loop ticks; rows written before it carry none)."""
+    if "measured.traversal_stream_loop_cycles" not in df:
+        return "These rows carry no traversal split by loop."
+    lines = ["| back end | scene | loop | predicted Mcyc (sum) | measured Mcyc (sum) | "
+             "error of sum | share of measured traversal |", "|---|---|---|---|---|---|---|"]
+    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
+        traversal = g["measured.traversal_cycles"].sum()
+        for key, name in LOOPS:
+            p = g[f"predicted.traversal_{key}_loop_cycles"].sum()
+            m = g[f"measured.traversal_{key}_loop_cycles"].sum()
+            if p == 0 and m == 0:
+                continue
+            lines.append(f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
+                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / max(traversal, 1):.0%} |")
+    return "\n".join(lines)
+
+
 def summary_text(s, isa=None):
     at = f" ({isa})" if isa else ""
     lines = [f"- workloads{at}: {s['workloads']}, of which {s['converged']} converged "
@@ -450,6 +472,13 @@ def write_page(df, page, plot_name, header):
         "machine model exposes of each miss (the latency of the level that holds the line, less "
         "the L1D hit inside the measured op costs, after the prefetch of the next op's data); "
         "the last column is the prediction without them.\n\n" + misses_text(df),
+        "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
+        "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
+        "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "
+        "stream loop. Measured: the stage clock's ticks in the short loops (their leaves left "
+        "out), split as the stages are; the stream loop is the rest of the traversal. "
+        "Predicted: the model's cycles of the box tests each loop runs (the stage's "
+        "end-of-pass tail is in no loop).\n\n" + loops_text(df),
     ])
     with open(page, "w") as f:
         f.write(text + "\n")

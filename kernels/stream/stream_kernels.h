@@ -153,6 +153,9 @@ struct TraversalJob {
     uint16_t generation;
     OpStage box_stage, triangle_stage, sphere_stage;  // stage_of(their kinds)
     uint64_t* leaf_tsc;                               // not null: adds the TSC ticks in leaves
+    // Not null: adds the TSC ticks of the one-ray loop ([0]) and of the few-ray loop ([1]) run
+    // from the stream loop, the ticks of their leaves (leaf_tsc) left out.
+    uint64_t* short_loop_tsc;
 };
 
 struct StreamKernels {

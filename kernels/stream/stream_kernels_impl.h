@@ -500,6 +500,17 @@ SFX_LANES_INLINE void timed_leaf(const TraversalJob& job, const BvhNode& node, u
     if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - start;
 }
 
+// `loop` (the one-ray loop 0, the few-ray loop 1), its TSC ticks less its leaves' added to
+// job.short_loop_tsc[loop] when the caller asks for the loop clock.
+template <class Loop>
+SFX_LANES_INLINE void timed_short_loop(const TraversalJob& job, int loop, Loop&& run) {
+    if (!job.short_loop_tsc) return run();
+    const uint64_t leaf = job.leaf_tsc ? *job.leaf_tsc : 0, start = __rdtsc();
+    run();
+    const uint64_t in_leaves = job.leaf_tsc ? *job.leaf_tsc - leaf : 0;
+    job.short_loop_tsc[loop] += __rdtsc() - start - in_leaves;
+}
+
 // What a node's test will need next arrives while the test runs: an interior node's
 // children, a leaf's primitives (four by default: 160 bytes).
 SFX_LANES_INLINE void prefetch_below(const TraversalJob& job, uint32_t node_index,
@@ -630,12 +641,13 @@ void traverse(const TraversalJob& job) {
         const TraversalStackEntry top = stack[--depth];
         const uint32_t node_index = top.node, len = top.length;
         if (len == 1) {
-            traverse_one<Detail>(job, node_index, report);
+            timed_short_loop(job, 0, [&] { traverse_one<Detail>(job, node_index, report); });
             continue;
         }
         if constexpr (Width >= int(k_few_ray_min_width) && Detail != TraceDetail::lanes) {
             if (len <= k_few_ray_lanes) {
-                traverse_few<Width, Detail>(job, node_index, len, report);
+                timed_short_loop(
+                    job, 1, [&] { traverse_few<Width, Detail>(job, node_index, len, report); });
                 continue;
             }
         }

@@ -101,10 +101,17 @@ constexpr TraceDetail trace_detail() {
 // holds every leaf the stream's rays can reach). The loop is the back end's
 // (StreamKernels::traverse), so its box filter and leaf tests run at the host's width without a
 // table call.
+// The stage clock's ticks in a generation's traversal: in leaves, and in the one-ray and
+// few-ray loops less their leaves (TraversalJob::leaf_tsc, short_loop_tsc).
+struct TraversalClock {
+    uint64_t leaf = 0;
+    uint64_t short_loop[2] = {0, 0};
+};
+
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
               uint16_t generation, Trace& trace, uint32_t entry = 0,
-              uint64_t* leaf_tsc = nullptr) {
+              TraversalClock* clock = nullptr) {
     if (n == 0) return;
     TraversalJob job = traversal_job(bvh, b);
     job.ids = b.trav_ids.data();
@@ -114,7 +121,8 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     job.sink = nullptr;
     if constexpr (Trace::k_enabled) job.sink = trace.sink;
     job.generation = generation;
-    job.leaf_tsc = leaf_tsc;
+    job.leaf_tsc = clock ? &clock->leaf : nullptr;
+    job.short_loop_tsc = clock ? clock->short_loop : nullptr;
     kernels.traverse[int(trace_detail<Trace>())](job);
 }
 
@@ -263,7 +271,7 @@ struct StreamTracer::Impl {
     // walk of its rays to their next cells, until every queue is empty.
     template <class Trace>
     void traverse_batched(uint32_t n, uint16_t generation, RenderStats& stats, Trace& trace,
-                          uint64_t* leaf_tsc) {
+                          TraversalClock* clock) {
         GridBuffers& g = gb;
         if (g.ids.size() < b.capacity) {
             g.last_entry.resize(b.capacity);
@@ -303,7 +311,7 @@ struct StreamTracer::Impl {
             stats.batch_queued_rays += q.size();
             const uint32_t len = uint32_t(q.size());
             std::copy(q.begin(), q.end(), b.trav_ids.begin());
-            traverse(kernels, bvh, b, len, generation, trace, grid->cell_node(cell), leaf_tsc);
+            traverse(kernels, bvh, b, len, generation, trace, grid->cell_node(cell), clock);
             grid_walk(q.data(), len, generation, trace);
             q.clear();
             g.empty.push_back(std::move(q));
@@ -314,11 +322,11 @@ struct StreamTracer::Impl {
     // The generation's traversal: plain (Fig. 3 from `entry`), or batched for secondary rays.
     template <class Trace>
     void traverse_generation(uint32_t n, uint16_t generation, uint32_t entry, RenderStats& stats,
-                             Trace& trace, uint64_t* leaf_tsc) {
+                             Trace& trace, TraversalClock* clock) {
         if (grid && generation > 0)
-            traverse_batched(n, generation, stats, trace, leaf_tsc);
+            traverse_batched(n, generation, stats, trace, clock);
         else
-            traverse(kernels, bvh, b, n, generation, trace, entry, leaf_tsc);
+            traverse(kernels, bvh, b, n, generation, trace, entry, clock);
     }
 
     // Moon et al.'s reordering of the stream ids[0, n) before it is traced: approximate hit
@@ -486,12 +494,13 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
             entry = primary_entry_point(traversal_rays, stats, trace);
         if (clock) {
-            uint64_t leaf = 0;
+            TraversalClock ticks;
             const uint64_t start = __rdtsc();
-            traverse_generation(traversal_rays, generation, entry, stats, trace, &leaf);
+            traverse_generation(traversal_rays, generation, entry, stats, trace, &ticks);
             const uint64_t spent = __rdtsc() - start;
-            stats.stage_tsc[0] += spent - leaf;
-            stats.stage_tsc[1] += leaf;
+            stats.stage_tsc[0] += spent - ticks.leaf;
+            stats.stage_tsc[1] += ticks.leaf;
+            for (int l = 0; l < 2; ++l) stats.short_loop_tsc[l] += ticks.short_loop[l];
             traverse_tsc += spent;
         } else {
             traverse_generation(traversal_rays, generation, entry, stats, trace, nullptr);

@@ -228,3 +228,26 @@ def test_speed_probe_flags_a_run_unlike_calibration(tmp_path):
     assert "(scalar)" in lines[2] and "not measured at calibration" in lines[2]
     assert "(avx2)" in lines[0] and "+2.0 % / -3.0 %: as calibrated" in lines[0]
     assert "(avx512)" in lines[1] and "+30.0 %" in lines[1] and "SLOWED OR SPED ALIKE" in lines[1]
+
+
+def test_traversal_by_loop(tmp_path):
+    # Two workloads of one scene: the loops' sums, errors and shares of the measured traversal
+    # (each row's is 100e6 / 6); a loop neither side ran is left out.
+    rows = [row("a", 16, 100e6, 100e6), row("a", 32, 100e6, 100e6)]
+    for r, (one, few) in zip(rows, [(2e6, 6e6), (1e6, 4e6)]):
+        r.update({"predicted.traversal_one_ray_loop_cycles": one / 2,
+                  "measured.traversal_one_ray_loop_cycles": one,
+                  "predicted.traversal_few_ray_loop_cycles": few,
+                  "measured.traversal_few_ray_loop_cycles": few,
+                  "predicted.traversal_stream_loop_cycles": 0.0,
+                  "measured.traversal_stream_loop_cycles": 0.0})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    text = silicon.loops_text(df)
+    assert "| avx512 | a | one-ray loop | 1.50 | 3.00 | -50.0 % | 9% |" in text
+    assert "| avx512 | a | few-ray loop | 10.00 | 10.00 | +0.0 % | 30% |" in text
+    assert "stream loop" not in text
+    # Rows written before the loop clock carry no split, and say so.
+    older = df.drop(columns=[c for c in df.columns if "_loop_" in c])
+    assert "no traversal split" in silicon.loops_text(older)

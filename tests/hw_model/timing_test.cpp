@@ -476,6 +476,46 @@ TEST_CASE("A chain of dependent ops has nothing for the window or the other unit
     CHECK(double(a.stalls.pipeline_fill) >= 0.85 * double(a.cycles));
 }
 
+TEST_CASE("A box test's cycles go to the tracer loop its stream entered", "[hw_model][systemc]") {
+    // A 16-lane op (stream loop) passes 3 rays: their stream (3 lanes) and the 1-lane stream
+    // below it run in the few-ray loop on a back end of k_few_ray_min_width lanes or more; a
+    // 1-lane stream from another 16-lane op runs in the one-ray loop.
+    std::vector<uint8_t> three(16, 0), one(16, 0);
+    three[0] = three[1] = three[2] = 1;
+    one[0] = 1;
+    const std::vector<CraftedOp> ops = {{OpKind::box_test, consecutive(16), three, 1},
+                                        {OpKind::box_test, consecutive(3), {1, 0, 0}, 2},
+                                        {OpKind::box_test, consecutive(1), {1}, 3},
+                                        {OpKind::box_test, consecutive(16, 1, 16), one, 4},
+                                        {OpKind::box_test, consecutive(1, 1, 16), {0}, 5}};
+    const auto loops = [](const FrameTiming& t) {
+        return std::array<uint64_t, 3>{t.traversal_loop_cycles[0], t.traversal_loop_cycles[1],
+                                       t.traversal_loop_cycles[2]};
+    };
+    const FrameTiming wide = time_passes(with_width(16), {ops});
+    const FrameTiming narrow = time_passes(with_width(4), {ops});
+    CHECK(loops(wide)[size_t(TraversalLoop::one_ray)] > 0);
+    CHECK(loops(wide)[size_t(TraversalLoop::few_ray)] > 0);
+    CHECK(loops(wide)[size_t(TraversalLoop::stream)] > 0);
+    // Four lanes run 2-4-ray streams in the stream loop: the 1-lane stream below them is the
+    // one-ray loop's.
+    CHECK(loops(narrow)[size_t(TraversalLoop::few_ray)] == 0);
+    CHECK(loops(narrow)[size_t(TraversalLoop::one_ray)] >
+          loops(wide)[size_t(TraversalLoop::one_ray)]);
+    for (const FrameTiming* t : {&wide, &narrow}) {
+        const StageTiming& traversal = t->stages[1][size_t(OpStage::traversal)];
+        CHECK(t->traversal_loop_cycles[0] + t->traversal_loop_cycles[1] +
+                  t->traversal_loop_cycles[2] <=
+              traversal.busy_cycles + traversal.stall_cycles);
+    }
+    CHECK(traversal_loop(1, 16, TraversalLoop::stream) == TraversalLoop::one_ray);
+    CHECK(traversal_loop(k_few_ray_lanes, 16, TraversalLoop::stream) == TraversalLoop::few_ray);
+    CHECK(traversal_loop(k_few_ray_lanes + 1, 16, TraversalLoop::stream) ==
+          TraversalLoop::stream);
+    CHECK(traversal_loop(1, 16, TraversalLoop::few_ray) == TraversalLoop::few_ray);
+    CHECK(traversal_loop(3, 4, TraversalLoop::stream) == TraversalLoop::stream);
+}
+
 TEST_CASE("Prefetching an op's children requests the back child's node with the front child's",
           "[hw_model][systemc]") {
     // Every node first read from DRAM.

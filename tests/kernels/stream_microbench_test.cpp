@@ -34,6 +34,33 @@ TEST_CASE("The stage clock never changes a bit and counts every stage", "[stream
     }
 }
 
+TEST_CASE("The stage clock splits the traversal by the loop that runs its short streams",
+          "[stream][host]") {
+    // Atrium's 64-ray streams narrow to one ray (the one-ray loop) on every back end, and to
+    // two to four (the few-ray loop) where the back end has k_few_ray_min_width lanes or more.
+    const Scene scene = load_scene("atrium");
+    const Bvh bvh(scene);
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.spp = 1;
+    s.tile = 8;
+    s.threads = 1;
+    s.max_depth = scene.max_depth;
+    for (const Isa isa : supported_isas()) {
+        INFO(isa_name(isa));
+        s.isa = isa;
+        s.stage_clock = false;
+        const RenderResult plain = render_stream(scene, bvh, s);
+        s.stage_clock = true;
+        const RenderResult clocked = render_stream(scene, bvh, s);
+        CHECK(plain.stats.short_loop_tsc[0] + plain.stats.short_loop_tsc[1] == 0);
+        CHECK(clocked.stats.short_loop_tsc[0] > 0);
+        CHECK((clocked.stats.short_loop_tsc[1] > 0) == (isa_width(isa) >= k_few_ray_min_width));
+        CHECK(clocked.stats.short_loop_tsc[0] + clocked.stats.short_loop_tsc[1] <
+              clocked.stats.stage_tsc[0]);
+    }
+}
+
 TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][host]") {
     MicrobenchOptions o;
     o.buffer_slots = {64};

@@ -141,6 +141,12 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(m.predicted_stage[size_t(i)] > 0);
         CHECK(m.measured_stage[size_t(i)] > 0);
     }
+    // The traversal by loop: the measured loops are the measured traversal; the predicted ones
+    // its box tests (the stage also holds a pass's tail), the stream loop's among them.
+    CHECK(m.measured_loop[0] + m.measured_loop[1] + m.measured_loop[2] ==
+          Approx(m.measured_stage[0]));
+    CHECK(m.predicted_loop[2] > 0);
+    CHECK(m.predicted_loop[0] + m.predicted_loop[1] + m.predicted_loop[2] <= m.predicted_stage[0]);
     // Within a factor of 20 either way: only a broken flow (units, a lost stage) misses that.
     CHECK(m.predicted_frame / m.measured_frame > 0.05);
     CHECK(m.predicted_frame / m.measured_frame < 20);
