@@ -176,6 +176,8 @@ void add_calibrate_command(CLI::App& app) {
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                                            {"one_lane", k.one_lane_cycles},
                                            {"few_lane", k.few_lane_cycles},
+                                           {"one_ray_entry", k.one_ray_entry_cycles},
+                                           {"few_ray_entry", k.few_ray_entry_cycles},
                                            {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                                            {"fit_median_error", cal.fit_errors[i].first},
                                            {"fit_worst_error", cal.fit_errors[i].second}};
@@ -201,10 +203,16 @@ void add_calibrate_command(CLI::App& app) {
                                               {"lanes", o.lanes},
                                               {"count", o.count},
                                               {"passed", o.passed}});
-                    j["one_ray_samples"].push_back(
-                        {{"rays", s.rays}, {"streams", s.streams}, {"ops", ops},
-                         {"few_ops", few_ops}, {"stream_ops", stream_ops}, {"cycles", s.cycles},
-                         {"converged", s.converged}, {"repetitions", s.repetitions}});
+                    j["one_ray_samples"].push_back({{"rays", s.rays},
+                                                    {"streams", s.streams},
+                                                    {"entry_depth", s.entry_depth},
+                                                    {"entries", {s.entries[0], s.entries[1]}},
+                                                    {"ops", ops},
+                                                    {"few_ops", few_ops},
+                                                    {"stream_ops", stream_ops},
+                                                    {"cycles", s.cycles},
+                                                    {"converged", s.converged},
+                                                    {"repetitions", s.repetitions}});
                 }
                 j["hit_read_exposed_share"] = cal.hit_read_fit.share;
                 j["hit_read_fit_median_error"] = cal.hit_read_fit.error.first;
@@ -254,6 +262,10 @@ void add_calibrate_command(CLI::App& app) {
                 "traversals, fit error median %.1f%%, worst %.1f%%\n",
                 cal.one_ray_samples.size(), 100 * cal.short_stream_fit_errors.first,
                 100 * cal.short_stream_fit_errors.second);
+            for (const OpCostConfig& k : cal.op_costs)
+                if (k.op == "box_test")
+                    std::printf("entering the one-ray loop %.1f cycles, the few-ray loop %.1f\n",
+                                k.one_ray_entry_cycles, k.few_ray_entry_cycles);
             for (size_t i = 0; i < cal.op_costs.size(); ++i)
                 if (cal.op_costs[i].per_op_cycles != cal.filter_costs[i].per_op_cycles)
                     std::printf("  %s per_op: %.1f in a traversal (above), %.1f in the filter "

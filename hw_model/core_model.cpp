@@ -68,12 +68,14 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_timing = FrameTiming();
     m_timing.passes = 1;
     m_loop.assign(n, TraversalLoop::stream);
+    m_enters_loop.assign(n, 0);
     for (uint32_t i = 0; i < n; ++i) {
         const StreamOp op = pass->at(i);
         if (op.kind != OpKind::box_test) continue;
         const int32_t producer = pass->producer(i);
-        m_loop[i] = traversal_loop(op.length, width(),
-                                   producer < 0 ? TraversalLoop::stream : m_loop[producer]);
+        const TraversalLoop from = producer < 0 ? TraversalLoop::stream : m_loop[producer];
+        m_loop[i] = traversal_loop(op.length, width(), from);
+        m_enters_loop[i] = from == TraversalLoop::stream && m_loop[i] != TraversalLoop::stream;
     }
     m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
@@ -294,8 +296,10 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
         for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
     // Fractional measured cycles: the unit carries the remainder to its next group.
     const double exact =
-        m_unit_carry[unit] + p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes,
-                                            passed, t.first == 0, m_beyond_l1);
+        m_unit_carry[unit] +
+        p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes, passed, t.first == 0,
+                       m_beyond_l1) +
+        (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
     const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact)));
     m_unit_carry[unit] = exact - double(busy);
     e.issue_end = e.start + busy;

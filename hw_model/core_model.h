@@ -128,8 +128,10 @@ class CoreModel {
     std::vector<uint64_t> m_unit_free;      // per SIMD unit
     std::vector<double> m_unit_carry;       // per SIMD unit: fractional issue cycles owed
     std::vector<uint8_t> m_unit_stage;  // per SIMD unit: [secondary * 3 + stage] of its last group
-    // Per op: the native tracer's loop that runs it (TraversalLoop; a box test's, else stream).
+    // Per op: the native tracer's loop that runs it (TraversalLoop; a box test's, else stream),
+    // and whether it enters that loop from the stream loop (a short loop's first op).
     std::vector<TraversalLoop> m_loop;
+    std::vector<uint8_t> m_enters_loop;
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;

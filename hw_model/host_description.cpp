@@ -389,6 +389,10 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
               << ", few_lane_cycles: " << fmt(o.few_lane_cycles, 2)
+              << (o.one_ray_entry_cycles > 0 || o.few_ray_entry_cycles > 0
+                      ? ", one_ray_entry_cycles: " + fmt(o.one_ray_entry_cycles, 2) +
+                            ", few_ray_entry_cycles: " + fmt(o.few_ray_entry_cycles, 2)
+                      : std::string())
               << (o.hit_read_exposed_share > 0
                       ? ", hit_read_exposed_share: " + fmt(o.hit_read_exposed_share, 3)
                       : std::string())

@@ -349,7 +349,11 @@ struct DatapathConfig {
 // box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene. The box
 // test's per_op is fitted on traversals of longer streams too (a stream-loop op waits for the
 // one before's output; the filter microbenchmarks' calls are independent, and a core overlaps
-// them), its other terms on the filter microbenchmarks.
+// them), its other terms on the filter microbenchmarks. The box test that enters the one-ray or
+// the few-ray loop from the stream loop also costs one_ray_entry_cycles or few_ray_entry_cycles
+// (the loop's set-up, and the branches that leave it), fitted on traversals whose streams enter
+// at the root and deep in the tree: from the root every subtree holds about as many box tests,
+// and a frame's short streams start deep.
 // Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
@@ -361,6 +365,8 @@ struct OpCostConfig {
     double beyond_l1_per_lane_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
     double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
+    double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
+    double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L1D hit that the core does not overlap with other work, fitted
     // on the surface-read microbenchmark (scene arrays beyond the caches) through the same
@@ -394,6 +400,14 @@ struct OpCostConfig {
         v.param("few_lane_cycles", few_lane_cycles, "cycles",
                 "cost of an op of 2 to 4 lanes in the few-ray traversal loop (0: not measured; "
                 "the formula above applies)",
+                0.0, 1e9);
+        v.param("one_ray_entry_cycles", one_ray_entry_cycles, "cycles",
+                "cost of entering the one-ray traversal loop from the stream loop, besides its "
+                "ops (the box test that enters it carries it; 0: not measured)",
+                0.0, 1e9);
+        v.param("few_ray_entry_cycles", few_ray_entry_cycles, "cycles",
+                "cost of entering the few-ray traversal loop from the stream loop, besides its "
+                "ops (the box test that enters it carries it; 0: not measured)",
                 0.0, 1e9);
         v.param("hit_read_exposed_share", hit_read_exposed_share, "",
                 "share of each lane's hit-primitive read latency beyond an L1D hit that is not "

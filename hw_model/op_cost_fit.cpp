@@ -126,9 +126,10 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
     return x;
 }
 
-// A sample's one-lane counts, its few-lane counts and its stream-loop counts, as a row of the
-// fit.
-constexpr size_t k_short_terms = 3 * k_op_kind_count;
+// A sample's one-lane counts, its few-lane counts, its stream-loop counts and its loop entries,
+// as a row of the fit.
+constexpr size_t k_entry_terms = 3 * k_op_kind_count;
+constexpr size_t k_short_terms = k_entry_terms + 2;
 std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
     std::array<double, k_short_terms> row{};
     for (size_t k = 0; k < k_op_kind_count; ++k) {
@@ -136,6 +137,7 @@ std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
         row[k_op_kind_count + k] = double(s.few_ops[k]);
         row[2 * k_op_kind_count + k] = double(s.stream_ops[k]);
     }
+    for (size_t l = 0; l < 2; ++l) row[k_entry_terms + l] = double(s.entries[l]);
     return row;
 }
 
@@ -144,6 +146,7 @@ double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s
     for (size_t k = 0; k < k_op_kind_count; ++k)
         cycles += double(s.ops[k]) * costs.one_lane[k] + double(s.few_ops[k]) * costs.few_lane[k] +
                   double(s.stream_ops[k]) * costs.stream_per_op[k];
+    for (size_t l = 0; l < 2; ++l) cycles += double(s.entries[l]) * costs.entry[l];
     return cycles;
 }
 
@@ -198,6 +201,7 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         costs.stream_per_op[k] = x[2 * k_op_kind_count + k];
         costs.stream_measured[k] = active[2 * k_op_kind_count + k];
     }
+    for (size_t l = 0; l < 2; ++l) costs.entry[l] = x[k_entry_terms + l];
     return costs;
 }
 

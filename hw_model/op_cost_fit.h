@@ -50,6 +50,7 @@ struct OneLaneSample {
     std::array<uint64_t, k_op_kind_count> few_ops{};
     double stream_op_cycles = 0.0;
     std::array<uint64_t, k_op_kind_count> stream_ops{};
+    std::array<uint64_t, 2> entries{};  // the one-ray and few-ray loops entered (TraversalLoop)
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
@@ -62,6 +63,9 @@ struct OneLaneSample {
 struct ShortStreamCosts {
     std::array<double, k_op_kind_count> one_lane{}, few_lane{}, stream_per_op{};
     std::array<bool, k_op_kind_count> stream_measured{};  // the samples' stream loops made it
+    // What entering the one-ray and the few-ray loop costs besides their ops (OpCostConfig::
+    // one_ray_entry_cycles, few_ray_entry_cycles).
+    std::array<double, 2> entry{};
 };
 ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
 

@@ -265,6 +265,13 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
            cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
 }
 
+double OpProfile::loop_entry_cycles(TraversalLoop loop) const {
+    if (!measured) return 0.0;
+    if (loop == TraversalLoop::one_ray) return cost.one_ray_entry_cycles;
+    if (loop == TraversalLoop::few_ray) return cost.few_ray_entry_cycles;
+    return 0.0;
+}
+
 double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
     if (measured) return issue;
     if (cluster(d)) return double(schedule.length);

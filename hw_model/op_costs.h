@@ -98,6 +98,10 @@ struct OpProfile {
     // the body's modulo-schedule II (cluster).
     double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_passed,
                         uint32_t lanes, uint32_t passed, bool first, double beyond_l1) const;
+    // Cycles an op adds on its first group when it enters the traversal's one-ray or few-ray
+    // loop from the stream loop (TraversalLoop, kernels/trace.h): a measured box test's loop
+    // entry cost; 0 for any other op or loop.
+    double loop_entry_cycles(TraversalLoop loop) const;
     // Cycles from a group's first issue to its mask: the measured cost (its loads and chain are
     // inside it), the datapath's dependent chain or the cluster's schedule length.
     double result_cycles(const DatapathConfig& datapath, double issue) const;

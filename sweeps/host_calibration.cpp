@@ -53,7 +53,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
             cost_of[size_t(kind)] = &o;
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
-        OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}};
+        OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
         const double beyond = beyond_l1_fraction(s.slots, stream_slot_bytes(), l1d_kib);
         // One-lane leaf tests at their directly timed cost.
         for (size_t k = 0; k < k_op_kind_count; ++k)
@@ -92,6 +92,10 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
             o.one_lane_cycles = fit.one_lane[size_t(kind)];
         o.few_lane_cycles = fit.few_lane[size_t(kind)];
         if (fit.stream_measured[size_t(kind)]) o.per_op_cycles = fit.stream_per_op[size_t(kind)];
+        if (kind == OpKind::box_test) {
+            o.one_ray_entry_cycles = fit.entry[0];
+            o.few_ray_entry_cycles = fit.entry[1];
+        }
     }
 }
 

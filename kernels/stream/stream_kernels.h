@@ -127,6 +127,13 @@ struct TraversalStackEntry {
 // A depth-first walk of a binary tree keeps at most one entry per level, plus the one popped.
 constexpr uint32_t k_traversal_stack_size = Bvh::k_max_depth + 2;
 
+// The one-ray loop's ([0]) and the few-ray loop's ([1]) entries from the stream loop, and their
+// TSC ticks with their leaves' (TraversalJob::leaf_tsc) left out.
+struct ShortLoopClock {
+    uint64_t ticks[2] = {0, 0};
+    uint64_t entries[2] = {0, 0};
+};
+
 // What one traversal (Fig. 3) of a stream works on. Plain pointers, so the wide translation
 // units instantiate no out-of-line member of a library type.
 struct TraversalJob {
@@ -153,9 +160,9 @@ struct TraversalJob {
     uint16_t generation;
     OpStage box_stage, triangle_stage, sphere_stage;  // stage_of(their kinds)
     uint64_t* leaf_tsc;                               // not null: adds the TSC ticks in leaves
-    // Not null: adds the TSC ticks of the one-ray loop ([0]) and of the few-ray loop ([1]) run
-    // from the stream loop, the ticks of their leaves (leaf_tsc) left out.
-    uint64_t* short_loop_tsc;
+    // Not null: counts the one-ray and few-ray loops entered from the stream loop and adds
+    // their TSC ticks (ShortLoopClock).
+    ShortLoopClock* short_loops;
 };
 
 struct StreamKernels {

@@ -500,15 +500,16 @@ SFX_LANES_INLINE void timed_leaf(const TraversalJob& job, const BvhNode& node, u
     if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - start;
 }
 
-// `loop` (the one-ray loop 0, the few-ray loop 1), its TSC ticks less its leaves' added to
-// job.short_loop_tsc[loop] when the caller asks for the loop clock.
+// `loop` (the one-ray loop 0, the few-ray loop 1), counted and its TSC ticks less its leaves'
+// added to job.short_loops when the caller asks for them.
 template <class Loop>
 SFX_LANES_INLINE void timed_short_loop(const TraversalJob& job, int loop, Loop&& run) {
-    if (!job.short_loop_tsc) return run();
+    if (!job.short_loops) return run();
     const uint64_t leaf = job.leaf_tsc ? *job.leaf_tsc : 0, start = __rdtsc();
     run();
     const uint64_t in_leaves = job.leaf_tsc ? *job.leaf_tsc - leaf : 0;
-    job.short_loop_tsc[loop] += __rdtsc() - start - in_leaves;
+    job.short_loops->ticks[loop] += __rdtsc() - start - in_leaves;
+    ++job.short_loops->entries[loop];
 }
 
 // What a node's test will need next arrives while the test runs: an interior node's

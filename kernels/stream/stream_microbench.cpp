@@ -10,6 +10,7 @@
 #include "base/core_clock.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
+#include "kernels/intersect.h"
 #include "kernels/path.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
@@ -526,6 +527,27 @@ class OpLengthTally : public TraceSink {
     std::map<std::pair<OpKind, uint32_t>, std::pair<uint64_t, uint64_t>> m_tally;
 };
 
+namespace {
+
+// The node `depth` levels below the root on a ray's way down (the left child if the ray enters
+// its box, else the right), or the last it reached.
+uint32_t entry_below(const Bvh& bvh, const RayPrecomp& ray, float t_max, uint32_t depth) {
+    const BvhNodes& nodes = bvh.nodes();
+    uint32_t at = 0;
+    for (uint32_t d = 0; d < depth && !nodes[at].is_leaf(); ++d) {
+        const uint32_t left = BvhNode::left(at), right = nodes[at].right();
+        if (intersect_box(ray, nodes[left].bounds, t_max) < INFINITY)
+            at = left;
+        else if (intersect_box(ray, nodes[right].bounds, t_max) < INFINITY)
+            at = right;
+        else
+            break;
+    }
+    return at;
+}
+
+}  // namespace
+
 std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
                                                       uint64_t seed) {
     const Scene scene = synthetic_scene(true);
@@ -547,14 +569,21 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
     struct Shape {
         uint32_t rays, streams;  // rays per stream, streams one after another
         bool bundle;             // each stream a bundle (below), or rays drawn at random
+        uint32_t entry_depth = 0;
     };
     std::vector<Shape> shapes;
+    const bool few_loop = isa_width(resolved) >= k_few_ray_min_width;
     for (uint32_t streams : {1u, 2u, 4u, 8u, 16u, 32u}) shapes.push_back({1, streams, false});
     // Few-ray streams where the few-ray loop runs them: elsewhere the stream loop does, whose
     // costs the filter microbenchmarks measure.
-    if (isa_width(resolved) >= k_few_ray_min_width)
+    if (few_loop)
         for (uint32_t rays = 2; rays <= k_few_ray_lanes; ++rays)
             for (uint32_t streams : {4u, 8u, 16u, 32u}) shapes.push_back({rays, streams, false});
+    // Short streams entering deep, whose subtrees are small: what a loop's start costs apart
+    // from its box tests (from the root, every stream's subtree holds about as many).
+    for (uint32_t depth : {3u, 6u})
+        for (uint32_t rays = 1; rays <= (few_loop ? k_few_ray_lanes : 1u); ++rays)
+            for (uint32_t streams : {8u, 32u}) shapes.push_back({rays, streams, false, depth});
     // Streams the stream loop starts (every back end): its box tests in a traversal, where each
     // op's stream is the one before's output, not the filter microbenchmarks' independent calls;
     // bundles that stay together, as a tile's camera rays do, and rays that part at once, as
@@ -592,9 +621,10 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                     b.hit[ids[i]] = Hit{};
                 }
             };
-            auto traverse = [&](uint32_t* ids, TraceDetail detail) {
+            auto traverse = [&](uint32_t* ids, TraceDetail detail, uint32_t entry_depth) {
                 job.n = rays;
                 job.ids = ids;
+                job.entry = entry_below(bvh, b.pre[ids[0]], b.ray[ids[0]].t_max, entry_depth);
                 job.shared_origin = shared_origin(job.rays, ids, rays);  // as the tracer
                 kernels.traverse[int(detail)](job);
             };
@@ -604,7 +634,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             };
             auto run = [&](TraceDetail detail) {
                 for (uint32_t s = 0; s < streams; ++s)
-                    traverse(stream_ids.data() + size_t(s) * stride, detail);
+                    traverse(stream_ids.data() + size_t(s) * stride, detail, shape.entry_depth);
             };
             // Before each repetition, every other ray's traversal, in streams of as many rays, in
             // a new order: a branch predictor learns a batch of a few traversals that repeats
@@ -617,19 +647,24 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                 other_ids.assign(stride, 0u);
                 for (uint32_t first = batch_rays; first + rays <= k_slots; first += rays) {
                     load_stream(first, other_ids.data());
-                    traverse(other_ids.data(), TraceDetail::none);
+                    traverse(other_ids.data(), TraceDetail::none, 0);
                 }
             };
             OneRaySample sample;
             sample.rays = rays;
             sample.streams = streams;
             sample.slots = batch_rays;
+            sample.entry_depth = shape.entry_depth;
             OpLengthTally tally;
+            ShortLoopClock loops;
             job.sink = &tally;
+            job.short_loops = &loops;
             reset();
             run(TraceDetail::counts);
             tally.fill(sample, isa_width(resolved));
+            sample.entries = {loops.entries[0], loops.entries[1]};
             job.sink = nullptr;
+            job.short_loops = nullptr;
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
             while (needs_more_samples(times, convergence)) {

@@ -84,6 +84,13 @@ struct OneRaySample {
     uint32_t rays = 0;         // per stream
     uint32_t streams = 0;      // traversed one after another
     uint32_t slots = 0;        // of the ray buffer the batch's rays occupy (its footprint)
+    // Where each stream enters the tree: the root (0), or the node this many levels down its
+    // first ray's way (a frame's short streams start deep: a one-ray subtree of atrium, 64 x 64,
+    // tile 16, holds 4.9 box tests, a ray from the root 15 in this scene).
+    uint32_t entry_depth = 0;
+    // The one-ray and few-ray loops the traversals entered from the stream loop (a stream of one
+    // to k_few_ray_lanes rays enters one at once): what costs a loop's start (ShortLoopClock).
+    std::array<uint64_t, 2> entries{};
     // Counted by the same traversals: per kind, its one-lane ops (the one-ray loop's) and its
     // few-ray loop's ops (box tests of 2 to k_few_ray_lanes lanes on a wide back end); every
     // other op by kind and length (priced by the stream formula).
@@ -95,8 +102,9 @@ struct OneRaySample {
     uint32_t repetitions = 0;
 };
 // Batches of 1 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
-// 32 streams of 2, 3 and 4 rays; and of 1 and 4 streams of 8 to 128 rays, whose first ops run
-// in the stream loop (several batches of each shape), drawn from 4096 rays; before
+// 32 streams of 2, 3 and 4 rays; the same streams entering 3 and 6 levels down (8 and 32 of
+// them); and of 1 and 4 streams of 8 to 128 rays, whose first ops run in the stream loop
+// (several batches of each shape), drawn from 4096 rays; before
 // each repetition of a batch the other rays are traversed in a new order, so that a branch
 // predictor meets the batch as a frame's traversals, which never repeat.
 std::vector<OneRaySample> run_one_ray_microbenchmarks(

@@ -102,10 +102,10 @@ constexpr TraceDetail trace_detail() {
 // (StreamKernels::traverse), so its box filter and leaf tests run at the host's width without a
 // table call.
 // The stage clock's ticks in a generation's traversal: in leaves, and in the one-ray and
-// few-ray loops less their leaves (TraversalJob::leaf_tsc, short_loop_tsc).
+// few-ray loops less their leaves (TraversalJob::leaf_tsc, short_loops).
 struct TraversalClock {
     uint64_t leaf = 0;
-    uint64_t short_loop[2] = {0, 0};
+    ShortLoopClock short_loops;
 };
 
 template <class Trace>
@@ -122,7 +122,7 @@ void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint3
     if constexpr (Trace::k_enabled) job.sink = trace.sink;
     job.generation = generation;
     job.leaf_tsc = clock ? &clock->leaf : nullptr;
-    job.short_loop_tsc = clock ? clock->short_loop : nullptr;
+    job.short_loops = clock ? &clock->short_loops : nullptr;
     kernels.traverse[int(trace_detail<Trace>())](job);
 }
 
@@ -500,7 +500,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             const uint64_t spent = __rdtsc() - start;
             stats.stage_tsc[0] += spent - ticks.leaf;
             stats.stage_tsc[1] += ticks.leaf;
-            for (int l = 0; l < 2; ++l) stats.short_loop_tsc[l] += ticks.short_loop[l];
+            for (int l = 0; l < 2; ++l) stats.short_loop_tsc[l] += ticks.short_loops.ticks[l];
             traverse_tsc += spent;
         } else {
             traverse_generation(traversal_rays, generation, entry, stats, trace, nullptr);

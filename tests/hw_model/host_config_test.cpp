@@ -259,8 +259,10 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
           "stream-priced groups and lanes take",
           "[host]") {
     auto sample = [](uint64_t boxes, uint64_t triangles, uint64_t spheres, uint64_t few_boxes,
-                     uint64_t stream_boxes, double stream_cycles) {
+                     uint64_t stream_boxes, double stream_cycles, uint64_t one_entries = 0,
+                     uint64_t few_entries = 0) {
         OneLaneSample s;
+        s.entries = {one_entries, few_entries};
         s.ops[size_t(OpKind::box_test)] = boxes;
         s.ops[size_t(OpKind::triangle_test)] = triangles;
         s.ops[size_t(OpKind::sphere_test)] = spheres;
@@ -268,7 +270,7 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
         s.stream_ops[size_t(OpKind::box_test)] = stream_boxes;
         s.stream_op_cycles = stream_cycles;
         s.cycles = 30.0 * boxes + 90.0 * triangles + 40.0 * spheres + 55.0 * few_boxes +
-                   140.0 * stream_boxes + stream_cycles;
+                   140.0 * stream_boxes + stream_cycles + 25.0 * one_entries + 260.0 * few_entries;
         return s;
     };
     std::vector<OneLaneSample> samples;
@@ -306,6 +308,74 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     for (OneLaneSample& s : unpriced) s.stream_op_cycles = 0;
     CHECK(fit_short_stream_cycles(unpriced).few_lane[size_t(OpKind::box_test)] > 60);
     CHECK_THROWS_AS(fit_short_stream_cycles({}), std::invalid_argument);
+
+    // Loop entries: told from the ops only where subtrees hold fewer or more ops per entry (as
+    // streams that enter deep and at the root do).
+    std::vector<OneLaneSample> entered;
+    for (uint64_t b : {7u, 23u, 130u})
+        for (uint64_t t : {0u, 2u, 12u})
+            for (uint64_t f : {0u, 3u, 40u})
+                for (uint64_t e : {1u, 4u, 9u})
+                    for (uint64_t g : {0u, 2u, 5u})
+                        entered.push_back(sample(b, t, 1, f, 4, 500.0, e, g));
+    const ShortStreamCosts with_entries = fit_short_stream_cycles(entered);
+    CHECK(with_entries.entry[0] == Approx(25).epsilon(1e-6));
+    CHECK(with_entries.entry[1] == Approx(260).epsilon(1e-6));
+    CHECK(with_entries.one_lane[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
+    CHECK(with_entries.few_lane[size_t(OpKind::box_test)] == Approx(55).epsilon(1e-6));
+    CHECK(short_stream_fit_error(with_entries, entered).second < 1e-9);
+    ShortStreamCosts no_entry = with_entries;
+    no_entry.entry[1] = 0;
+    CHECK(short_stream_fit_error(no_entry, entered).second > 0.05);
+    CHECK(fit.entry[0] == 0.0);  // samples without entries: none fitted
+}
+
+TEST_CASE("The box test that enters a short loop from the stream loop carries its entry cost",
+          "[host]") {
+    OpProfile p;
+    p.measured = true;
+    p.cost.one_ray_entry_cycles = 25;
+    p.cost.few_ray_entry_cycles = 260;
+    CHECK(p.loop_entry_cycles(TraversalLoop::one_ray) == 25);
+    CHECK(p.loop_entry_cycles(TraversalLoop::few_ray) == 260);
+    CHECK(p.loop_entry_cycles(TraversalLoop::stream) == 0);
+    p.measured = false;  // instruction-priced: no loops
+    CHECK(p.loop_entry_cycles(TraversalLoop::few_ray) == 0);
+
+    // In the machine model: a 16-lane box test passes one ray, whose stream enters the one-ray
+    // loop (its first op carries the entry), and the op below it stays in that loop.
+    auto time_chain = [](double entry) {
+        OpCostConfig box = cost("box_test", 10, 4, 0, 0, 0);
+        box.one_lane_cycles = 5;
+        box.one_ray_entry_cycles = entry;
+        SystemcTiming timing({host_with({box})}, shape());
+        const std::vector<uint32_t> ids = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+        std::vector<uint8_t> first(16, 0), one = {1};
+        first[0] = 1;
+        TilePass pass;
+        pass.slot_count = 64;
+        timing.begin_pass(pass);
+        for (uint32_t length : {16u, 1u, 1u}) {
+            StreamOp op;
+            op.kind = OpKind::box_test;
+            op.stage = OpStage::traversal;
+            op.length = length;
+            op.pass_count = 1;
+            op.slots = ids.data();
+            op.passed = length == 16 ? first.data() : one.data();
+            timing.op(op);
+        }
+        timing.end_pass(pass);
+        return timing.timing(0);
+    };
+    const FrameTiming without = time_chain(0), with = time_chain(100);
+    const auto busy = [](const FrameTiming& t) {
+        return t.stages[0][size_t(OpStage::traversal)].busy_cycles;
+    };
+    CHECK(busy(without) == 10 + 4 + 5 + 5);
+    CHECK(busy(with) == busy(without) + 100);  // one entry, not two
+    CHECK(with.traversal_loop_cycles[size_t(TraversalLoop::one_ray)] ==
+          without.traversal_loop_cycles[size_t(TraversalLoop::one_ray)] + 100);
 }
 
 TEST_CASE("The machine model times a host: measured costs, scene data beyond the L1D",
@@ -375,6 +445,8 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.one_lane_cycles = 6;
     box.few_lane_cycles = 4.5;
     box.per_minority_lane_cycles = 7;
+    box.one_ray_entry_cycles = 8;
+    box.few_ray_entry_cycles = 9.5;
     HostDescription host = small_host();
     host.last_level_chases = {{4096, 15.5}, {8192, 98.4}, {16384, 130.5}};
     const std::string yaml = host_hw_yaml(host, {box}, "test samples");
@@ -395,6 +467,8 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
     CHECK(c.op_costs[0].few_lane_cycles == Approx(4.5));
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
+    CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
+    CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
     // A host file written before one-lane costs were measured: the formula for every op.
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
                           "old.hw.yaml")

@@ -37,7 +37,20 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     const bool wide = isa_width(isa) >= k_few_ray_min_width;
     std::map<OpKind, uint64_t> made, few, streamed, streamed_short;
     double one_ray_cycles = 0;
+    // Short streams' box tests and entries, by the depth they enter at.
+    std::map<uint32_t, std::pair<uint64_t, uint64_t>> ops_and_entries;
+    uint64_t long_stream_entries = 0;
     for (const OneRaySample& s : one_ray) {
+        // A stream of 1 to k_few_ray_lanes rays enters its loop at once: one entry a stream.
+        if (s.rays <= k_few_ray_lanes && (s.rays == 1 || wide)) {
+            CHECK(s.entries[0] + s.entries[1] == s.streams);
+            CHECK(s.entries[s.rays == 1 ? 0 : 1] == s.streams);
+            ops_and_entries[s.entry_depth].first +=
+                s.ops[size_t(OpKind::box_test)] + s.few_ops[size_t(OpKind::box_test)];
+            ops_and_entries[s.entry_depth].second += s.streams;
+        }
+        if (s.rays > k_few_ray_lanes) long_stream_entries += s.entries[0] + s.entries[1];
+        CHECK((wide || s.entries[1] == 0));
         // A batch of one ray that misses the root costs about what reading the TSC does, so
         // its cycles can be 0 (after the overhead); the batches together cannot.
         CHECK(s.cycles >= 0);
@@ -56,6 +69,15 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         if (s.rays == 1) CHECK(s.stream_ops.empty());
     }
     CHECK(one_ray_cycles > 0);
+    CHECK(long_stream_entries > 0);  // longer streams narrow into the short loops
+    // Streams that enter deep run fewer box tests each than streams from the root: what tells a
+    // loop's entry from its ops.
+    REQUIRE(ops_and_entries.size() == 3);
+    auto per_entry = [&](uint32_t depth) {
+        return double(ops_and_entries[depth].first) / double(ops_and_entries[depth].second);
+    };
+    CHECK(per_entry(6) < per_entry(3));
+    CHECK(per_entry(3) < per_entry(0));
     CHECK(made.size() == 3);
     CHECK(made[OpKind::box_test] > 10 * one_ray.size());  // deep enough to be a loop
     CHECK(made[OpKind::triangle_test] > 0);
@@ -95,6 +117,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(short_costs.one_lane[size_t(OpKind::box_test)] > 0);
     CHECK((short_costs.few_lane[size_t(OpKind::box_test)] > 0) == wide);
     CHECK(short_costs.stream_measured[size_t(OpKind::box_test)]);
+    if (!wide) CHECK(short_costs.entry[1] == 0.0);  // no few-ray loop: no entry to fit
     set_short_stream_costs(short_costs, costs);
     const HwConfig config = parse_hw_config(host_hw_yaml(host, costs, "test"), "host.hw.yaml");
 
