@@ -351,9 +351,9 @@ struct DatapathConfig {
 // one before's output; the filter microbenchmarks' calls are independent, and a core overlaps
 // them), its other terms on the filter microbenchmarks. The box test that enters the one-ray or
 // the few-ray loop from the stream loop also costs one_ray_entry_cycles or few_ray_entry_cycles
-// (the loop's set-up, and the branches that leave it), fitted on traversals whose streams enter
-// at the root and deep in the tree: from the root every subtree holds about as many box tests,
-// and a frame's short streams start deep.
+// (whatever a loop's start and end cost beyond its box tests), fitted on traversals whose
+// streams enter at the root and deep in the tree: from the root every subtree holds about as
+// many box tests, and a frame's short streams start deep.
 // Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
