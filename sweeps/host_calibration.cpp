@@ -183,10 +183,12 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "error; the triangle and sphere tests' one-lane costs their one-lane points' "
          << "median (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
          << "+ lanes) few-lane box "
-         << "costs, and the stream loop's per-op box cost, from " << c.one_ray_samples.size()
+         << "costs, the one-ray and few-ray loops' entry costs and the stream loop's per-op "
+         << "box cost, from " << c.one_ray_samples.size()
          << " batches of traversals (1-32 streams of 1 to " << k_few_ray_lanes
-         << " rays, 1 and 4 of 8 to 128) of the same scene, other rays' traversals between "
-         << "repetitions; the hit reads' exposed "
+         << " rays from the root, 8 and 32 entering 3 and 6 levels down, 1 and 4 of 8 to 128) "
+         << "of the same scene, other rays' traversals between repetitions; the hit reads' "
+         << "exposed "
          << "share from " << c.surface_read_samples.size()
          << " streams of 4096 hits on meshes of 416 KiB-52 MiB against a resident one, "
          << "through the cache model (relative error median "

@@ -90,6 +90,13 @@ constexpr TraceDetail trace_detail() {
                              : TraceDetail::counts;
 }
 
+// The stage clock's ticks in a generation's traversal: in leaves, and in the one-ray and
+// few-ray loops less their leaves (TraversalJob::leaf_tsc, short_loops).
+struct TraversalClock {
+    uint64_t leaf = 0;
+    ShortLoopClock short_loops;
+};
+
 // Fig. 3: test the stream against the node's box, filter, stop on empty; at a leaf intersect
 // each primitive with the sub-stream; else the front child, then the back child. Closest-hit
 // rays tighten their t as they find hits; shadow rays leave the stream once occluded.
@@ -101,13 +108,6 @@ constexpr TraceDetail trace_detail() {
 // holds every leaf the stream's rays can reach). The loop is the back end's
 // (StreamKernels::traverse), so its box filter and leaf tests run at the host's width without a
 // table call.
-// The stage clock's ticks in a generation's traversal: in leaves, and in the one-ray and
-// few-ray loops less their leaves (TraversalJob::leaf_tsc, short_loops).
-struct TraversalClock {
-    uint64_t leaf = 0;
-    ShortLoopClock short_loops;
-};
-
 template <class Trace>
 void traverse(const StreamKernels& kernels, const Bvh& bvh, RayBuffers& b, uint32_t n,
               uint16_t generation, Trace& trace, uint32_t entry = 0,
