@@ -73,19 +73,19 @@ SFX_LANES_INLINE vfloat<Width> minus_origin(vfloat<Width> plane, BoxRelativeToOr
 }
 
 // The slab's near and far planes on one axis: (hi, lo) where the direction is negative (its
-// inverse's sign bit set: -0 too), else (lo, hi). One lane picks them by bit operations on the
-// sign, not by `negative ? hi : lo`, which GCC compiles to a jump that mispredicts on rays of
-// mixed directions: the scalar box filter's cost a lane then followed the rays' directions
-// (1 : 2.3 : 5.2 for rays of one sign, of random x signs as the microbenchmark's, of random
-// signs on every axis, as a frame's bounced rays; AMD Zen 5 VM, 2026-11-27), which no per-op
-// cost and no trace carries. By bit operations it is 1.5 on all three.
+// inverse's sign bit set: -0 too), else (lo, hi). One lane picks them by bit operations, not
+// by `negative ? hi : lo`, which GCC compiles to a jump that mispredicts on rays of mixed
+// directions: the scalar box filter's cost a lane then followed the rays' directions (1 : 2.3
+// : 5.2 for rays of one sign, of random x signs as the microbenchmark's, of random signs on
+// every axis as a frame's bounced rays; by bit operations 1.5 on all three; AMD Zen 5 VM,
+// 2026-11-27), which no per-op cost and no trace carries.
 template <int Width>
 SFX_LANES_INLINE void planes_by_sign(vfloat<Width> inv_dir, float lo, float hi,
                                      vfloat<Width>& near_plane, vfloat<Width>& far_plane) {
     if constexpr (Width == 1) {
         const __m128i l = _mm_castps_si128(_mm_set_ss(lo)), h = _mm_castps_si128(_mm_set_ss(hi));
         const __m128i negative = _mm_srai_epi32(_mm_castps_si128(_mm_set_ss(inv_dir)), 31);
-        const __m128i swap = _mm_and_si128(_mm_xor_si128(l, h), negative);
+        const __m128i swap = _mm_and_si128(_mm_xor_si128(l, h), negative);  // lo ^ hi or 0
         near_plane = _mm_cvtss_f32(_mm_castsi128_ps(_mm_xor_si128(l, swap)));
         far_plane = _mm_cvtss_f32(_mm_castsi128_ps(_mm_xor_si128(h, swap)));
     } else {
@@ -157,7 +157,16 @@ struct ShearedTriangle {
 template <int Width>
 SFX_LANES_INLINE vfloat<Width> pick_axis(vint<Width> k, vfloat<Width> x, vfloat<Width> y,
                                          vfloat<Width> z) {
-    return select(k == 0, x, select(k == 1, y, z));
+    if constexpr (Width == 1) {
+        // Indexed, not by jumps (GCC's code for the selects), which mispredict where the major
+        // axis changes from ray to ray: the scalar triangle filter cost 2.3-2.8 times as much
+        // a lane on rays of random major axes as on rays of one (AMD Zen 5 VM, 2026-11-27);
+        // indexed, 0.8-0.95 of the latter on both.
+        const float axes[3] = {x, y, z};
+        return axes[k];
+    } else {
+        return select(k == 0, x, select(k == 1, y, z));
+    }
 }
 
 // One vertex relative to the origin, sheared: x, y and the distance along the major axis.
