@@ -151,10 +151,19 @@ struct GroupReader {
 template <int Width>
 SFX_LANES_INLINE uint32_t negative_lanes(const vfloat<Width> (&inv_dir)[3], int axis,
                                          uint32_t lanes) {
-    const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
-    const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
-    return uint32_t(__builtin_popcount(
-        bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & lanes));
+    if constexpr (Width == 1) {
+        // Indexed and without jumps (GCC's code for the ternaries and &&): the one-ray loop
+        // votes at every inner node, whose split axis changes from node to node and whose
+        // sign follows the ray's direction, so jumps would mispredict on a frame's bounced
+        // rays as they do not on coherent ones (see planes_by_sign, kernels/intersect.h).
+        const float inv = inv_dir[axis];
+        return uint32_t((inv < 0.f) & (inv != -INFINITY)) & lanes;
+    } else {
+        const vfloat<Width> inv = axis == 0 ? inv_dir[0] : axis == 1 ? inv_dir[1] : inv_dir[2];
+        const vfloat<Width> zero = broadcast<Width>(0.f), minus_inf = broadcast<Width>(-INFINITY);
+        return uint32_t(__builtin_popcount(
+            bits<Width>(mask_and<vbool<Width>>(inv < zero, inv != minus_inf)) & lanes));
+    }
 }
 
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
@@ -554,10 +563,12 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
             continue;
         }
         // The front child by the ray's sign on the split axis: box_group's vote of one lane.
-        const bool right_first = negative_lanes<1>(inv_dir, node.axis, 1u) == 1;
+        const uint32_t right_first = negative_lanes<1>(inv_dir, node.axis, 1u);
         const uint32_t left = BvhNode::left(node_index), right = node.right();
-        stack[depth++] = right_first ? left : right;  // back: popped last
-        stack[depth++] = right_first ? right : left;
+        // right_first ? (left, right) : (right, left), without a jump (negative_lanes).
+        const uint32_t swap = (left ^ right) & (0u - right_first);
+        stack[depth++] = right ^ swap;  // back: popped last
+        stack[depth++] = left ^ swap;
     }
 }
 
@@ -619,10 +630,12 @@ SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint3
             continue;
         }
         // The front child by a majority of the passing rays' direction signs, as box_group's.
-        const bool right_first = 2 * negative_lanes<W>(ray.inv_dir, node.axis, pass) > k;
+        const uint32_t right_first = 2 * negative_lanes<W>(ray.inv_dir, node.axis, pass) > k;
         const uint32_t left = BvhNode::left(top.node), right = node.right();
-        stack[depth++] = {right_first ? left : right, pass};  // back: popped last
-        stack[depth++] = {right_first ? right : left, pass};
+        // right_first ? (left, right) : (right, left), without a jump, as traverse_one's.
+        const uint32_t swap = (left ^ right) & (0u - right_first);
+        stack[depth++] = {right ^ swap, pass};  // back: popped last
+        stack[depth++] = {left ^ swap, pass};
     }
 }
 
