@@ -166,6 +166,19 @@ SFX_LANES_INLINE uint32_t negative_lanes(const vfloat<Width> (&inv_dir)[3], int 
     }
 }
 
+// A node's children in push order: `back` (popped last), then `front`, the right child in
+// front where right_first. By an xor swap, not a jump: the choice follows the rays' direction
+// signs (negative_lanes), and GCC's jumps for it mispredict on a frame's bounced rays.
+struct ChildOrder {
+    uint32_t back, front;
+};
+SFX_LANES_INLINE ChildOrder child_order(uint32_t node_index, const BvhNode& node,
+                                        bool right_first) {
+    const uint32_t left = BvhNode::left(node_index), right = node.right();
+    const uint32_t swap = (left ^ right) & (0u - uint32_t(right_first));
+    return {right ^ swap, left ^ swap};
+}
+
 // One group of box_filter: the `left` ids from ids on (all of them if left >= Width).
 // Shared: the lanes share their origin, and `box` is relative to it.
 template <int Width, bool Shared>
@@ -563,12 +576,10 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
             continue;
         }
         // The front child by the ray's sign on the split axis: box_group's vote of one lane.
-        const uint32_t right_first = negative_lanes<1>(inv_dir, node.axis, 1u);
-        const uint32_t left = BvhNode::left(node_index), right = node.right();
-        // right_first ? (left, right) : (right, left), without a jump (negative_lanes).
-        const uint32_t swap = (left ^ right) & (0u - right_first);
-        stack[depth++] = right ^ swap;  // back: popped last
-        stack[depth++] = left ^ swap;
+        const ChildOrder order =
+            child_order(node_index, node, negative_lanes<1>(inv_dir, node.axis, 1u) == 1);
+        stack[depth++] = order.back;
+        stack[depth++] = order.front;
     }
 }
 
@@ -630,12 +641,10 @@ SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint3
             continue;
         }
         // The front child by a majority of the passing rays' direction signs, as box_group's.
-        const uint32_t right_first = 2 * negative_lanes<W>(ray.inv_dir, node.axis, pass) > k;
-        const uint32_t left = BvhNode::left(top.node), right = node.right();
-        // right_first ? (left, right) : (right, left), without a jump, as traverse_one's.
-        const uint32_t swap = (left ^ right) & (0u - right_first);
-        stack[depth++] = {right ^ swap, pass};  // back: popped last
-        stack[depth++] = {left ^ swap, pass};
+        const ChildOrder order =
+            child_order(top.node, node, 2 * negative_lanes<W>(ray.inv_dir, node.axis, pass) > k);
+        stack[depth++] = {order.back, pass};
+        stack[depth++] = {order.front, pass};
     }
 }
 
@@ -691,10 +700,9 @@ void traverse(const TraversalJob& job) {
             timed_leaf<Width, Detail>(job, node, k, report);
         } else {
             // The front child by a majority of the passing rays' direction signs.
-            const bool right_first = 2 * negative > k;
-            const uint32_t left = BvhNode::left(node_index), right = node.right();
-            stack[depth++] = {right_first ? left : right, k};  // back: popped last
-            stack[depth++] = {right_first ? right : left, k};
+            const ChildOrder order = child_order(node_index, node, 2 * negative > k);
+            stack[depth++] = {order.back, k};
+            stack[depth++] = {order.front, k};
         }
     }
     if constexpr (Detail == TraceDetail::counts) report.send();
