@@ -185,7 +185,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "+ lanes) few-lane box "
          << "costs, the one-ray and few-ray loops' entry costs and the stream loop's per-op "
          << "box cost, from " << c.one_ray_samples.size()
-         << " batches of traversals (1-32 streams of 1 to " << k_few_ray_lanes
+         << " batches of traversals (8-32 streams of one ray and 4-32 of 2 to " << k_few_ray_lanes
          << " rays from the root, 8 and 32 entering 3 and 6 levels down, 1 and 4 of 8 to 128) "
          << "of the same scene, other rays' traversals between repetitions; the hit reads' "
          << "exposed "

@@ -101,7 +101,7 @@ struct OneRaySample {
     bool converged = false;
     uint32_t repetitions = 0;
 };
-// Batches of 1 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
+// Batches of 8 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
 // 32 streams of 2, 3 and 4 rays; the same streams entering 3 and 6 levels down (8 and 32 of
 // them); and of 1 and 4 streams of 8 to 128 rays, whose first ops run in the stream loop
 // (several batches of each shape), drawn from 4096 rays; before

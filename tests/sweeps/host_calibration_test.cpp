@@ -56,6 +56,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(s.cycles >= 0);
         one_ray_cycles += s.cycles;
         CHECK(s.slots == s.rays * s.streams);  // the batch's footprint
+        CHECK((s.rays > 1 || s.streams >= 8));  // one-ray streams by the 8 at least, as frames
         for (uint32_t k = 0; k < k_op_kind_count; ++k) {
             if (s.ops[k]) made[OpKind(k)] += s.ops[k];
             if (s.few_ops[k]) few[OpKind(k)] += s.few_ops[k];
