@@ -154,8 +154,8 @@ SFX_LANES_INLINE uint32_t negative_lanes(const vfloat<Width> (&inv_dir)[3], int 
     if constexpr (Width == 1) {
         // Indexed and without jumps (GCC's code for the ternaries and &&): the one-ray loop
         // votes at every inner node, whose split axis changes from node to node and whose
-        // sign follows the ray's direction, so jumps would mispredict on a frame's bounced
-        // rays as they do not on coherent ones (see planes_by_sign, kernels/intersect.h).
+        // sign follows the ray's direction: jumps mispredict on a frame's bounced rays, not on
+        // the microbenchmarks' rays of fixed y and z signs (planes_by_sign, kernels/intersect.h).
         const float inv = inv_dir[axis];
         return uint32_t((inv < 0.f) & (inv != -INFINITY)) & lanes;
     } else {

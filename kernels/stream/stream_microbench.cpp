@@ -576,8 +576,8 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
     // One-ray streams by the 8 to 32, as a frame runs them (hundreds in a row): a batch of one
     // to four, timed again and again, ran 13-33 % cheaper a box test than a batch of 32 (AMD
     // Zen 5 VM, 2026-11-27), a regime no frame has, and with them the fit could not tell the
-    // one-ray entry cost (0 to 98 cycles over six fits; from 8 streams on, three fits' samples
-    // gave 120-157, residuals median 4-5 % and worst 15-24 %, against 9-16 % and 93-123 %).
+    // one-ray entry cost: 0 to 98 cycles over six fits, the one-lane fit's worst error 65-103 %;
+    // without them, 21-48 (AVX2, AVX-512) and 88-101 (scalar) over six, worst error 21-44 %.
     for (uint32_t streams : {8u, 16u, 32u}) shapes.push_back({1, streams, false});
     // Few-ray streams where the few-ray loop runs them: elsewhere the stream loop does, whose
     // costs the filter microbenchmarks measure.
