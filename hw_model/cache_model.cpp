@@ -6,7 +6,8 @@
 
 namespace sfx {
 
-SetAssociativeCache::SetAssociativeCache(const CacheLevelConfig& config) : m_config(config) {
+SetAssociativeCache::SetAssociativeCache(const CacheLevelConfig& config, double core_mhz)
+    : m_config(config) {
     const uint64_t lines = uint64_t(config.kib) * 1024 / config.line_bytes;
     if (config.ways == 0 || lines % config.ways != 0 ||
         (config.line_bytes & (config.line_bytes - 1)))
@@ -17,6 +18,7 @@ SetAssociativeCache::SetAssociativeCache(const CacheLevelConfig& config) : m_con
     while ((1u << m_line_shift) < config.line_bytes) ++m_line_shift;
     m_tree_ways = 1;
     while (m_tree_ways < m_ways) m_tree_ways *= 2;
+    m_foreign_per_set_cycle = config.foreign_fill_per_us / core_mhz / double(m_sets);
     clear();
 }
 
@@ -24,6 +26,31 @@ void SetAssociativeCache::clear() {
     m_tags.assign(size_t(m_sets) * m_ways, ~0ull);
     m_plru.assign(size_t(m_sets) * std::max(1u, m_tree_ways - 1), 0);
     m_hits = m_misses = 0;
+    if (m_foreign_per_set_cycle > 0) {
+        m_foreign_since.assign(m_sets, 0);
+        m_foreign_due.assign(m_sets, 0.0);
+    }
+}
+
+// Others' fills due in `set` since its last lookup, in whole lines (the rest carried); more
+// than the ways have replaced the set whatever their number. Their tags have the top bit set,
+// which no address of this machine's reaches.
+void SetAssociativeCache::fill_foreign(uint32_t set, uint64_t now) {
+    if (now <= m_foreign_since[set]) return;  // another core's lookup, earlier in time
+    const double due =
+        m_foreign_due[set] + double(now - m_foreign_since[set]) * m_foreign_per_set_cycle;
+    m_foreign_since[set] = now;
+    const uint32_t lines = uint32_t(std::min<double>(std::floor(due), m_ways));
+    m_foreign_due[set] = due - std::floor(due);
+    uint64_t* tags = &m_tags[size_t(set) * m_ways];
+    for (uint32_t i = 0; i < lines; ++i) {
+        uint32_t way = m_ways;
+        for (uint32_t w = 0; w < m_ways && way == m_ways; ++w)
+            if (tags[w] == ~0ull) way = w;
+        if (way == m_ways) way = victim(set);
+        tags[way] = (1ull << 63) | (m_foreign_tag++ & ((1ull << 62) - 1));
+        touch(set, way);
+    }
 }
 
 // Tree PLRU: each internal node's bit points to the half to evict next; touching a way turns
@@ -54,9 +81,10 @@ uint32_t SetAssociativeCache::victim(uint32_t set) const {
     return std::min(lo, m_ways - 1);
 }
 
-bool SetAssociativeCache::access(uint64_t address) {
+bool SetAssociativeCache::access(uint64_t address, uint64_t now) {
     const uint64_t line = address >> m_line_shift;
     const uint32_t set = uint32_t(line % m_sets);
+    if (m_foreign_per_set_cycle > 0) fill_foreign(set, now);
     uint64_t* tags = &m_tags[size_t(set) * m_ways];
     for (uint32_t w = 0; w < m_ways; ++w)
         if (tags[w] == line) {
@@ -88,6 +116,10 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     if (a.cores.count != 1 || b.cores.count != 1 || x.caches.size() != y.caches.size() ||
         x.prefetch_depth != y.prefetch_depth || x.prefetch_children != y.prefetch_children)
         return false;
+    // Others' fills evict by time, and each machine's lookups come at its own times.
+    for (const SceneMemoryConfig* m : {&x, &y})
+        for (const CacheLevelConfig& level : m->caches)
+            if (level.foreign_fill_per_us > 0) return false;
     // Every machine looks its lanes' hit primitives up (CoreModel::request_scene), where
     // hit_reads says.
     if (x.hit_reads != y.hit_reads) return false;
@@ -104,9 +136,9 @@ namespace {
 // The nearest of `levels` caches holding `address` (`levels`: none); each level missed fills
 // it (inclusive), as a read does.
 template <class CacheOf>
-uint32_t first_holding(uint32_t levels, uint64_t address, CacheOf cache_of) {
+uint32_t first_holding(uint32_t levels, uint64_t address, uint64_t now, CacheOf cache_of) {
     uint32_t level = 0;
-    while (level < levels && !cache_of(level).access(address)) ++level;
+    while (level < levels && !cache_of(level).access(address, now)) ++level;
     return level;
 }
 
@@ -132,7 +164,7 @@ uint32_t SharedCacheLookups::level_of(uint32_t reader, uint64_t address) {
     }
     // This reader is the first here: simulate, and keep the outcome for the others.
     const uint32_t level =
-        first_holding(uint32_t(m_levels.size()), address,
+        first_holding(uint32_t(m_levels.size()), address, 0,
                       [&](uint32_t l) -> SetAssociativeCache& { return m_levels[l]; });
     m_addresses.push_back(address);
     m_found.push_back(uint8_t(level));
@@ -161,7 +193,7 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
     for (const CacheLevelConfig& level : config.caches) {
         if (!m_shared)
             m_levels.emplace_back(level.shared ? 1 : std::max(1u, cores),
-                                  SetAssociativeCache(level));
+                                  SetAssociativeCache(level, core_mhz));
         m_latency.push_back(ns_to_cycles(level.hit_latency_ns, core_mhz));
     }
     m_line_bytes = dram_line_bytes(config);
@@ -172,12 +204,12 @@ SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
     return v[v.size() == 1 ? 0 : core % v.size()];
 }
 
-uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line) {
+uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
     const uint64_t address = line * m_line_bytes;
     const uint32_t levels = level_count();
     const uint32_t level =
         m_shared ? m_shared->level_of(m_reader, address)
-                 : first_holding(levels, address, [&](uint32_t l) -> SetAssociativeCache& {
+                 : first_holding(levels, address, now, [&](uint32_t l) -> SetAssociativeCache& {
                        return instance(l, core);
                    });
     for (uint32_t l = 0; l < level; ++l) ++m_misses[l];
@@ -189,7 +221,7 @@ void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {
     if (bytes == 0) return;
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line)
-        look_up(core, line);
+        look_up(core, line, 0);
 }
 
 uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
@@ -200,7 +232,7 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
     const uint64_t first = address / m_line_bytes, last = (address + bytes - 1) / m_line_bytes;
     uint64_t arrival = now;
     for (uint64_t line = first; line <= last; ++line) {
-        const uint32_t level = look_up(core, line);
+        const uint32_t level = look_up(core, line, now);
         uint64_t ready = 0, latency = 0;
         if (level < level_count()) {
             latency = m_latency[level];

@@ -15,10 +15,13 @@ namespace sfx {
 
 class SetAssociativeCache {
   public:
-    explicit SetAssociativeCache(const CacheLevelConfig& config);
+    // `core_mhz` times the level's foreign fills (CacheLevelConfig::foreign_fill_per_us).
+    explicit SetAssociativeCache(const CacheLevelConfig& config, double core_mhz = 1000.0);
 
-    // Looks up the line holding `address`; on a miss, fills it (evicting the pseudo-LRU way).
-    bool access(uint64_t address);
+    // Looks up the line holding `address` at cycle `now`; on a miss, fills it (evicting the
+    // pseudo-LRU way). Others' fills into the set since its last lookup come first: each
+    // takes the pseudo-LRU way, as a fill of this machine's would.
+    bool access(uint64_t address, uint64_t now = 0);
     void clear();
 
     const CacheLevelConfig& config() const { return m_config; }
@@ -28,6 +31,7 @@ class SetAssociativeCache {
   private:
     void touch(uint32_t set, uint32_t way);
     uint32_t victim(uint32_t set) const;
+    void fill_foreign(uint32_t set, uint64_t now);
 
     CacheLevelConfig m_config;
     uint32_t m_sets, m_ways, m_line_shift;
@@ -35,6 +39,10 @@ class SetAssociativeCache {
     std::vector<uint8_t> m_plru;   // sets * (ways - 1) tree bits (ways rounded up to 2^k)
     uint32_t m_tree_ways;
     uint64_t m_hits = 0, m_misses = 0;
+    double m_foreign_per_set_cycle = 0.0;   // others' fills per set per cycle
+    std::vector<uint64_t> m_foreign_since;  // per set: the cycle its others' fills are due from
+    std::vector<double> m_foreign_due;      // per set: fills due and not yet a whole line
+    uint64_t m_foreign_tag = 0;
 };
 
 // The line DRAM transfers: the last cache level's (64 bytes without caches).
@@ -56,7 +64,8 @@ uint64_t scene_latency_in_costs(const HwConfig& config);
 // (several cores take passes in an order their timing decides), equal cache sizes, lines and
 // ways (latencies may differ) and equal prefetch (which decides when an op's data is looked
 // up), and the same storage (an l1d core does not look up its lanes' hit primitives). The trace
-// decides the rest: ops are dispatched in order on every machine.
+// decides the rest: ops are dispatched in order on every machine. Never with others' fills
+// (foreign_fill_per_us): they evict by time.
 bool same_cache_lookups(const HwConfig& a, const HwConfig& b);
 
 // The lookups of one cache hierarchy shared by configurations with same_cache_lookups: the
@@ -96,7 +105,9 @@ class SceneMemoryModel {
     // queue of one op's reads all issued at once is the accelerator's).
     uint64_t read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
                   uint64_t* unloaded = nullptr);
-    // Touches the lines of a read in the caches only (cache warming: no time, no DRAM traffic).
+    // Touches the lines of a read in the caches only (cache warming: no time, no DRAM traffic;
+    // at cycle 0, so that others' fills, which count from there, find a warm frame's lines as
+    // it leaves them the moment the timed frame starts).
     void warm(uint32_t core, uint64_t address, uint32_t bytes);
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
@@ -110,8 +121,8 @@ class SceneMemoryModel {
 
   private:
     SetAssociativeCache& instance(uint32_t level, uint32_t core);
-    // The nearest level holding `line` for `core` (level_count(): DRAM), counted.
-    uint32_t look_up(uint32_t core, uint64_t line);
+    // The nearest level holding `line` for `core` at cycle `now` (level_count(): DRAM), counted.
+    uint32_t look_up(uint32_t core, uint64_t line, uint64_t now);
 
     SceneMemoryConfig m_config;
     std::vector<std::vector<SetAssociativeCache>> m_levels;  // [level][instance]; none if shared

@@ -213,6 +213,10 @@ struct CacheLevelConfig {
     uint32_t ways = 8;
     double hit_latency_ns = 1.4;  // Bikker's L1 (SceneMemoryConfig below says how)
     bool shared = false;          // one instance for all cores (else one per core)
+    // Lines others sharing the level fill into it per microsecond (a host's L3 on a shared
+    // machine: its neighbours'), spread evenly over the sets, each evicting as this machine's
+    // own fills do; 0: none (a machine of its own). Measured for a host (host_description.h).
+    double foreign_fill_per_us = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -223,6 +227,9 @@ struct CacheLevelConfig {
         v.param("hit_latency_ns", hit_latency_ns, "ns",
                 "hit latency (rounded up to whole core cycles)", 0.01, 1e5);
         v.param("shared", shared, "", "one level shared by all cores (else private per core)");
+        v.param("foreign_fill_per_us", foreign_fill_per_us, "lines/us",
+                "lines others sharing the level fill into it (0: none; full and sampled fidelity)",
+                0.0, 1e9);
     }
 };
 

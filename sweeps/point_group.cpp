@@ -521,10 +521,16 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     }
     PointGroupResult result;
     // Warm frames: the same render into the caches only; the timed frame's counters exclude
-    // their lookups.
+    // their lookups. Where others fill a cache level (foreign_fill_per_us), lines are lost by
+    // age: the warm frames are then timed too, so that each line is as old when the timed
+    // frame starts as the render before left it (untimed, every line would be fresh).
     std::vector<FrameTiming> warmed(configs.size());
     if (systemc && sampling.warm_frames > 0) {
-        systemc->set_warming(true);
+        const bool by_age = std::any_of(configs.begin(), configs.end(), [](const HwConfig& c) {
+            return std::any_of(c.scene_memory.caches.begin(), c.scene_memory.caches.end(),
+                               [](const CacheLevelConfig& l) { return l.foreign_fill_per_us > 0; });
+        });
+        systemc->set_warming(!by_age);
         for (uint32_t f = 0; f < sampling.warm_frames; ++f)
             render_stream(scene, bvh, settings, systemc.get());
         systemc->set_warming(false);

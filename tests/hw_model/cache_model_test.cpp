@@ -34,6 +34,26 @@ TEST_CASE("Pseudo-LRU evicts the line not recently used", "[hw_model][cache]") {
     CHECK(misses_before > 5);
 }
 
+TEST_CASE("Others' fills into a shared level evict a line left untouched long enough",
+          "[hw_model][cache]") {
+    // 64 lines of 4 ways: 16 sets; at 1000 MHz others fill 1 line a microsecond, so a set gets
+    // one in 16000 cycles and all 4 of its ways in 64000.
+    CacheLevelConfig level{"l3", 4, 64, 4, 10, true};
+    level.foreign_fill_per_us = 1.0;
+    SetAssociativeCache c(level, 1000.0);
+    CHECK_FALSE(c.access(0, 0));
+    CHECK(c.access(0, 16000));                // one of theirs since: the line, just touched, stays
+    CHECK(c.access(0, 48000));                // two more since its last touch
+    CHECK_FALSE(c.access(0, 48000 + 64000));  // four: the whole set is theirs
+    // Touched often enough, it stays however long the run.
+    for (uint64_t t = 48000 + 64000; t < 1'000'000; t += 32000) CHECK(c.access(0, t));
+    // Without others' fills, nothing is lost by waiting.
+    level.foreign_fill_per_us = 0.0;
+    SetAssociativeCache own(level, 1000.0);
+    own.access(0, 0);
+    CHECK(own.access(0, 1'000'000'000));
+}
+
 TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",
           "[hw_model][cache]") {
     SceneMemoryConfig config;       // at 500 MHz (2 ns): l1 1.4 ns -> 1, l2 3.8 -> 2, l3 13.3 -> 7

@@ -333,3 +333,34 @@ TEST_CASE("Full fidelity after warm frames: the timed frame finds its scene in t
     CHECK(warm.timing.cache_misses[0] < cold.timing.cache_misses[0]);
     CHECK(warm.total_passes == cold.total_passes);
 }
+
+TEST_CASE("Warm frames where others fill a cache level: timed, so that their lines age",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings settings = small_settings(scene);
+    settings.width = settings.height = 32;
+    settings.spp = 1;
+    settings.tile = 16;
+    HwConfig shared_l3;  // one level, which others fill
+    shared_l3.scene_memory.caches = {{"l3", 2048, 64, 16, 13.3, true}};
+    SamplingOptions warm_options;
+    warm_options.warm_frames = 1;
+    auto run = [&](double fill_per_us, const SamplingOptions& options) {
+        shared_l3.scene_memory.caches[0].foreign_fill_per_us = fill_per_us;
+        return run_point_group(scene, bvh, settings, {shared_l3}, Fidelity::full, options)
+            .predictions[0]
+            .timing;
+    };
+    const FrameTiming cold = run(0.0, {});
+    const FrameTiming kept = run(1.0, warm_options);  // a line lasts 32768 / 1 us: the frame
+    const FrameTiming lost = run(1e6, warm_options);  // every set refilled between two lookups
+    CHECK(cold.dram_reads > 0);
+    CHECK(kept.dram_reads == 0);
+    // Every lookup misses, warm frame or not: it left nothing the frame finds.
+    CHECK(lost.dram_reads == run(1e6, {}).dram_reads);
+    CHECK(lost.dram_reads > cold.dram_reads);
+    CHECK(lost.cycles > kept.cycles);
+    // Only the timed frame's lookups are counted, though the warm frame was timed too.
+    CHECK(lost.cache_hits[0] + lost.cache_misses[0] == cold.cache_hits[0] + cold.cache_misses[0]);
+}
