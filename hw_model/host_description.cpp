@@ -1,7 +1,5 @@
 #include "hw_model/host_description.h"
 
-#include "base/core_clock.h"
-
 #include <cpuid.h>
 #include <sched.h>
 #include <x86intrin.h>
@@ -9,14 +7,16 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <cstring>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <numeric>
 #include <random>
 #include <sstream>
 #include <thread>
 
+#include "base/core_clock.h"
 #include "base/host_clock.h"
 #include "base/huge_pages.h"
 #include "base/strict_number.h"
@@ -217,7 +217,17 @@ double measure_tsc_mhz(double seconds) {
     return double(c1 - c0) / (seconds_between(t0, t1) * 1e6);
 }
 
-double measure_load_latency_ns(uint64_t bytes, double tsc_mhz) {
+namespace {
+
+// `spin` dependent multiplies by one: a wait the compiler cannot fold, a few cycles each.
+inline size_t spin_on(size_t x, uint32_t spin) {
+    for (uint32_t i = 0; i < spin; ++i) asm volatile("imul $1, %0, %0" : "+r"(x));
+    return x;
+}
+
+}  // namespace
+
+double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, double* step_ns) {
     constexpr uint32_t k_line = 64;
     const size_t lines = std::max<uint64_t>(bytes / k_line, 8);
     const size_t stride = k_line / sizeof(size_t);
@@ -229,26 +239,112 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz) {
     std::vector<size_t, HugePageAllocator<size_t>> chase(lines * stride);
     for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
     size_t at = 0;
-    for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i) at = chase[at];  // warm
+    for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i)  // warm
+        at = spin_on(chase[at], spin);
     // Many short runs, the fastest kept: on a shared machine a run is often descheduled, and
     // the TSC keeps counting then (three runs of 2^19 loads each read 4-5x the true latency at
     // a load average of 8). A run of 2^12 loads (well under a millisecond even from DRAM) is
-    // usually not interrupted at all.
+    // usually not interrupted at all. Fewer runs when spaced out: each is longer.
     const size_t loads = 1u << 12;
-    double best = 1e30;
-    for (int rep = 0; rep < 128; ++rep) {
+    const int runs = spin == 0 ? 128 : 16;
+    double best = 1e30, spin_best = spin == 0 ? 0.0 : 1e30;
+    for (int rep = 0; rep < runs; ++rep) {
         const uint64_t c0 = __rdtsc();
-        for (size_t i = 0; i < loads; ++i) at = chase[at];
+        for (size_t i = 0; i < loads; ++i) at = spin_on(chase[at], spin);
         const uint64_t c1 = __rdtsc();
         best = std::min(best, double(c1 - c0) / double(loads));
     }
+    for (int rep = 0; spin > 0 && rep < runs; ++rep) {  // the spin alone, to take out
+        size_t x = at;
+        const uint64_t c0 = __rdtsc();
+        for (size_t i = 0; i < loads; ++i) x = spin_on(x, spin);
+        const uint64_t c1 = __rdtsc();
+        spin_best = std::min(spin_best, double(c1 - c0) / double(loads));
+        at += x - at;  // keeps the chain
+    }
     if (at == size_t(-1)) std::printf(" ");  // keeps the chase
-    return best / tsc_mhz * 1000.0;
+    if (step_ns) *step_ns = best / tsc_mhz * 1000.0;
+    return std::max(0.0, best - spin_best) / tsc_mhz * 1000.0;
 }
+
+namespace {
 
 // DRAM: a chase over 256 MiB (beyond the L3 a core sees on any current CPU; no larger, the
 // machine may be shared), in huge pages as the BVH's nodes and leaf primitives are.
 constexpr uint64_t k_largest_chase = 256ull << 20;
+
+// The last level's chases: from twice the level before it (mostly beyond that level) in steps
+// of a quarter to a half, up to the level's size and at most 64 MiB (a quarter of DRAM's).
+std::vector<uint32_t> last_level_chase_kib(uint32_t before_kib, uint32_t last_kib) {
+    static const double k_steps[] = {1, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32};
+    const uint64_t most = std::min<uint64_t>(last_kib, (k_largest_chase / 4) >> 10);
+    std::vector<uint32_t> kib;
+    for (double step : k_steps) {
+        const uint64_t k = uint64_t(step * 2.0 * before_kib);
+        if (k > most) break;
+        kib.push_back(uint32_t(k));
+    }
+    return kib;
+}
+
+}  // namespace
+
+namespace {
+
+// Where `points` (x rising, a latency each) first pass `mid`, x interpolated in log x between
+// the points either side (the first point's x if it is past already; 0: never).
+double crossing(const std::vector<std::pair<double, double>>& points, double mid) {
+    for (size_t i = 0; i < points.size(); ++i) {
+        if (points[i].second <= mid) continue;
+        if (i == 0) return points[0].first;
+        const auto [x0, l0] = points[i - 1];
+        const auto [x1, l1] = points[i];
+        return std::exp(std::log(x0) + (mid - l0) / (l1 - l0) * (std::log(x1) - std::log(x0)));
+    }
+    return 0.0;
+}
+
+}  // namespace
+
+SeenLevel last_level_seen(const HostDescription& h) {
+    SeenLevel seen;
+    if (h.caches.empty()) return seen;
+    const HostCacheLevel& last = h.caches.back();
+    seen.kib = last.kib;
+    seen.latency_ns =
+        h.latency_ns.size() >= h.caches.size() ? h.latency_ns[h.caches.size() - 1] : 0.0;
+    if (h.last_level_chases.empty()) return seen;
+    const double hit = h.last_level_chases.front().second;
+    // A line evicted: the slowest end of either kind of chase.
+    const double evicted =
+        std::max(h.last_level_chases.back().second,
+                 h.last_level_idle_chases.empty() ? 0.0 : h.last_level_idle_chases.back().second);
+    seen.latency_ns = hit;
+    if (evicted < 2.0 * hit) return seen;  // no chase lost its lines
+    const double mid = 0.5 * (hit + evicted);
+    std::vector<std::pair<double, double>> sizes;  // lines, ns
+    for (const auto& [kib, ns] : h.last_level_chases)
+        sizes.emplace_back(double(kib) * 1024.0 / last.line_bytes, ns);
+    const double s0 = sizes.front().first, s_star = crossing(sizes, mid);
+    const double t_star = crossing(h.last_level_idle_chases, mid);
+    double capacity = 0.0, per_ns = 0.0;  // lines, others' lines per ns
+    if (s_star > s0 && t_star > 0.0 && s0 * t_star > s_star * hit) {
+        per_ns = (s_star - s0) / (s0 * t_star - s_star * hit);
+        capacity = s_star * (1.0 + per_ns * hit);
+    } else if (s_star > 0.0) {
+        capacity = s_star;  // spacing the loads out lost nothing more than size did
+    } else if (t_star > 0.0) {
+        capacity = sizes.back().first;  // at least the largest chase, which kept its lines
+        per_ns = std::max(0.0, (capacity / s0 - 1.0) / t_star);
+    } else {
+        return seen;
+    }
+    const uint64_t kib = uint64_t(std::llround(capacity * last.line_bytes / 1024.0));
+    seen.kib = uint32_t(std::clamp<uint64_t>(kib, 1, last.kib));
+    seen.cut = seen.kib < last.kib;
+    seen.foreign_fill_per_us = per_ns * 1000.0;
+    return seen;
+}
 
 HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     HostDescription h;
@@ -259,19 +355,28 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     h.tsc_mhz = measure_tsc_mhz();
     h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21, simd_width);
     h.caches = read_host_caches();
-    for (const HostCacheLevel& c : h.caches) {
-        // Half the level: it fits there, and not in the level before (which is smaller). At
-        // most 8 MiB: a virtual machine may report a whole socket's L3 for one core.
-        h.latency_ns.push_back(measure_load_latency_ns(
-            std::min<uint64_t>(uint64_t(c.kib) * 1024 / 2, k_largest_chase / 32), h.tsc_mhz));
+    for (size_t i = 0; i < h.caches.size(); ++i) {
+        const HostCacheLevel& c = h.caches[i];
+        if (i > 0 && i + 1 == h.caches.size()) {
+            for (uint32_t kib : last_level_chase_kib(h.caches[i - 1].kib, c.kib))
+                h.last_level_chases.emplace_back(
+                    kib, measure_load_latency_ns(uint64_t(kib) << 10, h.tsc_mhz));
+            if (!h.last_level_chases.empty()) {
+                h.latency_ns.push_back(h.last_level_chases.front().second);
+                // Spaced out by 16 to 2048 multiplies (about 14 ns to 2 us a step at 3.5 GHz).
+                for (uint32_t spin = 16; spin <= 2048; spin *= 2) {
+                    double step = 0.0;
+                    const double ns = measure_load_latency_ns(
+                        uint64_t(h.last_level_chases.front().first) << 10, h.tsc_mhz, spin, &step);
+                    h.last_level_idle_chases.emplace_back(step, ns);
+                }
+                continue;
+            }
+        }
+        // Half the level: it fits there, and not in the level before (which is smaller).
+        h.latency_ns.push_back(measure_load_latency_ns(uint64_t(c.kib) * 1024 / 2, h.tsc_mhz));
     }
     h.latency_ns.push_back(measure_load_latency_ns(k_largest_chase, h.tsc_mhz));
-    // Around the last level's chase (over 8 MiB when it reports more than 16 MiB), the same
-    // sample as its latency, not a second one.
-    if (!h.caches.empty() && h.caches.back().kib > 16384)
-        h.last_level_chases = {{4096u, measure_load_latency_ns(4096ull << 10, h.tsc_mhz)},
-                               {8192u, h.latency_ns[h.caches.size() - 1]},
-                               {16384u, measure_load_latency_ns(16384ull << 10, h.tsc_mhz)}};
     return h;
 }
 
@@ -301,6 +406,12 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         cl.hit_latency_ns = i < h.latency_ns.size() ? h.latency_ns[i] : 1.0;
         cl.shared = l.shared;
         c.scene_memory.caches.push_back(cl);
+    }
+    if (!c.scene_memory.caches.empty()) {  // the last level as this core's chases see it
+        const SeenLevel seen = last_level_seen(h);
+        c.scene_memory.caches.back().kib = seen.kib;
+        c.scene_memory.caches.back().hit_latency_ns = seen.latency_ns;
+        c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
     // The native tracer prefetches a node's children (a leaf's primitives) while it tests the
@@ -350,15 +461,32 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
         const CacheLevelConfig& l = c.scene_memory.caches[i];
         y << "    - {name: " << l.name << ", kib: " << l.kib << ", line_bytes: " << l.line_bytes
           << ", ways: " << l.ways << ", hit_latency_ns: " << fmt(l.hit_latency_ns, 2)
-          << ", shared: " << (l.shared ? "true" : "false") << "}  # " << h.caches[i].source
-          << "; latency measured (pointer chase over "
-          << std::min<uint64_t>(h.caches[i].kib / 2, 8192) << " KiB)";
-        if (i + 1 == c.scene_memory.caches.size() && !h.last_level_chases.empty()) {
-            y << "; chases over";
-            for (const auto& [kib, ns] : h.last_level_chases)
-                y << " " << kib / 1024 << " MiB " << fmt(ns, 1) << " ns"
-                  << (kib == h.last_level_chases.back().first ? "" : ",");
-            y << " (a jump between two: the L3 this core sees ends there)";
+          << ", shared: " << (l.shared ? "true" : "false")
+          << (l.foreign_fill_per_us > 0 ? ", foreign_fill_per_us: " + fmt(l.foreign_fill_per_us, 2)
+                                        : std::string())
+          << "}  # " << h.caches[i].source << "; latency measured (pointer chase over ";
+        const bool chased = i + 1 == c.scene_memory.caches.size() && !h.last_level_chases.empty();
+        if (!chased) {
+            y << h.caches[i].kib / 2 << " KiB)\n";
+            continue;
+        }
+        const SeenLevel seen = last_level_seen(h);
+        y << h.last_level_chases.front().first << " KiB); kib"
+          << (seen.foreign_fill_per_us > 0 ? " and foreign_fill_per_us" : "")
+          << (seen.cut || seen.foreign_fill_per_us > 0
+                  ? ": the LRU stack through this core's chases (last_level_seen; cpuid: " +
+                        std::to_string(h.caches[i].kib) + " KiB)"
+                  : ": cpuid's (no chase lost its lines)")
+          << "; chases over";
+        for (const auto& [kib, ns] : h.last_level_chases)
+            y << " " << fmt(kib / 1024.0, kib % 1024 ? 1 : 0) << " MiB " << fmt(ns, 1) << " ns"
+              << (kib == h.last_level_chases.back().first ? "" : ",");
+        if (!h.last_level_idle_chases.empty()) {
+            const uint32_t kib = h.last_level_chases.front().first;
+            y << "; over " << fmt(kib / 1024.0, kib % 1024 ? 1 : 0) << " MiB with steps of";
+            for (const auto& [step, ns] : h.last_level_idle_chases)
+                y << " " << fmt(step, 0) << " ns " << fmt(ns, 1) << " ns"
+                  << (step == h.last_level_idle_chases.back().first ? "" : ",");
         }
         y << "\n";
     }

@@ -32,8 +32,12 @@ std::vector<HostCacheLevel> read_host_caches();
 double measure_tsc_mhz(double seconds = 0.2);
 
 // Average load-to-use latency in ns of a dependent pointer chase over a random cycle of lines
-// spanning `bytes` (so it hits the level that holds that many bytes).
-double measure_load_latency_ns(uint64_t bytes, double tsc_mhz);
+// spanning `bytes` (so it hits the level that holds that many bytes). With `spin`, each load
+// waits for a chain of that many dependent multiplies before the next (its time taken out of
+// the latency; the whole step's time in `step_ns`): lines then go untouched longer between
+// laps, which tells how long a shared level keeps them while others fill it.
+double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin = 0,
+                               double* step_ns = nullptr);
 
 // Reads the TSC (rdtsc): the clock the native tracer's cycles are counted in.
 uint64_t read_tsc();
@@ -67,10 +71,14 @@ struct HostDescription {
     double core_mhz = 0.0;
     std::vector<HostCacheLevel> caches;
     std::vector<double> latency_ns;  // per cache level, then DRAM (measured)
-    // Chases over 4, 8 and 16 MiB (KiB, ns) when the last level reports more than 16 MiB: on a
-    // virtual machine the L3 a core sees can end well short of what cpuid reports, and its
-    // latency (the 8 MiB chase) is then a draw on that knee. Reported, not used.
+    // Chases (KiB, ns) from twice the level before the last up to the last level's size (at
+    // most 64 MiB), smallest first; the first is the last level's latency. On a virtual machine
+    // the L3 a core sees can end well short of what cpuid reports, and where it ends is a draw
+    // (the neighbours' share): last_level_seen reads it from these.
     std::vector<std::pair<uint32_t, double>> last_level_chases;
+    // Chases over the first of those sizes with loads spaced out (spin): (ns a step, ns a load),
+    // shortest step first.
+    std::vector<std::pair<double, double>> last_level_idle_chases;
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
     // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine
@@ -78,6 +86,24 @@ struct HostDescription {
     // runs pinned where its host was described (scripts/silicon-check --cpu).
     int cpu = -1;
 };
+
+// The last cache level as this core sees it, from its chases, by the LRU stack: a line is
+// still there when the lines filled since its last touch, this core's and others', number
+// fewer than the level holds. A chase over S lines with steps of t ns fills S of its own and
+// r t S of others' between touches of a line, so it hits while S (1 + r t) < C. The chases over
+// growing sizes cross at S* (steps of the level's latency H), the spaced-out chases over S0
+// lines at t*: two equations for the capacity C and others' fill rate r. A crossing is where a
+// chase's latency passes the midpoint between H and a line evicted (the slower of the largest
+// chase and the most spaced-out). On this project's AMD VM (2026-11-27) the chases jumped from
+// 16 to 115 ns between 4 and 6 MiB, and a 2 MiB chase went from 14 to 127 ns as its steps
+// grew from 0.1 to 1 us. Without crossings, the level cpuid reports and no others' fills.
+struct SeenLevel {
+    uint32_t kib = 0;
+    double latency_ns = 0.0;
+    double foreign_fill_per_us = 0.0;  // r, lines per microsecond
+    bool cut = false;                  // ends short of what cpuid reports
+};
+SeenLevel last_level_seen(const HostDescription& host);
 
 // Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).
 HostDescription describe_host(uint32_t simd_width, const std::string& isa);

@@ -448,9 +448,17 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.one_ray_entry_cycles = 8;
     box.few_ray_entry_cycles = 9.5;
     HostDescription host = small_host();
-    host.last_level_chases = {{4096, 15.5}, {8192, 98.4}, {16384, 130.5}};
+    host.caches.push_back({3, "unified", 32768, 64, 16, true, "test"});
+    host.latency_ns = {1.0, 5.0, 15.5, 81.0};
+    host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
+    host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
     const std::string yaml = host_hw_yaml(host, {box}, "test samples");
-    CHECK(yaml.find("chases over 4 MiB 15.5 ns, 8 MiB 98.4 ns, 16 MiB 130.5 ns") !=
+    const SeenLevel seen = last_level_seen(host);
+    REQUIRE(seen.foreign_fill_per_us > 0.0);
+    CHECK(yaml.find("kib: " + std::to_string(seen.kib) + ",") != std::string::npos);
+    CHECK(yaml.find("cpuid: 32768 KiB") != std::string::npos);
+    CHECK(yaml.find("chases over 0.5 MiB 15.5 ns, 1 MiB 16.0 ns, 2 MiB 98.4 ns, 4 MiB 130.5 ns; "
+                    "over 0.5 MiB with steps of 100 ns 15.5 ns, 1000 ns 140.0 ns") !=
           std::string::npos);
     const HwConfig c = parse_hw_config(yaml, "host.hw.yaml");
     CHECK(c.ray_buffer.storage == "l1d");
@@ -459,8 +467,12 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.simd.width == 16);
     CHECK(c.simd.units == 1);
     CHECK(c.clock.core_mhz == Approx(1000));
-    REQUIRE(c.scene_memory.caches.size() == 2);
+    REQUIRE(c.scene_memory.caches.size() == 3);
     CHECK(c.scene_memory.caches[1].hit_latency_ns == Approx(5));
+    CHECK(c.scene_memory.caches[2].kib == seen.kib);
+    CHECK(c.scene_memory.caches[2].hit_latency_ns == Approx(15.5));
+    CHECK(c.scene_memory.caches[2].foreign_fill_per_us ==
+          Approx(seen.foreign_fill_per_us).epsilon(0.01));
     CHECK(c.scene_memory.dram_latency_ns == Approx(81));
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
@@ -488,6 +500,51 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
                     InputError);
     CHECK_THROWS_AS(parse_hw_config("version: 1\nray_buffer: {storage: dram}\n", "bad.hw.yaml"),
                     InputError);
+}
+
+TEST_CASE("The last level's size and others' fills come from this core's chases", "[host]") {
+    HostDescription host = small_host();  // L2 of 256 KiB at 5 ns
+    host.caches.push_back({3, "unified", 520192, 64, 16, true, "test"});
+    host.latency_ns = {1.0, 5.0, 16.0, 180.0};
+    // No chases: cpuid's size, the level's latency, no others' fills.
+    SeenLevel seen = last_level_seen(host);
+    CHECK(seen.kib == 520192);
+    CHECK(seen.latency_ns == Approx(16));
+    CHECK(seen.foreign_fill_per_us == 0.0);
+    CHECK_FALSE(seen.cut);
+    // Chases that lose their lines between 6400 and 7744 KiB (the midpoint of 16 and 144 ns
+    // halfway, in log size, at 7040 KiB), and over 2 MiB with steps of 300 ns.
+    host.last_level_chases = {
+        {2048, 16.0}, {4096, 16.0}, {6400, 16.0}, {7744, 144.0}, {16384, 140.0}};
+    host.last_level_idle_chases = {{100.0, 16.0}, {250.0, 16.0}, {360.0, 144.0}, {1000.0, 144.0}};
+    seen = last_level_seen(host);
+    CHECK(seen.latency_ns == Approx(16));
+    CHECK(seen.cut);
+    // Both crossings sit on the LRU stack's edge: S (1 + r t) = C, the size chase's with steps
+    // of the level's latency, the spaced-out chase's (2 MiB: 32768 lines) with steps of 300 ns.
+    const double r = seen.foreign_fill_per_us / 1000.0, lines = seen.kib * 1024.0 / 64;
+    CHECK(7040.0 * 16 * (1 + r * 16) == Approx(lines).epsilon(1e-3));
+    CHECK(32768.0 * (1 + r * 300) == Approx(lines).epsilon(1e-3));
+    CHECK(r > 0.0);
+    HwConfig c = host_hw_config(host, {});
+    CHECK(c.scene_memory.caches.back().kib == seen.kib);
+    CHECK(c.scene_memory.caches.back().foreign_fill_per_us == seen.foreign_fill_per_us);
+    CHECK(c.scene_memory.caches.back().hit_latency_ns == Approx(16));
+    CHECK(c.scene_memory.dram_latency_ns == Approx(180));
+    // Spacing the loads out loses nothing the size did not: the level ends at the size's
+    // crossing, with no others' fills.
+    host.last_level_idle_chases = {{100.0, 16.0}, {1000.0, 17.0}};
+    host.last_level_chases.back().second = 144.0;
+    seen = last_level_seen(host);
+    CHECK(seen.kib == 7040);
+    CHECK(seen.foreign_fill_per_us == 0.0);
+    // No chase ever slower than twice the first: nothing is lost, cpuid's size.
+    host.last_level_chases = {{2048, 16.0}, {4096, 20.0}, {8192, 30.0}, {16384, 31.9}};
+    host.last_level_idle_chases.clear();
+    seen = last_level_seen(host);
+    CHECK(seen.kib == 520192);
+    CHECK_FALSE(seen.cut);
+    CHECK(seen.foreign_fill_per_us == 0.0);
 }
 
 TEST_CASE("The host's caches and clock are read from the CPU", "[host]") {
