@@ -44,6 +44,15 @@ RenderSettings small_settings(const Scene& scene) {
     return s;
 }
 
+// A frame of 32x32 pixels, one sample each, in tiles of 16: the warm-frame tests' workload.
+RenderSettings warm_frame_settings(const Scene& scene) {
+    RenderSettings s = small_settings(scene);
+    s.width = s.height = 32;
+    s.spp = 1;
+    s.tile = 16;
+    return s;
+}
+
 // Every width x units x banks (the rest gr08's), last fastest; named by width.
 std::vector<HwConfig> width_unit_bank_grid(std::initializer_list<uint32_t> widths,
                                            std::initializer_list<uint32_t> units,
@@ -312,10 +321,7 @@ TEST_CASE("Full fidelity after warm frames: the timed frame finds its scene in t
           "[sampling]") {
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
-    RenderSettings settings = small_settings(scene);
-    settings.width = settings.height = 32;
-    settings.spp = 1;
-    settings.tile = 16;
+    const RenderSettings settings = warm_frame_settings(scene);
     const std::vector<HwConfig> configs = {HwConfig{}};
     const Prediction cold = run_point_group(scene, bvh, settings, configs, Fidelity::full).predictions[0];
     SamplingOptions warm_options;
@@ -338,10 +344,7 @@ TEST_CASE("Warm frames where others fill a cache level: timed, so that their lin
           "[sampling]") {
     const Scene scene = load_scene("cornell");
     const Bvh bvh(scene);
-    RenderSettings settings = small_settings(scene);
-    settings.width = settings.height = 32;
-    settings.spp = 1;
-    settings.tile = 16;
+    const RenderSettings settings = warm_frame_settings(scene);
     HwConfig shared_l3;  // one level, which others fill
     shared_l3.scene_memory.caches = {{"l3", 2048, 64, 16, 13.3, true}};
     SamplingOptions warm_options;
