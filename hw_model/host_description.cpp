@@ -246,7 +246,7 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
     // a load average of 8). A run of 2^12 loads (well under a millisecond even from DRAM) is
     // usually not interrupted at all. Fewer runs when spaced out: each is longer.
     const size_t loads = 1u << 12;
-    const int runs = spin == 0 ? 128 : 16;
+    const int runs = spin == 0 ? 128 : int(std::clamp(16384u / std::max(spin, 1u), 4u, 16u));
     double best = 1e30, spin_best = spin == 0 ? 0.0 : 1e30;
     for (int rep = 0; rep < runs; ++rep) {
         const uint64_t c0 = __rdtsc();
@@ -363,8 +363,10 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
                     kib, measure_load_latency_ns(uint64_t(kib) << 10, h.tsc_mhz));
             if (!h.last_level_chases.empty()) {
                 h.latency_ns.push_back(h.last_level_chases.front().second);
-                // Spaced out by 16 to 2048 multiplies (about 14 ns to 2 us a step at 3.5 GHz).
-                for (uint32_t spin = 16; spin <= 2048; spin *= 2) {
+                // Spaced out by 16 to 8192 multiplies (about 14 ns to 7 us a step at 3.5 GHz,
+                // laps of 2 MiB up to a quarter of a second): on this project's AMD VM, with
+                // quiet neighbours, 2 us steps lost a third of the lines (2026-11-27).
+                for (uint32_t spin = 16; spin <= 8192; spin *= 2) {
                     double step = 0.0;
                     const double ns = measure_load_latency_ns(
                         uint64_t(h.last_level_chases.front().first) << 10, h.tsc_mhz, spin, &step);
