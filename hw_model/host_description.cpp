@@ -260,7 +260,7 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
         for (size_t i = 0; i < loads; ++i) x = spin_on(x, spin);
         const uint64_t c1 = __rdtsc();
         spin_best = std::min(spin_best, double(c1 - c0) / double(loads));
-        at += x - at;  // keeps the chain
+        at = x;  // the same value (multiplies by one), after the spin
     }
     if (at == size_t(-1)) std::printf(" ");  // keeps the chase
     if (step_ns) *step_ns = best / tsc_mhz * 1000.0;
@@ -286,10 +286,6 @@ std::vector<uint32_t> last_level_chase_kib(uint32_t before_kib, uint32_t last_ki
     }
     return kib;
 }
-
-}  // namespace
-
-namespace {
 
 // Where `points` (x rising, a latency each) first pass `mid`, x interpolated in log x between
 // the points either side (the first point's x if it is past already; 0: never).
