@@ -208,10 +208,10 @@ uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
     const uint64_t address = line * m_line_bytes;
     const uint32_t levels = level_count();
     const uint32_t level =
-        m_shared ? m_shared->level_of(m_reader, address)
-                 : first_holding(levels, address, now, [&](uint32_t l) -> SetAssociativeCache& {
-                       return instance(l, core);
-                   });
+        m_shared
+            ? m_shared->level_of(m_reader, address)
+            : first_holding(levels, address, now - std::min(now, m_paused),
+                            [&](uint32_t l) -> SetAssociativeCache& { return instance(l, core); });
     for (uint32_t l = 0; l < level; ++l) ++m_misses[l];
     if (level < levels) ++m_hits[level];
     return level;

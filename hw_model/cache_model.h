@@ -112,6 +112,11 @@ class SceneMemoryModel {
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
 
+    // Cycles the machine sat idle while others simulated beside it finished their work: later
+    // reads are looked up that much earlier on others' fills' clock, so that what a level loses
+    // by age does not depend on the configurations timed with this one.
+    void pause(uint64_t cycles) { m_paused += cycles; }
+
     uint32_t level_count() const { return uint32_t(m_config.caches.size()); }
     // Hits and misses of a level, summed over its instances (one per core when private).
     uint64_t hits(uint32_t level) const { return m_hits[level]; }
@@ -134,6 +139,7 @@ class SceneMemoryModel {
     uint32_t m_line_bytes;
     RateServer m_dram;  // bytes per cycle
     uint64_t m_dram_reads = 0, m_requests = 0;
+    uint64_t m_paused = 0;
 };
 
 }  // namespace sfx

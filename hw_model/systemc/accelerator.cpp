@@ -28,7 +28,16 @@ void Accelerator::enqueue(std::shared_ptr<const PassBuffer> pass) {
 }
 
 std::shared_ptr<const PassBuffer> Accelerator::next_pass() {
-    while (m_queue.empty()) sc_core::wait(m_work);
+    while (m_queue.empty()) {
+        // Every core waiting: the machine is idle until its next pass comes, however long the
+        // other configurations of its simulation take to finish theirs. That wait is not its
+        // own time, so its scene memory leaves it out (SceneMemoryModel::pause).
+        if (++m_waiting == m_cores.size()) m_idle_since = sc_core::sc_time_stamp().value();
+        sc_core::wait(m_work);
+        if (m_waiting-- == m_cores.size())
+            m_scene_memory->pause((sc_core::sc_time_stamp().value() - m_idle_since) /
+                                  clock_period(m_config.clock.core_mhz));
+    }
     std::shared_ptr<const PassBuffer> p = std::move(m_queue.front());
     m_queue.pop_front();
     return p;

@@ -40,6 +40,9 @@ class Accelerator : public sc_core::sc_module, public PassSource {
     std::deque<std::shared_ptr<const PassBuffer>> m_queue;
     sc_core::sc_event m_work;
     FrameTiming m_timing;
+    // Every core waiting for a pass: since when (time resolution units), and how many wait.
+    uint64_t m_idle_since = 0;
+    uint32_t m_waiting = 0;
 };
 
 }  // namespace sfx

@@ -3,6 +3,7 @@
 // the cycle "now" is the first edge at or after the simulated time, and waiting until a cycle
 // waits exactly to its edge, so time stays on the clock however many clocks share a simulation.
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <systemc>
@@ -43,12 +44,16 @@ class CycleWakeups {
     std::vector<Pending> m_pending;
 };
 
+// One cycle of a clock of `mhz`, in units of the time resolution.
+inline uint64_t clock_period(double mhz) {
+    return uint64_t(
+        std::llround(1e6 / mhz / sc_core::sc_get_time_resolution().to_seconds() / 1e12));
+}
+
 class CoreClock {
   public:
     CoreClock(double mhz, std::shared_ptr<CycleWakeups> wakeups)
-        : m_period(uint64_t(
-              std::llround(1e6 / mhz / sc_core::sc_get_time_resolution().to_seconds() / 1e12))),
-          m_wakeups(std::move(wakeups)) {}
+        : m_period(clock_period(mhz)), m_wakeups(std::move(wakeups)) {}
     uint64_t now() const {
         const uint64_t t = sc_core::sc_time_stamp().value();
         return (t + m_period - 1) / m_period;

@@ -367,3 +367,29 @@ TEST_CASE("Warm frames where others fill a cache level: timed, so that their lin
     // Only the timed frame's lookups are counted, though the warm frame was timed too.
     CHECK(lost.cache_hits[0] + lost.cache_misses[0] == cold.cache_hits[0] + cold.cache_misses[0]);
 }
+
+TEST_CASE("Others' fills age a configuration's lines on its own time, whatever is timed beside it",
+          "[sampling]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    const RenderSettings settings = warm_frame_settings(scene);
+    HwConfig filled;  // lines last about as long as a pass: what is lost depends on time
+    filled.scene_memory.caches = {{"l3", 64, 64, 16, 13.3, true}};
+    filled.scene_memory.caches[0].foreign_fill_per_us = 200.0;
+    HwConfig slow = filled;  // slower passes: alone in a group with it, `filled` would idle
+    slow.scene_memory.caches[0].foreign_fill_per_us = 0.0;
+    slow.scene_memory.dram_latency_ns = 2000.0;
+    SamplingOptions warm_options;
+    warm_options.warm_frames = 1;
+    const FrameTiming alone =
+        run_point_group(scene, bvh, settings, {filled}, Fidelity::full, warm_options)
+            .predictions[0]
+            .timing;
+    const FrameTiming beside =
+        run_point_group(scene, bvh, settings, {slow, filled}, Fidelity::full, warm_options)
+            .predictions[1]
+            .timing;
+    CHECK(alone.dram_reads > 0);
+    CHECK(beside.dram_reads == alone.dram_reads);
+    CHECK(beside.cycles == alone.cycles);
+}
