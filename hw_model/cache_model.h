@@ -106,8 +106,8 @@ class SceneMemoryModel {
     uint64_t read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
                   uint64_t* unloaded = nullptr);
     // Touches the lines of a read in the caches only (cache warming: no time, no DRAM traffic;
-    // at cycle 0, so that others' fills, which count from there, find a warm frame's lines as
-    // it leaves them the moment the timed frame starts).
+    // looked up at cycle 0, which others' fills do not age: where a level has them, full
+    // fidelity times its warm frames instead, run_point_group).
     void warm(uint32_t core, uint64_t address, uint32_t bytes);
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
