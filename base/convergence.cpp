@@ -31,6 +31,13 @@ Convergence judge_convergence(const std::vector<double>& samples, const Converge
     return c;
 }
 
+double median(std::vector<double> samples) {
+    if (samples.empty()) return 0.0;
+    const auto middle = samples.begin() + long(samples.size() / 2);
+    std::nth_element(samples.begin(), middle, samples.end());
+    return *middle;
+}
+
 bool needs_more_samples(const std::vector<double>& samples, const ConvergenceRule& rule) {
     if (samples.size() >= rule.budget) return false;
     if (samples.size() < rule.min_samples) return true;

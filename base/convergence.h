@@ -36,6 +36,10 @@ Convergence judge_convergence(const std::vector<double>& samples, const Converge
 // Whether to take another sample: fewer than min_samples, or not converged and budget left.
 bool needs_more_samples(const std::vector<double>& samples, const ConvergenceRule& rule);
 
+// The middle sample (the upper middle of an even count; 0 without samples): the typical
+// reading where one interrupted sample must not move it.
+double median(std::vector<double> samples);
+
 // "fastest 3 of 7-31 samples within 3 %": how the rule reads on a page.
 std::string describe(const ConvergenceRule& rule);
 

@@ -22,23 +22,19 @@
 #include <systemc>
 #include <vector>
 
+#include "base/convergence.h"
+#include "base/host_clock.h"
 #include "hw_model/core_model.h"
 #include "hw_model/pass_buffer.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "kernels/bvh.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
-#include "base/host_clock.h"
 #include "workloads/scene_loader.h"
 
 using namespace sfx;
 
 namespace {
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 struct EmptyClocked : sc_core::sc_module {
     sc_core::sc_in<bool> clk;

@@ -42,15 +42,19 @@ void SetAssociativeCache::fill_foreign(uint32_t set, uint64_t now) {
     m_foreign_since[set] = now;
     const uint32_t lines = uint32_t(std::min<double>(std::floor(due), m_ways));
     m_foreign_due[set] = due - std::floor(due);
+    for (uint32_t i = 0; i < lines; ++i)
+        place(set, (1ull << 63) | (m_foreign_tag++ & ((1ull << 62) - 1)));
+}
+
+// A fill, this machine's or another's: an empty way first, else the pseudo-LRU way.
+void SetAssociativeCache::place(uint32_t set, uint64_t tag) {
     uint64_t* tags = &m_tags[size_t(set) * m_ways];
-    for (uint32_t i = 0; i < lines; ++i) {
-        uint32_t way = m_ways;
-        for (uint32_t w = 0; w < m_ways && way == m_ways; ++w)
-            if (tags[w] == ~0ull) way = w;
-        if (way == m_ways) way = victim(set);
-        tags[way] = (1ull << 63) | (m_foreign_tag++ & ((1ull << 62) - 1));
-        touch(set, way);
-    }
+    uint32_t way = m_ways;
+    for (uint32_t w = 0; w < m_ways && way == m_ways; ++w)
+        if (tags[w] == ~0ull) way = w;
+    if (way == m_ways) way = victim(set);
+    tags[way] = tag;
+    touch(set, way);
 }
 
 // Tree PLRU: each internal node's bit points to the half to evict next; touching a way turns
@@ -93,12 +97,7 @@ bool SetAssociativeCache::access(uint64_t address, uint64_t now) {
             return true;
         }
     ++m_misses;
-    uint32_t way = m_ways;
-    for (uint32_t w = 0; w < m_ways && way == m_ways; ++w)
-        if (tags[w] == ~0ull) way = w;  // fill empty ways first
-    if (way == m_ways) way = victim(set);
-    tags[way] = line;
-    touch(set, way);
+    place(set, line);
     return false;
 }
 

@@ -31,6 +31,7 @@ class SetAssociativeCache {
   private:
     void touch(uint32_t set, uint32_t way);
     uint32_t victim(uint32_t set) const;
+    void place(uint32_t set, uint64_t tag);
     void fill_foreign(uint32_t set, uint64_t now);
 
     CacheLevelConfig m_config;

@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "base/convergence.h"
 #include "base/cpu_load.h"
 #include "base/cycle_source.h"
 #include "base/huge_pages.h"
@@ -20,11 +21,6 @@
 namespace sfx {
 
 namespace {
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 // Whose per-op cost in a traversal the traversal samples measure: the box test's. A leaf test
 // follows a box test nearly always in them, so the two per-op costs cannot be told apart (with

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <random>
 
+#include "base/convergence.h"
 #include "base/core_clock.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
@@ -150,11 +151,6 @@ void deal_rays(Buffers& b, const std::vector<uint32_t>& deal, bool hits) {
         b.any_hit[i] = b.saved_any_hit[from];
         b.surf[i] = b.saved_surf[from];
     }
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
 }
 
 // TSC ticks of an empty timed region (subtracted from every measurement).

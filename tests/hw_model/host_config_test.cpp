@@ -515,7 +515,7 @@ TEST_CASE("The last level's size and others' fills come from this core's chases"
     // Chases that lose their lines between 6400 and 7744 KiB (the midpoint of 16 and 144 ns
     // halfway, in log size, at 7040 KiB), and over 2 MiB with steps of 300 ns.
     host.last_level_chases = {
-        {2048, 16.0}, {4096, 16.0}, {6400, 16.0}, {7744, 144.0}, {16384, 140.0}};
+        {2048, 16.0}, {4096, 16.0}, {6400, 16.0}, {7744, 144.0}, {16384, 144.0}};
     host.last_level_idle_chases = {{100.0, 16.0}, {250.0, 16.0}, {360.0, 144.0}, {1000.0, 144.0}};
     seen = last_level_seen(host);
     CHECK(seen.latency_ns == Approx(16));
@@ -526,6 +526,11 @@ TEST_CASE("The last level's size and others' fills come from this core's chases"
     CHECK(7040.0 * 16 * (1 + r * 16) == Approx(lines).epsilon(1e-3));
     CHECK(32768.0 * (1 + r * 300) == Approx(lines).epsilon(1e-3));
     CHECK(r > 0.0);
+    // One interrupted spaced-out chase, far slower than an evicted line, moves nothing.
+    host.last_level_idle_chases.push_back({2000.0, 600.0});
+    CHECK(last_level_seen(host).kib == seen.kib);
+    CHECK(last_level_seen(host).foreign_fill_per_us == seen.foreign_fill_per_us);
+    host.last_level_idle_chases.pop_back();
     HwConfig c = host_hw_config(host, {});
     CHECK(c.scene_memory.caches.back().kib == seen.kib);
     CHECK(c.scene_memory.caches.back().foreign_fill_per_us == seen.foreign_fill_per_us);
@@ -534,10 +539,18 @@ TEST_CASE("The last level's size and others' fills come from this core's chases"
     // Spacing the loads out loses nothing the size did not: the level ends at the size's
     // crossing, with no others' fills.
     host.last_level_idle_chases = {{100.0, 16.0}, {1000.0, 17.0}};
-    host.last_level_chases.back().second = 144.0;
     seen = last_level_seen(host);
     CHECK(seen.kib == 7040);
     CHECK(seen.foreign_fill_per_us == 0.0);
+    // Every size chase kept its lines and only spacing lost them: an evicted line reads as
+    // the three most spaced-out chases' median, so the level is at least the largest chase
+    // and others fill it.
+    host.last_level_chases = {{2048, 16.0}, {16384, 17.0}};
+    host.last_level_idle_chases = {
+        {100.0, 16.0}, {1000.0, 140.0}, {2000.0, 144.0}, {4000.0, 900.0}};
+    seen = last_level_seen(host);
+    CHECK(seen.kib == 16384);
+    CHECK(seen.foreign_fill_per_us > 0.0);
     // No chase ever slower than twice the first: nothing is lost, cpuid's size.
     host.last_level_chases = {{2048, 16.0}, {4096, 20.0}, {8192, 30.0}, {16384, 31.9}};
     host.last_level_idle_chases.clear();
