@@ -92,10 +92,30 @@ def self_consistency(df):
             ratio = b["measured.frame_cycles"] / a["measured.frame_cycles"]
             lo, hi = CONSISTENT[0] * pixel_ratio, CONSISTENT[1] * pixel_ratio
             rows.append({"isa": isa, "scene": scene, "tile": tile, "small": a["res"],
-                         "large": b["res"], "ratio": ratio, "lo": lo, "hi": hi,
-                         "consistent": bool(lo <= ratio <= hi)})
-    return pd.DataFrame(rows, columns=["isa", "scene", "tile", "small", "large", "ratio", "lo",
-                                       "hi", "consistent"])
+                         "large": b["res"], "ratio": ratio,
+                         "predicted_ratio":
+                             b["predicted.frame_cycles"] / a["predicted.frame_cycles"],
+                         "lo": lo, "hi": hi, "consistent": bool(lo <= ratio <= hi)})
+    return pd.DataFrame(rows, columns=["isa", "scene", "tile", "small", "large", "ratio",
+                                       "predicted_ratio", "lo", "hi", "consistent"])
+
+
+def scaling_text(df):
+    """Per back end and scene, the larger resolution's frame over the smaller one's, measured
+    and predicted (the mean over the tiles converged at both). A check of the model that no
+    draw of the machine's speed moves: a model whose misses grow with the frame's length (lines
+    that age out between two frames) predicts a ratio the silicon does not show."""
+    c = self_consistency(df)
+    if c.empty:
+        return "No scene was measured (converged) at two resolutions."
+    lines = ["| back end | scene | resolutions | tiles | measured ratio | predicted ratio | "
+             "error |", "|---|---|---|---|---|---|---|"]
+    for (isa, scene, small, large), g in c.groupby(["isa", "scene", "small", "large"],
+                                                   sort=False):
+        m, p = g["ratio"].mean(), g["predicted_ratio"].mean()
+        lines.append(f"| {isa} | {scene} | {large} / {small} | {len(g)} | {m:.2f} | {p:.2f} | "
+                     f"{pct(p / m - 1)} |")
+    return "\n".join(lines)
 
 
 def consistency_text(df):
@@ -468,6 +488,11 @@ def write_page(df, page, plot_name, header):
         "## SIMD-width ranking\n\nThe same workload on each back end, each predicted by its "
         "own host configuration (per-op costs from that back end's microbenchmarks); judged as "
         "the tiles are.\n\n" + width_ranking_text(df),
+        "## Resolution scaling\n\nA scene's frame at the larger resolution over its frame at "
+        "the smaller, measured and predicted, on the tiles converged at both. Rays of the "
+        "larger frame are more coherent, so the ratio is below the pixels' ratio; a model "
+        "that loses lines by age between frames loses more of them in the longer frame and "
+        "predicts a ratio above the measured one.\n\n" + scaling_text(df),
         "## Where the prediction goes wrong, by stage\n\nScene-data stalls are what the "
         "machine model exposes of each miss (the latency of the level that holds the line, less "
         "the L1D hit inside the measured op costs, after the prefetch of the next op's data); "

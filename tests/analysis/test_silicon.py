@@ -166,6 +166,11 @@ def test_self_consistency_flag(tmp_path):
     text = silicon.consistency_text(df)
     assert "1 of 2 (scene, tile) frames cost 3-5x at 128x128" in text
     assert "FLAGGED" in text and "b tile 64: 1.50x" in text
+    # The model's ratio beside the measured one: a predicts 4.00 against 4.10 measured.
+    assert list(c["predicted_ratio"]) == pytest.approx([4.0, 4.0])
+    scaling = silicon.scaling_text(df)
+    assert "| avx512 | a | 128x128 / 64x64 | 1 | 4.10 | 4.00 | -2.4 % |" in scaling
+    assert "| avx512 | b | 128x128 / 64x64 | 1 | 1.50 | 4.00 | +167.1 % |" in scaling
     # Consistent everywhere: not flagged.
     assert "FLAGGED" not in silicon.consistency_text(df[df["scene"] == "a"])
     # An unconverged frame is not used to flag either.
