@@ -351,6 +351,9 @@ void add_calibrate_command(CLI::App& app) {
                         v.settings.max_depth = loaded[sc]->max_depth;
                         v.settings.isa = host_isas[k];
                         v.host = &hosts[k];
+                        // From cold caches too, on one tile (the middle one listed): enough
+                        // to see what the frame pays for what the render before left.
+                        v.cold = tile == tiles[tiles.size() / 2];
                         variants.push_back(v);
                         variant_scene.push_back(scenes[sc]);
                     }
@@ -395,6 +398,12 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.neighbours_busy"] = m.neighbours_busy;
             row["measured.speed_probe_before"] = m.probe_before;
             row["measured.speed_probe_after"] = m.probe_after;
+            if (variants[i].cold) {
+                row["predicted.cold_frame_cycles"] = m.predicted_cold_frame;
+                row["measured.cold_frame_cycles"] = m.measured_cold_frame;
+                row["measured.cold_converged"] = m.cold_convergence.converged;
+                row["measured.cold_renders"] = m.cold_convergence.samples;
+            }
             row["host.vendor"] = vendor_short_name(uarch.vendor);
             row["host.family"] = uarch.signature.family;
             row["host.model"] = uarch.signature.model;

@@ -207,7 +207,7 @@ namespace {
 
 // The machine model's prediction of one workload, through the path sfx simulate takes.
 void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
-             SiliconMeasurement& m) {
+             bool cold, SiliconMeasurement& m) {
     settings.stage_clock = false;
     // Every measured render follows a render of its scene (predict_and_measure: its own warming
     // render, or the workload before it), so the prediction starts from the caches a render of
@@ -225,6 +225,20 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
         }
     for (int l = 0; l < 3; ++l) m.predicted_loop[size_t(l)] = double(t.traversal_loop_cycles[l]);
     m.predicted_frame = double(t.cycles);
+    if (cold)  // from empty caches, as the renders after evict_caches start
+        m.predicted_cold_frame =
+            double(run_point_group(scene, bvh, settings, {host}, Fidelity::full, SamplingOptions{})
+                       .predictions.front()
+                       .timing.cycles);
+}
+
+// Reads 256 MiB of other data (the DRAM chase's size, beyond the L3 a core keeps on any
+// current CPU): none of the scene is left in this core's caches after it.
+void evict_caches() {
+    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other((256u << 20) / 8, 1);
+    uint64_t sum = 0;
+    for (size_t i = 0; i < other.size(); i += 8) sum += other[i];  // one read a line
+    if (sum == 0) std::fprintf(stderr, " ");                       // keeps the reads
 }
 
 // One render, trace off, with or without the stage clock: its core cycles from `source`
@@ -271,7 +285,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
         if (progress) progress("predicting", v, n);
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
-        predict(*variants[v].scene, *variants[v].bvh, settings[v], *variants[v].host, out[v]);
+        predict(*variants[v].scene, *variants[v].bvh, settings[v], *variants[v].host,
+                variants[v].cold, out[v]);
     }
     // One cycle source per back end: its clock is measured under that back end's instructions.
     const double tsc_mhz = measure_tsc_mhz();
@@ -327,17 +342,20 @@ std::vector<SiliconMeasurement> predict_and_measure(
     std::mt19937_64 rng(seed);
     std::vector<uint64_t> others_busy(n, 0), others_total(n, 0);
     const int own_cpu = sched_getcpu();
+    auto needs_more = [&](size_t v) {
+        return needs_more_samples(out[v].frame_samples, convergence) ||
+               (variants[v].cold && needs_more_samples(out[v].cold_samples, convergence));
+    };
     for (uint32_t round = 1;; ++round) {
         size_t open = 0;
-        for (size_t v = 0; v < n; ++v)
-            open += needs_more_samples(out[v].frame_samples, convergence);
+        for (size_t v = 0; v < n; ++v) open += needs_more(v);
         if (open == 0) break;
         if (progress)
             progress("round " + std::to_string(round) + ": " + std::to_string(open) + " open",
                      n - open, n);
         for (size_t v = 0; v < n; ++v) {
             SiliconMeasurement& m = out[v];
-            if (!needs_more_samples(m.frame_samples, convergence)) continue;
+            if (!needs_more(v)) continue;
             const Scene& scene = *variants[v].scene;
             const Bvh& bvh = *variants[v].bvh;
             if (warm_scene != &scene) warm(v);
@@ -368,6 +386,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 short_loop_min[v][size_t(l)] =
                     std::min(short_loop_min[v][size_t(l)], double(r.stats.short_loop_tsc[l]));
             clocked_totals[v].push_back(clocked.cycles);
+            if (variants[v].cold) {
+                evict_caches();
+                m.cold_samples.push_back(timed_render(scene, bvh, settings[v], false, source_of(v),
+                                                      tsc_mhz, r, m.interrupted)
+                                             .first.cycles);
+            }
         }
     }
     probe_all(probe_after);
@@ -378,6 +402,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
         m.probe_after = probe_after[lanes];
         m.convergence = judge_convergence(m.frame_samples, convergence);
         m.measured_frame = m.convergence.fastest;
+        if (variants[v].cold) {
+            m.cold_convergence = judge_convergence(m.cold_samples, convergence);
+            m.measured_cold_frame = m.cold_convergence.fastest;
+        }
         const size_t fastest = size_t(
             std::min_element(m.frame_samples.begin(), m.frame_samples.end()) -
             m.frame_samples.begin());

@@ -102,6 +102,12 @@ struct SiliconMeasurement {
     // (NaN: the host file has none). The same for every workload of a back end; a probe beyond
     // +-10 % flags a run slowed (or sped) alike.
     double probe_before = 0.0, probe_after = 0.0;
+    // From cold caches (SiliconVariant::cold): the renders after reading 256 MiB of other data,
+    // which leaves none of the scene in this core's caches, under the same rule; the
+    // prediction from empty caches. 0 and no samples where not asked for.
+    double predicted_cold_frame = 0.0, measured_cold_frame = 0.0;
+    Convergence cold_convergence;
+    std::vector<double> cold_samples;
 };
 
 // The speed probe: microbenchmark points of a traversal, an intersection and two shading
@@ -117,6 +123,9 @@ struct SiliconVariant {
     const Bvh* bvh = nullptr;
     RenderSettings settings;
     const HwConfig* host = nullptr;
+    // Also measured and predicted from cold caches: what a frame pays for the scene lines the
+    // render before left (the model's misses to DRAM, and the lines' ageing, on silicon).
+    bool cold = false;
 };
 
 // The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
@@ -126,7 +135,8 @@ struct SiliconVariant {
 // converged or spent its budget (`convergence`): every workload's renders span the whole run,
 // so that the drift of a shared machine touches all of them alike, and a slow spell shows as
 // disagreement instead of a bias. Consecutive workloads of one scene share its caches; where
-// the scene changes, an unmeasured render warms them first. `seed` draws the heap offsets that
+// the scene changes, an unmeasured render warms them first. A workload asked for `cold` also
+// renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
 // vary placement. `progress(what, done, total)` as it goes.
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,

@@ -140,6 +140,32 @@ def consistency_text(df):
     return "\n".join(lines)
 
 
+def cold_text(df):
+    """Per workload measured from cold caches too: what the frame pays for starting with none
+    of its scene cached (cold - warm), measured and predicted. The measured pair counts only
+    where both converged."""
+    if "measured.cold_frame_cycles" not in df:
+        return "These rows carry no renders from cold caches."
+    g = df[df["measured.cold_frame_cycles"].notna()]
+    if g.empty:
+        return "These rows carry no renders from cold caches."
+    lines = ["| back end | scene | res | tile | measured warm / cold Mcyc | measured cost | "
+             "predicted warm / cold Mcyc | predicted cost | predicted / measured cost |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for _, r in g.iterrows():
+        mw, mc = r["measured.frame_cycles"], r["measured.cold_frame_cycles"]
+        pw, pc = r["predicted.frame_cycles"], r["predicted.cold_frame_cycles"]
+        both = bool(r["measured.converged"]) and bool(r["measured.cold_converged"])
+        measured = (f"{(mc - mw) / 1e6:+.2f} M ({pct(mc / mw - 1)})" if both
+                    else "not converged")
+        ratio = f"{(pc - pw) / (mc - mw):.2f}" if both and mc > mw else "n/a"
+        lines.append(f"| {r['isa']} | {r['scene']} | {r['res']} | {r['tile']} | "
+                     f"{mw / 1e6:.2f} / {mc / 1e6:.2f} | {measured} | "
+                     f"{pw / 1e6:.2f} / {pc / 1e6:.2f} | {(pc - pw) / 1e6:+.2f} M "
+                     f"({pct(pc / pw - 1)}) | {ratio} |")
+    return "\n".join(lines)
+
+
 def isas(df):
     """The back ends of the rows, narrowest first."""
     return sorted(df["isa"].unique(), key=lambda i: WIDTHS.get(i, 0))
@@ -493,6 +519,14 @@ def write_page(df, page, plot_name, header):
         "larger frame are more coherent, so the ratio is below the pixels' ratio; a model "
         "that loses lines by age between frames loses more of them in the longer frame and "
         "predicts a ratio above the measured one.\n\n" + scaling_text(df),
+        "## Cold caches\n\nOne tile per scene, resolution and back end also rendered after "
+        "reading 256 MiB of other data, so that none of the scene is left in this core's "
+        "caches (the same convergence rule), and predicted from empty caches. The cost of cold "
+        "caches is what the frame otherwise saves from the lines the render before left: on "
+        "silicon, what those lines are worth after their ageing by the neighbours' fills; in "
+        "the model, its misses to DRAM at its DRAM latency and exposure. (The eviction also "
+        "empties the TLBs and the ray buffers' lines, which the model does not price.)\n\n"
+        + cold_text(df),
         "## Where the prediction goes wrong, by stage\n\nScene-data stalls are what the "
         "machine model exposes of each miss (the latency of the level that holds the line, less "
         "the L1D hit inside the measured op costs, after the prefetch of the next op's data); "

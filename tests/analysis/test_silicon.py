@@ -256,3 +256,23 @@ def test_traversal_by_loop(tmp_path):
     # Rows written before the loop clock carry no split, and say so.
     older = df.drop(columns=[c for c in df.columns if "_loop_" in c])
     assert "no traversal split" in silicon.loops_text(older)
+
+
+def test_cold_caches(tmp_path):
+    # a: silicon pays 2 M for cold caches, the model 8 M; b: cold not converged; c: not asked.
+    rows = [row("a", 32, 14e6, 17e6), row("b", 32, 30e6, 33e6), row("c", 32, 5e6, 5e6)]
+    rows[0].update({"predicted.cold_frame_cycles": 22e6, "measured.cold_frame_cycles": 19e6,
+                    "measured.cold_converged": True, "measured.cold_renders": 7})
+    rows[1].update({"predicted.cold_frame_cycles": 31e6, "measured.cold_frame_cycles": 40e6,
+                    "measured.cold_converged": False, "measured.cold_renders": 31})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    text = silicon.cold_text(silicon.load_rows(p))
+    assert ("| avx512 | a | 64x64 | 32 | 17.00 / 19.00 | +2.00 M (+11.8 %) | 14.00 / 22.00 | "
+            "+8.00 M (+57.1 %) | 4.00 |") in text
+    assert "| avx512 | b | 64x64 | 32 | 33.00 / 40.00 | not converged |" in text
+    assert "| c |" not in text
+    # Rows from before the cold renders: said so.
+    p.write_text(json.dumps([row("a", 32, 1, 1)]))
+    assert "no renders from cold caches" in silicon.cold_text(silicon.load_rows(p))
+

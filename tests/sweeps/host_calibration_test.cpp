@@ -143,10 +143,19 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     f.max_depth = furnace.max_depth;
     std::vector<std::string> rounds;
     const std::vector<SiliconMeasurement> cell = predict_and_measure(
-        {{&scene, &bvh, s, &config}, {&furnace, &furnace_bvh, f, &config}}, rule, 1,
+        {{&scene, &bvh, s, &config}, {&furnace, &furnace_bvh, f, &config, true}}, rule, 1,
         [&](const std::string& what, size_t, size_t) { rounds.push_back(what); });
     REQUIRE(cell.size() == 2);
     CHECK(cell[1].frame_samples.size() == 2);
+    // The workload asked for cold caches renders from them too, under the same rule, and is
+    // predicted from empty caches (never cheaper); the other does neither.
+    CHECK(cell[1].cold_samples.size() == 2);
+    CHECK(cell[1].cold_convergence.samples == 2);
+    CHECK(cell[1].measured_cold_frame ==
+          Approx(std::min(cell[1].cold_samples[0], cell[1].cold_samples[1])));
+    CHECK(cell[1].predicted_cold_frame >= cell[1].predicted_frame);
+    CHECK(cell[0].cold_samples.empty());
+    CHECK(cell[0].predicted_cold_frame == 0.0);
     CHECK(cell[1].predicted_frame > 0);
     CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
     CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
