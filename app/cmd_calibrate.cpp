@@ -66,6 +66,7 @@ void add_calibrate_command(CLI::App& app) {
     struct Options {
         bool describe = false;
         std::string output = "host.hw.yaml";
+        std::string memory_from;
         std::string check;
         std::string isa = "auto";
         uint32_t repeats = 41;
@@ -86,6 +87,10 @@ void add_calibrate_command(CLI::App& app) {
                 "describe the host, fit its per-op costs on microbenchmarks, write -o");
     c->add_option("-o,--output", o->output, "the host configuration written by --describe-host")
         ->capture_default_str();
+    c->add_option("--memory-from", o->memory_from,
+                  "--describe-host: take the scene memory (caches, their latencies, the L3 this "
+                  "core keeps, DRAM) from this host file of the same machine instead of "
+                  "measuring it, so that every back end's file describes one memory");
     c->add_option("--check", o->check,
                   "HOST.hw.yaml[,MORE.hw.yaml]: predict and measure the native tracer's cycles "
                   "per workload, each file on the back end of its SIMD width");
@@ -143,15 +148,22 @@ void add_calibrate_command(CLI::App& app) {
             throw InputError("command line", 0, "--spp", "expected 1 to 4096");
         const bool pinned = pin_to_current_cpu();
         const int cpu = sched_getcpu();  // the rows say where they were measured
+        if (!o->memory_from.empty() && !o->describe)
+            throw InputError("command line", 0, "--memory-from", "only with --describe-host");
         if (o->describe) {
+            std::unique_ptr<HwConfig> memory_from;
+            if (!o->memory_from.empty())
+                memory_from = std::make_unique<HwConfig>(load_hw_config(o->memory_from));
             OutputFiles outputs;
             const std::string temp = outputs.add(o->output, "--output");
             Progress progress("calibrate", 15, "op kinds");
-            const HostCalibration cal =
-                calibrate_host(isa, bench_rule, [&](uint32_t done, uint32_t total) {
+            const HostCalibration cal = calibrate_host(
+                isa, bench_rule,
+                [&](uint32_t done, uint32_t total) {
                     progress.set_total(total);
                     progress.set_done(done);
-                });
+                },
+                memory_from.get(), o->memory_from);
             progress.finish();
             std::ofstream(temp) << cal.yaml;
             parse_hw_config(cal.yaml, o->output);  // what was written reads back

@@ -352,7 +352,7 @@ SeenLevel last_level_seen(const HostDescription& h) {
     return seen;
 }
 
-HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
+HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool measure_memory) {
     HostDescription h;
     h.microarchitecture = read_microarchitecture();
     h.simd_width = simd_width;
@@ -361,6 +361,7 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa) {
     h.tsc_mhz = measure_tsc_mhz();
     h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21, simd_width);
     h.caches = read_host_caches();
+    if (!measure_memory) return h;
     for (size_t i = 0; i < h.caches.size(); ++i) {
         const HostCacheLevel& c = h.caches[i];
         if (i > 0 && i + 1 == h.caches.size()) {
@@ -422,6 +423,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
+    if (!h.memory_source.empty()) c.scene_memory = h.memory;
     // The native tracer prefetches a node's children (a leaf's primitives) while it tests the
     // node (prefetch_below in kernels/stream/stream_kernels_impl.h), and nothing else.
     c.scene_memory.prefetch_depth = 0;
@@ -472,7 +474,12 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
           << ", shared: " << (l.shared ? "true" : "false")
           << (l.foreign_fill_per_us > 0 ? ", foreign_fill_per_us: " + fmt(l.foreign_fill_per_us, 2)
                                         : std::string())
-          << "}  # " << h.caches[i].source << "; latency measured (pointer chase over ";
+          << "}  # ";
+        if (!h.memory_source.empty()) {
+            y << "as " << h.memory_source << " describes it\n";
+            continue;
+        }
+        y << h.caches[i].source << "; latency measured (pointer chase over ";
         const bool chased = i + 1 == c.scene_memory.caches.size() && !h.last_level_chases.empty();
         if (!chased) {
             y << h.caches[i].kib / 2 << " KiB)\n";
@@ -498,12 +505,15 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
         }
         y << "\n";
     }
-    y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2)
-      << "  # measured: pointer chase over 256 MiB\n"
+    y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2) << "  # "
+      << (h.memory_source.empty() ? "measured: pointer chase over 256 MiB"
+                                  : "as " + h.memory_source + " describes it")
+      << "\n"
       << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
       << "  # assumed: not measured; DRAM lines queue for it\n"
       << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
-      << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) as it\n"
+      << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) as "
+         "it\n"
       << "                           # tests the node (prefetch_below, kernels/stream)\n"
       << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";

@@ -85,6 +85,12 @@ struct HostDescription {
     // one CPU's L3 may not be another's (a neighbour's load on its physical core): the check
     // runs pinned where its host was described (scripts/silicon-check --cpu).
     int cpu = -1;
+    // The scene memory as another host file of this machine describes it (`sfx calibrate
+    // --describe-host --memory-from FILE`), instead of this description's own chases: the
+    // back ends' host files of one check then share one memory, measured once, and their
+    // predictions differ only where the back ends do. Empty `memory_source`: measured here.
+    SceneMemoryConfig memory;
+    std::string memory_source;
 };
 
 // The last cache level as this core sees it, from its chases, by the LRU stack: a line is
@@ -105,12 +111,15 @@ struct SeenLevel {
 };
 SeenLevel last_level_seen(const HostDescription& host);
 
-// Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h).
-HostDescription describe_host(uint32_t simd_width, const std::string& isa);
+// Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h);
+// without `measure_memory`, no load latencies or chases (the caller sets memory_source).
+HostDescription describe_host(uint32_t simd_width, const std::string& isa,
+                              bool measure_memory = true);
 
 // The configuration: one core, one SIMD unit of the ISA's width at the TSC clock; the ray
 // buffers in the L1D (storage l1d, no banks), partition by compress; the caches as scene
-// memory with measured latencies. `op_costs` as given (the fitted ones, or empty).
+// memory with measured latencies (or HostDescription::memory, where it names its source).
+// `op_costs` as given (the fitted ones, or empty).
 HwConfig host_hw_config(const HostDescription& host, const std::vector<OpCostConfig>& op_costs);
 
 // host.hw.yaml text: host_hw_config with a comment on every value naming its source.

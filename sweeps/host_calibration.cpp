@@ -96,10 +96,15 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 }
 
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
-                               const std::function<void(uint32_t, uint32_t)>& progress) {
+                               const std::function<void(uint32_t, uint32_t)>& progress,
+                               const HwConfig* memory_from, const std::string& memory_source) {
     HostCalibration c;
     const Isa resolved = resolve_isa(isa);
-    c.host = describe_host(isa_width(resolved), describe_isa(resolved));
+    c.host = describe_host(isa_width(resolved), describe_isa(resolved), memory_from == nullptr);
+    if (memory_from) {
+        c.host.memory = memory_from->scene_memory;
+        c.host.memory_source = memory_source;
+    }
     c.host.slot_bytes = stream_slot_bytes();
     MicrobenchOptions options;
     options.isa = resolved;

@@ -61,8 +61,12 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 
 // Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and
 // fits. `isa`: the back end measured (auto: the widest). `progress(done, total)` per op kind.
+// `memory_from` (a host file of this machine, read as `memory_source` names it), where given:
+// its scene memory instead of measuring one (HostDescription::memory).
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
-                               const std::function<void(uint32_t, uint32_t)>& progress = {});
+                               const std::function<void(uint32_t, uint32_t)>& progress = {},
+                               const HwConfig* memory_from = nullptr,
+                               const std::string& memory_source = "");
 
 // Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
 bool pin_to_current_cpu();

@@ -573,6 +573,13 @@ TEST_CASE("The host's caches and clock are read from the CPU", "[host]") {
     const double mhz = measure_tsc_mhz(0.02);
     CHECK(mhz > 100.0);
     CHECK(mhz < 10000.0);
+    // A description whose memory comes from another file measures none: no chases.
+    const HostDescription h = describe_host(1, "scalar", false);
+    CHECK(h.caches.size() == caches.size());
+    CHECK(h.core_mhz > 0.0);
+    CHECK(h.latency_ns.empty());
+    CHECK(h.last_level_chases.empty());
+    CHECK(h.last_level_idle_chases.empty());
 }
 
 TEST_CASE("The host's microarchitecture: vendor, family and model from cpuid", "[host]") {
@@ -603,4 +610,30 @@ TEST_CASE("The host's microarchitecture: vendor, family and model from cpuid", "
     h.microarchitecture = m;
     CHECK_THAT(host_hw_yaml(h, {}, "test"),
                Catch::Contains("# Microarchitecture (cpuid): " + m.vendor + " family 0x"));
+}
+
+TEST_CASE("A host file can take its scene memory from another of the same machine", "[host]") {
+    HostDescription h = small_host();
+    const HwConfig own = host_hw_config(h, {});
+    h.memory = own.scene_memory;
+    h.memory.caches.back().kib = 12288;
+    h.memory.caches.back().foreign_fill_per_us = 3.5;
+    h.memory.dram_latency_ns = 150;
+    h.memory_source = "out/host-scalar.hw.yaml";
+    const HwConfig c = host_hw_config(h, {});
+    CHECK(c.scene_memory.caches.back().kib == 12288);
+    CHECK(c.scene_memory.caches.back().foreign_fill_per_us == 3.5);
+    CHECK(c.scene_memory.dram_latency_ns == 150);
+    CHECK(c.clock.core_mhz == own.clock.core_mhz);  // the rest is this description's
+    CHECK(c.simd.width == own.simd.width);
+    // The file says where its memory came from, on every level, and reads back the same.
+    const std::string yaml = host_hw_yaml(h, {}, "test");
+    CHECK_THAT(yaml, Catch::Contains("foreign_fill_per_us: 3.50}  # as out/host-scalar.hw.yaml "
+                                     "describes it"));
+    CHECK_THAT(yaml, Catch::Contains("dram_latency_ns: 150.00  # as out/host-scalar.hw.yaml"));
+    CHECK_THAT(yaml, !Catch::Contains("pointer chase"));
+    const HwConfig back = parse_hw_config(yaml, "host.hw.yaml");
+    REQUIRE(back.scene_memory.caches.size() == c.scene_memory.caches.size());
+    CHECK(back.scene_memory.caches.back().kib == 12288);
+    CHECK(back.scene_memory.dram_latency_ns == Approx(150));
 }
