@@ -423,6 +423,8 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
+    // Caches and DRAM from another file of this machine; the prefetch and hit reads below are
+    // this tracer's whoever measured them.
     if (!h.memory_source.empty()) c.scene_memory = h.memory;
     // The native tracer prefetches a node's children (a leaf's primitives) while it tests the
     // node (prefetch_below in kernels/stream/stream_kernels_impl.h), and nothing else.

@@ -85,8 +85,8 @@ struct HostDescription {
     // one CPU's L3 may not be another's (a neighbour's load on its physical core): the check
     // runs pinned where its host was described (scripts/silicon-check --cpu).
     int cpu = -1;
-    // The scene memory as another host file of this machine describes it (`sfx calibrate
-    // --describe-host --memory-from FILE`), instead of this description's own chases: the
+    // The scene memory's caches and DRAM as another host file of this machine describes them
+    // (`sfx calibrate --describe-host --memory-from FILE`), instead of its own chases: the
     // back ends' host files of one check then share one memory, measured once, and their
     // predictions differ only where the back ends do. Empty `memory_source`: measured here.
     SceneMemoryConfig memory;
@@ -99,10 +99,10 @@ struct HostDescription {
 // r t S of others' between touches of a line, so it hits while S (1 + r t) < C. The chases over
 // growing sizes cross at S* (steps of the level's latency H), the spaced-out chases over S0
 // lines at t*: two equations for the capacity C and others' fill rate r. A crossing is where a
-// chase's latency passes the midpoint between H and a line evicted (the slower of the largest
-// chase and the most spaced-out). On this project's AMD VM (2026-11-27) the chases jumped from
-// 16 to 115 ns between 4 and 6 MiB, and a 2 MiB chase went from 14 to 127 ns as its steps
-// grew from 0.1 to 1 us. Without crossings, the level cpuid reports and no others' fills.
+// chase's latency passes the midpoint between H and a line evicted (the largest size chase;
+// where even it kept its lines, the median of the three most spaced-out). On this project's
+// AMD VM (2026-11-27) the chases jumped from 16 to 115 ns between 4 and 6 MiB, and a 2 MiB
+// chase went from 14 to 127 ns as its steps grew from 0.1 to 1 us. Without crossings, the level cpuid reports and no others' fills.
 struct SeenLevel {
     uint32_t kib = 0;
     double latency_ns = 0.0;
