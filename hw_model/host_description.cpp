@@ -270,15 +270,11 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
 
 namespace {
 
-// DRAM: a chase over 256 MiB (beyond the L3 a core sees on any current CPU; no larger, the
-// machine may be shared), in huge pages as the BVH's nodes and leaf primitives are.
-constexpr uint64_t k_largest_chase = 256ull << 20;
-
 // The last level's chases: from twice the level before it (mostly beyond that level) in steps
 // of a quarter to a half, up to the level's size and at most 64 MiB (a quarter of DRAM's).
 std::vector<uint32_t> last_level_chase_kib(uint32_t before_kib, uint32_t last_kib) {
     static const double k_steps[] = {1, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32};
-    const uint64_t most = std::min<uint64_t>(last_kib, (k_largest_chase / 4) >> 10);
+    const uint64_t most = std::min<uint64_t>(last_kib, (k_beyond_last_level_bytes / 4) >> 10);
     std::vector<uint32_t> kib;
     for (double step : k_steps) {
         const uint64_t k = uint64_t(step * 2.0 * before_kib);
@@ -317,12 +313,11 @@ SeenLevel last_level_seen(const HostDescription& h) {
     // the slowest reading of all: one interrupted chase (566 ns where its neighbours read
     // 112-145 ns, 2026-11-27) set the midpoint above every crossing, and the level to 64 MiB.
     double evicted = h.last_level_chases.back().second;
-    if (evicted < 2.0 * hit && !h.last_level_idle_chases.empty()) {
+    const auto& idle = h.last_level_idle_chases;
+    if (evicted < 2.0 * hit && !idle.empty()) {
         std::vector<double> tail;
-        for (size_t i = h.last_level_idle_chases.size() -
-                        std::min<size_t>(h.last_level_idle_chases.size(), 3);
-             i < h.last_level_idle_chases.size(); ++i)
-            tail.push_back(h.last_level_idle_chases[i].second);
+        for (auto it = idle.end() - long(std::min<size_t>(idle.size(), 3)); it != idle.end(); ++it)
+            tail.push_back(it->second);
         evicted = median(tail);
     }
     seen.latency_ns = hit;
@@ -385,7 +380,8 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
         // Half the level: it fits there, and not in the level before (which is smaller).
         h.latency_ns.push_back(measure_load_latency_ns(uint64_t(c.kib) * 1024 / 2, h.tsc_mhz));
     }
-    h.latency_ns.push_back(measure_load_latency_ns(k_largest_chase, h.tsc_mhz));
+    // DRAM: in huge pages, as the BVH's nodes and leaf primitives are.
+    h.latency_ns.push_back(measure_load_latency_ns(k_beyond_last_level_bytes, h.tsc_mhz));
     return h;
 }
 

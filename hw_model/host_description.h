@@ -39,6 +39,10 @@ double measure_tsc_mhz(double seconds = 0.2);
 double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin = 0,
                                double* step_ns = nullptr);
 
+// Beyond the L3 a core sees on any current CPU (no larger: the machine may be shared): the
+// DRAM chase's size, and what the silicon check reads to leave a core's caches cold.
+constexpr uint64_t k_beyond_last_level_bytes = 256ull << 20;
+
 // Reads the TSC (rdtsc): the clock the native tracer's cycles are counted in.
 uint64_t read_tsc();
 

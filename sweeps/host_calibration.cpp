@@ -237,10 +237,11 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
                        .timing.cycles);
 }
 
-// Reads 256 MiB of other data (the DRAM chase's size, beyond the L3 a core keeps on any
-// current CPU): none of the scene is left in this core's caches after it.
+// Reads other data beyond the L3 a core keeps: none of the scene is left in this core's
+// caches after it.
 void evict_caches() {
-    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other((256u << 20) / 8, 1);
+    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other(k_beyond_last_level_bytes / 8,
+                                                                    1);
     uint64_t sum = 0;
     for (size_t i = 0; i < other.size(); i += 8) sum += other[i];  // one read a line
     if (sum == 0) std::fprintf(stderr, " ");                       // keeps the reads
