@@ -442,10 +442,11 @@ void add_calibrate_command(CLI::App& app) {
                 row[std::string("measured.traversal_") + loops[l] + "_loop_cycles"] =
                     m.measured_loop[size_t(l)];
             }
-            // The machine model's stall causes, as sfx simulate reports them.
+            // The machine model's stall causes and its scene-data misses per level, as sfx
+            // simulate reports them (the page sets the frame's error against the misses).
             for (const Stat& stat : m.prediction.stats())
-                if (stat.name.rfind("stall_cycles.", 0) == 0)
-                    row["predicted." + stat.name] = stat.value;
+                for (const char* prefix : {"stall_cycles.", "scene_cache.", "scene_memory."})
+                    if (stat.name.rfind(prefix, 0) == 0) row["predicted." + stat.name] = stat.value;
             rows.push_back(row);
             if (!o->json)
                 progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) + " tile " +

@@ -338,6 +338,39 @@ def misses_text(df):
     return "\n".join(lines)
 
 
+def cache_levels(df):
+    """The model's scene-cache levels the rows carry misses of, in name order (the host files
+    name them l1, l2, l3)."""
+    prefix, suffix = "predicted.scene_cache.", ".misses"
+    return sorted(c[len(prefix):-len(suffix)] for c in df.columns
+                  if c.startswith(prefix) and c.endswith(suffix))
+
+
+def residual_text(df):
+    """Per back end, scene and resolution (converged tiles summed): the measured frame less the
+    predicted one, against the model's scene-data misses per level. A residual that keeps one
+    size per miss of the first level across scenes and resolutions points at what the model
+    charges for scene data beyond the L1D; one that keeps a size per pixel, at the op costs."""
+    levels = cache_levels(df)
+    if not levels or "predicted.scene_memory.dram_reads" not in df:
+        return "These rows carry no scene-data misses of the model."
+    first = levels[0]
+    lines = ["| back end | scene | res | tiles | measured - predicted Mcyc | per pixel | "
+             + " | ".join(f"model's {lv} misses" for lv in levels)
+             + f" | model's DRAM reads | per {first} miss |",
+             "|---|---|---|---|---|---|" + "---|" * (len(levels) + 2)]
+    for (isa, scene, res), g in scored(df).groupby(["isa", "scene", "res"], sort=False):
+        residual = (g["measured.frame_cycles"] - g["predicted.frame_cycles"]).sum()
+        pixels = (g["width"] * g["height"]).sum()
+        misses = [g[f"predicted.scene_cache.{lv}.misses"].sum() for lv in levels]
+        per_miss = f"{residual / misses[0]:+.0f}" if misses[0] > 0 else "n/a"
+        lines.append(f"| {isa} | {scene} | {res} | {len(g)} | {residual / 1e6:+.2f} | "
+                     f"{residual / pixels:+.0f} | "
+                     + " | ".join(f"{m:,.0f}" for m in misses)
+                     + f" | {g['predicted.scene_memory.dram_reads'].sum():,.0f} | {per_miss} |")
+    return "\n".join(lines)
+
+
 LOOPS = (("one_ray", "one-ray loop"), ("few_ray", "few-ray loop"), ("stream", "stream loop"))
 
 
@@ -531,6 +564,14 @@ def write_page(df, page, plot_name, header):
         "machine model exposes of each miss (the latency of the level that holds the line, less "
         "the L1D hit inside the measured op costs, after the prefetch of the next op's data); "
         "the last column is the prediction without them.\n\n" + misses_text(df),
+        "## The residual against the model's misses\n\nPer resolution, the tiles' measured "
+        "frames less their predicted ones (summed over the converged tiles), per pixel and "
+        "per miss of the model's first scene-cache level, beside the model's misses per level "
+        "and its DRAM reads. A residual that the model's pricing of scene data beyond the L1D "
+        "leaves keeps one size per first-level miss across scenes and resolutions; one that "
+        "the op costs leave keeps one size per pixel. DRAM reads the silicon does not pay (the "
+        "cold-cache table) lower the residual where the model has them.\n\n"
+        + residual_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

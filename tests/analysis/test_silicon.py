@@ -276,3 +276,28 @@ def test_cold_caches(tmp_path):
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
     assert "no renders from cold caches" in silicon.cold_text(silicon.load_rows(p))
 
+
+
+def test_residual_against_the_models_misses(tmp_path):
+    # Scene a at 64x64: two tiles 2 M and 1 M short of the silicon, 1,000 + 500 first-level
+    # misses: +3 M over two frames of 4,096 pixels, +366 cycles a pixel, +2,000 a miss. Scene
+    # b has no misses: n/a. Unconverged rows count nowhere.
+    rows = [row("a", 16, 10e6, 12e6), row("a", 32, 10e6, 11e6), row("b", 16, 5e6, 5.5e6),
+            row("a", 64, 1e6, 9e6)]
+    for r, (l1, l2, dram) in zip(rows, [(1000, 400, 10), (500, 100, 0), (0, 0, 0),
+                                        (9999, 9999, 9999)]):
+        r.update({"predicted.scene_cache.l1.misses": l1, "predicted.scene_cache.l2.misses": l2,
+                  "predicted.scene_cache.l1.hit_rate": 0.5,
+                  "predicted.scene_memory.dram_reads": dram, "measured.converged": True})
+    rows[3]["measured.converged"] = False
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    assert silicon.cache_levels(df) == ["l1", "l2"]
+    text = silicon.residual_text(df)
+    assert "| model's l1 misses | model's l2 misses | model's DRAM reads | per l1 miss |" in text
+    assert "| avx512 | a | 64x64 | 2 | +3.00 | +366 | 1,500 | 500 | 10 | +2000 |" in text
+    assert "| avx512 | b | 64x64 | 1 | +0.50 | +122 | 0 | 0 | 0 | n/a |" in text
+    # Rows written before the model's misses were kept: said so.
+    older = df.drop(columns=[c for c in df.columns if "scene_" in c])
+    assert "no scene-data misses" in silicon.residual_text(older)
