@@ -214,9 +214,9 @@ namespace {
 void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
              bool cold, SiliconMeasurement& m) {
     settings.stage_clock = false;
-    // Every measured render follows a render of its scene (predict_and_measure: its own warming
-    // render, or the workload before it), so the prediction starts from the caches a render of
-    // this workload leaves, not from empty ones.
+    // Every measured render follows an unmeasured render of its own workload
+    // (predict_and_measure), so the prediction starts from the caches a render of this workload
+    // leaves, not from empty ones.
     SamplingOptions warm;
     warm.warm_frames = 1;
     const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full, warm);
@@ -318,13 +318,15 @@ std::vector<SiliconMeasurement> predict_and_measure(
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
     std::vector<std::vector<CycleReading>> readings(n);
     RenderResult r;
-    // Warm: the caches with the workload's scene, page faults, the tracer's buffers.
-    const Scene* warm_scene = nullptr;
+    // Warm: the caches with the workload's own frame (what predict() starts from), page
+    // faults, the tracer's buffers. A workload of the same scene before it leaves other lines:
+    // a 128 x 128 frame after a 64 x 64 one finds a quarter of its own.
+    size_t warm_variant = n;
     auto warm = [&](size_t v) {
         uint32_t ignored = 0;
         timed_render(*variants[v].scene, *variants[v].bvh, settings[v], false, source_of(v),
                      tsc_mhz, r, ignored);
-        warm_scene = variants[v].scene;
+        warm_variant = v;
     };
     for (size_t v = 0; v < n; ++v) warm(v);
     // The machine's speed against calibration, per back end, before the renders and after.
@@ -364,7 +366,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
             if (!needs_more(v)) continue;
             const Scene& scene = *variants[v].scene;
             const Bvh& bvh = *variants[v].bvh;
-            if (warm_scene != &scene) warm(v);
+            if (warm_variant != v) warm(v);
             std::vector<char> shift(64 * size_t(rng() % 1024));
             const std::vector<CpuTimes> load_before = read_cpu_times();
             const auto [reading, ticks] = timed_render(scene, bvh, settings[v], false,

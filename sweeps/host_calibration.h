@@ -138,8 +138,8 @@ struct SiliconVariant {
 // converged in turn (trace off), once plain and once with the stage clock, until each has
 // converged or spent its budget (`convergence`): every workload's renders span the whole run,
 // so that the drift of a shared machine touches all of them alike, and a slow spell shows as
-// disagreement instead of a bias. Consecutive workloads of one scene share its caches; where
-// the scene changes, an unmeasured render warms them first. A workload asked for `cold` also
+// disagreement instead of a bias. Each measured render follows an unmeasured render of its own
+// workload, so that it starts from the caches predict() assumes. A workload asked for `cold` also
 // renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
 // vary placement. `progress(what, done, total)` as it goes.
 std::vector<SiliconMeasurement> predict_and_measure(

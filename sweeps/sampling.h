@@ -21,7 +21,7 @@ struct SamplingOptions {
     uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
     // Full fidelity: frames of the same workload rendered into the scene caches (no time, no
     // counts) before the timed one; 0: the timed frame starts from empty caches. 1 predicts a
-    // frame that follows a render of its scene, as the silicon check's measured renders do.
+    // frame that follows a render of its workload, as the silicon check's measured renders do.
     // As sampled fidelity's warm-up passes, they pass through the first core's private levels
     // and the shared ones (Accelerator::warm): another core's private levels start empty.
     uint32_t warm_frames = 0;
