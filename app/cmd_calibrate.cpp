@@ -5,24 +5,29 @@
 //     trace against the native tracer's measured core cycles (counted or estimated:
 //     base/cycle_source.h; one pinned thread, trace off), each workload rendered until its
 //     fastest renders agree (base/convergence.h) or its budget runs out; one host file per back
-//     end (its SIMD width), all measured in turn per cell.
+//     end (its SIMD width), all measured in turn per cell; then per scene and back end, what the
+//     branch predictor saves a tile's traversal (kernels/stream/stream_microbench.h).
 
 #include <sched.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/progress.h"
-#include "kernels/bvh.h"
-#include "sweeps/host_calibration.h"
-#include "base/input_error.h"
-#include "workloads/scene_loader.h"
 #include "base/core_clock.h"
+#include "base/input_error.h"
 #include "base/strict_number.h"
 #include "base/user_files.h"
+#include "kernels/bvh.h"
+#include "kernels/stream/stream_microbench.h"
+#include "sweeps/host_calibration.h"
+#include "workloads/scene_loader.h"
 
 namespace sfx {
 
@@ -375,6 +380,19 @@ void add_calibrate_command(CLI::App& app) {
                 progress.set_total(total);
                 progress.set_done(done);
             });
+        // What the branch predictor saves a traversal it has just run, per scene and back end
+        // (run_predictor_microbenchmarks): the per-op costs come from the synthetic scene's
+        // traversals, and the model prices no branch.
+        // The synthetic scene's (scene index scenes.size()) are what the per-op costs hold.
+        std::map<std::pair<size_t, Isa>, std::vector<PredictorSample>> predictor;
+        for (const Isa k : host_isas) {
+            for (size_t sc = 0; sc < scenes.size(); ++sc) {
+                progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(k));
+                predictor[{sc, k}] =
+                    run_predictor_microbenchmarks(*loaded[sc], *bvhs[sc], k, bench_rule);
+            }
+            predictor[{scenes.size(), k}] = run_predictor_microbenchmarks(k, bench_rule);
+        }
         const Microarchitecture uarch = read_microarchitecture();
         uint32_t workloads = 0, converged = 0;
         std::string sources;
@@ -383,6 +401,8 @@ void add_calibrate_command(CLI::App& app) {
             const SiliconMeasurement& m = measured[i];
             const RenderSettings& st = variants[i].settings;
             const std::string& name = variant_scene[i];
+            const size_t scene_index =
+                size_t(std::find(scenes.begin(), scenes.end(), name) - scenes.begin());
             const uint32_t w = st.width, h = st.height;
             nlohmann::json row;
             row["scene"] = name;
@@ -447,6 +467,19 @@ void add_calibrate_command(CLI::App& app) {
             for (const Stat& stat : m.prediction.stats())
                 for (const char* prefix : {"stall_cycles.", "scene_cache.", "scene_memory."})
                     if (stat.name.rfind(prefix, 0) == 0) row["predicted." + stat.name] = stat.value;
+            for (const auto& [which, index] :
+                 {std::pair<std::string, size_t>{"", scene_index}, {"synthetic.", scenes.size()}})
+                for (const PredictorSample& p : predictor[{index, st.isa}]) {
+                    const std::string key =
+                        "measured.predictor." + which + (p.bounce ? "bounce" : "camera") + ".";
+                    row[key + "primed_cycles"] = p.primed_cycles;
+                    row[key + "cached_cycles"] = p.cached_cycles;
+                    row[key + "displaced_cycles"] = p.displaced_cycles;
+                    row[key + "box_tests"] = p.box_tests;
+                    row[key + "lines"] = p.lines;
+                    row[key + "batches"] = p.batches;
+                    row[key + "converged_batches"] = p.converged_batches;
+                }
             rows.push_back(row);
             if (!o->json)
                 progress.log(name + " " + std::to_string(w) + "x" + std::to_string(h) + " tile " +

@@ -371,6 +371,41 @@ def residual_text(df):
     return "\n".join(lines)
 
 
+def predictor_text(df):
+    """Per back end and scene (and the synthetic scene the per-op costs come from): what the
+    branch predictor saves a tile's traversal it has just run (displaced over lines cached),
+    and what the caches do (lines cached over primed), for camera rays and their bounces,
+    beside the scene's frame error at its smallest resolution (mean over the converged
+    tiles)."""
+    if "measured.predictor.camera.primed_cycles" not in df:
+        return "These rows carry no branch-predictor microbenchmarks."
+    lines = ["| back end | scene | rays | box tests per batch | batches converged | "
+             "caches (cached / primed) | predictor (displaced / cached) | frame error |",
+             "|---|---|---|---|---|---|---|---|"]
+
+    def row(isa, scene, prefix, r, error):
+        for rays in ("camera", "bounce"):
+            k = f"{prefix}{rays}."
+            primed, cached = r[k + "primed_cycles"], r[k + "cached_cycles"]
+            displaced, batches = r[k + "displaced_cycles"], r[k + "batches"]
+            lines.append(f"| {isa} | {scene} | {rays} | {r[k + 'box_tests'] / batches:,.0f} | "
+                         f"{r[k + 'converged_batches']:.0f} of {batches:.0f} | "
+                         f"{pct(cached / primed - 1)} | {pct(displaced / cached - 1)} | {error} |")
+
+    for isa in isas(df):
+        g = df[df["isa"] == isa]
+        row(isa, "synthetic (the per-op costs' scene)", "measured.predictor.synthetic.",
+            g.iloc[0], "-")
+        for scene, h in g.groupby("scene", sort=False):
+            smallest = scored(h)
+            smallest = smallest[smallest["width"] * smallest["height"]
+                                == (smallest["width"] * smallest["height"]).min()]
+            error = (f"{pct(smallest['error.frame'].mean())} ({smallest['res'].iloc[0]})"
+                     if not smallest.empty else "not converged")
+            row(isa, scene, "measured.predictor.", h.iloc[0], error)
+    return "\n".join(lines)
+
+
 LOOPS = (("one_ray", "one-ray loop"), ("few_ray", "few-ray loop"), ("stream", "stream loop"))
 
 
@@ -572,6 +607,16 @@ def write_page(df, page, plot_name, header):
         "the op costs leave keeps one size per pixel. DRAM reads the silicon does not pay (the "
         "cold-cache table) lower the residual where the model has them.\n\n"
         + residual_text(df),
+        "## The branch predictor\n\nThe batches of a 64x64 frame's 16x16 tiles (camera "
+        "rays, and a bounce of each in a random direction from its hit), each traversed by the "
+        "native kernels and timed (the fastest repetition, the microbenchmarks' rule) in three "
+        "states: right after itself (primed); after itself and a read of the scene lines the "
+        "other tiles' batches touch (cached); after the other tiles' traversals (displaced: a "
+        "frame's traversals never repeat). Displaced over cached is what the branch predictor "
+        "saves a traversal it has just run; cached over primed, what the caches do. The per-op "
+        "costs are fitted on the synthetic scene's displaced traversals, and the model prices no "
+        "branch: a scene whose traversals the predictor learns less well than the synthetic "
+        "scene's costs more than they say, whatever its caches hold.\n\n" + predictor_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

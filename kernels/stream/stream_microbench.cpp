@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include "base/convergence.h"
 #include "base/core_clock.h"
@@ -825,6 +826,154 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
         out.push_back(sample);
     }
     return out;
+}
+
+namespace {
+
+// The scene lines a traversal reads: each box test's node, each passed leaf's primitives.
+class SceneLineSink : public TraceSink {
+  public:
+    explicit SceneLineSink(const Bvh& bvh) : m_bvh(bvh) {}
+    void op(const StreamOp& op) override {
+        if (op.kind != OpKind::box_test) return;
+        ++box_tests;
+        const BvhNode& node = m_bvh.nodes()[op.object];
+        add(&node, sizeof(BvhNode));
+        if (node.is_leaf() && op.pass_count > 0)
+            add(&m_bvh.leaf_primitives()[node.first], size_t(node.count) * sizeof(LeafPrimitive));
+    }
+    std::vector<const uint64_t*> lines() const {
+        std::vector<const uint64_t*> out;
+        for (const uintptr_t l : m_lines) out.push_back(reinterpret_cast<const uint64_t*>(l << 6));
+        return out;
+    }
+    uint64_t box_tests = 0;
+
+  private:
+    void add(const void* p, size_t bytes) {
+        const uintptr_t first = reinterpret_cast<uintptr_t>(p) >> 6;
+        const uintptr_t last = (reinterpret_cast<uintptr_t>(p) + bytes - 1) >> 6;
+        for (uintptr_t l = first; l <= last; ++l) m_lines.insert(l);
+    }
+    const Bvh& m_bvh;
+    std::set<uintptr_t> m_lines;
+};
+
+}  // namespace
+
+std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, const Bvh& bvh,
+                                                           Isa isa,
+                                                           const ConvergenceRule& convergence,
+                                                           uint64_t seed) {
+    constexpr uint32_t k_res = 64, k_tile = 16, k_tiles = (k_res / k_tile) * (k_res / k_tile);
+    constexpr uint32_t k_pixels = k_res * k_res;
+    const Isa resolved = resolve_isa(isa);
+    const StreamKernels& kernels = stream_kernels(resolved);
+    std::mt19937 rng{uint32_t(seed)};
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    // Slots [0, k_pixels): the camera rays in pixel order; [k_pixels, 2 k_pixels): their bounces.
+    Buffers b = make_buffers(scene, bvh, 2 * k_pixels, rng);
+    const CameraFrame camera(scene.camera, k_res, k_res);
+    for (uint32_t p = 0; p < k_pixels; ++p) {
+        const Ray r = camera.generate(PathKey(seed, p, 0));
+        const Hit h = bvh.intersect(r);
+        Vec3 d;
+        do d = Vec3(u(rng), u(rng), u(rng));
+        while (dot(d, d) > 1.f || dot(d, d) < 1e-4f);
+        d = normalize(d);
+        if (dot(d, r.dir) > 0.f) d = -d;
+        Ray bounce;
+        bounce.org = h.valid() ? r.org + r.dir * (h.t * 0.999f) : r.org;
+        bounce.dir = d;
+        b.ray[p] = r;
+        b.ray[k_pixels + p] = bounce;
+    }
+    for (uint32_t i = 0; i < 2 * k_pixels; ++i) {
+        b.pre[i] = RayPrecomp(b.ray[i]);
+        b.any_hit[i] = 0;
+    }
+    TraversalJob job = traversal_job(bvh, b);
+    const double overhead = tsc_overhead();
+    const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
+    std::vector<PredictorSample> out;
+    for (const bool bounce : {false, true}) {
+        // Each tile's batch: its slots in increasing order, as the tracer's streams are.
+        std::vector<std::vector<uint32_t>> batches(k_tiles);
+        for (uint32_t t = 0; t < k_tiles; ++t) {
+            const uint32_t x0 = (t % (k_res / k_tile)) * k_tile,
+                           y0 = (t / (k_res / k_tile)) * k_tile;
+            for (uint32_t y = y0; y < y0 + k_tile; ++y)
+                for (uint32_t x = x0; x < x0 + k_tile; ++x)
+                    batches[t].push_back((bounce ? k_pixels : 0) + y * k_res + x);
+        }
+        auto traverse = [&](uint32_t t, TraceDetail detail) {
+            const std::vector<uint32_t>& ids = batches[t];
+            for (const uint32_t id : ids) {
+                b.trav.set(id, b.pre[id], b.ray[id].t_max);
+                b.hit[id] = Hit{};
+            }
+            std::copy(ids.begin(), ids.end(), b.ids.begin());
+            job.ids = b.ids.data();
+            job.n = uint32_t(ids.size());
+            job.entry = 0;
+            job.shared_origin = shared_origin(job.rays, job.ids, job.n);
+            kernels.traverse[int(detail)](job);
+        };
+        PredictorSample sample;
+        sample.bounce = bounce;
+        sample.batches = k_tiles;
+        std::vector<std::vector<const uint64_t*>> lines(k_tiles);
+        for (uint32_t t = 0; t < k_tiles; ++t) {
+            SceneLineSink sink(bvh);
+            job.sink = &sink;
+            traverse(t, TraceDetail::lanes);
+            job.sink = nullptr;
+            lines[t] = sink.lines();
+            sample.box_tests += sink.box_tests;
+            sample.lines += lines[t].size();
+        }
+        uint64_t touched = 0;
+        for (uint32_t t = 0; t < k_tiles; ++t) {
+            bool converged = true;
+            // The state before the timed traversal: `primed`, then the others' lines or the
+            // others' traversals.
+            auto timed = [&](int state) {
+                std::vector<double> times;
+                while (needs_more_samples(times, convergence)) {
+                    if (state == 2) {
+                        for (uint32_t o = 0; o < k_tiles; ++o)
+                            if (o != t) traverse(o, TraceDetail::none);
+                    } else {
+                        traverse(t, TraceDetail::none);
+                        if (state == 1)
+                            for (uint32_t o = 0; o < k_tiles; ++o)
+                                if (o != t)
+                                    for (const uint64_t* line : lines[o]) touched += *line;
+                    }
+                    const uint64_t start = __rdtsc();
+                    traverse(t, TraceDetail::none);
+                    times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+                }
+                const Convergence c = judge_convergence(times, convergence);
+                converged = converged && c.converged;
+                return c.fastest / ticks_per_cycle;
+            };
+            sample.primed_cycles += timed(0);
+            sample.cached_cycles += timed(1);
+            sample.displaced_cycles += timed(2);
+            sample.converged_batches += converged;
+        }
+        if (touched == 1) out.clear();  // keeps the reads of the others' lines
+        out.push_back(sample);
+    }
+    return out;
+}
+
+std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
+                                                           const ConvergenceRule& convergence,
+                                                           uint64_t seed) {
+    const Scene scene = synthetic_scene(true);
+    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed);
 }
 
 }  // namespace sfx

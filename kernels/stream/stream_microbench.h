@@ -26,6 +26,9 @@
 
 namespace sfx {
 
+class Bvh;
+struct Scene;
+
 // Bytes of the stream tracer's ray buffers per slot (every per-slot array of a pass): what a
 // pass of n slots asks the L1D to hold.
 uint32_t stream_slot_bytes();
@@ -141,5 +144,34 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence, uint64_t seed = 5);
 // The triangles hit by repetition `repetition` of a sample's stream, in stream order.
 std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_t repetition);
+
+// What the branch predictor saves a traversal it has just run, in a given scene: the batches
+// of a 64 x 64 frame's 16 x 16 tiles (their camera rays, and a bounce of each in a random
+// direction from its hit, the hemisphere toward the camera), one stream each, through
+// StreamKernels::traverse (trace off). Each batch is timed (the fastest repetition, until it
+// converges) in three states: right after itself (primed); right after itself and a read of
+// the scene lines that the other tiles' batches of its kind touch (primed, their lines
+// cached: what a frame's caches hold); and right after those batches' traversals (displaced:
+// a frame's traversals never repeat, so its predictor has seen other ones). Displaced over
+// lines cached is the predictor's part; lines cached over primed, the caches'. The per-op costs
+// come from the synthetic scene's traversals (run_one_ray_microbenchmarks, displaced too); a
+// scene whose branches are harder to predict pays more than they say, and the model prices no
+// branch.
+struct PredictorSample {
+    bool bounce = false;                // camera rays, or a bounce of each
+    uint32_t batches = 0;               // tiles
+    uint64_t box_tests = 0, lines = 0;  // over the batches; lines: distinct scene lines per batch
+    double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
+    uint32_t converged_batches = 0;  // in all three states (base/convergence.h)
+};
+std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, const Bvh& bvh,
+                                                           Isa isa,
+                                                           const ConvergenceRule& convergence,
+                                                           uint64_t seed = 3);
+// The same in the synthetic scene whose traversals the per-op costs are fitted on (the floor of
+// 16 x 16 quads and 16 spheres of run_one_ray_microbenchmarks): what those costs hold of it.
+std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
+                                                           const ConvergenceRule& convergence,
+                                                           uint64_t seed = 3);
 
 }  // namespace sfx

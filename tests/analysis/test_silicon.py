@@ -301,3 +301,28 @@ def test_residual_against_the_models_misses(tmp_path):
     # Rows written before the model's misses were kept: said so.
     older = df.drop(columns=[c for c in df.columns if "scene_" in c])
     assert "no scene-data misses" in silicon.residual_text(older)
+
+
+def test_branch_predictor(tmp_path):
+    # Scene a: camera batches 1 % dearer with the others' lines cached, 20 % dearer displaced;
+    # the synthetic scene 2 %. The frame error is the smallest resolution's converged tiles'.
+    def predictor(r, prefix, primed, cached, displaced):
+        for rays in ("camera", "bounce"):
+            k = f"measured.predictor.{prefix}{rays}."
+            r.update({k + "primed_cycles": primed, k + "cached_cycles": cached,
+                      k + "displaced_cycles": displaced, k + "box_tests": 3200, k + "lines": 3000,
+                      k + "batches": 16, k + "converged_batches": 12})
+
+    rows = [row("a", 16, 80, 100), row("a", 32, 90, 100), row("a", 16, 300, 400, res=(128, 128))]
+    for r in rows:
+        predictor(r, "", 100.0, 101.0, 121.2)
+        predictor(r, "synthetic.", 50.0, 50.0, 51.0)
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    text = silicon.predictor_text(silicon.load_rows(p))
+    assert ("| avx512 | synthetic (the per-op costs' scene) | camera | 200 | 12 of 16 | +0.0 % | "
+            "+2.0 % | - |") in text
+    assert "| avx512 | a | bounce | 200 | 12 of 16 | +1.0 % | +20.0 % | -15.0 % (64x64) |" in text
+    # Rows from before the predictor microbenchmarks: said so.
+    p.write_text(json.dumps([row("a", 32, 1, 1)]))
+    assert "no branch-predictor" in silicon.predictor_text(silicon.load_rows(p))

@@ -158,3 +158,25 @@ TEST_CASE("The surface reads beyond the caches are timed on the tracer's own loo
     CHECK(samples[0].triangles == 1u << 13);
     CHECK(samples[2].triangles == 1u << 20);
 }
+
+TEST_CASE("The branch predictor's part is timed on a scene's tile batches in three states",
+          "[stream][host]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    for (const std::vector<PredictorSample>& samples :
+         {run_predictor_microbenchmarks(scene, bvh, Isa::automatic, microbench_rule(1)),
+          run_predictor_microbenchmarks(Isa::automatic, microbench_rule(1))}) {
+        REQUIRE(samples.size() == 2);
+        CHECK_FALSE(samples[0].bounce);
+        CHECK(samples[1].bounce);
+        for (const PredictorSample& s : samples) {
+            CHECK(s.batches == 16);           // the 16 x 16 tiles of a 64 x 64 frame
+            CHECK(s.box_tests >= s.batches);  // every batch tests the root at least
+            CHECK(s.lines >= s.batches);
+            CHECK(s.primed_cycles > 0.0);
+            CHECK(s.cached_cycles > 0.0);
+            CHECK(s.displaced_cycles > 0.0);
+            CHECK(s.converged_batches == s.batches);  // the fastest 1 of 1 agrees with itself
+        }
+    }
+}
