@@ -381,9 +381,8 @@ void add_calibrate_command(CLI::App& app) {
                 progress.set_done(done);
             });
         // What the branch predictor saves a traversal it has just run, per scene and back end
-        // (run_predictor_microbenchmarks): the per-op costs come from the synthetic scene's
-        // traversals, and the model prices no branch.
-        // The synthetic scene's (scene index scenes.size()) are what the per-op costs hold.
+        // (run_predictor_microbenchmarks), and in the synthetic scene whose traversals the
+        // per-op costs come from (at scene index scenes.size()): the model prices no branch.
         std::map<std::pair<size_t, Isa>, std::vector<PredictorSample>> predictor;
         for (const Isa k : host_isas) {
             for (size_t sc = 0; sc < scenes.size(); ++sc) {

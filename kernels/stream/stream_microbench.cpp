@@ -933,19 +933,19 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
             sample.lines += lines[t].size();
         }
         uint64_t touched = 0;
+        // What runs before each timed traversal of a batch.
+        enum class Before { itself, itself_and_others_lines, others_traversals };
         for (uint32_t t = 0; t < k_tiles; ++t) {
             bool converged = true;
-            // The state before the timed traversal: `primed`, then the others' lines or the
-            // others' traversals.
-            auto timed = [&](int state) {
+            auto timed = [&](Before before) {
                 std::vector<double> times;
                 while (needs_more_samples(times, convergence)) {
-                    if (state == 2) {
+                    if (before == Before::others_traversals) {
                         for (uint32_t o = 0; o < k_tiles; ++o)
                             if (o != t) traverse(o, TraceDetail::none);
                     } else {
                         traverse(t, TraceDetail::none);
-                        if (state == 1)
+                        if (before == Before::itself_and_others_lines)
                             for (uint32_t o = 0; o < k_tiles; ++o)
                                 if (o != t)
                                     for (const uint64_t* line : lines[o]) touched += *line;
@@ -958,9 +958,9 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
                 converged = converged && c.converged;
                 return c.fastest / ticks_per_cycle;
             };
-            sample.primed_cycles += timed(0);
-            sample.cached_cycles += timed(1);
-            sample.displaced_cycles += timed(2);
+            sample.primed_cycles += timed(Before::itself);
+            sample.cached_cycles += timed(Before::itself_and_others_lines);
+            sample.displaced_cycles += timed(Before::others_traversals);
             sample.converged_batches += converged;
         }
         if (touched == 1) out.clear();  // keeps the reads of the others' lines

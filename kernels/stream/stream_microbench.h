@@ -160,7 +160,7 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 struct PredictorSample {
     bool bounce = false;                // camera rays, or a bounce of each
     uint32_t batches = 0;               // tiles
-    uint64_t box_tests = 0, lines = 0;  // over the batches; lines: distinct scene lines per batch
+    uint64_t box_tests = 0, lines = 0;  // summed over the batches (lines: each one's distinct)
     double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
     uint32_t converged_batches = 0;  // in all three states (base/convergence.h)
 };
