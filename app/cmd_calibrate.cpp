@@ -353,7 +353,7 @@ void add_calibrate_command(CLI::App& app) {
         }
         // Every tile on every back end of every (scene, resolution) cell.
         std::vector<SiliconVariant> variants;
-        std::vector<std::string> variant_scene;
+        std::vector<size_t> variant_scene;  // index into scenes
         for (size_t sc = 0; sc < scenes.size(); ++sc)
             for (const auto& [w, h] : resolutions)
                 for (size_t k = 0; k < hosts.size(); ++k)
@@ -372,7 +372,7 @@ void add_calibrate_command(CLI::App& app) {
                         // to see what the frame pays for what the render before left.
                         v.cold = tile == tiles[tiles.size() / 2];
                         variants.push_back(v);
-                        variant_scene.push_back(scenes[sc]);
+                        variant_scene.push_back(sc);
                     }
         const std::vector<SiliconMeasurement> measured = predict_and_measure(
             variants, render_rule, 1, [&](const std::string& what, size_t done, size_t total) {
@@ -399,9 +399,8 @@ void add_calibrate_command(CLI::App& app) {
         for (size_t i = 0; i < variants.size(); ++i) {
             const SiliconMeasurement& m = measured[i];
             const RenderSettings& st = variants[i].settings;
-            const std::string& name = variant_scene[i];
-            const size_t scene_index =
-                size_t(std::find(scenes.begin(), scenes.end(), name) - scenes.begin());
+            const size_t scene_index = variant_scene[i];
+            const std::string& name = scenes[scene_index];
             const uint32_t w = st.width, h = st.height;
             nlohmann::json row;
             row["scene"] = name;

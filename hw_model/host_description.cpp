@@ -510,8 +510,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
       << "  # assumed: not measured; DRAM lines queue for it\n"
       << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
-      << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) as "
-         "it\n"
+      << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) "
+      << "as it\n"
       << "                           # tests the node (prefetch_below, kernels/stream)\n"
       << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";

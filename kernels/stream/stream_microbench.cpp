@@ -85,10 +85,8 @@ struct Buffers {
     TraversalRays next_trav;
 };
 
-// Random rays from above the scene toward random points of it: a mix of hits on every
-// material, misses and (every fourth) shadow rays.
-Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt19937& rng) {
-    std::uniform_real_distribution<float> u(-1.f, 1.f);
+// Every per-slot array and id list sized for `slots`, the rays left unset.
+Buffers allocate_buffers(uint32_t slots) {
     Buffers b;
     b.path.resize(slots);
     b.ray.resize(slots);
@@ -111,6 +109,14 @@ Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt
     b.positions.resize(padded);
     b.mask.resize(padded);
     b.op_tally.assign(op_tally_size(slots), 0);
+    return b;
+}
+
+// Random rays from above the scene toward random points of it: a mix of hits on every
+// material, misses and (every fourth) shadow rays.
+Buffers make_buffers(const Scene& scene, const Bvh& bvh, uint32_t slots, std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    Buffers b = allocate_buffers(slots);
     for (uint32_t i = 0; i < slots; ++i) {
         Ray r;
         r.org = Vec3(3 * u(rng), 5.f + u(rng), 6.f + u(rng));
@@ -872,7 +878,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
     std::mt19937 rng{uint32_t(seed)};
     std::uniform_real_distribution<float> u(-1.f, 1.f);
     // Slots [0, k_pixels): the camera rays in pixel order; [k_pixels, 2 k_pixels): their bounces.
-    Buffers b = make_buffers(scene, bvh, 2 * k_pixels, rng);
+    Buffers b = allocate_buffers(2 * k_pixels);
     const CameraFrame camera(scene.camera, k_res, k_res);
     for (uint32_t p = 0; p < k_pixels; ++p) {
         const Ray r = camera.generate(PathKey(seed, p, 0));
@@ -888,10 +894,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
         b.ray[p] = r;
         b.ray[k_pixels + p] = bounce;
     }
-    for (uint32_t i = 0; i < 2 * k_pixels; ++i) {
-        b.pre[i] = RayPrecomp(b.ray[i]);
-        b.any_hit[i] = 0;
-    }
+    for (uint32_t i = 0; i < 2 * k_pixels; ++i) b.pre[i] = RayPrecomp(b.ray[i]);
     TraversalJob job = traversal_job(bvh, b);
     const double overhead = tsc_overhead();
     const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
