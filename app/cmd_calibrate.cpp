@@ -245,6 +245,19 @@ void add_calibrate_command(CLI::App& app) {
                          {"converged", s.converged},
                          {"repetitions", s.repetitions}});
                 }
+                j["branch_predictor"] = cal.host.branch_predictor.kind;
+                j["mispredict_cycles"] = cal.host.branch_predictor.mispredict_cycles;
+                for (const PredictorCheck& b : cal.branch_samples)
+                    j["branch_samples"].push_back(
+                        {{"bounce", b.measured.bounce},
+                         {"batches", b.measured.batches},
+                         {"converged_batches", b.measured.converged_batches},
+                         {"primed_cycles", b.measured.primed_cycles},
+                         {"cached_cycles", b.measured.cached_cycles},
+                         {"displaced_cycles", b.measured.displaced_cycles},
+                         {"branches", b.modelled.branches},
+                         {"primed_mispredictions", b.modelled.primed},
+                         {"displaced_mispredictions", b.modelled.displaced}});
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
                                           {"slots", r.slots},
@@ -289,6 +302,20 @@ void add_calibrate_command(CLI::App& app) {
                                 "microbenchmarks' independent calls (their fit error)\n",
                                 cal.op_costs[i].op.c_str(), cal.op_costs[i].per_op_cycles,
                                 cal.filter_costs[i].per_op_cycles);
+            std::printf(
+                "branch mispredictions (the model's predictor): %.1f cycles each, from "
+                "the branch microbenchmark:\n",
+                cal.host.branch_predictor.mispredict_cycles);
+            for (const PredictorCheck& b : cal.branch_samples)
+                std::printf(
+                    "  %-7s cycles primed %.0f, cached %.0f, displaced %.0f (%u of %u "
+                    "batches converged); model: %llu branches, mispredicted %llu "
+                    "primed, %llu displaced\n",
+                    b.measured.bounce ? "bounces" : "camera", b.measured.primed_cycles,
+                    b.measured.cached_cycles, b.measured.displaced_cycles,
+                    b.measured.converged_batches, b.measured.batches,
+                    (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
+                    (unsigned long long)b.modelled.displaced);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,
@@ -383,14 +410,17 @@ void add_calibrate_command(CLI::App& app) {
         // What the branch predictor saves a traversal it has just run, per scene and back end
         // (run_predictor_microbenchmarks), and in the synthetic scene whose traversals the
         // per-op costs come from (at scene index scenes.size()): the model prices no branch.
-        std::map<std::pair<size_t, Isa>, std::vector<PredictorSample>> predictor;
-        for (const Isa k : host_isas) {
+        // The model's predictor replays each scene's batches (check_predictor); each back end's
+        // host file prices its mispredictions.
+        std::map<std::pair<size_t, Isa>, std::vector<PredictorCheck>> predictor;
+        for (size_t k = 0; k < host_isas.size(); ++k) {
+            const Isa isa = host_isas[k];
             for (size_t sc = 0; sc < scenes.size(); ++sc) {
-                progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(k));
-                predictor[{sc, k}] =
-                    run_predictor_microbenchmarks(*loaded[sc], *bvhs[sc], k, bench_rule);
+                progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
+                predictor[{sc, isa}] = check_predictor(*loaded[sc], *bvhs[sc], isa, bench_rule);
             }
-            predictor[{scenes.size(), k}] = run_predictor_microbenchmarks(k, bench_rule);
+            for (const PredictorSample& p : run_predictor_microbenchmarks(isa, bench_rule))
+                predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}});
         }
         const Microarchitecture uarch = read_microarchitecture();
         uint32_t workloads = 0, converged = 0;
@@ -467,9 +497,21 @@ void add_calibrate_command(CLI::App& app) {
                     if (stat.name.rfind(prefix, 0) == 0) row["predicted." + stat.name] = stat.value;
             for (const auto& [which, index] :
                  {std::pair<std::string, size_t>{"", scene_index}, {"synthetic.", scenes.size()}})
-                for (const PredictorSample& p : predictor[{index, st.isa}]) {
-                    const std::string key =
-                        "measured.predictor." + which + (p.bounce ? "bounce" : "camera") + ".";
+                for (const PredictorCheck& c : predictor[{index, st.isa}]) {
+                    const PredictorSample& p = c.measured;
+                    const std::string kind = which + (p.bounce ? "bounce" : "camera") + ".";
+                    const std::string key = "measured.predictor." + kind;
+                    if (index == scene_index) {
+                        const BranchPredictorConfig& b = variants[i].host->branch_predictor;
+                        const std::string model = "predicted.predictor." + kind;
+                        row[model + "branches"] = c.modelled.branches;
+                        row[model + "primed_mispredictions"] = c.modelled.primed;
+                        row[model + "displaced_mispredictions"] = c.modelled.displaced;
+                        row[model + "extra_cycles"] =
+                            b.kind == "none" ? 0.0
+                                             : b.mispredict_cycles * (double(c.modelled.displaced) -
+                                                                      double(c.modelled.primed));
+                    }
                     row[key + "primed_cycles"] = p.primed_cycles;
                     row[key + "cached_cycles"] = p.cached_cycles;
                     row[key + "displaced_cycles"] = p.displaced_cycles;

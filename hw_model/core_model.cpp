@@ -46,7 +46,17 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_scene_memory(std::move(scene_memory)),
       m_unit_free(config.simd.units, 0),
       m_unit_carry(config.simd.units, 0.0),
-      m_unit_stage(config.simd.units, 0) {}
+      m_unit_stage(config.simd.units, 0) {
+    if (config.branch_predictor.kind == "tage") m_predictor = std::make_unique<TagePredictor>();
+}
+
+void CoreModel::warm_branches(const PassBuffer& pass) {
+    if (!m_predictor) return;
+    const std::vector<uint8_t> none;
+    replay_traversal_branches(pass, traversal_loops(pass, width()), width(),
+                              m_map.node_leaf ? *m_map.node_leaf : none, *m_predictor,
+                              m_mispredicted);
+}
 
 const OpProfile& CoreModel::profile(uint32_t op) const {
     return m_costs[m_pass->at(op).kind];
@@ -67,15 +77,20 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_partition_free = std::max(m_partition_free, now);
     m_timing = FrameTiming();
     m_timing.passes = 1;
-    m_loop.assign(n, TraversalLoop::stream);
+    m_loop = traversal_loops(*pass, width());
     m_enters_loop.assign(n, 0);
     for (uint32_t i = 0; i < n; ++i) {
-        const StreamOp op = pass->at(i);
-        if (op.kind != OpKind::box_test) continue;
         const int32_t producer = pass->producer(i);
-        const TraversalLoop from = producer < 0 ? TraversalLoop::stream : m_loop[producer];
-        m_loop[i] = traversal_loop(op.length, width(), from);
-        m_enters_loop[i] = from == TraversalLoop::stream && m_loop[i] != TraversalLoop::stream;
+        const TraversalLoop from = producer < 0 ? TraversalLoop::stream : m_loop[size_t(producer)];
+        m_enters_loop[i] = pass->at(i).kind == OpKind::box_test && from == TraversalLoop::stream &&
+                           m_loop[i] != TraversalLoop::stream;
+    }
+    m_mispredicted.assign(n, 0);
+    if (m_predictor) {
+        const std::vector<uint8_t> none;
+        replay_traversal_branches(*pass, m_loop, width(), m_map.node_leaf ? *m_map.node_leaf : none,
+                                  *m_predictor, m_mispredicted);
+        for (const uint32_t m : m_mispredicted) m_timing.branch_mispredictions += m;
     }
     m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
@@ -300,8 +315,12 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
         p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes, passed, t.first == 0,
                        m_beyond_l1) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
-    const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact)));
-    m_unit_carry[unit] = exact - double(busy);
+    // The op's mispredicted branches, on its first group.
+    const double mispredicted =
+        t.first == 0 ? m_config.branch_predictor.mispredict_cycles * m_mispredicted[t.op] : 0.0;
+    m_timing.branch_cycles += uint64_t(std::llround(mispredicted));
+    const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact + mispredicted)));
+    m_unit_carry[unit] = exact + mispredicted - double(busy);
     e.issue_end = e.start + busy;
     const uint64_t result =
         e.start + ceil_cycle(p.result_cycles(m_config.datapath, double(busy)));

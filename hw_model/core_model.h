@@ -11,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "hw_model/branch_predictor.h"
 #include "hw_model/cache_model.h"
 #include "hw_model/hw_config.h"
 #include "hw_model/machine_resources.h"
@@ -40,8 +41,11 @@ class CoreModel {
               uint32_t record_words, uint32_t slot_capacity, uint32_t core_index,
               std::shared_ptr<SceneMemoryModel> scene_memory);
 
-    // A pass starts at `now`; per-op state is sized for it.
+    // A pass starts at `now`; per-op state is sized for it (and the traversal's branches run
+    // through the core's branch predictor, if it has one).
     void begin_pass(const PassBuffer* pass, uint64_t now);
+    // Warming: the pass's branches train the branch predictor; nothing is timed.
+    void warm_branches(const PassBuffer& pass);
     // Counts an op as it is dispatched (ops, lanes, groups, the op mix).
     void dispatch_op(uint32_t op);
     // Requests op's scene data (a node, primitive or material) at `now`, unless it was
@@ -132,6 +136,9 @@ class CoreModel {
     // and whether it enters that loop from the stream loop (a short loop's first op).
     std::vector<TraversalLoop> m_loop;
     std::vector<uint8_t> m_enters_loop;
+    // A CPU core's branch predictor (null: none), and per op of the pass its mispredictions.
+    std::unique_ptr<TagePredictor> m_predictor;
+    std::vector<uint32_t> m_mispredicted;
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;

@@ -429,6 +429,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     // Its surface_at reads the mesh's triangle and vertex arrays, not the leaves' copies.
     c.scene_memory.hit_reads = "mesh";
     c.op_costs = op_costs;
+    c.branch_predictor = h.branch_predictor;
     c.speed_probe_cycles = h.speed_probe_cycles;
     return c;
 }
@@ -515,6 +516,12 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "                           # tests the node (prefetch_below, kernels/stream)\n"
       << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";
+    if (h.branch_predictor.kind != "none")
+        y << "branch_predictor:\n  kind: " << h.branch_predictor.kind
+          << "  # the model's (L-TAGE's TAGE, hw_model/branch_predictor.h) over the traversal's\n"
+          << "              # branches: the core's own predictor is not published\n"
+          << "  mispredict_cycles: " << fmt(h.branch_predictor.mispredict_cycles, 1)
+          << "  # fitted: " << h.branch_predictor_fit << "\n";
     if (h.speed_probe_cycles > 0)
         y << "speed_probe_cycles: " << fmt(h.speed_probe_cycles, 0)
           << "  # measured: the speed probe's microbenchmark points at calibration (fastest of "

@@ -95,6 +95,10 @@ struct HostDescription {
     // predictions differ only where the back ends do. Empty `memory_source`: measured here.
     SceneMemoryConfig memory;
     std::string memory_source;
+    // The model's branch predictor over the traversal's branches and the fitted cost of its
+    // mispredictions (sweeps/host_calibration.h), with how it was fitted; kind none: not fitted.
+    BranchPredictorConfig branch_predictor;
+    std::string branch_predictor_fit;
 };
 
 // The last cache level as this core sees it, from its chases, by the LRU stack: a line is

@@ -336,6 +336,32 @@ struct DatapathConfig {
     }
 };
 
+// A CPU core's conditional-branch predictor (hw_model/branch_predictor.h). Fitted op costs come
+// from microbenchmarks that repeat their ops, whose branches the core's predictor learns; a
+// frame's traversals never repeat. With a predictor the model runs it over the traversal's
+// branches (derived from the trace) and prices each misprediction it makes. The paper's machine
+// has none: its SIMD units run filters without branches.
+struct BranchPredictorConfig {
+    std::string kind = "none";
+    // What one misprediction of the model's predictor costs the core, fitted by
+    // `sfx calibrate --describe-host` on the branch microbenchmark (a synthetic scene of random
+    // triangles: its traversal batches after themselves and after the others), never on
+    // frames: the pipeline's refill, the overlap a miss loses in a traversal, and the branches
+    // the replay leaves out.
+    double mispredict_cycles = 0.0;
+
+    template <class V>
+    void visit(V& v) {
+        v.choice("kind", kind, {"none", "tage"},
+                 "branch predictor (none: no branches priced; tage: L-TAGE's TAGE run over the "
+                 "traversal's branches, each misprediction priced)");
+        v.param("mispredict_cycles", mispredict_cycles, "cycles",
+                "cost of one misprediction of the model's predictor (fitted on a "
+                "microbenchmark)",
+                0.0, 1e6);
+    }
+};
+
 // A CPU core's measured cost of one kind of stream operation (priced by OpProfile in
 // hw_model/op_costs.h, the one place an op is priced), fitted
 // by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
@@ -437,6 +463,7 @@ struct HwConfig {
     InterconnectConfig interconnect;
     SceneMemoryConfig scene_memory;
     DatapathConfig datapath;
+    BranchPredictorConfig branch_predictor;
     std::vector<OpCostConfig> op_costs;  // measured per-op costs of a CPU core (host only)
     // Host only: the speed probe's cycles when the host was calibrated (sweeps/host_calibration.h
     // speed_probe_cycles), for a silicon check to see whether the machine still runs as then.
@@ -457,6 +484,7 @@ struct HwConfig {
         v.group("interconnect", interconnect);
         v.group("scene_memory", scene_memory);
         v.group("datapath", datapath);
+        v.group("branch_predictor", branch_predictor);
         v.list("op_costs", op_costs,
                "measured per-op costs of a CPU core (sfx calibrate --describe-host); empty: "
                "priced from instruction counts");

@@ -283,6 +283,7 @@ SceneDataMap scene_data_map(const WorkloadShape& shape) {
     map.nodes = shape.bvh_nodes;
     map.triangles = shape.triangles;
     map.spheres = shape.spheres;
+    map.node_leaf = shape.node_leaf;
     return map;
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,7 @@ struct SceneDataMap {
     // triangle order (a mesh shares vertices; the trace names no vertex ids).
     uint64_t mesh_triangle_bytes = 16;
     uint64_t nodes = 0, triangles = 0, spheres = 0;
+    std::shared_ptr<const std::vector<uint8_t>> node_leaf;  // WorkloadShape::node_leaf
 
     uint64_t address(OpKind kind, uint32_t object) const;
 

@@ -180,6 +180,12 @@ std::vector<Stat> Prediction::stats() const {
     }
     add("scene_memory.dram_reads", double(timing.dram_reads), "lines",
         "scene-data lines read from DRAM");
+    if (config.branch_predictor.kind != "none") {
+        add("branch_predictor.mispredictions", double(timing.branch_mispredictions), "branches",
+            "traversal branches the core's branch predictor mispredicted");
+        add("branch_predictor.cycles", double(timing.branch_cycles), "cycles",
+            "unit-cycles the mispredictions cost (part of the busy cycles)");
+    }
     for (size_t i = 0; i < timing.cache_misses.size() && i < config.scene_memory.caches.size(); ++i)
         add("scene_cache." + config.scene_memory.caches[i].name + ".misses",
             double(timing.cache_misses[i]), "accesses",

@@ -139,6 +139,9 @@ struct FrameTiming {
     // (TraversalLoop, kernels/trace.h): what the tracer's stage clock splits the traversal
     // into (RenderStats::short_loop_tsc). Cycle-level models only.
     uint64_t traversal_loop_cycles[3] = {0, 0, 0};
+    // A CPU core's branch predictor (HwConfig::branch_predictor): the traversal's branches it
+    // mispredicted, and the unit-cycles they cost (part of the busy cycles). Cycle level only.
+    uint64_t branch_mispredictions = 0, branch_cycles = 0;
 
     // Every counter of a and b in step (b's cache levels are made a's first if a has fewer).
     template <class A, class B, class F>
@@ -199,6 +202,13 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
                       "box tests' unit-cycles in the tracer's loop of that name")
               .under("traversal_loop_cycles"),
           a.traversal_loop_cycles[l], b.traversal_loop_cycles[l]);
+    f(CounterInfo("mispredictions", "branches",
+                  "traversal branches the core's branch predictor mispredicted")
+          .under("branch_predictor"),
+      a.branch_mispredictions, b.branch_mispredictions);
+    f(CounterInfo("cycles", "cycles", "unit-cycles the mispredictions cost (part of busy)")
+          .under("branch_predictor"),
+      a.branch_cycles, b.branch_cycles);
     ActionCounts::visit(a.actions, b.actions, [&](const CounterInfo& c, auto& x, auto& y) {
         f(c.under("actions"), x, y);
     });

@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include "kernels/trace.h"
 #include "workloads/scene.h"
@@ -17,6 +19,10 @@ struct WorkloadShape {
     uint64_t triangles = 0;
     uint64_t spheres = 0;
     uint64_t bvh_nodes = 0;
+    // Per BVH node, whether it is a leaf: the tree's shape, which a CPU core's traversal
+    // branches on (hw_model/branch_predictor.h); the trace names the nodes tested, not their
+    // kind. Null: unknown (a leaf is then told by the leaf tests that follow a passing node).
+    std::shared_ptr<const std::vector<uint8_t>> node_leaf;
     uint32_t tile = 32;                // tile edge: tile^2 ray slots per pass
     bool primary_entry_aepsa = false;  // the workload searches primary entry points
     bool reorder_hit_point = false;    // the workload sorts streams by approximate hit point

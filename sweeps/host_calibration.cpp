@@ -95,6 +95,24 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
     }
 }
 
+std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
+                                            const ConvergenceRule& convergence) {
+    std::vector<std::unique_ptr<PassBuffer>> batches[2];  // camera rays, bounces
+    const std::vector<PredictorSample> measured =
+        run_predictor_microbenchmarks(scene, bvh, isa, convergence, 3, [&](bool bounce, uint32_t) {
+            batches[bounce].push_back(std::make_unique<PassBuffer>());
+            return batches[bounce].back().get();
+        });
+    const std::vector<uint8_t> leaves = bvh_leaves(bvh);
+    std::vector<PredictorCheck> out;
+    for (const PredictorSample& m : measured) {
+        std::vector<const PassBuffer*> kind;
+        for (const auto& b : batches[m.bounce]) kind.push_back(b.get());
+        out.push_back({m, simulate_predictor_states(kind, isa_width(resolve_isa(isa)), leaves)});
+    }
+    return out;
+}
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source) {
@@ -164,6 +182,31 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.converged_points += s.converged;
     }
     c.points += uint32_t(c.surface_read_samples.size());
+    // The cost of a misprediction of the model's branch predictor: on a scene of random
+    // triangles, what the displaced batches took beyond the cached ones, over the
+    // mispredictions the model adds from primed to displaced on the same batches.
+    const Scene branch_scene = branch_microbench_scene();
+    c.branch_samples = check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence);
+    std::vector<double> extra_cycles, extra_mispredictions;
+    for (const PredictorCheck& b : c.branch_samples) {
+        extra_cycles.push_back(b.measured.displaced_cycles - b.measured.cached_cycles);
+        extra_mispredictions.push_back(double(b.modelled.displaced) - double(b.modelled.primed));
+        c.converged_points += b.measured.converged_batches;
+        c.points += b.measured.batches;
+    }
+    c.host.branch_predictor.kind = "tage";
+    c.host.branch_predictor.mispredict_cycles =
+        fit_mispredict_cycles(extra_cycles, extra_mispredictions);
+    std::ostringstream branch_note;
+    branch_note << "the branch microbenchmark (kernels/stream/stream_microbench.h: 20,000 random "
+                << "triangles, a 64 x 64 frame's 16 x 16 tile batches, camera rays and bounces):";
+    for (size_t k = 0; k < c.branch_samples.size(); ++k)
+        branch_note << (k ? ";" : "") << " "
+                    << (c.branch_samples[k].measured.bounce ? "bounces" : "camera rays")
+                    << " displaced over cached " << std::llround(extra_cycles[k]) << " cycles, "
+                    << std::llround(extra_mispredictions[k]) << " mispredictions added";
+    branch_note << " (the model's predictor, primed to displaced); no frame";
+    c.host.branch_predictor_fit = branch_note.str();
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "base/convergence.h"
+#include "hw_model/branch_predictor.h"
 #include "hw_model/host_description.h"
 #include "hw_model/op_cost_fit.h"
 #include "hw_model/prediction.h"
@@ -23,6 +24,17 @@
 #include "workloads/scene.h"
 
 namespace sfx {
+
+// A predictor microbenchmark's batches of one kind (kernels/stream/stream_microbench.h) as
+// measured, and the model's predictor on the same batches (hw_model/branch_predictor.h).
+struct PredictorCheck {
+    PredictorSample measured;
+    PredictorStates modelled;
+};
+// run_predictor_microbenchmarks on `scene` (its BVH `bvh`) with `isa`, and the model's
+// predictor replaying each batch's trace at that back end's width.
+std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
+                                            const ConvergenceRule& convergence);
 
 struct HostCalibration {
     HostDescription host;
@@ -43,6 +55,9 @@ struct HostCalibration {
     // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
     std::vector<SurfaceReadSample> surface_read_samples;
     HitReadFit hit_read_fit;
+    // The branch microbenchmark (run_branch_microbenchmarks) and the model's mispredictions on
+    // its batches, on which HostDescription::branch_predictor's cost is fitted.
+    std::vector<PredictorCheck> branch_samples;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml

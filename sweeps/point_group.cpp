@@ -462,6 +462,12 @@ PointGroupResult run_sampled(const Scene& scene, const Bvh& bvh, const RenderSet
 
 }  // namespace
 
+std::vector<uint8_t> bvh_leaves(const Bvh& bvh) {
+    std::vector<uint8_t> leaf(bvh.nodes().size());
+    for (size_t i = 0; i < leaf.size(); ++i) leaf[i] = bvh.nodes()[i].is_leaf();
+    return leaf;
+}
+
 WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSettings& settings) {
     WorkloadShape shape;
     shape.features = scene.features();
@@ -469,6 +475,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.triangles = scene.triangles.size();
     shape.spheres = scene.spheres.size();
     shape.bvh_nodes = bvh.nodes().size();
+    shape.node_leaf = std::make_shared<const std::vector<uint8_t>>(bvh_leaves(bvh));
     shape.tile = settings.tile;
     shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;
     shape.reorder_hit_point = settings.reorder == RayReorder::hit_point;

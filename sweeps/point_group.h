@@ -20,6 +20,8 @@ namespace sfx {
 
 // What the hardware model needs to know of a workload besides its trace.
 WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSettings& settings);
+// Per node of `bvh`, whether it is a leaf (WorkloadShape::node_leaf).
+std::vector<uint8_t> bvh_leaves(const Bvh& bvh);
 
 struct PointGroupResult {
     std::vector<Prediction> predictions;  // one per configuration, in order

@@ -375,22 +375,34 @@ def predictor_text(df):
     """Per back end and scene (and the synthetic scene the per-op costs come from): what the
     branch predictor saves a tile's traversal it has just run (displaced over lines cached),
     and what the caches do (lines cached over primed), for camera rays and their bounces,
-    beside the scene's frame error at its smallest resolution (mean over the converged
-    tiles)."""
+    beside what the model's predictor adds on the same batches (its mispredictions from primed
+    to displaced at the host's fitted cost; rows written before it carry none) and the scene's
+    frame error at its smallest resolution (mean over the converged tiles)."""
     if "measured.predictor.camera.primed_cycles" not in df:
         return "These rows carry no branch-predictor microbenchmarks."
+    modelled = "predicted.predictor.camera.extra_cycles" in df
     lines = ["| back end | scene | rays | box tests per batch | batches converged | "
-             "caches (cached / primed) | predictor (displaced / cached) | frame error |",
-             "|---|---|---|---|---|---|---|---|"]
+             "caches (cached / primed) | predictor (displaced / cached) | "
+             + ("model's predictor (mispredictions primed, displaced) | " if modelled else "")
+             + "frame error |",
+             "|---|---|---|---|---|---|---|" + ("---|" if modelled else "") + "---|"]
 
     def row(isa, scene, prefix, r, error):
         for rays in ("camera", "bounce"):
             k = f"{prefix}{rays}."
             primed, cached = r[k + "primed_cycles"], r[k + "cached_cycles"]
             displaced, batches = r[k + "displaced_cycles"], r[k + "batches"]
+            model = ""
+            if modelled:
+                m = f"predicted.predictor.{rays}."
+                model = ("- | " if prefix.endswith("synthetic.") or pd.isna(r.get(m + "extra_cycles"))
+                         else f"{pct(r[m + 'extra_cycles'] / cached)} "
+                              f"({r[m + 'primed_mispredictions']:,.0f}, "
+                              f"{r[m + 'displaced_mispredictions']:,.0f}) | ")
             lines.append(f"| {isa} | {scene} | {rays} | {r[k + 'box_tests'] / batches:,.0f} | "
                          f"{r[k + 'converged_batches']:.0f} of {batches:.0f} | "
-                         f"{pct(cached / primed - 1)} | {pct(displaced / cached - 1)} | {error} |")
+                         f"{pct(cached / primed - 1)} | {pct(displaced / cached - 1)} | "
+                         f"{model}{error} |")
 
     for isa in isas(df):
         g = df[df["isa"] == isa]
@@ -614,9 +626,15 @@ def write_page(df, page, plot_name, header):
         "other tiles' batches touch (cached); after the other tiles' traversals (displaced: a "
         "frame's traversals never repeat). Displaced over cached is what the branch predictor "
         "saves a traversal it has just run; cached over primed, what the caches do. The per-op "
-        "costs are fitted on the synthetic scene's displaced traversals, and the model prices no "
-        "branch: a scene whose traversals the predictor learns less well than the synthetic "
-        "scene's costs more than they say, whatever its caches hold.\n\n" + predictor_text(df),
+        "costs are fitted on the synthetic scene's displaced traversals, which a predictor "
+        "learns well; a scene whose traversals it learns less well costs more than they say, "
+        "whatever its caches hold. The model runs its own predictor (L-TAGE's TAGE, "
+        "`hw_model/branch_predictor.h`) over the traversal's branches, which it derives from "
+        "the trace, and prices each misprediction at the host file's `mispredict_cycles`, "
+        "fitted on a scene of random triangles (the branch microbenchmark), never on these "
+        "scenes: its column is its prediction for the same batches (what its mispredictions "
+        "from primed to displaced cost, over the cached cycles), held out.\n\n"
+        + predictor_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

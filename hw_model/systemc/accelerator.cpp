@@ -48,6 +48,7 @@ void Accelerator::pass_done(const FrameTiming& timing) {
 }
 
 void Accelerator::warm(const PassBuffer& pass) {
+    m_cores[0]->model().warm_branches(pass);
     for (size_t i = 0; i < pass.size(); ++i) {
         const StreamOp op = pass.at(i);
         const OpProfile& p = m_costs[op.kind];

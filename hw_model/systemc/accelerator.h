@@ -21,7 +21,8 @@ class Accelerator : public sc_core::sc_module, public PassSource {
 
     // Queues a pass for the next idle core (runs when the simulation does).
     void enqueue(std::shared_ptr<const PassBuffer> pass);
-    // Warming: the pass's scene data only passes through the caches; no time is counted.
+    // Warming: the pass's scene data only passes through the caches, its branches through the
+    // first core's branch predictor; no time is counted.
     void warm(const PassBuffer& pass);
     // The frame so far (every finished pass), with the scene-cache counters filled in.
     FrameTiming timing() const;

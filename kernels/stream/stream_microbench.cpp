@@ -67,6 +67,34 @@ Scene synthetic_scene(bool dense = false) {
     return s;
 }
 
+// A cloud of small triangles at random in a box: a tree whose traversals follow no pattern, so
+// that a branch predictor learns a batch's branches from that batch only.
+Scene random_triangle_cloud(uint32_t triangles, uint64_t seed) {
+    Scene s;
+    s.name = "branch-microbench";
+    Material surface, light;
+    surface.kind = light.kind = MaterialKind::lambertian;
+    light.emission = Vec3(5.f);
+    s.materials = {surface, light};
+    SceneBuilder b(s);
+    b.begin_object();
+    std::mt19937 rng{uint32_t(seed)};
+    std::uniform_real_distribution<float> at(-2.f, 2.f), edge(-0.15f, 0.15f);
+    for (uint32_t i = 0; i < triangles; ++i) {
+        const Vec3 c(at(rng), 0.5f * at(rng) + 1.f, at(rng));
+        const uint32_t v0 = b.add_vertex(c);
+        const uint32_t v1 = b.add_vertex(c + Vec3(edge(rng), edge(rng), edge(rng)));
+        const uint32_t v2 = b.add_vertex(c + Vec3(edge(rng), edge(rng), edge(rng)));
+        b.add_triangle(v0, v1, v2, 0);
+    }
+    b.begin_object();
+    shapes::quad(b, Vec3(-1, 4, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), 1);
+    s.camera.eye = Vec3(0, 2, 8);
+    s.camera.look_at = Vec3(0, 1, 0);
+    s.finalize(b.light_groups());
+    return s;
+}
+
 struct Buffers {
     std::vector<PathState> path, saved_path;
     std::vector<Ray> ray, next, saved_ray;
@@ -839,8 +867,10 @@ namespace {
 // The scene lines a traversal reads: each box test's node, each passed leaf's primitives.
 class SceneLineSink : public TraceSink {
   public:
-    explicit SceneLineSink(const Bvh& bvh) : m_bvh(bvh) {}
+    // `also`, where given, receives every op too.
+    SceneLineSink(const Bvh& bvh, TraceSink* also) : m_bvh(bvh), m_also(also) {}
     void op(const StreamOp& op) override {
+        if (m_also) m_also->op(op);
         if (op.kind != OpKind::box_test) return;
         ++box_tests;
         const BvhNode& node = m_bvh.nodes()[op.object];
@@ -862,6 +892,7 @@ class SceneLineSink : public TraceSink {
         for (uintptr_t l = first; l <= last; ++l) m_lines.insert(l);
     }
     const Bvh& m_bvh;
+    TraceSink* m_also;
     std::set<uintptr_t> m_lines;
 };
 
@@ -870,7 +901,8 @@ class SceneLineSink : public TraceSink {
 std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, const Bvh& bvh,
                                                            Isa isa,
                                                            const ConvergenceRule& convergence,
-                                                           uint64_t seed) {
+                                                           uint64_t seed,
+                                                           const PredictorBatchSink& batch_sink) {
     constexpr uint32_t k_res = 64, k_tile = 16, k_tiles = (k_res / k_tile) * (k_res / k_tile);
     constexpr uint32_t k_pixels = k_res * k_res;
     const Isa resolved = resolve_isa(isa);
@@ -927,10 +959,16 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
         sample.batches = k_tiles;
         std::vector<std::vector<const uint64_t*>> lines(k_tiles);
         for (uint32_t t = 0; t < k_tiles; ++t) {
-            SceneLineSink sink(bvh);
+            TraceSink* model = batch_sink ? batch_sink(bounce, t) : nullptr;
+            TilePass pass;
+            pass.tile = t;
+            pass.slot_count = 2 * k_pixels;
+            if (model) model->begin_pass(pass);
+            SceneLineSink sink(bvh, model);
             job.sink = &sink;
             traverse(t, TraceDetail::lanes);
             job.sink = nullptr;
+            if (model) model->end_pass(pass);
             lines[t] = sink.lines();
             sample.box_tests += sink.box_tests;
             sample.lines += lines[t].size();
@@ -974,9 +1012,21 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
 
 std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
                                                            const ConvergenceRule& convergence,
-                                                           uint64_t seed) {
+                                                           uint64_t seed,
+                                                           const PredictorBatchSink& batch_sink) {
     const Scene scene = synthetic_scene(true);
-    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed);
+    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed, batch_sink);
+}
+
+Scene branch_microbench_scene() {
+    return random_triangle_cloud(20000, 7);
+}
+
+std::vector<PredictorSample> run_branch_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
+                                                        const PredictorBatchSink& batch_sink,
+                                                        uint64_t seed) {
+    const Scene scene = branch_microbench_scene();
+    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed, batch_sink);
 }
 
 }  // namespace sfx

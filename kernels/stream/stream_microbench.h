@@ -155,8 +155,11 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 // a frame's traversals never repeat, so its predictor has seen other ones). Displaced over
 // lines cached is the predictor's part; lines cached over primed, the caches'. The per-op costs
 // come from the synthetic scene's traversals (run_one_ray_microbenchmarks, displaced too); a
-// scene whose branches are harder to predict pays more than they say, and the model prices no
-// branch.
+// scene whose branches are harder to predict pays more than they say, which the model prices
+// by running its own predictor over the same batches (hw_model/branch_predictor.h).
+// `batch_sink`, where given, receives each batch's trace (TraceDetail::lanes: one TilePass of
+// 2 x 64 x 64 slots per batch, camera batches first) for the model to replay.
+using PredictorBatchSink = std::function<TraceSink*(bool bounce, uint32_t batch)>;
 struct PredictorSample {
     bool bounce = false;                // camera rays, or a bounce of each
     uint32_t batches = 0;               // tiles
@@ -164,14 +167,20 @@ struct PredictorSample {
     double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
     uint32_t converged_batches = 0;  // in all three states (base/convergence.h)
 };
-std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, const Bvh& bvh,
-                                                           Isa isa,
-                                                           const ConvergenceRule& convergence,
-                                                           uint64_t seed = 3);
+std::vector<PredictorSample> run_predictor_microbenchmarks(
+    const Scene& scene, const Bvh& bvh, Isa isa, const ConvergenceRule& convergence,
+    uint64_t seed = 3, const PredictorBatchSink& batch_sink = {});
 // The same in the synthetic scene whose traversals the per-op costs are fitted on (the floor of
 // 16 x 16 quads and 16 spheres of run_one_ray_microbenchmarks): what those costs hold of it.
-std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
-                                                           const ConvergenceRule& convergence,
-                                                           uint64_t seed = 3);
+std::vector<PredictorSample> run_predictor_microbenchmarks(
+    Isa isa, const ConvergenceRule& convergence, uint64_t seed = 3,
+    const PredictorBatchSink& batch_sink = {});
+// The same in a scene whose traversals no predictor learns from others: 20,000 small
+// triangles at random in a box (branch_microbench_scene), on which the cost of a misprediction
+// is fitted (sfx calibrate --describe-host).
+std::vector<PredictorSample> run_branch_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
+                                                        const PredictorBatchSink& batch_sink,
+                                                        uint64_t seed = 3);
+Scene branch_microbench_scene();
 
 }  // namespace sfx

@@ -323,6 +323,19 @@ def test_branch_predictor(tmp_path):
     assert ("| avx512 | synthetic (the per-op costs' scene) | camera | 200 | 12 of 16 | +0.0 % | "
             "+2.0 % | - |") in text
     assert "| avx512 | a | bounce | 200 | 12 of 16 | +1.0 % | +20.0 % | -15.0 % (64x64) |" in text
+    # With the model's predictor on the same batches: its cycles over the cached ones, and its
+    # mispredictions primed and displaced.
+    for r in rows:
+        for rays in ("camera", "bounce"):
+            k = f"predicted.predictor.{rays}."
+            r.update({k + "extra_cycles": 18.18, k + "primed_mispredictions": 3,
+                      k + "displaced_mispredictions": 1234, k + "branches": 9000})
+    p.write_text(json.dumps(rows))
+    text = silicon.predictor_text(silicon.load_rows(p))
+    assert ("| avx512 | a | bounce | 200 | 12 of 16 | +1.0 % | +20.0 % | +18.0 % (3, 1,234) | "
+            "-15.0 % (64x64) |") in text
+    assert ("| avx512 | synthetic (the per-op costs' scene) | camera | 200 | 12 of 16 | +0.0 % | "
+            "+2.0 % | - | - |") in text
     # Rows from before the predictor microbenchmarks: said so.
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
     assert "no branch-predictor" in silicon.predictor_text(silicon.load_rows(p))

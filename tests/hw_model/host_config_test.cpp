@@ -2,15 +2,15 @@
 // is priced (OpProfile), their fit, scene-data latency through the host's caches, and the host
 // configuration's knobs (storage l1d, slot_bytes, partition by compress, op_costs).
 
-#include "hw_model/op_cost_fit.h"
-
 #include <catch2/catch.hpp>
+#include <random>
 
+#include "base/input_error.h"
 #include "hw_model/host_description.h"
+#include "hw_model/op_cost_fit.h"
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
-#include "base/input_error.h"
 #include "tests/hw_model/test_hosts.h"
 
 using namespace sfx;
@@ -378,6 +378,49 @@ TEST_CASE("The box test that enters a short loop from the stream loop carries it
           without.traversal_loop_cycles[size_t(TraversalLoop::one_ray)] + 100);
 }
 
+TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
+          "[host][systemc][branch]") {
+    // 400 one-ray box tests, passing at random: branches no predictor learns.
+    auto time_random = [](const HwConfig& host) {
+        SystemcTiming timing({host}, shape());
+        std::mt19937 rng(3);
+        const uint32_t id = 0;
+        TilePass pass;
+        pass.slot_count = 64;
+        timing.begin_pass(pass);
+        for (int i = 0; i < 400; ++i) {
+            const uint8_t passed = rng() & 1;
+            StreamOp op;
+            op.kind = OpKind::box_test;
+            op.stage = OpStage::traversal;
+            op.object = uint32_t(rng() % 64);
+            op.length = 1;
+            op.pass_count = passed;
+            op.slots = &id;
+            op.passed = &passed;
+            timing.op(op);
+        }
+        timing.end_pass(pass);
+        return timing.timing(0);
+    };
+    OpCostConfig box = cost("box_test", 10, 4, 0, 0, 0);
+    box.one_lane_cycles = 5;
+    HwConfig host = host_with({box});
+    CHECK(host.branch_predictor.kind == "none");  // not fitted: no branch priced
+    const FrameTiming none = time_random(host);
+    CHECK(none.branch_mispredictions == 0);
+    host.branch_predictor.kind = "tage";
+    host.branch_predictor.mispredict_cycles = 50;
+    const FrameTiming tage = time_random(host);
+    CHECK(tage.branch_mispredictions > 100);
+    CHECK(tage.branch_cycles == 50 * tage.branch_mispredictions);
+    const auto busy = [](const FrameTiming& t) {
+        return t.stages[0][size_t(OpStage::traversal)].busy_cycles;
+    };
+    CHECK(busy(tage) == busy(none) + tage.branch_cycles);
+    CHECK(HwConfig().branch_predictor.kind == "none");  // the paper's machine: no branches
+}
+
 TEST_CASE("The machine model times a host: measured costs, scene data beyond the L1D",
           "[host][systemc]") {
     const HwConfig host = host_with({cost("box_test", 10, 4, 0, 0, 8)});
@@ -452,6 +495,9 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.latency_ns = {1.0, 5.0, 15.5, 81.0};
     host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
     host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
+    host.branch_predictor.kind = "tage";
+    host.branch_predictor.mispredict_cycles = 61.5;
+    host.branch_predictor_fit = "test batches";
     const std::string yaml = host_hw_yaml(host, {box}, "test samples");
     const SeenLevel seen = last_level_seen(host);
     REQUIRE(seen.foreign_fill_per_us > 0.0);
@@ -481,6 +527,10 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
     CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
     CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
+    CHECK(c.branch_predictor.kind == "tage");
+    CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
+    CHECK(yaml.find("fitted: test batches") != std::string::npos);
+    CHECK(host_hw_yaml(small_host(), {box}, "").find("branch_predictor") == std::string::npos);
     // A host file written before one-lane costs were measured: the formula for every op.
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
                           "old.hw.yaml")

@@ -1,0 +1,279 @@
+#include "hw_model/branch_predictor.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sfx {
+
+namespace {
+
+// L-TAGE's tagged tables (gem5 LTAGE_TAGE: logTagTableSizes, tagTableTagWidths; minHist 4,
+// maxHist 640).
+constexpr std::array<uint32_t, 12> k_log_sizes = {10, 10, 11, 11, 11, 11, 10, 10, 10, 10, 9, 9};
+constexpr std::array<uint32_t, 12> k_tag_bits = {7, 7, 8, 8, 9, 10, 11, 12, 12, 13, 14, 15};
+constexpr uint32_t k_min_history = 4, k_max_history = 640;
+constexpr uint32_t k_log_base = 14;                            // the bimodal base's entries
+constexpr uint32_t k_history_slots = 1024;                     // > k_max_history, a power of two
+constexpr uint64_t k_useful_reset_period = uint64_t(1) << 19;  // gem5 LTAGE logUResetPeriod
+
+}  // namespace
+
+void TagePredictor::Folded::update(uint8_t newest, uint8_t oldest) {
+    value = (value << 1) | newest;
+    value ^= uint32_t(oldest) << (length % bits);
+    value ^= value >> bits;
+    value &= (1u << bits) - 1;
+}
+
+TagePredictor::TagePredictor() : m_base(size_t(1) << k_log_base, 0), m_history(k_history_slots, 0) {
+    for (int t = 0; t < k_tables; ++t) {
+        // Geometric: L(t) = min * (max / min)^(t / (tables - 1)).
+        m_history_length[t] =
+            uint32_t(std::lround(k_min_history * std::pow(double(k_max_history) / k_min_history,
+                                                          double(t) / (k_tables - 1))));
+        m_log_size[t] = k_log_sizes[t];
+        m_tag_bits[t] = k_tag_bits[t];
+        m_table[t].assign(size_t(1) << m_log_size[t], Entry{});
+        m_fold_index[t] = {0, m_history_length[t], m_log_size[t]};
+        m_fold_tag0[t] = {0, m_history_length[t], m_tag_bits[t]};
+        m_fold_tag1[t] = {0, m_history_length[t], m_tag_bits[t] - 1};
+    }
+}
+
+uint32_t TagePredictor::index(int t, uint32_t pc) const {
+    const uint32_t bits = m_log_size[t];
+    return (pc ^ (pc >> (bits - uint32_t(t) % bits)) ^ m_fold_index[t].value ^
+            (uint32_t(t) * 0x9e37u)) &
+           ((1u << bits) - 1);
+}
+
+uint16_t TagePredictor::tag(int t, uint32_t pc) const {
+    return uint16_t((pc ^ m_fold_tag0[t].value ^ (m_fold_tag1[t].value << 1)) &
+                    ((1u << m_tag_bits[t]) - 1));
+}
+
+void TagePredictor::push_history(bool taken) {
+    m_head = (m_head + k_history_slots - 1) % k_history_slots;
+    m_history[m_head] = taken;
+    for (int t = 0; t < k_tables; ++t) {
+        const uint8_t oldest = m_history[(m_head + m_history_length[t]) % k_history_slots];
+        m_fold_index[t].update(taken, oldest);
+        m_fold_tag0[t].update(taken, oldest);
+        m_fold_tag1[t].update(taken, oldest);
+    }
+}
+
+bool TagePredictor::predict_and_update(uint32_t pc, bool taken) {
+    std::array<uint32_t, k_tables> idx;
+    std::array<uint16_t, k_tables> tags;
+    int provider = -1, alt = -1;
+    for (int t = k_tables - 1; t >= 0; --t) {
+        idx[t] = index(t, pc);
+        tags[t] = tag(t, pc);
+        if (m_table[t][idx[t]].tag != tags[t]) continue;
+        if (provider < 0)
+            provider = t;
+        else if (alt < 0)
+            alt = t;
+    }
+    int8_t& base = m_base[pc & ((1u << k_log_base) - 1)];
+    const bool base_pred = base >= 0;
+    const bool alt_pred = alt >= 0 ? m_table[alt][idx[alt]].ctr >= 0 : base_pred;
+    bool provider_pred = base_pred, prediction = base_pred, fresh = false;
+    if (provider >= 0) {
+        const Entry& e = m_table[provider][idx[provider]];
+        provider_pred = e.ctr >= 0;
+        fresh = (e.ctr == 0 || e.ctr == -1) && e.u == 0;
+        prediction = fresh && m_use_alt_on_new >= 0 ? alt_pred : provider_pred;
+    }
+    const bool mispredicted = prediction != taken;
+    ++m_branches;
+    m_mispredictions += mispredicted;
+
+    if (fresh && provider_pred != alt_pred)
+        m_use_alt_on_new = std::clamp(m_use_alt_on_new + (alt_pred == taken ? 1 : -1), -8, 7);
+    // A wrong provider allocates an entry in one longer table whose entry is not useful (the
+    // first such, or the second with probability 1/2), else ages the longer ones.
+    if (provider_pred != taken && provider < k_tables - 1) {
+        int chosen = -1;
+        for (int t = provider + 1; t < k_tables; ++t) {
+            if (m_table[t][idx[t]].u != 0) continue;
+            if (chosen < 0) {
+                chosen = t;
+                m_seed = m_seed * 1103515245u + 12345u;
+                if ((m_seed >> 16) & 1) continue;
+                break;
+            }
+            chosen = t;
+            break;
+        }
+        if (chosen >= 0)
+            m_table[chosen][idx[chosen]] = Entry{int8_t(taken ? 0 : -1), tags[chosen], 0};
+        else
+            for (int t = provider + 1; t < k_tables; ++t)
+                if (m_table[t][idx[t]].u > 0) --m_table[t][idx[t]].u;
+    }
+    if (provider >= 0) {
+        Entry& e = m_table[provider][idx[provider]];
+        e.ctr = int8_t(std::clamp(e.ctr + (taken ? 1 : -1), -4, 3));
+        if (provider_pred != alt_pred)
+            e.u = uint8_t(std::clamp(int(e.u) + (provider_pred == taken ? 1 : -1), 0, 3));
+        if (e.u == 0 && alt < 0) base = int8_t(std::clamp(base + (taken ? 1 : -1), -2, 1));
+    } else {
+        base = int8_t(std::clamp(base + (taken ? 1 : -1), -2, 1));
+    }
+    if (m_branches % k_useful_reset_period == 0)
+        for (auto& table : m_table)
+            for (Entry& e : table) e.u >>= 1;
+    push_history(taken);
+    return mispredicted;
+}
+
+std::vector<TraversalLoop> traversal_loops(const PassBuffer& pass, uint32_t width) {
+    std::vector<TraversalLoop> loop(pass.size(), TraversalLoop::stream);
+    for (uint32_t i = 0; i < pass.size(); ++i) {
+        const StreamOp op = pass.at(i);
+        if (op.kind != OpKind::box_test) continue;
+        const int32_t producer = pass.producer(i);
+        const TraversalLoop from = producer < 0 ? TraversalLoop::stream : loop[size_t(producer)];
+        loop[i] = traversal_loop(op.length, width, from);
+    }
+    return loop;
+}
+
+namespace {
+
+// The static branches of the traversal (kernels/stream/stream_kernels_impl.h), one address each.
+enum class Branch : uint32_t {
+    stream_one_ray,   // traverse: len == 1
+    stream_few_ray,   // traverse: len <= k_few_ray_lanes (wide back ends)
+    stream_group,     // box_filter's group loop: another group
+    stream_none,      // traverse: k == 0
+    stream_leaf,      // traverse: node.is_leaf()
+    few_one_ray,      // traverse_few: n == 1
+    few_none,         // traverse_few: k == 0
+    few_leaf,         // traverse_few: node.is_leaf()
+    stream_prefetch,  // prefetch_below in the stream loop: node.is_leaf()
+    few_prefetch,     // the same in traverse_few
+    one_prefetch,     // the same in traverse_one
+    one_stack,        // traverse_one: another node on its stack
+    one_pass,         // traverse_one: the ray passes
+    one_leaf,         // traverse_one: node.is_leaf()
+    leaf_took_wide,   // traverse_leaf: a lane took the hit
+    leaf_took_one,    // the same, one lane
+    leaf_more_wide,   // traverse_leaf: another primitive
+    leaf_more_one,
+};
+uint32_t address(Branch b) {
+    return 0x401000u + 0x40u * uint32_t(b);
+}
+
+}  // namespace
+
+void replay_traversal_branches(const PassBuffer& pass, const std::vector<TraversalLoop>& loops,
+                               uint32_t width, const std::vector<uint8_t>& node_leaf,
+                               TagePredictor& predictor, std::vector<uint32_t>& mispredicted) {
+    const size_t n = pass.size();
+    mispredicted.assign(n, 0);
+    const bool few_loop = width >= k_few_ray_min_width;
+    for (size_t i = 0; i < n; ++i) {
+        const StreamOp op = pass.at(i);
+        const bool next_is_leaf_test = i + 1 < n && (pass.at(i + 1).kind == OpKind::triangle_test ||
+                                                     pass.at(i + 1).kind == OpKind::sphere_test);
+        uint32_t& missed = mispredicted[i];
+        auto branch = [&](Branch b, bool taken) {
+            missed += predictor.predict_and_update(address(b), taken);
+        };
+        if (op.kind == OpKind::triangle_test || op.kind == OpKind::sphere_test) {
+            const bool one = op.length == 1;
+            branch(one ? Branch::leaf_took_one : Branch::leaf_took_wide, op.pass_count > 0);
+            branch(one ? Branch::leaf_more_one : Branch::leaf_more_wide, next_is_leaf_test);
+            continue;
+        }
+        if (op.kind != OpKind::box_test) continue;
+        const uint32_t len = op.length, k = op.pass_count;
+        const int32_t producer = pass.producer(i);
+        const TraversalLoop from = producer < 0 ? TraversalLoop::stream : loops[size_t(producer)];
+        const bool node_is_leaf =
+            op.object < node_leaf.size() ? node_leaf[op.object] != 0 : next_is_leaf_test;
+        const bool leaf = k > 0 && node_is_leaf;
+        // The stream loop pops every stream it or its root made, and sends short ones on.
+        if (loops[i] == TraversalLoop::stream || from == TraversalLoop::stream) {
+            branch(Branch::stream_one_ray, len == 1);
+            if (len > 1 && few_loop) branch(Branch::stream_few_ray, len <= k_few_ray_lanes);
+        } else if (loops[i] == TraversalLoop::few_ray) {
+            branch(Branch::few_one_ray, len == 1);
+        }
+        if (len == 1) {
+            // A one-ray traversal starts where its stream came from a longer one.
+            const bool starts = producer < 0 || pass.at(size_t(producer)).length > 1;
+            branch(Branch::one_stack, !starts);
+            branch(Branch::one_prefetch, node_is_leaf);
+            branch(Branch::one_pass, k > 0);
+            if (k > 0) branch(Branch::one_leaf, leaf);
+        } else if (loops[i] == TraversalLoop::few_ray) {
+            branch(Branch::few_prefetch, node_is_leaf);
+            branch(Branch::few_none, k == 0);
+            if (k > 0) branch(Branch::few_leaf, leaf);
+        } else {
+            branch(Branch::stream_prefetch, node_is_leaf);
+            const uint32_t groups = (len + width - 1) / width;
+            for (uint32_t g = 1; g <= groups; ++g) branch(Branch::stream_group, g < groups);
+            branch(Branch::stream_none, k == 0);
+            if (k > 0) branch(Branch::stream_leaf, leaf);
+        }
+    }
+}
+
+PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& batches,
+                                          uint32_t width, const std::vector<uint8_t>& node_leaf,
+                                          uint32_t repetitions) {
+    std::vector<std::vector<TraversalLoop>> loops;
+    for (const PassBuffer* b : batches) loops.push_back(traversal_loops(*b, width));
+    TagePredictor predictor;
+    std::vector<uint32_t> scratch;
+    auto run = [&](size_t b) {
+        const uint64_t before = predictor.mispredictions();
+        replay_traversal_branches(*batches[b], loops[b], width, node_leaf, predictor, scratch);
+        return predictor.mispredictions() - before;
+    };
+    PredictorStates states;
+    const uint64_t start = predictor.branches();
+    for (size_t b = 0; b < batches.size(); ++b) run(b);
+    states.branches = predictor.branches() - start;
+    // Primed: as the microbenchmark's samples, each an untimed run of the batch and a timed
+    // one, until the fewest mispredictions stopped falling for two samples (the predictor has
+    // learned what it will; the microbenchmark keeps its fastest sample), at most 16.
+    for (size_t b = 0; b < batches.size(); ++b) {
+        uint64_t fewest = ~uint64_t(0);
+        for (uint32_t r = 0, steady = 0; r < 16 && (r < repetitions || steady < 2); ++r) {
+            run(b);
+            const uint64_t m = run(b);
+            steady = m < fewest ? 0 : steady + 1;
+            fewest = std::min(fewest, m);
+        }
+        states.primed += fewest;
+    }
+    for (size_t b = 0; b < batches.size(); ++b) {
+        uint64_t fewest = ~uint64_t(0);
+        for (uint32_t r = 0; r < repetitions; ++r) {
+            for (size_t o = 0; o < batches.size(); ++o)
+                if (o != b) run(o);
+            fewest = std::min(fewest, run(b));
+        }
+        states.displaced += fewest;
+    }
+    return states;
+}
+
+double fit_mispredict_cycles(const std::vector<double>& extra_cycles,
+                             const std::vector<double>& extra_mispredictions) {
+    double cycles = 0.0, mispredictions = 0.0;
+    for (size_t i = 0; i < extra_cycles.size() && i < extra_mispredictions.size(); ++i) {
+        cycles += extra_cycles[i];
+        mispredictions += extra_mispredictions[i];
+    }
+    return mispredictions > 0 ? std::max(0.0, cycles / mispredictions) : 0.0;
+}
+
+}  // namespace sfx

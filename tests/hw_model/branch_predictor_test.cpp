@@ -1,0 +1,120 @@
+#include "hw_model/branch_predictor.h"
+
+#include <catch2/catch.hpp>
+#include <random>
+
+using namespace sfx;
+
+namespace {
+
+// The share of `outcomes` (at the pcs given) the predictor mispredicts.
+double mispredicted(TagePredictor& p, const std::vector<uint32_t>& pcs,
+                    const std::vector<uint8_t>& outcomes) {
+    const uint64_t before = p.mispredictions();
+    for (size_t i = 0; i < outcomes.size(); ++i) p.predict_and_update(pcs[i], outcomes[i]);
+    return double(p.mispredictions() - before) / double(outcomes.size());
+}
+
+// One op of a pass: a box test or a triangle test of `slots`, the first `passed` lanes passing.
+void add_op(PassBuffer& pass, OpKind kind, uint32_t object, const std::vector<uint32_t>& slots,
+            uint32_t passed) {
+    std::vector<uint8_t> mask(slots.size(), 0);
+    for (uint32_t i = 0; i < passed; ++i) mask[i] = 1;
+    StreamOp op;
+    op.kind = kind;
+    op.stage = kind == OpKind::box_test ? OpStage::traversal : OpStage::intersection;
+    op.object = object;
+    op.length = uint32_t(slots.size());
+    op.pass_count = passed;
+    op.slots = slots.data();
+    op.passed = mask.data();
+    pass.op(op);
+}
+
+}  // namespace
+
+TEST_CASE("The predictor learns a repeated sequence, never a random one", "[branch]") {
+    std::mt19937 rng(1);
+    std::vector<uint32_t> pcs(1000);
+    std::vector<uint8_t> outcomes(1000);
+    for (size_t i = 0; i < outcomes.size(); ++i) {
+        outcomes[i] = rng() & 1;
+        pcs[i] = 0x400000 + 64 * (rng() % 8);
+    }
+    TagePredictor p;
+    const double first = mispredicted(p, pcs, outcomes);
+    CHECK(first > 0.35);
+    CHECK(first < 0.65);
+    double later = 1.0;
+    for (int rep = 0; rep < 6; ++rep) later = mispredicted(p, pcs, outcomes);
+    CHECK(later < 0.05);
+    // New random outcomes at the same branches: nothing to learn.
+    for (uint8_t& o : outcomes) o = rng() & 1;
+    CHECK(mispredicted(p, pcs, outcomes) > 0.35);
+    // A loop of eight iterations: its exit is learned from the history.
+    TagePredictor loop;
+    std::vector<uint8_t> eights;
+    for (int rep = 0; rep < 200; ++rep)
+        for (int i = 0; i < 8; ++i) eights.push_back(i < 7);
+    mispredicted(loop, std::vector<uint32_t>(eights.size(), 0x400040), eights);
+    CHECK(mispredicted(loop, std::vector<uint32_t>(eights.size(), 0x400040), eights) < 0.01);
+    CHECK(loop.branches() == 2 * eights.size());
+}
+
+TEST_CASE("A pass's traversal branches follow the tracer's loops", "[branch]") {
+    // Width 8: a 16-lane box test on interior node 0, all passing; its child, leaf 1, which one
+    // ray passes; that ray's triangle test, which it hits.
+    const std::vector<uint32_t> sixteen = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+    PassBuffer pass;
+    TilePass tile;
+    tile.slot_count = 16;
+    pass.begin_pass(tile);
+    add_op(pass, OpKind::box_test, 0, sixteen, 16);
+    add_op(pass, OpKind::box_test, 1, sixteen, 1);
+    add_op(pass, OpKind::triangle_test, 5, {0}, 1);
+    pass.end_pass(tile);
+    const std::vector<TraversalLoop> loops = traversal_loops(pass, 8);
+    CHECK(loops[0] == TraversalLoop::stream);
+    CHECK(loops[1] == TraversalLoop::stream);
+    TagePredictor p;
+    std::vector<uint32_t> missed;
+    replay_traversal_branches(pass, loops, 8, {0, 1}, p, missed);
+    // Each box test in the stream loop: one ray? few? leaf (prefetch)? two groups, none
+    // passed? leaf? Seven each. The triangle test: took the hit? another primitive? Two.
+    CHECK(p.branches() == 7 + 7 + 2);
+    REQUIRE(missed.size() == 3);
+    CHECK(missed[0] + missed[1] + missed[2] == p.mispredictions());
+    // Without the tree's leaves a passing node is a leaf where leaf tests follow it.
+    TagePredictor q;
+    replay_traversal_branches(pass, loops, 8, {}, q, missed);
+    CHECK(q.branches() == p.branches());
+    // A narrow back end has no few-ray loop: no such test.
+    TagePredictor r;
+    replay_traversal_branches(pass, traversal_loops(pass, 4), 4, {0, 1}, r, missed);
+    CHECK(r.branches() == 2 * (7 - 1 + 2) + 2);  // four groups of four a test
+}
+
+TEST_CASE("A batch mispredicts less after itself than after others", "[branch]") {
+    // Batches of one-ray traversals with outcomes at random: each its own sequence, together
+    // more than the predictor holds.
+    std::mt19937 rng(2);
+    std::vector<PassBuffer> batches(8);
+    std::vector<uint8_t> leaves(64, 0);
+    for (PassBuffer& b : batches) {
+        TilePass tile;
+        tile.slot_count = 1;
+        b.begin_pass(tile);
+        for (int i = 0; i < 2000; ++i) add_op(b, OpKind::box_test, rng() % 64, {0}, rng() & 1);
+        b.end_pass(tile);
+    }
+    std::vector<const PassBuffer*> views;
+    for (const PassBuffer& b : batches) views.push_back(&b);
+    const PredictorStates s = simulate_predictor_states(views, 8, leaves);
+    CHECK(s.branches > 8 * 2000);
+    CHECK(s.primed < s.displaced);
+    CHECK(s.primed < s.branches / 20);
+
+    CHECK(fit_mispredict_cycles({100, 200}, {2, 2}) == Approx(75));
+    CHECK(fit_mispredict_cycles({100}, {0}) == 0.0);
+    CHECK(fit_mispredict_cycles({-100}, {2}) == 0.0);
+}
