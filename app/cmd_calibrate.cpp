@@ -407,14 +407,12 @@ void add_calibrate_command(CLI::App& app) {
                 progress.set_total(total);
                 progress.set_done(done);
             });
-        // What the branch predictor saves a traversal it has just run, per scene and back end
-        // (run_predictor_microbenchmarks), and in the synthetic scene whose traversals the
-        // per-op costs come from (at scene index scenes.size()): the model prices no branch.
-        // The model's predictor replays each scene's batches (check_predictor); each back end's
-        // host file prices its mispredictions.
+        // What the branch predictor saves a traversal it has just run, per scene and back end,
+        // beside what the model's predictor makes of the same batches (check_predictor; each
+        // back end's host file prices its mispredictions), and in the synthetic scene whose
+        // traversals the per-op costs come from (at scene index scenes.size(), measured only).
         std::map<std::pair<size_t, Isa>, std::vector<PredictorCheck>> predictor;
-        for (size_t k = 0; k < host_isas.size(); ++k) {
-            const Isa isa = host_isas[k];
+        for (const Isa isa : host_isas) {
             for (size_t sc = 0; sc < scenes.size(); ++sc) {
                 progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
                 predictor[{sc, isa}] = check_predictor(*loaded[sc], *bvhs[sc], isa, bench_rule);
