@@ -53,9 +53,9 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
 void CoreModel::warm_branches(const PassBuffer& pass) {
     if (!m_predictor) return;
     const std::vector<uint8_t> none;
+    std::vector<uint32_t> untimed;  // a pass in flight keeps its own counts
     replay_traversal_branches(pass, traversal_loops(pass, width()), width(),
-                              m_map.node_leaf ? *m_map.node_leaf : none, *m_predictor,
-                              m_mispredicted);
+                              m_map.node_leaf ? *m_map.node_leaf : none, *m_predictor, untimed);
 }
 
 const OpProfile& CoreModel::profile(uint32_t op) const {
