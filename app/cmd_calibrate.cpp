@@ -245,6 +245,10 @@ void add_calibrate_command(CLI::App& app) {
                          {"converged", s.converged},
                          {"repetitions", s.repetitions}});
                 }
+                j["exposed_share"] = cal.exposed_share_fit.share;
+                j["exposed_share_measured_cycles"] = cal.exposed_share_fit.measured;
+                j["exposed_share_modelled_cycles_at_one"] = cal.exposed_share_fit.modelled_at_one;
+                j["exposed_share_modelled_cycles"] = cal.exposed_share_fit.modelled;
                 j["branch_predictor"] = cal.host.branch_predictor.kind;
                 j["mispredict_cycles"] = cal.host.branch_predictor.mispredict_cycles;
                 for (const PredictorCheck& b : cal.branch_samples)
@@ -255,6 +259,7 @@ void add_calibrate_command(CLI::App& app) {
                          {"primed_cycles", b.measured.primed_cycles},
                          {"cached_cycles", b.measured.cached_cycles},
                          {"displaced_cycles", b.measured.displaced_cycles},
+                         {"evicted_cycles", b.measured.evicted_cycles},
                          {"branches", b.modelled.branches},
                          {"primed_mispredictions", b.modelled.primed},
                          {"displaced_mispredictions", b.modelled.displaced}});
@@ -316,6 +321,12 @@ void add_calibrate_command(CLI::App& app) {
                     b.measured.converged_batches, b.measured.batches,
                     (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
                     (unsigned long long)b.modelled.displaced);
+            std::printf(
+                "scene data from DRAM: exposed share %.3f of the model's latency (the "
+                "batches evicted over primed: %.0f cycles measured, the model %.0f at a "
+                "share of 1, %.0f at this one)\n",
+                cal.exposed_share_fit.share, cal.exposed_share_fit.measured,
+                cal.exposed_share_fit.modelled_at_one, cal.exposed_share_fit.modelled);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,
@@ -411,11 +422,19 @@ void add_calibrate_command(CLI::App& app) {
         // beside what the model's predictor makes of the same batches (check_predictor; each
         // back end's host file prices its mispredictions), and in the synthetic scene whose
         // traversals the per-op costs come from (at scene index scenes.size(), measured only).
+        // The model also times the batches from empty caches and after themselves
+        // (model_batch_memory), against their evicted and primed states.
         std::map<std::pair<size_t, Isa>, std::vector<PredictorCheck>> predictor;
-        for (const Isa isa : host_isas) {
+        std::map<std::pair<size_t, Isa>, std::vector<BatchMemoryCycles>> batch_memory;
+        for (size_t k = 0; k < host_isas.size(); ++k) {
+            const Isa isa = host_isas[k];
             for (size_t sc = 0; sc < scenes.size(); ++sc) {
                 progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
                 predictor[{sc, isa}] = check_predictor(*loaded[sc], *bvhs[sc], isa, bench_rule);
+                for (PredictorCheck& c : predictor[{sc, isa}]) {
+                    batch_memory[{sc, isa}].push_back(model_batch_memory(hosts[k], c));
+                    c.batches.clear();  // their memory, no longer needed
+                }
             }
             for (const PredictorSample& p : run_predictor_microbenchmarks(isa, bench_rule))
                 predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}});
@@ -495,7 +514,8 @@ void add_calibrate_command(CLI::App& app) {
                     if (stat.name.rfind(prefix, 0) == 0) row["predicted." + stat.name] = stat.value;
             for (const auto& [which, index] :
                  {std::pair<std::string, size_t>{"", scene_index}, {"synthetic.", scenes.size()}})
-                for (const PredictorCheck& c : predictor[{index, st.isa}]) {
+                for (size_t at = 0; at < predictor[{index, st.isa}].size(); ++at) {
+                    const PredictorCheck& c = predictor[{index, st.isa}][at];
                     const PredictorSample& p = c.measured;
                     const std::string kind = which + (p.bounce ? "bounce" : "camera") + ".";
                     const std::string key = "measured.predictor." + kind;
@@ -509,8 +529,12 @@ void add_calibrate_command(CLI::App& app) {
                             b.kind == "none" ? 0.0
                                              : b.mispredict_cycles * (double(c.modelled.displaced) -
                                                                       double(c.modelled.primed));
+                        const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
+                        row[model + "cold_cycles"] = memory.cold;
+                        row[model + "warm_cycles"] = memory.warm;
                     }
                     row[key + "primed_cycles"] = p.primed_cycles;
+                    row[key + "evicted_cycles"] = p.evicted_cycles;
                     row[key + "cached_cycles"] = p.cached_cycles;
                     row[key + "displaced_cycles"] = p.displaced_cycles;
                     row[key + "box_tests"] = p.box_tests;

@@ -15,6 +15,7 @@
 #include "base/huge_pages.h"
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
+#include "hw_model/systemc/systemc_timing.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
 
@@ -97,20 +98,72 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
                                             const ConvergenceRule& convergence) {
-    std::vector<std::unique_ptr<PassBuffer>> batches[2];  // camera rays, bounces
+    std::vector<std::shared_ptr<PassBuffer>> batches[2];  // camera rays, bounces
     const std::vector<PredictorSample> measured =
         run_predictor_microbenchmarks(scene, bvh, isa, convergence, 3, [&](bool bounce, uint32_t) {
-            batches[bounce].push_back(std::make_unique<PassBuffer>());
+            batches[bounce].push_back(std::make_shared<PassBuffer>());
             return batches[bounce].back().get();
         });
     const std::vector<uint8_t> leaves = bvh_leaves(bvh);
+    RenderSettings settings;
+    settings.tile = 128;  // the batches' slots span both kinds' rays (2 x 64 x 64)
+    const WorkloadShape shape = workload_shape(scene, bvh, settings);
     std::vector<PredictorCheck> out;
     for (const PredictorSample& m : measured) {
         std::vector<const PassBuffer*> kind;
         for (const auto& b : batches[m.bounce]) kind.push_back(b.get());
-        out.push_back({m, simulate_predictor_states(kind, isa_width(resolve_isa(isa)), leaves)});
+        PredictorCheck c{
+            m, simulate_predictor_states(kind, isa_width(resolve_isa(isa)), leaves), {}, shape};
+        c.batches.assign(batches[m.bounce].begin(), batches[m.bounce].end());
+        out.push_back(std::move(c));
     }
     return out;
+}
+
+BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample) {
+    HwConfig config = host;
+    config.branch_predictor.kind = "none";
+    BatchMemoryCycles out;
+    for (const auto& batch : sample.batches) {
+        SystemcTiming timing({config}, sample.shape);
+        uint64_t before = 0;
+        for (int run = 0; run < 2; ++run) {
+            timing.begin_pass(batch->pass());
+            for (size_t i = 0; i < batch->size(); ++i) timing.op(batch->at(i));
+            timing.end_pass(batch->pass());
+            const uint64_t cycles = timing.timing(0).cycles;
+            (run == 0 ? out.cold : out.warm) += double(cycles - before);
+            before = cycles;
+        }
+    }
+    return out;
+}
+
+ExposedShareFit fit_exposed_share(const HwConfig& host,
+                                  const std::vector<PredictorCheck>& samples) {
+    ExposedShareFit fit;
+    for (const PredictorCheck& s : samples)
+        fit.measured += s.measured.evicted_cycles - s.measured.primed_cycles;
+    auto modelled = [&](double share) {
+        HwConfig c = host;
+        c.scene_memory.exposed_share = share;
+        double extra = 0.0;
+        for (const PredictorCheck& s : samples) {
+            const BatchMemoryCycles m = model_batch_memory(c, s);
+            extra += m.cold - m.warm;
+        }
+        return extra;
+    };
+    fit.modelled_at_one = modelled(1.0);
+    double lo = 0.0, hi = 1.0;
+    if (fit.measured >= fit.modelled_at_one) lo = 1.0;
+    for (int step = 0; step < 10 && lo < hi; ++step) {
+        const double mid = 0.5 * (lo + hi);
+        (modelled(mid) < fit.measured ? lo : hi) = mid;
+    }
+    fit.share = lo < hi ? 0.5 * (lo + hi) : lo;
+    fit.modelled = modelled(fit.share);
+    return fit;
 }
 
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
@@ -210,6 +263,17 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
+    c.exposed_share_fit = fit_exposed_share(host_config, c.branch_samples);
+    c.host.exposed_share = c.exposed_share_fit.share;
+    std::ostringstream exposed_note;
+    exposed_note << "the branch microbenchmark's batches right after themselves and a read of "
+                 << "256 MiB of other data, over right after themselves: "
+                 << std::llround(c.exposed_share_fit.measured)
+                 << " cycles measured, the model's cold over warm caches "
+                 << std::llround(c.exposed_share_fit.modelled_at_one)
+                 << " with all the latency exposed, " << std::llround(c.exposed_share_fit.modelled)
+                 << " with this share; no frame";
+    c.host.exposed_share_fit = exposed_note.str();
     for (OpCostConfig& cost : c.op_costs) {
         const OpKind kind = op_kind_named(cost.op);
         if (kind != OpKind::count && op_info(kind).reads_hit_primitive)

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "hw_model/host_description.h"
 #include "hw_model/op_cost_fit.h"
 #include "hw_model/prediction.h"
+#include "hw_model/workload_shape.h"
 #include "kernels/bvh.h"
 #include "kernels/render.h"
 #include "kernels/stream/stream_microbench.h"
@@ -30,11 +32,32 @@ namespace sfx {
 struct PredictorCheck {
     PredictorSample measured;
     PredictorStates modelled;
+    // The batches' traces and their scene's shape, for the model to time (model_batch_memory).
+    std::vector<std::shared_ptr<const PassBuffer>> batches;
+    WorkloadShape shape;
 };
 // run_predictor_microbenchmarks on `scene` (its BVH `bvh`) with `isa`, and the model's
 // predictor replaying each batch's trace at that back end's width.
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
                                             const ConvergenceRule& convergence);
+
+// The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
+// priced: the states compared share the predictor's), each batch from empty caches (cold: the
+// microbenchmark's evicted state) and right after itself (warm: primed), summed.
+struct BatchMemoryCycles {
+    double cold = 0.0, warm = 0.0;
+};
+BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
+
+// SceneMemoryConfig::exposed_share: the share at which the model's cold over warm cycles
+// (model_batch_memory) equal the measured evicted over primed ones, pooled over the samples;
+// by bisection on [0, 1] (the model's extra grows with the share). With the measured and the
+// modelled extra cycles, at a share of 1 and at the fitted one.
+struct ExposedShareFit {
+    double share = 1.0;
+    double measured = 0.0, modelled_at_one = 0.0, modelled = 0.0;
+};
+ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples);
 
 struct HostCalibration {
     HostDescription host;
@@ -58,6 +81,8 @@ struct HostCalibration {
     // The branch microbenchmark (run_branch_microbenchmarks) and the model's mispredictions on
     // its batches, on which HostDescription::branch_predictor's cost is fitted.
     std::vector<PredictorCheck> branch_samples;
+    // On the same batches evicted: the share of scene-data latency a core leaves exposed.
+    ExposedShareFit exposed_share_fit;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml

@@ -418,6 +418,29 @@ def predictor_text(df):
     return "\n".join(lines)
 
 
+def dram_text(df):
+    """Per back end and scene: the predictor microbenchmark's batches right after themselves and
+    a read of 256 MiB of other data (every scene line in DRAM) over right after themselves,
+    measured, beside the model's same batches from empty caches over right after themselves
+    (rows written before either carry none)."""
+    if ("measured.predictor.camera.evicted_cycles" not in df
+            or "predicted.predictor.camera.cold_cycles" not in df):
+        return "These rows carry no batches timed from DRAM."
+    lines = ["| back end | scene | rays | measured (evicted / primed) | model (cold / warm) | "
+             "measured extra Mcyc | model extra Mcyc |", "|---|---|---|---|---|---|---|"]
+    for isa in isas(df):
+        for scene, h in df[df["isa"] == isa].groupby("scene", sort=False):
+            r = h.iloc[0]
+            for rays in ("camera", "bounce"):
+                m, p = f"measured.predictor.{rays}.", f"predicted.predictor.{rays}."
+                primed, evicted = r[m + "primed_cycles"], r[m + "evicted_cycles"]
+                warm, cold = r[p + "warm_cycles"], r[p + "cold_cycles"]
+                lines.append(f"| {isa} | {scene} | {rays} | {pct(evicted / primed - 1)} | "
+                             f"{pct(cold / warm - 1)} | {(evicted - primed) / 1e6:.2f} | "
+                             f"{(cold - warm) / 1e6:.2f} |")
+    return "\n".join(lines)
+
+
 LOOPS = (("one_ray", "one-ray loop"), ("few_ray", "few-ray loop"), ("stream", "stream loop"))
 
 
@@ -635,6 +658,13 @@ def write_page(df, page, plot_name, header):
         "scenes: its column is its prediction for the same batches (what its mispredictions "
         "from primed to displaced cost, over the cached cycles), held out.\n\n"
         + predictor_text(df),
+        "## Scene data from DRAM\n\nThe same batches right after themselves and a read of "
+        "256 MiB of other data (every scene line in DRAM, the predictor primed), over right "
+        "after themselves: what reading the scene from DRAM costs a traversal, measured, "
+        "beside the model's timing of the same batches' traces from empty caches over right "
+        "after themselves. The host file's `exposed_share` (the share of a scene read's latency "
+        "beyond an L1D hit the core leaves exposed) is fitted so on the branch microbenchmark's "
+        "random triangles, never on these scenes.\n\n" + dram_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

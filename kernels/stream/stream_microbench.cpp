@@ -931,6 +931,9 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
     const double overhead = tsc_overhead();
     const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
     std::vector<PredictorSample> out;
+    // Other data, read a line at a time to evict the scene's lines (256 MiB: beyond any L3 a
+    // core keeps, as the scene memory's DRAM latency is measured).
+    std::vector<uint64_t> other_data((size_t(256) << 20) / sizeof(uint64_t), 1);
     for (const bool bounce : {false, true}) {
         // Each tile's batch: its slots in increasing order, as the tracer's streams are.
         std::vector<std::vector<uint32_t>> batches(k_tiles);
@@ -975,7 +978,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
         }
         uint64_t touched = 0;
         // What runs before each timed traversal of a batch.
-        enum class Before { itself, itself_and_others_lines, others_traversals };
+        enum class Before { itself, itself_and_others_lines, others_traversals, itself_evicted };
         for (uint32_t t = 0; t < k_tiles; ++t) {
             bool converged = true;
             auto timed = [&](Before before) {
@@ -990,6 +993,9 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
                             for (uint32_t o = 0; o < k_tiles; ++o)
                                 if (o != t)
                                     for (const uint64_t* line : lines[o]) touched += *line;
+                        if (before == Before::itself_evicted)
+                            for (size_t i = 0; i < other_data.size(); i += 8)
+                                touched += other_data[i];
                     }
                     const uint64_t start = __rdtsc();
                     traverse(t, TraceDetail::none);
@@ -1002,6 +1008,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
             sample.primed_cycles += timed(Before::itself);
             sample.cached_cycles += timed(Before::itself_and_others_lines);
             sample.displaced_cycles += timed(Before::others_traversals);
+            sample.evicted_cycles += timed(Before::itself_evicted);
             sample.converged_batches += converged;
         }
         if (touched == 1) out.clear();  // keeps the reads of the others' lines

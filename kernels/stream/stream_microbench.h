@@ -153,7 +153,9 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 // the scene lines that the other tiles' batches of its kind touch (primed, their lines
 // cached: what a frame's caches hold); and right after those batches' traversals (displaced:
 // a frame's traversals never repeat, so its predictor has seen other ones). Displaced over
-// lines cached is the predictor's part; lines cached over primed, the caches'. The per-op costs
+// lines cached is the predictor's part; lines cached over primed, the caches'. A fourth state,
+// right after itself and a read of 256 MiB of other data (evicted: every line in DRAM, the
+// predictor primed), over primed is what reading the scene from DRAM costs. The per-op costs
 // come from the synthetic scene's traversals (run_one_ray_microbenchmarks, displaced too); a
 // scene whose branches are harder to predict pays more than they say, which the model prices
 // by running its own predictor over the same batches (hw_model/branch_predictor.h).
@@ -165,7 +167,8 @@ struct PredictorSample {
     uint32_t batches = 0;               // tiles
     uint64_t box_tests = 0, lines = 0;  // summed over the batches (lines: each one's distinct)
     double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
-    uint32_t converged_batches = 0;  // in all three states (base/convergence.h)
+    double evicted_cycles = 0.0;
+    uint32_t converged_batches = 0;  // in all four states (base/convergence.h)
 };
 std::vector<PredictorSample> run_predictor_microbenchmarks(
     const Scene& scene, const Bvh& bvh, Isa isa, const ConvergenceRule& convergence,

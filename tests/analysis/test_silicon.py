@@ -336,6 +336,16 @@ def test_branch_predictor(tmp_path):
             "-15.0 % (64x64) |") in text
     assert ("| avx512 | synthetic (the per-op costs' scene) | camera | 200 | 12 of 16 | +0.0 % | "
             "+2.0 % | - | - |") in text
+    # Batches from DRAM: measured evicted over primed beside the model's cold over warm.
+    assert "no batches timed from DRAM" in silicon.dram_text(silicon.load_rows(p))
+    for r in rows:
+        for rays in ("camera", "bounce"):
+            r.update({f"measured.predictor.{rays}.evicted_cycles": 150.0,
+                      f"predicted.predictor.{rays}.cold_cycles": 3e6,
+                      f"predicted.predictor.{rays}.warm_cycles": 2e6})
+    p.write_text(json.dumps(rows))
+    assert ("| avx512 | a | camera | +50.0 % | +50.0 % | 0.00 | 1.00 |"
+            in silicon.dram_text(silicon.load_rows(p)))
     # Rows from before the predictor microbenchmarks: said so.
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
     assert "no branch-predictor" in silicon.predictor_text(silicon.load_rows(p))
