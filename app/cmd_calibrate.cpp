@@ -247,6 +247,7 @@ void add_calibrate_command(CLI::App& app) {
                 }
                 j["exposed_share"] = cal.exposed_share_fit.share;
                 j["exposed_share_measured_cycles"] = cal.exposed_share_fit.measured;
+                j["exposed_share_baseline_cycles"] = cal.exposed_share_fit.baseline;
                 j["exposed_share_modelled_cycles_at_one"] = cal.exposed_share_fit.modelled_at_one;
                 j["exposed_share_modelled_cycles"] = cal.exposed_share_fit.modelled;
                 j["branch_predictor"] = cal.host.branch_predictor.kind;
@@ -323,10 +324,11 @@ void add_calibrate_command(CLI::App& app) {
                     (unsigned long long)b.modelled.displaced);
             std::printf(
                 "scene data from DRAM: exposed share %.3f of the model's latency (the "
-                "batches evicted over primed: %.0f cycles measured, the model %.0f at a "
-                "share of 1, %.0f at this one)\n",
+                "batches evicted over primed: %.0f cycles measured beyond the synthetic "
+                "scene's %.0f, the model %.0f at a share of 1, %.0f at this one)\n",
                 cal.exposed_share_fit.share, cal.exposed_share_fit.measured,
-                cal.exposed_share_fit.modelled_at_one, cal.exposed_share_fit.modelled);
+                cal.exposed_share_fit.baseline, cal.exposed_share_fit.modelled_at_one,
+                cal.exposed_share_fit.modelled);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,

@@ -139,11 +139,13 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     return out;
 }
 
-ExposedShareFit fit_exposed_share(const HwConfig& host,
-                                  const std::vector<PredictorCheck>& samples) {
+ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples,
+                                  const std::vector<PredictorSample>& baseline) {
     ExposedShareFit fit;
     for (const PredictorCheck& s : samples)
         fit.measured += s.measured.evicted_cycles - s.measured.primed_cycles;
+    for (const PredictorSample& b : baseline) fit.baseline += b.evicted_cycles - b.primed_cycles;
+    fit.measured = std::max(0.0, fit.measured - fit.baseline);
     auto modelled = [&](double share) {
         HwConfig c = host;
         c.scene_memory.exposed_share = share;
@@ -263,13 +265,16 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
-    c.exposed_share_fit = fit_exposed_share(host_config, c.branch_samples);
+    c.exposed_share_fit = fit_exposed_share(host_config, c.branch_samples,
+                                            run_predictor_microbenchmarks(resolved, convergence));
     c.host.exposed_share = c.exposed_share_fit.share;
     std::ostringstream exposed_note;
     exposed_note << "the branch microbenchmark's batches right after themselves and a read of "
                  << "256 MiB of other data, over right after themselves: "
-                 << std::llround(c.exposed_share_fit.measured)
-                 << " cycles measured, the model's cold over warm caches "
+                 << std::llround(c.exposed_share_fit.measured) << " cycles measured beyond the "
+                 << std::llround(c.exposed_share_fit.baseline)
+                 << " the synthetic scene's batches pay for it (code, TLB, page tables), the "
+                 << "model's cold over warm caches "
                  << std::llround(c.exposed_share_fit.modelled_at_one)
                  << " with all the latency exposed, " << std::llround(c.exposed_share_fit.modelled)
                  << " with this share; no frame";

@@ -50,14 +50,17 @@ struct BatchMemoryCycles {
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
 
 // SceneMemoryConfig::exposed_share: the share at which the model's cold over warm cycles
-// (model_batch_memory) equal the measured evicted over primed ones, pooled over the samples;
-// by bisection on [0, 1] (the model's extra grows with the share). With the measured and the
-// modelled extra cycles, at a share of 1 and at the fitted one.
+// (model_batch_memory) equal the measured evicted over primed ones, pooled over the samples,
+// less what evicting costs the `baseline` batches (the synthetic scene's, whose scene is a few
+// lines: the code, TLB and page tables a read of 256 MiB evicts too, which a frame keeps); by
+// bisection on [0, 1] (the model's extra grows with the share). With the measured extra (less
+// the baseline's), the baseline's, and the modelled extra at a share of 1 and the fitted one.
 struct ExposedShareFit {
     double share = 1.0;
-    double measured = 0.0, modelled_at_one = 0.0, modelled = 0.0;
+    double measured = 0.0, baseline = 0.0, modelled_at_one = 0.0, modelled = 0.0;
 };
-ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples);
+ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples,
+                                  const std::vector<PredictorSample>& baseline = {});
 
 struct HostCalibration {
     HostDescription host;

@@ -340,11 +340,13 @@ def test_branch_predictor(tmp_path):
     assert "no batches timed from DRAM" in silicon.dram_text(silicon.load_rows(p))
     for r in rows:
         for rays in ("camera", "bounce"):
-            r.update({f"measured.predictor.{rays}.evicted_cycles": 150.0,
+            r.update({f"measured.predictor.{rays}.evicted_cycles": 2.6e6,
+                      f"measured.predictor.synthetic.{rays}.evicted_cycles": 0.5e6 + 50,
                       f"predicted.predictor.{rays}.cold_cycles": 3e6,
                       f"predicted.predictor.{rays}.warm_cycles": 2e6})
+            r[f"measured.predictor.{rays}.primed_cycles"] = 1e6
     p.write_text(json.dumps(rows))
-    assert ("| avx512 | a | camera | +50.0 % | +50.0 % | 0.00 | 1.00 |"
+    assert ("| avx512 | a | camera | +160.0 % | 0.50 Mcyc | +110.0 % | +50.0 % | 1.10 | 1.00 |"
             in silicon.dram_text(silicon.load_rows(p)))
     # Rows from before the predictor microbenchmarks: said so.
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
