@@ -245,11 +245,6 @@ void add_calibrate_command(CLI::App& app) {
                          {"converged", s.converged},
                          {"repetitions", s.repetitions}});
                 }
-                j["exposed_share"] = cal.exposed_share_fit.share;
-                j["exposed_share_measured_cycles"] = cal.exposed_share_fit.measured;
-                j["exposed_share_baseline_cycles"] = cal.exposed_share_fit.baseline;
-                j["exposed_share_modelled_cycles_at_one"] = cal.exposed_share_fit.modelled_at_one;
-                j["exposed_share_modelled_cycles"] = cal.exposed_share_fit.modelled;
                 j["branch_predictor"] = cal.host.branch_predictor.kind;
                 j["mispredict_cycles"] = cal.host.branch_predictor.mispredict_cycles;
                 for (const PredictorCheck& b : cal.branch_samples)
@@ -322,13 +317,6 @@ void add_calibrate_command(CLI::App& app) {
                     b.measured.converged_batches, b.measured.batches,
                     (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
                     (unsigned long long)b.modelled.displaced);
-            std::printf(
-                "scene data from DRAM: exposed share %.3f of the model's latency (the "
-                "batches evicted over primed: %.0f cycles measured beyond the synthetic "
-                "scene's %.0f, the model %.0f at a share of 1, %.0f at this one)\n",
-                cal.exposed_share_fit.share, cal.exposed_share_fit.measured,
-                cal.exposed_share_fit.baseline, cal.exposed_share_fit.modelled_at_one,
-                cal.exposed_share_fit.modelled);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,
@@ -439,7 +427,7 @@ void add_calibrate_command(CLI::App& app) {
                 }
             }
             for (const PredictorSample& p : run_predictor_microbenchmarks(isa, bench_rule))
-                predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}});
+                predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}, {}, {}});
         }
         const Microarchitecture uarch = read_microarchitecture();
         uint32_t workloads = 0, converged = 0;

@@ -188,11 +188,7 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
     }
     const uint64_t ready =
         m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
-    uint64_t exposed = std::max(now, ready - std::min(ready, m_scene_hidden)) - now;
-    // A CPU core overlaps part of it (scene_memory.exposed_share).
-    if (m_l1d)
-        exposed = uint64_t(std::llround(m_config.scene_memory.exposed_share * double(exposed)));
-    m_scene_ready[index] = now + exposed;
+    m_scene_ready[index] = std::max(now, ready - std::min(ready, m_scene_hidden));
 }
 
 uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,

@@ -428,7 +428,6 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     c.scene_memory.prefetch_children = true;
     // Its surface_at reads the mesh's triangle and vertex arrays, not the leaves' copies.
     c.scene_memory.hit_reads = "mesh";
-    c.scene_memory.exposed_share = h.exposed_share;
     c.op_costs = op_costs;
     c.branch_predictor = h.branch_predictor;
     c.speed_probe_cycles = h.speed_probe_cycles;
@@ -517,9 +516,6 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "                           # tests the node (prefetch_below, kernels/stream)\n"
       << "  hit_reads: mesh  # surface_at reads the mesh's triangle and vertex arrays, not the\n"
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";
-    if (!h.exposed_share_fit.empty())
-        y << "  exposed_share: " << fmt(h.exposed_share, 3) << "  # fitted: " << h.exposed_share_fit
-          << "\n";
     if (h.branch_predictor.kind != "none")
         y << "branch_predictor:\n  kind: " << h.branch_predictor.kind
           << "  # the model's (L-TAGE's TAGE, hw_model/branch_predictor.h) over the traversal's\n"

@@ -99,10 +99,6 @@ struct HostDescription {
     // mispredictions (sweeps/host_calibration.h), with how it was fitted; kind none: not fitted.
     BranchPredictorConfig branch_predictor;
     std::string branch_predictor_fit;
-    // SceneMemoryConfig::exposed_share, fitted (sweeps/host_calibration.h), with how; an empty
-    // note: not fitted (1, all of the latency exposed).
-    double exposed_share = 1.0;
-    std::string exposed_share_fit;
 };
 
 // The last cache level as this core sees it, from its chases, by the LRU stack: a line is

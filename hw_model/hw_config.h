@@ -254,12 +254,6 @@ struct SceneMemoryConfig {
     // tracer's surface_at reads the mesh's own arrays (a 16-byte triangle record indexed by
     // primitive, then its vertices), not the copies its leaf tests read in BVH order.
     std::string hit_reads = "primitives";
-    // A CPU core (ray_buffer.storage l1d): the share of an op's scene-data read latency beyond
-    // an L1D hit that the core leaves exposed; its out-of-order window and the tracer's
-    // prefetch overlap the rest. Fitted by `sfx calibrate --describe-host` on the branch
-    // microbenchmark's batches timed after every line was evicted, through this model, never on
-    // frames. 1: all of it (an accelerator's unit waits for its data).
-    double exposed_share = 1.0;
 
     template <class V>
     void visit(V& v) {
@@ -278,10 +272,6 @@ struct SceneMemoryConfig {
                  "where a lane's hit primitive is read when its surface is computed: "
                  "primitives (the record its intersection test fetched) or mesh (separate "
                  "triangle and vertex arrays, as the native tracer's surface_at reads)");
-        v.param("exposed_share", exposed_share, "",
-                "a CPU core's share of an op's scene-data read latency beyond an L1D hit left "
-                "exposed (fitted on a microbenchmark); 1: all of it",
-                0.0, 1.0);
     }
 };
 

@@ -139,35 +139,6 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     return out;
 }
 
-ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples,
-                                  const std::vector<PredictorSample>& baseline) {
-    ExposedShareFit fit;
-    for (const PredictorCheck& s : samples)
-        fit.measured += s.measured.evicted_cycles - s.measured.primed_cycles;
-    for (const PredictorSample& b : baseline) fit.baseline += b.evicted_cycles - b.primed_cycles;
-    fit.measured = std::max(0.0, fit.measured - fit.baseline);
-    auto modelled = [&](double share) {
-        HwConfig c = host;
-        c.scene_memory.exposed_share = share;
-        double extra = 0.0;
-        for (const PredictorCheck& s : samples) {
-            const BatchMemoryCycles m = model_batch_memory(c, s);
-            extra += m.cold - m.warm;
-        }
-        return extra;
-    };
-    fit.modelled_at_one = modelled(1.0);
-    double lo = 0.0, hi = 1.0;
-    if (fit.measured >= fit.modelled_at_one) lo = 1.0;
-    for (int step = 0; step < 10 && lo < hi; ++step) {
-        const double mid = 0.5 * (lo + hi);
-        (modelled(mid) < fit.measured ? lo : hi) = mid;
-    }
-    fit.share = lo < hi ? 0.5 * (lo + hi) : lo;
-    fit.modelled = modelled(fit.share);
-    return fit;
-}
-
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source) {
@@ -265,20 +236,6 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
-    c.exposed_share_fit = fit_exposed_share(host_config, c.branch_samples,
-                                            run_predictor_microbenchmarks(resolved, convergence));
-    c.host.exposed_share = c.exposed_share_fit.share;
-    std::ostringstream exposed_note;
-    exposed_note << "the branch microbenchmark's batches right after themselves and a read of "
-                 << "256 MiB of other data, over right after themselves: "
-                 << std::llround(c.exposed_share_fit.measured) << " cycles measured beyond the "
-                 << std::llround(c.exposed_share_fit.baseline)
-                 << " the synthetic scene's batches pay for it (code, TLB, page tables), the "
-                 << "model's cold over warm caches "
-                 << std::llround(c.exposed_share_fit.modelled_at_one)
-                 << " with all the latency exposed, " << std::llround(c.exposed_share_fit.modelled)
-                 << " with this share; no frame";
-    c.host.exposed_share_fit = exposed_note.str();
     for (OpCostConfig& cost : c.op_costs) {
         const OpKind kind = op_kind_named(cost.op);
         if (kind != OpKind::count && op_info(kind).reads_hit_primitive)

@@ -43,24 +43,12 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
 
 // The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
 // priced: the states compared share the predictor's), each batch from empty caches (cold: the
-// microbenchmark's evicted state) and right after itself (warm: primed), summed.
+// microbenchmark's evicted state) and right after itself (warm: primed), summed: how the model
+// prices scene data from DRAM, held out against the evicted batches.
 struct BatchMemoryCycles {
     double cold = 0.0, warm = 0.0;
 };
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
-
-// SceneMemoryConfig::exposed_share: the share at which the model's cold over warm cycles
-// (model_batch_memory) equal the measured evicted over primed ones, pooled over the samples,
-// less what evicting costs the `baseline` batches (the synthetic scene's, whose scene is a few
-// lines: the code, TLB and page tables a read of 256 MiB evicts too, which a frame keeps); by
-// bisection on [0, 1] (the model's extra grows with the share). With the measured extra (less
-// the baseline's), the baseline's, and the modelled extra at a share of 1 and the fitted one.
-struct ExposedShareFit {
-    double share = 1.0;
-    double measured = 0.0, baseline = 0.0, modelled_at_one = 0.0, modelled = 0.0;
-};
-ExposedShareFit fit_exposed_share(const HwConfig& host, const std::vector<PredictorCheck>& samples,
-                                  const std::vector<PredictorSample>& baseline = {});
 
 struct HostCalibration {
     HostDescription host;
@@ -84,8 +72,6 @@ struct HostCalibration {
     // The branch microbenchmark (run_branch_microbenchmarks) and the model's mispredictions on
     // its batches, on which HostDescription::branch_predictor's cost is fitted.
     std::vector<PredictorCheck> branch_samples;
-    // On the same batches evicted: the share of scene-data latency a core leaves exposed.
-    ExposedShareFit exposed_share_fit;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     std::string yaml;  // host.hw.yaml

@@ -668,9 +668,9 @@ def write_page(df, page, plot_name, header):
         "what evicting costs the synthetic scene's batches, whose scene is a few lines (the "
         "code, TLB and page tables the read evicts too, which a frame keeps), beside the "
         "model's timing of the same batches' traces from empty caches over right after "
-        "themselves. The host file's `exposed_share` (the share of a scene read's latency "
-        "beyond an L1D hit the core leaves exposed) is fitted so on the branch microbenchmark's "
-        "random triangles, never on these scenes.\n\n" + dram_text(df),
+        "themselves: how the model prices a scene read from DRAM (its measured latency, less "
+        "what the tracer's prefetch of a node's children hides), held out, fitted on "
+        "nothing.\n\n" + dram_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

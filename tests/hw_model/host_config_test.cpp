@@ -498,8 +498,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
     host.branch_predictor_fit = "test batches";
-    host.exposed_share = 0.625;
-    host.exposed_share_fit = "test evictions";
     const std::string yaml = host_hw_yaml(host, {box}, "test samples");
     const SeenLevel seen = last_level_seen(host);
     REQUIRE(seen.foreign_fill_per_us > 0.0);
@@ -529,10 +527,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
     CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
     CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
-    CHECK(c.scene_memory.exposed_share == Approx(0.625));
-    CHECK(yaml.find("fitted: test evictions") != std::string::npos);
-    CHECK(parse_hw_config(host_hw_yaml(small_host(), {box}, ""), "h.hw.yaml")
-              .scene_memory.exposed_share == 1.0);
     CHECK(c.branch_predictor.kind == "tage");
     CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
     CHECK(yaml.find("fitted: test batches") != std::string::npos);
