@@ -255,7 +255,6 @@ void add_calibrate_command(CLI::App& app) {
                          {"primed_cycles", b.measured.primed_cycles},
                          {"cached_cycles", b.measured.cached_cycles},
                          {"displaced_cycles", b.measured.displaced_cycles},
-                         {"evicted_cycles", b.measured.evicted_cycles},
                          {"branches", b.modelled.branches},
                          {"primed_mispredictions", b.modelled.primed},
                          {"displaced_mispredictions", b.modelled.displaced}});

@@ -50,12 +50,16 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
     if (config.branch_predictor.kind == "tage") m_predictor = std::make_unique<TagePredictor>();
 }
 
+const std::vector<uint8_t>& CoreModel::node_leaf() const {
+    static const std::vector<uint8_t> unknown;
+    return m_map.node_leaf ? *m_map.node_leaf : unknown;
+}
+
 void CoreModel::warm_branches(const PassBuffer& pass) {
     if (!m_predictor) return;
-    const std::vector<uint8_t> none;
     std::vector<uint32_t> untimed;  // a pass in flight keeps its own counts
-    replay_traversal_branches(pass, traversal_loops(pass, width()), width(),
-                              m_map.node_leaf ? *m_map.node_leaf : none, *m_predictor, untimed);
+    replay_traversal_branches(pass, traversal_loops(pass, width()), width(), node_leaf(),
+                              *m_predictor, untimed);
 }
 
 const OpProfile& CoreModel::profile(uint32_t op) const {
@@ -87,9 +91,8 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     }
     m_mispredicted.assign(n, 0);
     if (m_predictor) {
-        const std::vector<uint8_t> none;
-        replay_traversal_branches(*pass, m_loop, width(), m_map.node_leaf ? *m_map.node_leaf : none,
-                                  *m_predictor, m_mispredicted);
+        replay_traversal_branches(*pass, m_loop, width(), node_leaf(), *m_predictor,
+                                  m_mispredicted);
         for (const uint32_t m : m_mispredicted) m_timing.branch_mispredictions += m;
     }
     m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);

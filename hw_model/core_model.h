@@ -139,6 +139,8 @@ class CoreModel {
     // A CPU core's branch predictor (null: none), and per op of the pass its mispredictions.
     std::unique_ptr<TagePredictor> m_predictor;
     std::vector<uint32_t> m_mispredicted;
+    // The tree's leaves (SceneDataMap::node_leaf), empty where unknown.
+    const std::vector<uint8_t>& node_leaf() const;
     uint64_t m_partition_free = 0;
     FrameTiming m_timing;  // the current pass
     std::vector<uint32_t> m_scratch;

@@ -339,9 +339,10 @@ struct DatapathConfig {
 // A CPU core's conditional-branch predictor (hw_model/branch_predictor.h). Fitted op costs come
 // from microbenchmarks that repeat their ops, whose branches the core's predictor learns; a
 // frame's traversals never repeat. With a predictor the model runs it over the traversal's
-// branches (derived from the trace) and prices each misprediction it makes. The paper's machine
-// has none: its SIMD units run filters without branches.
+// branches (derived from the trace) and prices each misprediction it makes.
 struct BranchPredictorConfig {
+    // Assumed for the paper's machine: G&R describe SIMD filters over streams and a partition
+    // unit, no branch predictor; its filters' outcomes become masks, not jumps.
     std::string kind = "none";
     // What one misprediction of the model's predictor costs the core, fitted by
     // `sfx calibrate --describe-host` on the branch microbenchmark (a synthetic scene of random

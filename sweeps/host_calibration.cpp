@@ -97,14 +97,15 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 }
 
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
-                                            const ConvergenceRule& convergence) {
+                                            const ConvergenceRule& convergence, bool time_evicted) {
     std::vector<std::shared_ptr<PassBuffer>> batches[2];  // camera rays, bounces
-    const std::vector<PredictorSample> measured =
-        run_predictor_microbenchmarks(scene, bvh, isa, convergence, 3, [&](bool bounce, uint32_t) {
+    const std::vector<PredictorSample> measured = run_predictor_microbenchmarks(
+        scene, bvh, isa, convergence, 3,
+        [&](bool bounce, uint32_t) {
             batches[bounce].push_back(std::make_shared<PassBuffer>());
             return batches[bounce].back().get();
-        });
-    const std::vector<uint8_t> leaves = bvh_leaves(bvh);
+        },
+        time_evicted);
     RenderSettings settings;
     settings.tile = 128;  // the batches' slots span both kinds' rays (2 x 64 x 64)
     const WorkloadShape shape = workload_shape(scene, bvh, settings);
@@ -113,7 +114,10 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
         std::vector<const PassBuffer*> kind;
         for (const auto& b : batches[m.bounce]) kind.push_back(b.get());
         PredictorCheck c{
-            m, simulate_predictor_states(kind, isa_width(resolve_isa(isa)), leaves), {}, shape};
+            m,
+            simulate_predictor_states(kind, isa_width(resolve_isa(isa)), *shape.node_leaf),
+            {},
+            shape};
         c.batches.assign(batches[m.bounce].begin(), batches[m.bounce].end());
         out.push_back(std::move(c));
     }
@@ -212,7 +216,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     // triangles, what the displaced batches took beyond the cached ones, over the
     // mispredictions the model adds from primed to displaced on the same batches.
     const Scene branch_scene = branch_microbench_scene();
-    c.branch_samples = check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence);
+    c.branch_samples =
+        check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence, false);
     std::vector<double> extra_cycles, extra_mispredictions;
     for (const PredictorCheck& b : c.branch_samples) {
         extra_cycles.push_back(b.measured.displaced_cycles - b.measured.cached_cycles);

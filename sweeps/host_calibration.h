@@ -36,10 +36,11 @@ struct PredictorCheck {
     std::vector<std::shared_ptr<const PassBuffer>> batches;
     WorkloadShape shape;
 };
-// run_predictor_microbenchmarks on `scene` (its BVH `bvh`) with `isa`, and the model's
-// predictor replaying each batch's trace at that back end's width.
+// run_predictor_microbenchmarks on `scene` (its BVH `bvh`) with `isa` (`time_evicted` as
+// there), and the model's predictor replaying each batch's trace at that back end's width.
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
-                                            const ConvergenceRule& convergence);
+                                            const ConvergenceRule& convergence,
+                                            bool time_evicted = true);
 
 // The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
 // priced: the states compared share the predictor's), each batch from empty caches (cold: the
@@ -69,8 +70,9 @@ struct HostCalibration {
     // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
     std::vector<SurfaceReadSample> surface_read_samples;
     HitReadFit hit_read_fit;
-    // The branch microbenchmark (run_branch_microbenchmarks) and the model's mispredictions on
-    // its batches, on which HostDescription::branch_predictor's cost is fitted.
+    // The branch microbenchmark (check_predictor on branch_microbench_scene, evicted state not
+    // timed) and the model's mispredictions on its batches, on which
+    // HostDescription::branch_predictor's cost is fitted.
     std::vector<PredictorCheck> branch_samples;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;

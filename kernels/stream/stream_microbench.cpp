@@ -906,11 +906,9 @@ class SceneLineSink : public TraceSink {
 
 }  // namespace
 
-std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, const Bvh& bvh,
-                                                           Isa isa,
-                                                           const ConvergenceRule& convergence,
-                                                           uint64_t seed,
-                                                           const PredictorBatchSink& batch_sink) {
+std::vector<PredictorSample> run_predictor_microbenchmarks(
+    const Scene& scene, const Bvh& bvh, Isa isa, const ConvergenceRule& convergence, uint64_t seed,
+    const PredictorBatchSink& batch_sink, bool time_evicted) {
     constexpr uint32_t k_res = 64, k_tile = 16, k_tiles = (k_res / k_tile) * (k_res / k_tile);
     constexpr uint32_t k_pixels = k_res * k_res;
     const Isa resolved = resolve_isa(isa);
@@ -941,7 +939,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
     std::vector<PredictorSample> out;
     // Other data, read a line at a time to evict the scene's lines (256 MiB: beyond any L3 a
     // core keeps, as the scene memory's DRAM latency is measured).
-    std::vector<uint64_t> other_data((size_t(256) << 20) / sizeof(uint64_t), 1);
+    std::vector<uint64_t> other_data(time_evicted ? (size_t(256) << 20) / sizeof(uint64_t) : 0, 1);
     for (const bool bounce : {false, true}) {
         // Each tile's batch: its slots in increasing order, as the tracer's streams are.
         std::vector<std::vector<uint32_t>> batches(k_tiles);
@@ -1030,7 +1028,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
             sample.primed_cycles += timed(Before::itself);
             sample.cached_cycles += timed(Before::itself_and_others_lines);
             sample.displaced_cycles += timed(Before::others_traversals);
-            sample.evicted_cycles += timed(Before::itself_evicted);
+            if (time_evicted) sample.evicted_cycles += timed(Before::itself_evicted);
             sample.converged_batches += converged;
         }
         if (touched == 1) out.clear();  // keeps the reads of the others' lines
@@ -1041,21 +1039,13 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(const Scene& scene, c
 
 std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
                                                            const ConvergenceRule& convergence,
-                                                           uint64_t seed,
-                                                           const PredictorBatchSink& batch_sink) {
+                                                           uint64_t seed) {
     const Scene scene = synthetic_scene(true);
-    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed, batch_sink);
+    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed);
 }
 
 Scene branch_microbench_scene() {
     return random_triangle_cloud(20000, 7);
-}
-
-std::vector<PredictorSample> run_branch_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
-                                                        const PredictorBatchSink& batch_sink,
-                                                        uint64_t seed) {
-    const Scene scene = branch_microbench_scene();
-    return run_predictor_microbenchmarks(scene, Bvh(scene), isa, convergence, seed, batch_sink);
 }
 
 }  // namespace sfx

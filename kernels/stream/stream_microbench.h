@@ -160,7 +160,8 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 // scene whose branches are harder to predict pays more than they say, which the model prices
 // by running its own predictor over the same batches (hw_model/branch_predictor.h).
 // `batch_sink`, where given, receives each batch's trace (TraceDetail::lanes: one TilePass of
-// 2 x 64 x 64 slots per batch, camera batches first) for the model to replay.
+// 2 x 64 x 64 slots per batch, camera batches first) for the model to replay. Without
+// `time_evicted` the evicted state is not timed (evicted_cycles 0).
 using PredictorBatchSink = std::function<TraceSink*(bool bounce, uint32_t batch)>;
 struct PredictorSample {
     bool bounce = false;                // camera rays, or a bounce of each
@@ -168,22 +169,19 @@ struct PredictorSample {
     uint64_t box_tests = 0, lines = 0;  // summed over the batches (lines: each one's distinct)
     double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
     double evicted_cycles = 0.0;
-    uint32_t converged_batches = 0;  // in all four states (base/convergence.h)
+    uint32_t converged_batches = 0;  // in every state timed (base/convergence.h)
 };
 std::vector<PredictorSample> run_predictor_microbenchmarks(
     const Scene& scene, const Bvh& bvh, Isa isa, const ConvergenceRule& convergence,
-    uint64_t seed = 3, const PredictorBatchSink& batch_sink = {});
+    uint64_t seed = 3, const PredictorBatchSink& batch_sink = {}, bool time_evicted = true);
 // The same in the synthetic scene whose traversals the per-op costs are fitted on (the floor of
 // 16 x 16 quads and 16 spheres of run_one_ray_microbenchmarks): what those costs hold of it.
-std::vector<PredictorSample> run_predictor_microbenchmarks(
-    Isa isa, const ConvergenceRule& convergence, uint64_t seed = 3,
-    const PredictorBatchSink& batch_sink = {});
-// The same in a scene whose traversals no predictor learns from others: 20,000 small
-// triangles at random in a box (branch_microbench_scene), on which the cost of a misprediction
-// is fitted (sfx calibrate --describe-host).
-std::vector<PredictorSample> run_branch_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
-                                                        const PredictorBatchSink& batch_sink,
-                                                        uint64_t seed = 3);
+std::vector<PredictorSample> run_predictor_microbenchmarks(Isa isa,
+                                                           const ConvergenceRule& convergence,
+                                                           uint64_t seed = 3);
+// The branch microbenchmark's scene, on which the cost of a misprediction is fitted (sfx
+// calibrate --describe-host): 20,000 small triangles at random in a box, whose traversals no
+// predictor learns from others.
 Scene branch_microbench_scene();
 
 }  // namespace sfx

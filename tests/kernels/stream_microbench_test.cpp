@@ -179,4 +179,29 @@ TEST_CASE("The branch predictor's part is timed on a scene's tile batches in thr
             CHECK(s.converged_batches == s.batches);  // the fastest 1 of 1 agrees with itself
         }
     }
+    // The evicted state, and each batch's trace to the caller's sink: 16 camera batches, then
+    // 16 of bounces, each one pass of both kinds' slots.
+    struct Passes : TraceSink {
+        std::vector<TilePass> begun;
+        uint64_t ops = 0;
+        void begin_pass(const TilePass& p) override { begun.push_back(p); }
+        void op(const StreamOp&) override { ++ops; }
+    };
+    Passes passes;
+    std::vector<std::pair<bool, uint32_t>> asked;
+    const std::vector<PredictorSample> traced = run_predictor_microbenchmarks(
+        scene, bvh, Isa::automatic, microbench_rule(1), 3, [&](bool bounce, uint32_t batch) {
+            asked.emplace_back(bounce, batch);
+            return &passes;
+        });
+    REQUIRE(asked.size() == 32);
+    CHECK(asked[15] == std::make_pair(false, 15u));
+    CHECK(asked[16] == std::make_pair(true, 0u));
+    CHECK(passes.begun.size() == 32);
+    CHECK(passes.begun[0].slot_count == 2 * 64 * 64);
+    CHECK(passes.ops >= traced[0].box_tests + traced[1].box_tests);
+    CHECK(traced[0].evicted_cycles > 0.0);
+    CHECK(run_predictor_microbenchmarks(scene, bvh, Isa::automatic, microbench_rule(1), 3, {},
+                                        false)[0]
+              .evicted_cycles == 0.0);
 }
