@@ -209,9 +209,12 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
     std::vector<double> global_misses;  // per cache level, for the action counts
     const TraceProfile& lines = footprint ? *footprint : profile;  // whose scene lines
-    const double fetch_cycles = std::max(
-        0.0, expected_fetch_cycles(c.scene_memory, c.clock.core_mhz, lines, &global_misses) -
-                 double(scene_latency_in_costs(c)));
+    // DRAM's latency at this scene's span, as the cycle level's SceneMemoryModel takes it.
+    SceneMemoryConfig memory = c.scene_memory;
+    memory.dram_latency_ns = dram_latency_ns_at(memory, scene_data_map(shape).span_bytes());
+    const double fetch_cycles =
+        std::max(0.0, expected_fetch_cycles(memory, c.clock.core_mhz, lines, &global_misses) -
+                          double(scene_latency_in_costs(c)));
     const double beyond_l1 =
         slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()));
     const double words_per_core_cycle =
@@ -334,10 +337,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         // group waits for its slowest lane beyond its ray data; later groups find theirs.
         double lane_stall = 0.0;
         if (p.lane_scene_reads && !l1d) {
-            lane_stall = std::max(
-                0.0, expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines,
-                                              double(std::min<uint32_t>(n, length))) -
-                         first_fetch);
+            lane_stall =
+                std::max(0.0, expected_hit_read_cycles(memory, c.clock.core_mhz, lines,
+                                                       double(std::min<uint32_t>(n, length))) -
+                                  first_fetch);
             lane_reads += ops * double(length);
         } else if (p.lane_scene_reads) {
             // A CPU core works through its lanes in turn and leaves the measured share of each
@@ -346,8 +349,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             // mesh record and its vertices are two reads.
             const double reads = c.scene_memory.hit_reads == "mesh" && shape.triangles ? 2.0 : 1.0;
             const double beyond =
-                std::max(0.0, expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines,
-                                                       1.0) -
+                std::max(0.0, expected_hit_read_cycles(memory, c.clock.core_mhz, lines, 1.0) -
                                   double(scene_latency_in_costs(c)));
             lane_stall = p.cost.hit_read_exposed_share * double(length) * reads * beyond;
             lane_reads += ops * double(length) * reads;
@@ -438,7 +440,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     // with the lanes' hit reads (one line each, at their re-touch misses).
     std::vector<double> lane_misses;
     if (lane_reads > 0)
-        expected_hit_read_cycles(c.scene_memory, c.clock.core_mhz, lines, 1.0, &lane_misses);
+        expected_hit_read_cycles(memory, c.clock.core_mhz, lines, 1.0, &lane_misses);
     double reaching = fetches + lane_reads;
     for (size_t i = 0; i < global_misses.size() && i < ActionCounts::k_max_cache_levels; ++i) {
         const double lane_missed = i < lane_misses.size() ? lane_reads * lane_misses[i] : 0.0;

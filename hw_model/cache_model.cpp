@@ -101,6 +101,20 @@ bool SetAssociativeCache::access(uint64_t address, uint64_t now) {
     return false;
 }
 
+double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes) {
+    const std::vector<DramSpanLatency>& points = memory.dram_latency_by_span;
+    if (points.empty() || span_bytes == 0) return memory.dram_latency_ns;
+    const double mib = double(span_bytes) / double(1u << 20);
+    if (mib <= points.front().span_mib) return points.front().latency_ns;
+    for (size_t i = 1; i < points.size(); ++i) {
+        const DramSpanLatency &a = points[i - 1], &b = points[i];
+        if (mib > b.span_mib) continue;
+        const double f = std::log(mib / a.span_mib) / std::log(b.span_mib / a.span_mib);
+        return std::exp(std::log(a.latency_ns) + f * std::log(b.latency_ns / a.latency_ns));
+    }
+    return points.back().latency_ns;
+}
+
 uint64_t ns_to_cycles(double ns, double mhz) {
     return uint64_t(std::ceil(ns * mhz / 1000.0 - 1e-9));
 }
@@ -180,12 +194,12 @@ uint32_t SharedCacheLookups::level_of(uint32_t reader, uint64_t address) {
 }
 
 SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores,
-                                   std::shared_ptr<SharedCacheLookups> shared)
+                                   std::shared_ptr<SharedCacheLookups> shared, uint64_t span_bytes)
     : m_config(config),
       m_shared(std::move(shared)),
       m_hits(config.caches.size(), 0),
       m_misses(config.caches.size(), 0),
-      m_dram_latency(ns_to_cycles(config.dram_latency_ns, core_mhz)),
+      m_dram_latency(ns_to_cycles(dram_latency_ns_at(config, span_bytes), core_mhz)),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
       m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz) {
     if (m_shared) m_reader = m_shared->add_reader();

@@ -51,6 +51,11 @@ inline uint32_t dram_line_bytes(const SceneMemoryConfig& memory) {
     return memory.caches.empty() ? 64 : memory.caches.back().line_bytes;
 }
 
+// The latency of a read from DRAM of scene data spanning `span_bytes`
+// (SceneMemoryConfig::dram_latency_by_span; dram_latency_ns where that is empty or the span
+// unknown, 0).
+double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes);
+
 // Whole core cycles for a latency in nanoseconds at a clock in MHz (rounded up: a result is
 // usable from the first clock edge after it arrives).
 uint64_t ns_to_cycles(double ns, double mhz);
@@ -95,8 +100,10 @@ class SharedCacheLookups {
 // caches are those lookups' and only latency and DRAM are this model's own.
 class SceneMemoryModel {
   public:
+    // `span_bytes`: the scene data's (SceneDataMap::span_bytes), which sets DRAM's latency
+    // (dram_latency_ns_at).
     SceneMemoryModel(const SceneMemoryConfig& config, double core_mhz, uint32_t cores = 1,
-                     std::shared_ptr<SharedCacheLookups> shared = nullptr);
+                     std::shared_ptr<SharedCacheLookups> shared = nullptr, uint64_t span_bytes = 0);
 
     // Cycle at which `bytes` at `address`, requested by `core` at cycle `now`, have arrived:
     // each line comes from the nearest level holding it (lines of one request overlap: the

@@ -226,19 +226,29 @@ inline size_t spin_on(size_t x, uint32_t spin) {
     return x;
 }
 
-}  // namespace
+using Chase = std::vector<size_t, HugePageAllocator<size_t>>;
 
-double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, double* step_ns) {
+// A cycle through the lines of `bytes` (at least 8) in random order: each line's first word
+// holds the index of the next line's. Allocated as the BVH is (base/huge_pages.h): huge pages
+// where the chase is 2 MiB or more, so the latency includes the page walks the traversal's
+// scene reads have, and no others.
+Chase random_chase(uint64_t bytes, size_t& lines) {
     constexpr uint32_t k_line = 64;
-    const size_t lines = std::max<uint64_t>(bytes / k_line, 8);
+    lines = std::max<uint64_t>(bytes / k_line, 8);
     const size_t stride = k_line / sizeof(size_t);
     std::vector<size_t> order(lines);
     std::iota(order.begin(), order.end(), size_t(0));
     std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(12345));
-    // Allocated as the BVH is (base/huge_pages.h): huge pages where the chase is 2 MiB or more,
-    // so the latency includes the page walks the traversal's scene reads have, and no others.
-    std::vector<size_t, HugePageAllocator<size_t>> chase(lines * stride);
+    Chase chase(lines * stride);
     for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
+    return chase;
+}
+
+}  // namespace
+
+double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, double* step_ns) {
+    size_t lines = 0;
+    const Chase chase = random_chase(bytes, lines);
     size_t at = 0;
     for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i)  // warm
         at = spin_on(chase[at], spin);
@@ -266,6 +276,31 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
     if (at == size_t(-1)) std::printf(" ");  // keeps the chase
     if (step_ns) *step_ns = best / tsc_mhz * 1000.0;
     return std::max(0.0, best - spin_best) / tsc_mhz * 1000.0;
+}
+
+void evict_caches() {
+    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other(k_beyond_last_level_bytes / 8,
+                                                                    1);
+    uint64_t sum = 0;
+    for (size_t i = 0; i < other.size(); i += 8) sum += other[i];  // one read a line
+    if (sum == 0) std::fprintf(stderr, " ");                       // keeps the reads
+}
+
+double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs) {
+    size_t lines = 0;
+    const Chase chase = random_chase(span_bytes, lines);
+    const size_t loads = std::min<size_t>(lines, 1u << 16);
+    size_t at = 0;
+    double best = 1e30;
+    for (int rep = 0; rep < runs; ++rep) {
+        evict_caches();
+        const uint64_t c0 = __rdtsc();
+        for (size_t i = 0; i < loads; ++i) at = chase[at];
+        const uint64_t c1 = __rdtsc();
+        best = std::min(best, double(c1 - c0) / double(loads));
+    }
+    if (at == size_t(-1)) std::printf(" ");  // keeps the chase
+    return best / tsc_mhz * 1000.0;
 }
 
 namespace {
@@ -382,6 +417,10 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
     }
     // DRAM: in huge pages, as the BVH's nodes and leaf primitives are.
     h.latency_ns.push_back(measure_load_latency_ns(k_beyond_last_level_bytes, h.tsc_mhz));
+    // And by span, from a few MiB (a small scene's data) to 256 MiB.
+    for (uint32_t mib = 2; mib <= (k_beyond_last_level_bytes >> 20); mib *= 2)
+        h.dram_span_latencies.emplace_back(
+            mib, measure_dram_first_pass_ns(uint64_t(mib) << 20, h.tsc_mhz));
     return h;
 }
 
@@ -419,6 +458,8 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
+    for (const auto& [mib, ns] : h.dram_span_latencies)
+        c.scene_memory.dram_latency_by_span.push_back({mib, ns});
     // Caches and DRAM from another file of this machine; the prefetch and hit reads below are
     // this tracer's whoever measured them.
     if (!h.memory_source.empty()) c.scene_memory = h.memory;
@@ -507,8 +548,22 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
     y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2) << "  # "
       << (h.memory_source.empty() ? "measured: pointer chase over 256 MiB"
                                   : "as " + h.memory_source + " describes it")
-      << "\n"
-      << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
+      << (c.scene_memory.dram_latency_by_span.empty() ? ""
+                                                      : " (a scene's reads: the latency at its "
+                                                        "span, below)")
+      << "\n";
+    if (!c.scene_memory.dram_latency_by_span.empty()) {
+        y << "  dram_latency_by_span:  # "
+          << (h.memory_source.empty()
+                  ? "measured: the first pass of a random chase over the span after 256 MiB "
+                    "read elsewhere (measure_dram_first_pass_ns)"
+                  : "as " + h.memory_source + " describes it")
+          << "\n";
+        for (const DramSpanLatency& s : c.scene_memory.dram_latency_by_span)
+            y << "    - {span_mib: " << fmt(s.span_mib, s.span_mib < 1 ? 3 : 0)
+              << ", latency_ns: " << fmt(s.latency_ns, 1) << "}\n";
+    }
+    y << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
       << "  # assumed: not measured; DRAM lines queue for it\n"
       << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
       << "  prefetch_children: true  # it prefetches a node's children (a leaf's primitives) "

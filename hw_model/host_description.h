@@ -83,6 +83,9 @@ struct HostDescription {
     // Chases over the first of those sizes with loads spaced out (spin): (ns a step, ns a load),
     // shortest step first.
     std::vector<std::pair<double, double>> last_level_idle_chases;
+    // DRAM's latency by the span the reads fall in (MiB, ns), smallest first
+    // (measure_dram_first_pass_ns): SceneMemoryConfig::dram_latency_by_span.
+    std::vector<std::pair<double, double>> dram_span_latencies;
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
     // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine
@@ -100,6 +103,17 @@ struct HostDescription {
     BranchPredictorConfig branch_predictor;
     std::string branch_predictor_fit;
 };
+
+// Reads other data beyond the L3 a core keeps (k_beyond_last_level_bytes, a line at a time):
+// nothing read before it is left in this core's caches.
+void evict_caches();
+
+// The latency of a read from DRAM within `span_bytes`: the first pass of a random chase over
+// the span (at most 2^16 of its lines), right after evict_caches, so that every load of it
+// misses every cache; the fastest of `runs`. The span sets how many DRAM rows and pages the
+// loads fall in: a scene of a few MiB reads DRAM faster than the 256 MiB chase of
+// dram_latency_ns (huge pages, as the BVH is allocated).
+double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs = 5);
 
 // The last cache level as this core sees it, from its chases, by the LRU stack: a line is
 // still there when the lines filled since its last touch, this core's and others', number

@@ -272,6 +272,11 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
         if (l.name.empty() || !names.insert(l.name).second)
             fail(key + ".name", "cache level names must be unique and non-empty");
     }
+    const std::vector<DramSpanLatency>& spans = c.scene_memory.dram_latency_by_span;
+    for (size_t i = 1; i < spans.size(); ++i)
+        if (spans[i].span_mib <= spans[i - 1].span_mib)
+            fail("scene_memory.dram_latency_by_span[" + std::to_string(i) + "].span_mib",
+                 "spans must grow from one entry to the next");
     std::set<std::string> ops;
     for (size_t i = 0; i < c.op_costs.size(); ++i) {
         const std::string& op = c.op_costs[i].op;

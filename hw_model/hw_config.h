@@ -233,6 +233,23 @@ struct CacheLevelConfig {
     }
 };
 
+// A read from DRAM within a span of memory: what it costs grows with the span (DRAM rows
+// and the TLB: the fewer pages and rows a scene's data lies in, the more of them are open or
+// cached). Measured for a host (host_description.h: the first pass of a random chase over the
+// span, after 512 MiB read elsewhere: 78-93 ns over 2 MiB, 117 ns over 5 MiB, 156 ns over 16
+// MiB and 294 ns over 256 MiB on this project's AMD VM, 2026-11-28).
+struct DramSpanLatency {
+    double span_mib = 0.0;
+    double latency_ns = 0.0;
+
+    template <class V>
+    void visit(V& v) {
+        v.param("span_mib", span_mib, "MiB", "span of memory the reads fall in", 0.001, 1e9);
+        v.param("latency_ns", latency_ns, "ns", "latency of a read from DRAM in that span", 0.01,
+                1e6);
+    }
+};
+
 struct SceneMemoryConfig {
     // Bikker (seed 000), Fig. 1: 32 KiB / 256 KiB / 2 MiB, 8/8/16-way, latencies 4:11:39:107
     // cycles of his Xeon X5670 at 2.93 GHz (Intel's specification), i.e. 1.4 / 3.8 / 13.3 /
@@ -241,6 +258,11 @@ struct SceneMemoryConfig {
                                             {"l2", 256, 64, 8, 3.8, false},
                                             {"l3", 2048, 64, 16, 13.3, true}};
     double dram_latency_ns = 36.5;
+    // Where given, a read from DRAM costs the latency at the scene data's span
+    // (SceneDataMap::span_bytes), interpolated in log-log between the spans (the nearest one's
+    // beyond them), instead of dram_latency_ns; empty (the default): dram_latency_ns for every
+    // scene, as Bikker's one latency.
+    std::vector<DramSpanLatency> dram_latency_by_span;
     double dram_bandwidth_gbps = 25.6;  // assumed: three DDR3-1066 channels, an X5670 configuration
     // Assumed: G&R describe no prefetch. 0: an op's scene data is requested when it dispatches.
     uint32_t prefetch_depth = 0;
@@ -258,7 +280,10 @@ struct SceneMemoryConfig {
     template <class V>
     void visit(V& v) {
         v.list("caches", caches, "scene-data cache levels, nearest first");
-        v.param("dram_latency_ns", dram_latency_ns, "ns", "DRAM access latency", 0.01, 1e6);
+        v.param("dram_latency_ns", dram_latency_ns, "ns",
+                "DRAM access latency (where dram_latency_by_span is empty)", 0.01, 1e6);
+        v.list("dram_latency_by_span", dram_latency_by_span,
+               "DRAM latency by the span of the scene's data (empty: dram_latency_ns)");
         v.param("dram_bandwidth_gbps", dram_bandwidth_gbps, "GB/s",
                 "DRAM bandwidth, shared by all cores", 0.001, 1e4);
         v.param("prefetch_depth", prefetch_depth, "ops",

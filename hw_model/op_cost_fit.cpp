@@ -229,9 +229,9 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
 }
 
 double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample) {
-    SceneMemoryModel scene(host.scene_memory, host.clock.core_mhz);
     SceneDataMap map;
     map.triangles = sample.triangles;
+    SceneMemoryModel scene(host.scene_memory, host.clock.core_mhz, 1, nullptr, map.span_bytes());
     // The mesh as its construction wrote it, in order, then the earlier repetitions' hits.
     for (uint32_t prim = 0; prim < sample.triangles; ++prim) warm_hit(scene, map, 0, prim, true);
     for (uint32_t prim : sample.warm_prims) warm_hit(scene, map, 0, prim, true);

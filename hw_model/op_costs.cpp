@@ -283,6 +283,7 @@ SceneDataMap scene_data_map(const WorkloadShape& shape) {
     map.nodes = shape.bvh_nodes;
     map.triangles = shape.triangles;
     map.spheres = shape.spheres;
+    map.vertices = shape.vertices;
     map.node_leaf = shape.node_leaf;
     return map;
 }
@@ -305,6 +306,12 @@ uint64_t SceneDataMap::address(OpKind kind, uint32_t object) const {
         default:
             return materials_base + uint64_t(object) * material_bytes;
     }
+}
+
+uint64_t SceneDataMap::span_bytes() const {
+    const uint64_t vertex_bytes = (vertices > 0 ? vertices : 3 * triangles) * 12;
+    return nodes * node_bytes + triangles * (triangle_bytes + mesh_triangle_bytes) + vertex_bytes +
+           spheres * sphere_bytes;
 }
 
 uint32_t SceneDataMap::hit_reads(uint32_t prim, bool mesh, Read out[2]) const {

@@ -135,9 +135,15 @@ struct SceneDataMap {
     // triangle order (a mesh shares vertices; the trace names no vertex ids).
     uint64_t mesh_triangle_bytes = 16;
     uint64_t nodes = 0, triangles = 0, spheres = 0;
+    uint64_t vertices = 0;  // the meshes' own (0: unknown; three a triangle then)
     std::shared_ptr<const std::vector<uint8_t>> node_leaf;  // WorkloadShape::node_leaf
 
     uint64_t address(OpKind kind, uint32_t object) const;
+    // The bytes the scene's data spans: nodes, primitive records, and the mesh's triangle
+    // records and its vertices (12 bytes each; hit_reads mesh reads them), without the room
+    // address() leaves for materials (a few lines). What DRAM's latency depends on
+    // (dram_latency_ns_at).
+    uint64_t span_bytes() const;
 
     // The reads of a hit primitive's surface (a global primitive id: triangles, then spheres):
     // its record as its intersection test fetched it, or (`mesh`) the mesh's triangle record

@@ -19,6 +19,7 @@ struct WorkloadShape {
     uint64_t triangles = 0;
     uint64_t spheres = 0;
     uint64_t bvh_nodes = 0;
+    uint64_t vertices = 0;  // the meshes' (0: unknown, three a triangle)
     // Per BVH node, whether it is a leaf: the tree's shape, which a CPU core's traversal
     // branches on (hw_model/branch_predictor.h); the trace names the nodes tested, not their
     // kind. Null: unknown (a leaf is then told by the leaf tests that follow a passing node).

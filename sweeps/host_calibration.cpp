@@ -311,16 +311,6 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
                        .timing.cycles);
 }
 
-// Reads other data beyond the L3 a core keeps: none of the scene is left in this core's
-// caches after it.
-void evict_caches() {
-    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other(k_beyond_last_level_bytes / 8,
-                                                                    1);
-    uint64_t sum = 0;
-    for (size_t i = 0; i < other.size(); i += 8) sum += other[i];  // one read a line
-    if (sum == 0) std::fprintf(stderr, " ");                       // keeps the reads
-}
-
 // One render, trace off, with or without the stage clock: its core cycles from `source`
 // (counted, or the thread's CPU time at the back end's clock measured before and after) and
 // its TSC ticks. The TSC counts while the thread is descheduled too, and on a shared machine

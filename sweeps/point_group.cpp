@@ -475,6 +475,7 @@ WorkloadShape workload_shape(const Scene& scene, const Bvh& bvh, const RenderSet
     shape.triangles = scene.triangles.size();
     shape.spheres = scene.spheres.size();
     shape.bvh_nodes = bvh.nodes().size();
+    shape.vertices = scene.positions.size();
     shape.node_leaf = std::make_shared<const std::vector<uint8_t>>(bvh_leaves(bvh));
     shape.tile = settings.tile;
     shape.primary_entry_aepsa = settings.primary_entry == PrimaryEntry::aepsa;

@@ -8,7 +8,8 @@ Accelerator::Accelerator(sc_core::sc_module_name name, const HwConfig& c,
       m_config(c),
       m_costs(RayRecordLayout(shape.features), c),
       m_scene_memory(std::make_shared<SceneMemoryModel>(c.scene_memory, c.clock.core_mhz,
-                                                        c.cores.count, std::move(lookups))) {
+                                                        c.cores.count, std::move(lookups),
+                                                        scene_data_map(shape).span_bytes())) {
     m_costs.check_measured(shape.needed_kinds(), c.name);
     const RayRecordLayout layout(shape.features);
     const uint32_t slots = buffer_slots(c.ray_buffer, layout.bytes(), shape.slots());

@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "hw_model/op_costs.h"
+
 using namespace sfx;
 
 TEST_CASE("A cache hits on a line it holds and misses on a new one", "[hw_model][cache]") {
@@ -52,6 +54,34 @@ TEST_CASE("Others' fills into a shared level evict a line left untouched long en
     SetAssociativeCache own(level, 1000.0);
     own.access(0, 0);
     CHECK(own.access(0, 1'000'000'000));
+}
+
+TEST_CASE("DRAM's latency is the one at the scene's span", "[hw_model][cache]") {
+    SceneMemoryConfig config;
+    config.dram_latency_ns = 300.0;
+    CHECK(dram_latency_ns_at(config, 8u << 20) == 300.0);  // no table: the one latency
+    config.dram_latency_by_span = {{4, 100.0}, {16, 200.0}, {64, 250.0}};
+    CHECK(dram_latency_ns_at(config, 0) == 300.0);                  // span unknown
+    CHECK(dram_latency_ns_at(config, 1u << 20) == 100.0);           // below the first span
+    CHECK(dram_latency_ns_at(config, 4u << 20) == Approx(100.0));   // at a span
+    CHECK(dram_latency_ns_at(config, 8u << 20) == Approx(141.42));  // log-log: sqrt(100 x 200)
+    CHECK(dram_latency_ns_at(config, 1ull << 30) == 250.0);         // beyond the last
+    // The model reads DRAM at that latency: no caches, 1000 MHz (a cycle a ns), one line.
+    config.caches.clear();
+    config.dram_bandwidth_gbps = 64.0;  // a line a cycle
+    SceneMemoryModel small(config, 1000.0, 1, nullptr, 4u << 20);
+    SceneMemoryModel large(config, 1000.0, 1, nullptr, 64u << 20);
+    CHECK(small.read(0, 64) == 100 + 1);
+    CHECK(large.read(0, 64) == 250 + 1);
+    // The span is the scene data's: nodes, primitive records, mesh records and vertices.
+    SceneDataMap map;
+    map.nodes = 10;
+    map.triangles = 4;
+    map.spheres = 1;
+    map.vertices = 6;
+    CHECK(map.span_bytes() == 10 * 32 + 4 * (36 + 16) + 6 * 12 + 16);
+    map.vertices = 0;  // unknown: three a triangle
+    CHECK(map.span_bytes() == 10 * 32 + 4 * (36 + 16) + 12 * 12 + 16);
 }
 
 TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",

@@ -495,6 +495,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.latency_ns = {1.0, 5.0, 15.5, 81.0};
     host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
     host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
+    host.dram_span_latencies = {{2, 78.5}, {16, 155.5}, {256, 294.2}};
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
     host.branch_predictor_fit = "test batches";
@@ -520,6 +521,10 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.scene_memory.caches[2].foreign_fill_per_us ==
           Approx(seen.foreign_fill_per_us).epsilon(0.01));
     CHECK(c.scene_memory.dram_latency_ns == Approx(81));
+    REQUIRE(c.scene_memory.dram_latency_by_span.size() == 3);
+    CHECK(c.scene_memory.dram_latency_by_span[1].span_mib == Approx(16));
+    CHECK(c.scene_memory.dram_latency_by_span[1].latency_ns == Approx(155.5));
+    CHECK(yaml.find("first pass of a random chase") != std::string::npos);
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
@@ -669,6 +674,7 @@ TEST_CASE("A host file can take its scene memory from another of the same machin
     h.memory.caches.back().kib = 12288;
     h.memory.caches.back().foreign_fill_per_us = 3.5;
     h.memory.dram_latency_ns = 150;
+    h.memory.dram_latency_by_span = {{4, 90.0}, {64, 180.0}};
     h.memory_source = "out/host-scalar.hw.yaml";
     const HwConfig c = host_hw_config(h, {});
     CHECK(c.scene_memory.caches.back().kib == 12288);
@@ -686,4 +692,16 @@ TEST_CASE("A host file can take its scene memory from another of the same machin
     REQUIRE(back.scene_memory.caches.size() == c.scene_memory.caches.size());
     CHECK(back.scene_memory.caches.back().kib == 12288);
     CHECK(back.scene_memory.dram_latency_ns == Approx(150));
+    REQUIRE(back.scene_memory.dram_latency_by_span.size() == 2);
+    CHECK(back.scene_memory.dram_latency_by_span[1].latency_ns == Approx(180));
+}
+
+TEST_CASE("DRAM's latency is measured by span, from the first pass after the caches are evicted",
+          "[host]") {
+    // A read from DRAM takes tens of nanoseconds at least; an L1D or L2 hit, which a chase
+    // whose caches were not evicted would time, takes a few.
+    const double tsc_mhz = measure_tsc_mhz();
+    const double ns = measure_dram_first_pass_ns(uint64_t(2) << 20, tsc_mhz, 1);
+    CHECK(ns > 20.0);
+    CHECK(ns < 5000.0);
 }

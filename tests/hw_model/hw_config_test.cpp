@@ -74,6 +74,12 @@ TEST_CASE("Bad hardware values name file, line and dotted key", "[hw_config]") {
     CHECK(banks.line() == 3);
     CHECK(banks.key() == "ray_buffer.banks");
 
+    const InputError spans = parse_error(
+        "scene_memory:\n  dram_latency_by_span:\n    - {span_mib: 16, latency_ns: 150}\n"
+        "    - {span_mib: 4, latency_ns: 100}\n");
+    CHECK(spans.key() == "scene_memory.dram_latency_by_span[1].span_mib");
+    CHECK(spans.line() == 4);
+
     const InputError type = parse_error("clock:\n  core_mhz: fast\n");
     CHECK(type.key() == "clock.core_mhz");
 
