@@ -228,14 +228,14 @@ inline size_t spin_on(size_t x, uint32_t spin) {
 
 using Chase = std::vector<size_t, HugePageAllocator<size_t>>;
 
+constexpr size_t k_chase_stride = 64 / sizeof(size_t);  // words a line
+
 // A cycle through the lines of `bytes` (at least 8) in random order: each line's first word
 // holds the index of the next line's. Allocated as the BVH is (base/huge_pages.h): huge pages
 // where the chase is 2 MiB or more, so the latency includes the page walks the traversal's
 // scene reads have, and no others.
-Chase random_chase(uint64_t bytes, size_t& lines) {
-    constexpr uint32_t k_line = 64;
-    lines = std::max<uint64_t>(bytes / k_line, 8);
-    const size_t stride = k_line / sizeof(size_t);
+Chase random_chase(uint64_t bytes) {
+    const size_t lines = std::max<uint64_t>(bytes / 64, 8), stride = k_chase_stride;
     std::vector<size_t> order(lines);
     std::iota(order.begin(), order.end(), size_t(0));
     std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(12345));
@@ -247,8 +247,8 @@ Chase random_chase(uint64_t bytes, size_t& lines) {
 }  // namespace
 
 double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, double* step_ns) {
-    size_t lines = 0;
-    const Chase chase = random_chase(bytes, lines);
+    const Chase chase = random_chase(bytes);
+    const size_t lines = chase.size() / k_chase_stride;
     size_t at = 0;
     for (size_t i = 0; i < std::min<size_t>(lines, 1u << 20); ++i)  // warm
         at = spin_on(chase[at], spin);
@@ -287,8 +287,8 @@ void evict_caches() {
 }
 
 double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs) {
-    size_t lines = 0;
-    const Chase chase = random_chase(span_bytes, lines);
+    const Chase chase = random_chase(span_bytes);
+    const size_t lines = chase.size() / k_chase_stride;
     const size_t loads = std::min<size_t>(lines, 1u << 16);
     size_t at = 0;
     double best = 1e30;

@@ -233,11 +233,12 @@ struct CacheLevelConfig {
     }
 };
 
-// A read from DRAM within a span of memory: what it costs grows with the span (DRAM rows
-// and the TLB: the fewer pages and rows a scene's data lies in, the more of them are open or
-// cached). Measured for a host (host_description.h: the first pass of a random chase over the
-// span, after 512 MiB read elsewhere: 78-93 ns over 2 MiB, 117 ns over 5 MiB, 156 ns over 16
-// MiB and 294 ns over 256 MiB on this project's AMD VM, 2026-11-28).
+// A read from DRAM within a span of memory: what it costs grows with the span (most likely
+// DRAM rows and the TLB: the fewer pages and rows a scene's data lies in, the more of them are
+// open or cached). Measured for a host (measure_dram_first_pass_ns, host_description.h: the
+// first pass of a random chase over the span right after 256 MiB read elsewhere): 91 ns over
+// 2 MiB, 169 ns over 16 MiB and 327 ns over 256 MiB on this project's AMD VM
+// (docs/silicon-check-amd-avx512-host-scalar.hw.yaml, 2026-11-28).
 struct DramSpanLatency {
     double span_mib = 0.0;
     double latency_ns = 0.0;
