@@ -84,6 +84,7 @@ void add_calibrate_command(CLI::App& app) {
         uint32_t spp = 1;
         uint32_t repeat = 31;
         bool json = false;
+        bool memory_now = false;
     };
     auto o = std::make_shared<Options>();
     CLI::App* c = app.add_subcommand(
@@ -121,6 +122,9 @@ void add_calibrate_command(CLI::App& app) {
     c->add_option("--repeat", o->repeat,
                   "--check: renders per workload at most (the budget; it stops when converged)")
         ->capture_default_str();
+    c->add_flag("--memory-now", o->memory_now,
+                "--check: predict with the L3 this core keeps just before the renders (chased "
+                "again) instead of the host file's; the file's prediction is kept beside it");
     c->add_flag("--json", o->json, "print one JSON document");
     c->callback([o] {
         if (o->describe == !o->check.empty())
@@ -155,6 +159,8 @@ void add_calibrate_command(CLI::App& app) {
         const int cpu = sched_getcpu();  // the rows say where they were measured
         if (!o->memory_from.empty() && !o->describe)
             throw InputError("command line", 0, "--memory-from", "only with --describe-host");
+        if (o->memory_now && o->check.empty())
+            throw InputError("command line", 0, "--memory-now", "only with --check");
         if (o->describe) {
             std::unique_ptr<HwConfig> memory_from;
             if (!o->memory_from.empty())
@@ -402,11 +408,13 @@ void add_calibrate_command(CLI::App& app) {
                         variant_scene.push_back(sc);
                     }
         const std::vector<SiliconMeasurement> measured = predict_and_measure(
-            variants, render_rule, 1, [&](const std::string& what, size_t done, size_t total) {
+            variants, render_rule, 1,
+            [&](const std::string& what, size_t done, size_t total) {
                 progress.set_label(what);
                 progress.set_total(total);
                 progress.set_done(done);
-            });
+            },
+            o->memory_now);
         // What the branch predictor saves a traversal it has just run, per scene and back end,
         // beside what the model's predictor makes of the same batches (check_predictor; each
         // back end's host file prices its mispredictions), and in the synthetic scene whose
@@ -464,6 +472,20 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.neighbours_busy"] = m.neighbours_busy;
             row["measured.speed_probe_before"] = m.probe_before;
             row["measured.speed_probe_after"] = m.probe_after;
+            // The L3: the host file's, and this core's just before the predictions and after
+            // the renders (kib 0: not chased); which one the model predicted with.
+            const HwConfig& described = *variants[i].host;
+            if (!described.scene_memory.caches.empty()) {
+                row["host.l3_kib"] = described.scene_memory.caches.back().kib;
+                row["host.l3_fill_per_us"] =
+                    described.scene_memory.caches.back().foreign_fill_per_us;
+            }
+            row["measured.l3_kib_before"] = m.l3_before.kib;
+            row["measured.l3_fill_per_us_before"] = m.l3_before.foreign_fill_per_us;
+            row["measured.l3_kib_after"] = m.l3_after.kib;
+            row["measured.l3_fill_per_us_after"] = m.l3_after.foreign_fill_per_us;
+            row["predicted.memory_now"] = o->memory_now;
+            row["predicted.frame_cycles_described"] = m.predicted_frame_described;
             if (variants[i].cold) {
                 row["predicted.cold_frame_cycles"] = m.predicted_cold_frame;
                 row["measured.cold_frame_cycles"] = m.measured_cold_frame;

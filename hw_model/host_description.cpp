@@ -382,6 +382,26 @@ SeenLevel last_level_seen(const HostDescription& h) {
     return seen;
 }
 
+void chase_last_level(HostDescription& h) {
+    h.last_level_chases.clear();
+    h.last_level_idle_chases.clear();
+    if (h.caches.size() < 2) return;
+    for (uint32_t kib :
+         last_level_chase_kib(h.caches[h.caches.size() - 2].kib, h.caches.back().kib))
+        h.last_level_chases.emplace_back(kib,
+                                         measure_load_latency_ns(uint64_t(kib) << 10, h.tsc_mhz));
+    if (h.last_level_chases.empty()) return;
+    // Spaced out by 16 to 8192 multiplies (about 14 ns to 7 us a step at 3.5 GHz, laps of 2 MiB
+    // up to a quarter of a second): on this project's AMD VM, with quiet neighbours, 2 us steps
+    // lost a third of the lines (2026-11-27).
+    for (uint32_t spin = 16; spin <= 8192; spin *= 2) {
+        double step = 0.0;
+        const double ns = measure_load_latency_ns(uint64_t(h.last_level_chases.front().first) << 10,
+                                                  h.tsc_mhz, spin, &step);
+        h.last_level_idle_chases.emplace_back(step, ns);
+    }
+}
+
 HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool measure_memory) {
     HostDescription h;
     h.microarchitecture = read_microarchitecture();
@@ -395,20 +415,9 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
     for (size_t i = 0; i < h.caches.size(); ++i) {
         const HostCacheLevel& c = h.caches[i];
         if (i > 0 && i + 1 == h.caches.size()) {
-            for (uint32_t kib : last_level_chase_kib(h.caches[i - 1].kib, c.kib))
-                h.last_level_chases.emplace_back(
-                    kib, measure_load_latency_ns(uint64_t(kib) << 10, h.tsc_mhz));
+            chase_last_level(h);
             if (!h.last_level_chases.empty()) {
                 h.latency_ns.push_back(h.last_level_chases.front().second);
-                // Spaced out by 16 to 8192 multiplies (about 14 ns to 7 us a step at 3.5 GHz,
-                // laps of 2 MiB up to a quarter of a second): on this project's AMD VM, with
-                // quiet neighbours, 2 us steps lost a third of the lines (2026-11-27).
-                for (uint32_t spin = 16; spin <= 8192; spin *= 2) {
-                    double step = 0.0;
-                    const double ns = measure_load_latency_ns(
-                        uint64_t(h.last_level_chases.front().first) << 10, h.tsc_mhz, spin, &step);
-                    h.last_level_idle_chases.emplace_back(step, ns);
-                }
                 continue;
             }
         }

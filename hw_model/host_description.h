@@ -115,6 +115,12 @@ void evict_caches();
 // dram_latency_ns (huge pages, as the BVH is allocated).
 double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs = 5);
 
+// Runs the last level's chases (HostDescription::last_level_chases and
+// last_level_idle_chases) from `h.caches` at `h.tsc_mhz`; none with fewer than two levels.
+// describe_host runs it, and the silicon check again around its renders: the L3 a core of a
+// shared machine keeps moves within a minute.
+void chase_last_level(HostDescription& h);
+
 // The last cache level as this core sees it, from its chases, by the LRU stack: a line is
 // still there when the lines filled since its last touch, this core's and others', number
 // fewer than the level holds. A chase over S lines with steps of t ns fills S of its own and

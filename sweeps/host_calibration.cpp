@@ -345,21 +345,52 @@ double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence) {
     return cycles;
 }
 
+SeenLevel chase_last_level_now(double tsc_mhz) {
+    HostDescription h;
+    h.caches = read_host_caches();
+    h.tsc_mhz = tsc_mhz;
+    chase_last_level(h);
+    if (h.last_level_chases.empty()) return {};
+    return last_level_seen(h);
+}
+
+HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen) {
+    HwConfig c = host;
+    if (seen.kib == 0 || c.scene_memory.caches.empty() || !c.scene_memory.caches.back().shared)
+        return c;
+    c.scene_memory.caches.back().kib = seen.kib;
+    c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
+    return c;
+}
+
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence, uint64_t seed,
-    const std::function<void(const std::string&, size_t, size_t)>& progress) {
+    const std::function<void(const std::string&, size_t, size_t)>& progress, bool memory_now) {
     const size_t n = variants.size();
     std::vector<SiliconMeasurement> out(n);
     std::vector<RenderSettings> settings(n);
+    const double tsc_mhz = measure_tsc_mhz();
+    if (progress) progress("chasing the L3", 0, n);
+    const SeenLevel l3_before = chase_last_level_now(tsc_mhz);
+    std::map<const HwConfig*, HwConfig> now;  // each host with the L3 chased now
     for (size_t v = 0; v < n; ++v) {
         if (progress) progress("predicting", v, n);
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
-        predict(*variants[v].scene, *variants[v].bvh, settings[v], *variants[v].host,
-                variants[v].cold, out[v]);
+        const HwConfig& described = *variants[v].host;
+        if (memory_now && !now.count(&described))
+            now.emplace(&described, with_last_level(described, l3_before));
+        predict(*variants[v].scene, *variants[v].bvh, settings[v],
+                memory_now ? now.at(&described) : described, variants[v].cold, out[v]);
+        out[v].predicted_frame_described = out[v].predicted_frame;
+        if (memory_now) {
+            SiliconMeasurement file;
+            predict(*variants[v].scene, *variants[v].bvh, settings[v], described, false, file);
+            out[v].predicted_frame_described = file.predicted_frame;
+        }
+        out[v].l3_before = l3_before;
     }
     // One cycle source per back end: its clock is measured under that back end's instructions.
-    const double tsc_mhz = measure_tsc_mhz();
     std::map<uint32_t, std::unique_ptr<CycleSource>> sources;
     for (size_t v = 0; v < n; ++v) {
         const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
@@ -467,8 +498,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
         }
     }
     probe_all(probe_after);
+    if (progress) progress("chasing the L3", n, n);
+    const SeenLevel l3_after = chase_last_level_now(tsc_mhz);
     for (size_t v = 0; v < n; ++v) {
         SiliconMeasurement& m = out[v];
+        m.l3_after = l3_after;
         const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
         m.probe_before = probe_before[lanes];
         m.probe_after = probe_after[lanes];

@@ -137,6 +137,14 @@ struct SiliconMeasurement {
     // (NaN: the host file has none). The same for every workload of a back end; a probe beyond
     // +-10 % flags a run slowed (or sped) alike.
     double probe_before = 0.0, probe_after = 0.0;
+    // The L3 this core keeps (last_level_seen: its size and others' fills), chased just before
+    // the predictions and just after the last render (kib 0: not chased). On a shared machine
+    // it moves within a minute (22.3 to 4.5 MiB in four descriptions on this project's AMD
+    // VM, 2026-11-28); a large move between the two flags a run whose memory was not the one
+    // predicted. With `memory_now` the model predicts with `l3_before` in place of the host
+    // file's L3, and `predicted_frame_described` is the frame with the file's, for comparison.
+    SeenLevel l3_before, l3_after;
+    double predicted_frame_described = 0.0;
     // From cold caches (SiliconVariant::cold): the renders after reading 256 MiB of other data,
     // which leaves none of the scene in this core's caches, under the same rule; the
     // prediction from empty caches. 0 and no samples where not asked for.
@@ -172,10 +180,20 @@ struct SiliconVariant {
 // disagreement instead of a bias. Each measured render follows an unmeasured render of its own
 // workload, so that it starts from the caches predict() assumes. A workload asked for `cold` also
 // renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
-// vary placement. `progress(what, done, total)` as it goes.
+// vary placement. `progress(what, done, total)` as it goes. With `memory_now`, every host's
+// last cache level is the one chased just before the predictions (SiliconMeasurement::
+// l3_before), not the file's: the check then predicts the memory the renders meet.
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,
-    uint64_t seed = 1,
-    const std::function<void(const std::string&, size_t, size_t)>& progress = {});
+    uint64_t seed = 1, const std::function<void(const std::string&, size_t, size_t)>& progress = {},
+    bool memory_now = false);
+
+// The L3 this core keeps now: the last level's chases (chase_last_level) on this machine's
+// caches, read by last_level_seen (kib 0 where the CPU reports fewer than two levels).
+SeenLevel chase_last_level_now(double tsc_mhz);
+
+// `host` with its last scene-memory level's size and others' fills as `seen` says (unchanged
+// where `seen` was not chased or the host has no shared last level).
+HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen);
 
 }  // namespace sfx

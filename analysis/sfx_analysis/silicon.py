@@ -38,6 +38,9 @@ WIDTHS = {"scalar": 1, "avx2": 8, "avx512": 16}
 # A speed probe (the same microbenchmark points re-run around the renders) this far from the
 # host's fitted costs says the machine ran faster or slower than when it was calibrated.
 SPEED_PROBE_LIMIT = 0.10
+# The L3 this core keeps, chased again just after the last render, this far (in size) from the
+# one chased just before the predictions says the renders met another memory than predicted.
+L3_MOVE_LIMIT = 0.25
 
 
 def load_rows(path):
@@ -223,6 +226,11 @@ def summary(df):
         out[f"{s}_worst"] = df[f"error.{s}"].abs().max()
     rank = ranking(df)
     measurable = rank[rank["measurable"].astype(bool)]
+    if "predicted.frame_cycles_described" in df and df.get("predicted.memory_now",
+                                                            pd.Series([False])).any():
+        described = df["predicted.frame_cycles_described"] / df["measured.frame_cycles"] - 1.0
+        out["frame_mae_described"] = described.abs().mean()
+        out["frame_worst_described"] = described.abs().max()
     out["ranking_right"] = int(measurable["right"].sum())
     out["ranking_cells"] = len(measurable)
     out["ranking_within_noise"] = len(rank) - len(measurable)
@@ -472,6 +480,10 @@ def summary_text(s, isa=None):
     lines = [f"- workloads{at}: {s['workloads']}, of which {s['converged']} converged "
              f"({100 * s['converged_share']:.0f} %; only these are scored)",
              f"- frame cycles: MAE {100 * s['frame_mae']:.1f} %, worst {100 * s['frame_worst']:.1f} %"]
+    if "frame_mae_described" in s:
+        lines.append(f"  - with the host file's L3 instead of the one chased before the renders "
+                     f"(same renders): MAE {100 * s['frame_mae_described']:.1f} %, worst "
+                     f"{100 * s['frame_worst_described']:.1f} %")
     for st in STAGES:
         lines.append(f"- {st}: MAE {100 * s[f'{st}_mae']:.1f} %, worst {100 * s[f'{st}_worst']:.1f} %")
     lines.append(f"- tile ranking right in {s['ranking_right']} of {s['ranking_cells']} "
@@ -546,7 +558,35 @@ def measurement_text(df):
                     f"measurements are not the calibrated machine's"
                     if max(abs(before), abs(after)) > SPEED_PROBE_LIMIT else "as calibrated")
             lines.append(f"{what}: {100 * before:+.1f} % / {100 * after:+.1f} %: {flag}")
+    if "measured.l3_kib_before" in df:
+        lines.append(l3_text(df))
     return "\n".join(lines)
+
+
+def l3_moved(df):
+    """Whether the L3 chased after the renders is beyond L3_MOVE_LIMIT of the one before."""
+    r = df.iloc[0]
+    before, after = r["measured.l3_kib_before"], r["measured.l3_kib_after"]
+    return bool(before > 0 and after > 0 and abs(after / before - 1) > L3_MOVE_LIMIT)
+
+
+def l3_text(df):
+    """The L3 this core kept: the host file's, and chased before the predictions and after the
+    renders; which one the model predicted with, and whether it held."""
+    r = df.iloc[0]
+
+    def level(kib, fills):
+        return f"{kib / 1024:.1f} MiB (others' fills {fills:.2f} lines/us)" if kib > 0 else \
+            "not chased"
+    now = bool(r.get("predicted.memory_now", False))
+    held = (f"MOVED (beyond +-{100 * L3_MOVE_LIMIT:.0f} % in size): the renders met another "
+            f"memory than the one predicted" if l3_moved(df) else "held")
+    return (f"- the L3 this core keeps (`last_level_seen`): the host file's "
+            f"{level(r.get('host.l3_kib', 0), r.get('host.l3_fill_per_us', 0.0))}; chased just "
+            f"before the predictions {level(r['measured.l3_kib_before'], r['measured.l3_fill_per_us_before'])}, "
+            f"just after the last render {level(r['measured.l3_kib_after'], r['measured.l3_fill_per_us_after'])}: "
+            f"{held}; the model predicted with "
+            f"{'the one chased before (--memory-now)' if now else 'the host file' + chr(39) + 's'}")
 
 
 def all_summaries_text(df):

@@ -235,6 +235,39 @@ def test_speed_probe_flags_a_run_unlike_calibration(tmp_path):
     assert "(avx512)" in lines[1] and "+30.0 %" in lines[1] and "SLOWED OR SPED ALIKE" in lines[1]
 
 
+def test_l3_chased_around_the_renders(tmp_path):
+    # The model predicted with the L3 chased before the renders (16 MiB); the host file's
+    # (8 MiB) would have predicted 20 % and 40 % over. A move of the L3 after the renders
+    # beyond 25 % of its size is flagged; within, it held.
+    rows = [row("a", 16, 100, 100), row("a", 32, 110, 100)]
+    for r, described in zip(rows, (120, 140)):
+        r.update({"host.l3_kib": 8192, "host.l3_fill_per_us": 10.0,
+                  "measured.l3_kib_before": 16384, "measured.l3_fill_per_us_before": 7.5,
+                  "measured.l3_kib_after": 4096, "measured.l3_fill_per_us_after": 5.0,
+                  "predicted.memory_now": True,
+                  "predicted.frame_cycles_described": described})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    s = silicon.summary(df)
+    assert s["frame_mae"] == pytest.approx(0.05)
+    assert s["frame_mae_described"] == pytest.approx(0.30)
+    assert s["frame_worst_described"] == pytest.approx(0.40)
+    assert "with the host file's L3 instead" in silicon.summary_text(s)
+    line = [x for x in silicon.measurement_text(df).splitlines() if "L3 this core" in x][0]
+    assert "host file's 8.0 MiB (others' fills 10.00" in line
+    assert "before the predictions 16.0 MiB" in line and "after the last render 4.0 MiB" in line
+    assert "MOVED" in line and "--memory-now" in line
+    for r in rows:
+        r["measured.l3_kib_after"] = 18000
+        r["predicted.memory_now"] = False
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    assert "frame_mae_described" not in silicon.summary(df)
+    line = [x for x in silicon.measurement_text(df).splitlines() if "L3 this core" in x][0]
+    assert ": held;" in line and "predicted with the host file's" in line
+
+
 def test_traversal_by_loop(tmp_path):
     # Two workloads of one scene: the loops' sums, errors and shares of the measured traversal
     # (each row's is 100e6 / 6); a loop under 1 % of the traversal on both sides is left out.

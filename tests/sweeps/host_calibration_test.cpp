@@ -195,9 +195,21 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(probe > 0);
     HwConfig probed = config;
     probed.speed_probe_cycles = 1000 * probe;
-    const std::vector<SiliconMeasurement> again =
-        predict_and_measure({{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}},
-                            rule, 1);
+    // This run also predicts with the L3 chased just before it (memory_now), and keeps the
+    // host file's prediction beside it: the same as the first run's, which used the file.
+    const std::vector<SiliconMeasurement> again = predict_and_measure(
+        {{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}}, rule, 1, {}, true);
+    for (size_t v = 0; v < 2; ++v) {
+        CHECK(cell[v].predicted_frame_described == cell[v].predicted_frame);
+        CHECK(again[v].predicted_frame_described == cell[v].predicted_frame);
+        CHECK(again[v].l3_before.kib == again[0].l3_before.kib);
+        CHECK(again[v].l3_after.kib == again[0].l3_after.kib);
+    }
+    if (read_host_caches().size() >= 2 && config.scene_memory.caches.back().shared) {
+        CHECK(again[0].l3_before.kib > 0);
+        CHECK(again[0].l3_after.kib > 0);
+        CHECK(again[0].prediction.config.scene_memory.caches.back().kib == again[0].l3_before.kib);
+    }
     CHECK(again[0].probe_before == again[1].probe_before);
     CHECK(again[0].probe_after == again[1].probe_after);
     CHECK(again[0].probe_before < -0.95);
@@ -282,4 +294,23 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(again.warm == m.warm);
     host.scene_memory.dram_latency_ns = 200;
     CHECK(model_batch_memory(host, sample).cold > m.cold);
+}
+
+TEST_CASE("The check's L3 chased now replaces a host file's shared last level only", "[host]") {
+    HwConfig host;
+    host.scene_memory.caches = {{"l1", 48, 64, 12, 1.0}, {"l3", 32768, 64, 16, 10.0}};
+    host.scene_memory.caches.back().shared = true;
+    host.scene_memory.caches.back().foreign_fill_per_us = 11.0;
+    SeenLevel seen;
+    seen.kib = 7000;
+    seen.foreign_fill_per_us = 4.5;
+    const HwConfig now = with_last_level(host, seen);
+    CHECK(now.scene_memory.caches.back().kib == 7000);
+    CHECK(now.scene_memory.caches.back().foreign_fill_per_us == 4.5);
+    CHECK(now.scene_memory.caches.back().hit_latency_ns == 10.0);  // the file's latency stays
+    CHECK(now.scene_memory.caches.front().kib == 48);
+    // Not chased (a CPU reporting one level), or a last level no one else fills: the file's.
+    CHECK(with_last_level(host, SeenLevel{}).scene_memory.caches.back().kib == 32768);
+    host.scene_memory.caches.back().shared = false;
+    CHECK(with_last_level(host, seen).scene_memory.caches.back().kib == 32768);
 }
