@@ -136,6 +136,11 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     // Every machine looks its lanes' hit primitives up (CoreModel::request_scene), where
     // hit_reads says.
     if (x.hit_reads != y.hit_reads) return false;
+    // A core whose ray buffers are its L1D reads their lines through the same caches
+    // (CoreModel::dispatch_op), at addresses its slot size sets.
+    const bool a_l1d = a.ray_buffer.storage == "l1d", b_l1d = b.ray_buffer.storage == "l1d";
+    if (a_l1d != b_l1d || (a_l1d && a.ray_buffer.slot_bytes != b.ray_buffer.slot_bytes))
+        return false;
     for (size_t i = 0; i < x.caches.size(); ++i)
         if (x.caches[i].kib != y.caches[i].kib ||
             x.caches[i].line_bytes != y.caches[i].line_bytes ||
@@ -228,6 +233,20 @@ uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
     for (uint32_t l = 0; l < level; ++l) ++m_misses[l];
     if (level < levels) ++m_hits[level];
     return level;
+}
+
+void SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now) {
+    if (bytes == 0) return;
+    const uint32_t levels = level_count();
+    for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
+         ++line) {
+        const uint64_t at = line * m_line_bytes;
+        if (m_shared)
+            m_shared->level_of(m_reader, at);
+        else
+            first_holding(levels, at, now - std::min(now, m_paused),
+                          [&](uint32_t l) -> SetAssociativeCache& { return instance(l, core); });
+    }
 }
 
 void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {

@@ -98,9 +98,30 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
 
-void CoreModel::dispatch_op(uint32_t index) {
+void CoreModel::touch_ray_lines(const StreamOp& op, uint64_t now) {
+    // The ray buffers of a core whose buffers are its L1D (storage l1d: the native tracer's
+    // RayBuffers, kernels/stream/stream_tracer.cpp) are read through the same caches as the
+    // scene data, and evict it: a traversal or intersection op reads each lane's traversal
+    // record (16 floats, one line: traversal_field in kernels/stream/stream_kernels.h), a
+    // shading op its whole slot. They lie in an address range of their own, far above any
+    // scene's (SceneDataMap), slot after slot; consecutive lanes on one line are one read. A
+    // tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5 core's L2.
+    constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
+    const bool record = op.stage != OpStage::shading;
+    const uint32_t bytes = record ? 64u : m_record_bytes;
+    uint64_t last = ~uint64_t(0);
+    for (uint32_t i = 0; i < op.length; ++i) {
+        const uint64_t address = (record ? k_records : k_slots) + uint64_t(op.slots[i]) * bytes;
+        if (address / 64 == last && address % 64 + bytes <= 64) continue;
+        last = (address + bytes - 1) / 64;
+        m_scene_memory->touch_other(m_core, address, bytes, now);
+    }
+}
+
+void CoreModel::dispatch_op(uint32_t index, uint64_t now) {
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
+    if (m_l1d && op.slots) touch_ray_lines(op, now);
     const uint32_t n = width();
     const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
     const uint64_t mix_before = m_timing.mix.total();

@@ -46,8 +46,9 @@ class CoreModel {
     void begin_pass(const PassBuffer* pass, uint64_t now);
     // Warming: the pass's branches train the branch predictor; nothing is timed.
     void warm_branches(const PassBuffer& pass);
-    // Counts an op as it is dispatched (ops, lanes, groups, the op mix).
-    void dispatch_op(uint32_t op);
+    // Counts an op as it is dispatched at `now` (ops, lanes, groups, the op mix); an l1d
+    // core's ray lines go through its caches then.
+    void dispatch_op(uint32_t op, uint64_t now = 0);
     // Requests op's scene data (a node, primitive or material) at `now`, unless it was
     // requested before (prefetched).
     void request_scene(uint32_t op, uint64_t now);
@@ -83,6 +84,7 @@ class CoreModel {
     const PassBuffer& pass() const { return *m_pass; }
 
   private:
+    void touch_ray_lines(const StreamOp& op, uint64_t now);
     // Books `words` for `lanes` slots of `buffer` (0: current generation, 1: next), one word's
     // requests per cycle at the earliest, from `issue`; returns the cycle the last word's data
     // is out of its bank.

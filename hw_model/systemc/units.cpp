@@ -124,7 +124,7 @@ void Core::dispatch() {
             if (children)
                 for (const uint32_t* c = pass->consumers_begin(i); c != pass->consumers_end(i); ++c)
                     m_model.request_scene(*c, now);
-            m_model.dispatch_op(i);
+            m_model.dispatch_op(i, now);
             ++m_outstanding;
             for (uint32_t first = 0; first < op.length; first += width) {
                 GroupToken t;

@@ -142,8 +142,12 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     other.scene_memory.hit_reads = "mesh";  // the lanes' hit primitives read elsewhere
     CHECK_FALSE(same_cache_lookups(a, other));
     other = a;
-    other.ray_buffer.storage = "l1d";  // a CPU core looks its lanes' hit primitives up too
-    CHECK(same_cache_lookups(a, other));
+    other.ray_buffer.storage = "l1d";  // a CPU core reads its ray lines through the caches
+    CHECK_FALSE(same_cache_lookups(a, other));
+    HwConfig l1d = other;
+    CHECK(same_cache_lookups(l1d, other));
+    other.ray_buffer.slot_bytes = 330;  // at other addresses
+    CHECK_FALSE(same_cache_lookups(l1d, other));
 
     auto shared = std::make_shared<SharedCacheLookups>(a.scene_memory.caches);
     SceneMemoryModel own_a(a.scene_memory, 500.0), own_b(b.scene_memory, 500.0);
@@ -157,9 +161,17 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     }
     for (size_t i = 0; i < addresses.size(); ++i) {
         CHECK(shared_a.read(0, addresses[i], 36, i) == own_a.read(0, addresses[i], 36, i));
+        if (i % 7 == 0) {  // other data between the reads: looked up alike, counted nowhere
+            shared_a.touch_other(0, (uint64_t(1) << 44) + addresses[i], 330, i);
+            own_a.touch_other(0, (uint64_t(1) << 44) + addresses[i], 330, i);
+        }
         if (i >= 5000) {  // b trails a by 5000 reads
             const size_t j = i - 5000;
             CHECK(shared_b.read(0, addresses[j], 36, j) == own_b.read(0, addresses[j], 36, j));
+            if (j % 7 == 0) {
+                shared_b.touch_other(0, (uint64_t(1) << 44) + addresses[j], 330, j);
+                own_b.touch_other(0, (uint64_t(1) << 44) + addresses[j], 330, j);
+            }
         }
     }
     for (uint32_t level = 0; level < own_a.level_count(); ++level) {
@@ -170,4 +182,23 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     CHECK(shared_a.dram_reads() == own_a.dram_reads());
     // A reader that looks up another line than the one simulated is a logic error.
     CHECK_THROWS_AS(shared_b.read(0, addresses[0] + 4096 * 64, 4, 0), std::logic_error);
+}
+
+TEST_CASE("Other data read through the caches evicts scene lines and is not counted",
+          "[hw_model][cache]") {
+    // One level of 1 KiB (16 lines: 8 sets of 2 ways) before DRAM.
+    SceneMemoryConfig memory;
+    memory.caches = {{"l1", 1, 64, 2, 2.0}};
+    memory.dram_latency_ns = 50.0;
+    SceneMemoryModel model(memory, 1000.0);
+    model.read(0, 0, 4, 0);
+    CHECK(model.read(0, 0, 4, 10) == 10 + 2);           // a hit
+    model.touch_other(0, uint64_t(1) << 44, 2048, 20);  // 32 lines of other data: 2 KiB
+    CHECK(model.hits(0) == 1);
+    CHECK(model.misses(0) == 1);
+    CHECK(model.requests() == 2);
+    CHECK(model.read(0, 0, 4, 30) > 30 + 2);  // evicted: from DRAM again
+    CHECK(model.dram_reads() == 2);
+    model.touch_other(0, 0, 0, 40);  // nothing
+    CHECK(model.read(0, 0, 4, 50) == 50 + 2);
 }
