@@ -108,7 +108,9 @@ void CoreModel::touch_ray_lines(const StreamOp& op, uint64_t now) {
     // tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5 core's L2.
     constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
     const bool record = op.stage != OpStage::shading;
-    const uint32_t bytes = record ? 64u : m_record_bytes;
+    const uint32_t slot_bytes =
+        m_config.ray_buffer.slot_bytes ? m_config.ray_buffer.slot_bytes : m_record_bytes;
+    const uint32_t bytes = record ? 64u : slot_bytes;
     uint64_t last = ~uint64_t(0);
     for (uint32_t i = 0; i < op.length; ++i) {
         const uint64_t address = (record ? k_records : k_slots) + uint64_t(op.slots[i]) * bytes;

@@ -455,6 +455,47 @@ TEST_CASE("The machine model times a host: measured costs, scene data beyond the
     CHECK(time_boxes(one_lane, 2, 3).cycles == 83 + 9 + 9);
 }
 
+TEST_CASE("A host's ray buffers share its caches with the scene data", "[host][systemc]") {
+    // Per pass: a box test on node 3, then a shading op over 1024 lanes whose slots the core
+    // reads through the same caches (storage l1d). Slots of 330 bytes (330 KiB) flush the
+    // 32 KiB L1D and the 256 KiB L2, so the next pass's box test reads node 3 from DRAM again;
+    // slots of 8 bytes (8 KiB) leave it in the L1D.
+    auto time_with_slots = [](uint32_t slot_bytes) {
+        HwConfig host = host_with({cost("box_test", 10, 4, 0, 0, 0)});
+        host.ray_buffer.slot_bytes = slot_bytes;
+        SystemcTiming timing({host}, shape());
+        std::vector<uint32_t> ids(1024);
+        for (uint32_t i = 0; i < 1024; ++i) ids[i] = i;
+        const std::vector<uint8_t> all(1024, 1), none(1024, 0);
+        for (int p = 0; p < 2; ++p) {
+            TilePass pass;
+            pass.slot_count = 1024;
+            timing.begin_pass(pass);
+            StreamOp box;
+            box.kind = OpKind::box_test;
+            box.stage = OpStage::traversal;
+            box.object = 3;
+            box.length = box.pass_count = 20;
+            box.slots = ids.data();
+            box.passed = all.data();
+            timing.op(box);
+            StreamOp shade;
+            shade.kind = OpKind::miss_filter;
+            shade.stage = OpStage::shading;
+            shade.length = 1024;
+            shade.slots = ids.data();
+            shade.passed = none.data();
+            timing.op(shade);
+            timing.end_pass(pass);
+        }
+        return timing.timing(0);
+    };
+    const FrameTiming fat = time_with_slots(330), thin = time_with_slots(8);
+    CHECK(thin.stalls.scene_memory == 83);      // node 3 from DRAM once (the test above)
+    CHECK(fat.stalls.scene_memory == 83 + 83);  // and again after the slots flushed it
+    CHECK(fat.stages[0][size_t(OpStage::traversal)].scene_memory_cycles == 2 * 83);
+}
+
 TEST_CASE("Each host knob moves the prediction the way it should", "[host][systemc]") {
     const HwConfig base = host_with({cost("box_test", 10, 4, 1, 0, 8)});
     const uint64_t cycles = time_boxes(base, 3, 40, 4096).cycles;
