@@ -104,19 +104,22 @@ void CoreModel::touch_ray_lines(const StreamOp& op, uint64_t now) {
     // scene data, and evict it: a traversal or intersection op reads each lane's traversal
     // record (16 floats, one line: traversal_field in kernels/stream/stream_kernels.h), a
     // shading op its whole slot. They lie in an address range of their own, far above any
-    // scene's (SceneDataMap), slot after slot; consecutive lanes on one line are one read. A
-    // tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5 core's L2.
+    // scene's (SceneDataMap), slot after slot; a line the lane before touched last is not
+    // touched again. A tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5
+    // core's L2.
     constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
+    constexpr uint64_t k_line = 64;
     const bool record = op.stage != OpStage::shading;
-    const uint32_t slot_bytes =
-        m_config.ray_buffer.slot_bytes ? m_config.ray_buffer.slot_bytes : m_record_bytes;
-    const uint32_t bytes = record ? 64u : slot_bytes;
-    uint64_t last = ~uint64_t(0);
+    const uint64_t bytes = record ? k_line : slot_bytes_of(m_config.ray_buffer, m_record_bytes);
+    uint64_t last = ~uint64_t(0);  // the line touched last
     for (uint32_t i = 0; i < op.length; ++i) {
-        const uint64_t address = (record ? k_records : k_slots) + uint64_t(op.slots[i]) * bytes;
-        if (address / 64 == last && address % 64 + bytes <= 64) continue;
-        last = (address + bytes - 1) / 64;
-        m_scene_memory->touch_other(m_core, address, bytes, now);
+        const uint64_t address = (record ? k_records : k_slots) + op.slots[i] * bytes;
+        const uint64_t first_line = address / k_line, last_line = (address + bytes - 1) / k_line;
+        const uint64_t from = first_line == last ? first_line + 1 : first_line;
+        if (from <= last_line)
+            m_scene_memory->touch_other(m_core, from * k_line,
+                                        uint32_t((last_line - from + 1) * k_line), now);
+        last = last_line;
     }
 }
 

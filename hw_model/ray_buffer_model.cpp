@@ -93,10 +93,13 @@ double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib)
     return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(l1d_kib) * 1024.0 / bytes);
 }
 
+uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {
+    return buffer.slot_bytes ? buffer.slot_bytes : record_bytes;
+}
+
 double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots) {
     if (buffer.storage != "l1d") return 0.0;
-    return beyond_l1_fraction(slots, buffer.slot_bytes ? buffer.slot_bytes : record_bytes,
-                              buffer.kib);
+    return beyond_l1_fraction(slots, slot_bytes_of(buffer, record_bytes), buffer.kib);
 }
 
 }  // namespace sfx

@@ -114,8 +114,11 @@ uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 // Ray buffers in a CPU core's L1D (storage l1d): the share of `slots` slots of `slot_bytes`
 // that an L1D of `l1d_kib` cannot hold; a random lane misses it with that probability.
 double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
-// The same for a configuration's buffer and a pass of `slots` slots of the scene's ray record
-// (`record_bytes`, unless ray_buffer.slot_bytes says otherwise); 0 for banked buffers.
+// A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
+// a host), else the scene's ray record (`record_bytes`).
+uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);
+// The same for a configuration's buffer and a pass of `slots` slots of slot_bytes_of; 0 for
+// banked buffers.
 double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots);
 
 }  // namespace sfx

@@ -50,15 +50,8 @@ FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes,
         TilePass pass;
         pass.slot_count = slots;
         timing.begin_pass(pass);
-        StreamOp box;
-        box.kind = OpKind::box_test;
-        box.stage = OpStage::traversal;
-        box.object = node;
-        box.length = lanes;
-        box.pass_count = lanes;
-        box.slots = ids.data();
-        box.passed = passed.data();
-        timing.op(box);
+        timing.op({OpKind::box_test, OpStage::traversal, 0, node, lanes, lanes, ids.data(),
+                   passed.data()});
         timing.end_pass(pass);
     }
     return timing.timing(0);
@@ -74,21 +67,10 @@ FrameTiming time_surfaces(const HwConfig& config, uint32_t prim = 7) {
     TilePass pass;
     pass.slot_count = 64;
     timing.begin_pass(pass);
-    StreamOp op;
-    op.kind = OpKind::triangle_test;
-    op.stage = OpStage::intersection;
-    op.object = prim;
-    op.length = 16;
-    op.pass_count = 16;
-    op.slots = ids.data();
-    op.passed = all.data();
-    timing.op(op);
-    op.kind = OpKind::emission_filter;
-    op.stage = OpStage::shading;
-    op.object = k_no_object;
-    op.pass_count = 0;
-    op.passed = none.data();
-    timing.op(op);
+    timing.op(
+        {OpKind::triangle_test, OpStage::intersection, 0, prim, 16, 16, ids.data(), all.data()});
+    timing.op({OpKind::emission_filter, OpStage::shading, 0, k_no_object, 16, 0, ids.data(),
+               none.data()});
     timing.end_pass(pass);
     return timing.timing(0);
 }
@@ -471,21 +453,9 @@ TEST_CASE("A host's ray buffers share its caches with the scene data", "[host][s
             TilePass pass;
             pass.slot_count = 1024;
             timing.begin_pass(pass);
-            StreamOp box;
-            box.kind = OpKind::box_test;
-            box.stage = OpStage::traversal;
-            box.object = 3;
-            box.length = box.pass_count = 20;
-            box.slots = ids.data();
-            box.passed = all.data();
-            timing.op(box);
-            StreamOp shade;
-            shade.kind = OpKind::miss_filter;
-            shade.stage = OpStage::shading;
-            shade.length = 1024;
-            shade.slots = ids.data();
-            shade.passed = none.data();
-            timing.op(shade);
+            timing.op({OpKind::box_test, OpStage::traversal, 0, 3, 20, 20, ids.data(), all.data()});
+            timing.op({OpKind::miss_filter, OpStage::shading, 0, k_no_object, 1024, 0, ids.data(),
+                       none.data()});
             timing.end_pass(pass);
         }
         return timing.timing(0);
