@@ -209,7 +209,9 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const uint32_t slots = std::max(1u, std::max(profile.slots(), shape.slots()));
     std::vector<double> global_misses;  // per cache level, for the action counts
     const TraceProfile& lines = footprint ? *footprint : profile;  // whose scene lines
-    // DRAM's latency at this scene's span, as the cycle level's SceneMemoryModel takes it.
+    // DRAM's latency at this scene's span: a page's first use at the cycle level, which prices
+    // later reads by their page's recency (dram_latency_ns_after), a sequence the closed form
+    // does not keep; its error bar is measured against the cycle level.
     SceneMemoryConfig memory = c.scene_memory;
     memory.dram_latency_ns = dram_latency_ns_at(memory, scene_data_map(shape).span_bytes());
     const double fetch_cycles =

@@ -115,6 +115,54 @@ double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes) 
     return points.back().latency_ns;
 }
 
+uint64_t PageRecency::use(uint64_t address) {
+    const uint64_t page = address / k_page_bytes;
+    if (++m_now >= m_marks.size()) renumber();
+    uint64_t between = k_never;
+    const auto [it, first] = m_last_use.try_emplace(page, m_now);
+    if (!first) {
+        between = marked_through(m_now - 1) - marked_through(it->second);
+        mark(it->second, -1);
+        it->second = m_now;
+    }
+    mark(m_now, +1);
+    return between;
+}
+
+void PageRecency::mark(uint64_t time, int delta) {
+    for (; time < m_marks.size(); time += time & (~time + 1)) m_marks[time] += uint32_t(delta);
+}
+
+uint64_t PageRecency::marked_through(uint64_t time) const {
+    uint64_t n = 0;
+    for (; time > 0; time -= time & (~time + 1)) n += m_marks[time];
+    return n;
+}
+
+void PageRecency::renumber() {
+    // Only the order of last uses matters: renumbering keeps the tree as small as the pages.
+    std::vector<std::pair<uint64_t, uint64_t>> by_time;  // (last use, page)
+    by_time.reserve(m_last_use.size());
+    for (const auto& [page, time] : m_last_use)
+        if (time < m_now) by_time.emplace_back(time, page);
+    std::sort(by_time.begin(), by_time.end());
+    m_marks.assign(std::max<size_t>(1024, 2 * by_time.size() + 2), 0);
+    uint64_t time = 0;
+    for (const auto& [old, page] : by_time) {
+        m_last_use[page] = ++time;
+        mark(time, +1);
+    }
+    m_now = time + 1;
+}
+
+double dram_latency_ns_after(const SceneMemoryConfig& memory, uint64_t pages_between,
+                             uint64_t span_bytes) {
+    if (pages_between == PageRecency::k_never || span_bytes == 0)
+        return dram_latency_ns_at(memory, span_bytes);
+    const uint64_t chase_bytes = 2 * (pages_between + 1) * PageRecency::k_page_bytes;
+    return dram_latency_ns_at(memory, std::min(chase_bytes, span_bytes));
+}
+
 uint64_t ns_to_cycles(double ns, double mhz) {
     return uint64_t(std::ceil(ns * mhz / 1000.0 - 1e-9));
 }
@@ -205,6 +253,9 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
       m_hits(config.caches.size(), 0),
       m_misses(config.caches.size(), 0),
       m_dram_latency(ns_to_cycles(dram_latency_ns_at(config, span_bytes), core_mhz)),
+      m_core_mhz(core_mhz),
+      m_span_bytes(span_bytes),
+      m_pages(config.dram_latency_by_span.empty() ? 0 : std::max(1u, cores)),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
       m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz) {
     if (m_shared) m_reader = m_shared->add_reader();
@@ -220,6 +271,10 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
 SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
     std::vector<SetAssociativeCache>& v = m_levels[level];
     return v[v.size() == 1 ? 0 : core % v.size()];
+}
+
+uint64_t SceneMemoryModel::use_page(uint32_t core, uint64_t address) {
+    return m_pages.empty() ? 0 : m_pages[core % m_pages.size()].use(address);
 }
 
 uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
@@ -241,6 +296,7 @@ void SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t byt
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line) {
         const uint64_t at = line * m_line_bytes;
+        use_page(core, at);
         if (m_shared)
             m_shared->level_of(m_reader, at);
         else
@@ -252,8 +308,10 @@ void SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t byt
 void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {
     if (bytes == 0) return;
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
-         ++line)
+         ++line) {
+        use_page(core, line * m_line_bytes);
         look_up(core, line, 0);
+    }
 }
 
 uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
@@ -265,17 +323,23 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
     uint64_t arrival = now;
     for (uint64_t line = first; line <= last; ++line) {
         const uint32_t level = look_up(core, line, now);
+        const uint64_t pages_between = use_page(core, line * m_line_bytes);
         uint64_t ready = 0, latency = 0;
         if (level < level_count()) {
             latency = m_latency[level];
             ready = now + latency;
         } else {
             ++m_dram_reads;
+            const uint64_t dram_latency =
+                m_pages.empty()
+                    ? m_dram_latency
+                    : ns_to_cycles(dram_latency_ns_after(m_config, pages_between, m_span_bytes),
+                                   m_core_mhz);
             // The line leaves DRAM after its latency, then occupies the channel for its transfer.
             const double transfer = double(m_line_bytes) / m_dram.per_cycle();
-            const double start = m_dram.serve(double(now + m_dram_latency), double(m_line_bytes));
+            const double start = m_dram.serve(double(now + dram_latency), double(m_line_bytes));
             ready = uint64_t(std::ceil(start + transfer - 1e-9));
-            latency = m_dram_latency + uint64_t(std::ceil(transfer - 1e-9));
+            latency = dram_latency + uint64_t(std::ceil(transfer - 1e-9));
         }
         arrival = std::max(arrival, ready);
         if (unloaded) *unloaded = std::max(*unloaded, latency);

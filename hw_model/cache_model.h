@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "hw_model/hw_config.h"
@@ -55,6 +56,36 @@ inline uint32_t dram_line_bytes(const SceneMemoryConfig& memory) {
 // (SceneMemoryConfig::dram_latency_by_span; dram_latency_ns where that is empty or the span
 // unknown, 0).
 double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes);
+
+// The pages one core has used, as the number of distinct other pages used since a page's last
+// use (its LRU stack distance, Mattson et al. 1970), counted exactly: a Fenwick tree over use
+// times marks each page's last use. A DRAM read's latency follows it
+// (SceneMemoryConfig::dram_latency_by_span).
+class PageRecency {
+  public:
+    static constexpr uint64_t k_page_bytes = 4096;
+    static constexpr uint64_t k_never = ~uint64_t(0);
+    // Records a use of the page holding `address`; returns the distinct other pages used since
+    // that page's last use, or k_never on its first.
+    uint64_t use(uint64_t address);
+
+  private:
+    void mark(uint64_t time, int delta);
+    uint64_t marked_through(uint64_t time) const;
+    void renumber();  // last uses renumbered 1..pages, keeping their order
+
+    std::unordered_map<uint64_t, uint64_t> m_last_use;  // page -> time of its last use
+    std::vector<uint32_t> m_marks;                      // Fenwick tree over times 1..size-1
+    uint64_t m_now = 0;
+};
+
+// The latency of a read from DRAM whose page was used `pages_between` distinct pages ago
+// (PageRecency; k_never: never) in scene data spanning `span_bytes`: the measured latency of a
+// random chase over twice those pages (a random chase over P pages finds each page used P / 2
+// distinct pages ago on average: its LRU stack position is uniform), a first use the span's,
+// and dram_latency_ns where no table is given.
+double dram_latency_ns_after(const SceneMemoryConfig& memory, uint64_t pages_between,
+                             uint64_t span_bytes);
 
 // Whole core cycles for a latency in nanoseconds at a clock in MHz (rounded up: a result is
 // usable from the first clock edge after it arrives).
@@ -138,6 +169,9 @@ class SceneMemoryModel {
 
   private:
     SetAssociativeCache& instance(uint32_t level, uint32_t core);
+    // Records the use of `address`'s page by `core`; returns PageRecency::use's distance (0
+    // when DRAM's latency does not depend on it).
+    uint64_t use_page(uint32_t core, uint64_t address);
     // The nearest level holding `line` for `core` at cycle `now` (level_count(): DRAM), counted.
     uint32_t look_up(uint32_t core, uint64_t line, uint64_t now);
 
@@ -147,7 +181,10 @@ class SceneMemoryModel {
     uint32_t m_reader = 0;                   // this model's reader number in m_shared
     std::vector<uint64_t> m_hits, m_misses;  // per level, over its instances
     std::vector<uint64_t> m_latency;         // per level, cycles
-    uint64_t m_dram_latency;
+    uint64_t m_dram_latency;                 // cycles, at the span (where no table: every read's)
+    double m_core_mhz;
+    uint64_t m_span_bytes;
+    std::vector<PageRecency> m_pages;  // per core; none without dram_latency_by_span
     uint32_t m_line_bytes;
     RateServer m_dram;  // bytes per cycle
     uint64_t m_dram_reads = 0, m_requests = 0;

@@ -558,8 +558,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << (h.memory_source.empty() ? "measured: pointer chase over 256 MiB"
                                   : "as " + h.memory_source + " describes it")
       << (c.scene_memory.dram_latency_by_span.empty() ? ""
-                                                      : " (a scene's reads: the latency at its "
-                                                        "span, below)")
+                                                      : " (a scene's reads: by their pages' "
+                                                        "recency, below)")
       << "\n";
     if (!c.scene_memory.dram_latency_by_span.empty()) {
         y << "  dram_latency_by_span:  # "

@@ -233,12 +233,16 @@ struct CacheLevelConfig {
     }
 };
 
-// A read from DRAM within a span of memory: what it costs grows with the span (most likely
-// DRAM rows and the TLB: the fewer pages and rows a scene's data lies in, the more of them are
-// open or cached). Measured for a host (measure_dram_first_pass_ns, host_description.h: the
-// first pass of a random chase over the span right after 256 MiB read elsewhere): 91 ns over
-// 2 MiB, 169 ns over 16 MiB and 327 ns over 256 MiB on this project's AMD VM
-// (docs/silicon-check-amd-avx512-host-scalar.hw.yaml, 2026-11-28).
+// A read from DRAM within a span of memory: what it costs grows with the span. Measured for a
+// host (measure_dram_first_pass_ns, host_description.h: the first pass of a random chase over
+// the span right after 256 MiB read elsewhere): 91 ns over 2 MiB, 169 ns over 16 MiB and 327 ns
+// over 256 MiB on this project's AMD VM (docs/silicon-check-amd-avx512-host-scalar.hw.yaml,
+// 2026-11-28). What it grows with is the pages used since the read's page was last used, not
+// the distance: on that VM (2026-11-28, first-pass chases after 256 MiB read elsewhere) reads
+// alternating between two 1 MiB blocks 200 MiB apart cost 92 ns, as over one 2 MiB block
+// (94 ns); over sixteen 64 KiB blocks 16 MiB apart, 99-103 ns; over 32 MiB, 182-195 ns; and
+// over 256 MiB with each 4 KiB page's lines read in a row, 96 ns against 347 ns at random. The
+// model prices each read by its page's recency (dram_latency_ns_after, hw_model/cache_model.h).
 struct DramSpanLatency {
     double span_mib = 0.0;
     double latency_ns = 0.0;
@@ -259,10 +263,12 @@ struct SceneMemoryConfig {
                                             {"l2", 256, 64, 8, 3.8, false},
                                             {"l3", 2048, 64, 16, 13.3, true}};
     double dram_latency_ns = 36.5;
-    // Where given, a read from DRAM costs the latency at the scene data's span
-    // (SceneDataMap::span_bytes), interpolated in log-log between the spans (the nearest one's
-    // beyond them), instead of dram_latency_ns; empty (the default): dram_latency_ns for every
-    // scene, as Bikker's one latency.
+    // Where given, a read from DRAM costs, instead of dram_latency_ns, the latency of a random
+    // chase over twice the distinct 4 KiB pages its core used since it last used the read's page
+    // (dram_latency_ns_after), and a page's first use the latency at the scene data's span
+    // (SceneDataMap::span_bytes); interpolated in log-log between the spans (the nearest one's
+    // beyond them), never beyond the scene's span. Empty (the default): dram_latency_ns for
+    // every read, as Bikker's one latency.
     std::vector<DramSpanLatency> dram_latency_by_span;
     double dram_bandwidth_gbps = 25.6;  // assumed: three DDR3-1066 channels, an X5670 configuration
     // Assumed: G&R describe no prefetch. 0: an op's scene data is requested when it dispatches.

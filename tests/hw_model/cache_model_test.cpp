@@ -56,7 +56,8 @@ TEST_CASE("Others' fills into a shared level evict a line left untouched long en
     CHECK(own.access(0, 1'000'000'000));
 }
 
-TEST_CASE("DRAM's latency is the one at the scene's span", "[hw_model][cache]") {
+TEST_CASE("DRAM's latency is the one at the scene's span on a page's first use",
+          "[hw_model][cache]") {
     SceneMemoryConfig config;
     config.dram_latency_ns = 300.0;
     CHECK(dram_latency_ns_at(config, 8u << 20) == 300.0);  // no table: the one latency
@@ -82,6 +83,58 @@ TEST_CASE("DRAM's latency is the one at the scene's span", "[hw_model][cache]") 
     CHECK(map.span_bytes() == 10 * 32 + 4 * (36 + 16) + 6 * 12 + 16);
     map.vertices = 0;  // unknown: three a triangle
     CHECK(map.span_bytes() == 10 * 32 + 4 * (36 + 16) + 12 * 12 + 16);
+}
+
+TEST_CASE("Page recency counts the distinct pages used since a page's last use",
+          "[hw_model][cache]") {
+    const uint64_t page = PageRecency::k_page_bytes;
+    PageRecency pages;
+    CHECK(pages.use(0) == PageRecency::k_never);
+    CHECK(pages.use(64) == 0);  // the same page
+    CHECK(pages.use(1 * page) == PageRecency::k_never);
+    CHECK(pages.use(2 * page) == PageRecency::k_never);
+    CHECK(pages.use(1 * page + 8) == 1);  // page 2 since
+    CHECK(pages.use(0) == 2);             // pages 2 and 1, once each however often used
+    // Thousands of uses (the tree renumbers its times as it fills): still exact.
+    for (uint64_t i = 0; i < 5000; ++i) pages.use((10 + i % 2500) * page);
+    CHECK(pages.use(0) == 2500);
+    CHECK(pages.use((10 + 2499) * page) == 1);  // page 0 since
+    CHECK(pages.use(2 * page) == 2502);         // all but itself: 0, 1 and the 2500
+}
+
+TEST_CASE("A DRAM read's latency follows the pages used since its page's last use",
+          "[hw_model][cache]") {
+    SceneMemoryConfig config;
+    config.caches.clear();              // every read from DRAM
+    config.dram_bandwidth_gbps = 64.0;  // at 1000 MHz: a line a cycle
+    config.dram_latency_ns = 300.0;
+    config.dram_latency_by_span = {{4, 100.0}, {16, 200.0}, {64, 250.0}};
+    const uint64_t page = PageRecency::k_page_bytes;
+    SceneMemoryModel memory(config, 1000.0, 1, nullptr, 64u << 20);
+    uint64_t now = 0;
+    auto latency = [&](uint64_t address) {
+        now += 10000;  // the channel idle
+        return memory.read(0, address, 4, now) - now;
+    };
+    CHECK(latency(0) == 250 + 1);   // a first use: the span's
+    CHECK(latency(64) == 100 + 1);  // its page just used: a chase of 8 KiB, the first point
+    for (uint64_t p = 1; p <= 1023; ++p) latency(p * page);
+    // 1023 pages since: a chase over 2 x 1024 pages (8 MiB), sqrt(100 x 200) = 141.4 ns.
+    CHECK(latency(128) == 142 + 1);
+    for (uint64_t p = 1; p <= 8191; ++p) latency(p * page);
+    CHECK(latency(192) == 250 + 1);  // 8191 since: 64 MiB
+    // Not beyond the span: a chase over more than the scene's data is the span's.
+    SceneMemoryModel small(config, 1000.0, 1, nullptr, 4u << 20);
+    now = 0;
+    CHECK(small.read(0, 0, 4, now += 10000) - now == 100 + 1);
+    for (uint64_t p = 1; p <= 8191; ++p) small.read(0, p * page, 4, now += 10000);
+    CHECK(small.read(0, 64, 4, now += 10000) - now == 100 + 1);
+    // Without a table, one latency for every read however recent its page.
+    config.dram_latency_by_span.clear();
+    SceneMemoryModel flat(config, 1000.0, 1, nullptr, 64u << 20);
+    now = 0;
+    CHECK(flat.read(0, 0, 4, now += 10000) - now == 300 + 1);
+    CHECK(flat.read(0, 64, 4, now += 10000) - now == 300 + 1);
 }
 
 TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",
