@@ -123,8 +123,9 @@ void add_calibrate_command(CLI::App& app) {
                   "--check: renders per workload at most (the budget; it stops when converged)")
         ->capture_default_str();
     c->add_flag("--memory-now", o->memory_now,
-                "--check: predict with the L3 this core keeps just before the renders (chased "
-                "again) instead of the host file's; the file's prediction is kept beside it");
+                "--check: predict each workload with the L3 this core kept in the round of its "
+                "fastest render (chased again at the start of every round) instead of the host "
+                "file's; the file's prediction is kept beside it");
     c->add_flag("--json", o->json, "print one JSON document");
     c->callback([o] {
         if (o->describe == !o->check.empty())
@@ -472,8 +473,9 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.neighbours_busy"] = m.neighbours_busy;
             row["measured.speed_probe_before"] = m.probe_before;
             row["measured.speed_probe_after"] = m.probe_after;
-            // The L3: the host file's, and this core's just before the predictions and after
-            // the renders (kib 0: not chased); which one the model predicted with.
+            // The L3: the host file's, and this core's just before the first render, after the
+            // last and (memory_now) in the round of the fastest render, which the model
+            // predicted with, and the least and most of the rounds' (kib 0: not chased).
             const HwConfig& described = *variants[i].host;
             if (!described.scene_memory.caches.empty()) {
                 row["host.l3_kib"] = described.scene_memory.caches.back().kib;
@@ -484,6 +486,10 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.l3_fill_per_us_before"] = m.l3_before.foreign_fill_per_us;
             row["measured.l3_kib_after"] = m.l3_after.kib;
             row["measured.l3_fill_per_us_after"] = m.l3_after.foreign_fill_per_us;
+            row["measured.l3_kib_render"] = m.l3_render.kib;
+            row["measured.l3_fill_per_us_render"] = m.l3_render.foreign_fill_per_us;
+            row["measured.l3_kib_rounds_min"] = m.l3_rounds_kib_max > 0 ? m.l3_rounds_kib_min : 0;
+            row["measured.l3_kib_rounds_max"] = m.l3_rounds_kib_max;
             row["predicted.memory_now"] = o->memory_now;
             row["predicted.frame_cycles_described"] = m.predicted_frame_described;
             if (variants[i].cold) {

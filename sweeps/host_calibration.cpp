@@ -372,24 +372,28 @@ std::vector<SiliconMeasurement> predict_and_measure(
     const double tsc_mhz = measure_tsc_mhz();
     if (progress) progress("chasing the L3", 0, n);
     const SeenLevel l3_before = chase_last_level_now(tsc_mhz);
-    std::map<const HwConfig*, HwConfig> now;  // each host with the L3 chased now
     for (size_t v = 0; v < n; ++v) {
-        if (progress) progress("predicting", v, n);
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
-        const HwConfig& described = *variants[v].host;
-        if (memory_now && !now.count(&described))
-            now.emplace(&described, with_last_level(described, l3_before));
-        predict(*variants[v].scene, *variants[v].bvh, settings[v],
-                memory_now ? now.at(&described) : described, variants[v].cold, out[v]);
-        out[v].predicted_frame_described = out[v].predicted_frame;
-        if (memory_now) {
-            SiliconMeasurement file;
-            predict(*variants[v].scene, *variants[v].bvh, settings[v], described, false, file);
-            out[v].predicted_frame_described = file.predicted_frame;
-        }
         out[v].l3_before = l3_before;
     }
+    // The predictions, with the host file's L3 before the renders; with memory_now, after
+    // them, each with the L3 chased in the round of its fastest render.
+    auto predict_all = [&](const std::function<HwConfig(size_t)>& host_of) {
+        for (size_t v = 0; v < n; ++v) {
+            if (progress) progress("predicting", v, n);
+            const HwConfig& described = *variants[v].host;
+            predict(*variants[v].scene, *variants[v].bvh, settings[v], host_of(v), variants[v].cold,
+                    out[v]);
+            out[v].predicted_frame_described = out[v].predicted_frame;
+            if (memory_now) {
+                SiliconMeasurement file;
+                predict(*variants[v].scene, *variants[v].bvh, settings[v], described, false, file);
+                out[v].predicted_frame_described = file.predicted_frame;
+            }
+        }
+    };
+    if (!memory_now) predict_all([&](size_t v) { return *variants[v].host; });
     // One cycle source per back end: its clock is measured under that back end's instructions.
     std::map<uint32_t, std::unique_ptr<CycleSource>> sources;
     for (size_t v = 0; v < n; ++v) {
@@ -412,6 +416,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
     std::vector<std::array<double, 2>> short_loop_min(n, {1e300, 1e300});
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
     std::vector<std::vector<CycleReading>> readings(n);
+    // With memory_now, the L3 chased at the start of each round, and each render's round.
+    std::vector<SeenLevel> round_l3;
+    std::vector<std::vector<uint32_t>> sample_round(n);
     RenderResult r;
     // Warm: the caches with the workload's own frame (what predict() starts from), page
     // faults, the tracer's buffers. A workload of the same scene before it leaves other lines:
@@ -456,6 +463,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
         if (progress)
             progress("round " + std::to_string(round) + ": " + std::to_string(open) + " open",
                      n - open, n);
+        if (memory_now) {
+            round_l3.push_back(chase_last_level_now(tsc_mhz));
+            warm_variant = n;  // the chases evicted the caches a render warmed
+        }
         for (size_t v = 0; v < n; ++v) {
             SiliconMeasurement& m = out[v];
             if (!needs_more(v)) continue;
@@ -473,6 +484,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
                     others_total[v] += load_after[c].total - load_before[c].total;
                 }
             m.frame_samples.push_back(reading.cycles);
+            sample_round[v].push_back(round - 1);
             readings[v].push_back(reading);
             tsc_samples[v].push_back(ticks);
             const int64_t huge = anon_huge_page_kib();
@@ -515,6 +527,13 @@ std::vector<SiliconMeasurement> predict_and_measure(
         const size_t fastest = size_t(
             std::min_element(m.frame_samples.begin(), m.frame_samples.end()) -
             m.frame_samples.begin());
+        if (memory_now) {
+            m.l3_render = round_l3[sample_round[v][fastest]];
+            for (const SeenLevel& seen : round_l3) {
+                m.l3_rounds_kib_min = std::min(m.l3_rounds_kib_min, seen.kib);
+                m.l3_rounds_kib_max = std::max(m.l3_rounds_kib_max, seen.kib);
+            }
+        }
         m.clock_mhz_before = readings[v][fastest].clock_mhz_before;
         m.clock_mhz_after = readings[v][fastest].clock_mhz_after;
         m.measured_frame_tsc = median(tsc_samples[v]);
@@ -535,6 +554,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 m.measured_frame -
             1.0;
     }
+    if (memory_now)
+        predict_all([&](size_t v) { return with_last_level(*variants[v].host, out[v].l3_render); });
     return out;
 }
 

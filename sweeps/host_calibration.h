@@ -138,12 +138,15 @@ struct SiliconMeasurement {
     // +-10 % flags a run slowed (or sped) alike.
     double probe_before = 0.0, probe_after = 0.0;
     // The L3 this core keeps (last_level_seen: its size and others' fills), chased just before
-    // the predictions and just after the last render (kib 0: not chased). On a shared machine
-    // it moves within a minute (22.3 to 4.5 MiB in four descriptions on this project's AMD
-    // VM, 2026-11-28); a large move between the two flags a run whose memory was not the one
-    // predicted. With `memory_now` the model predicts with `l3_before` in place of the host
-    // file's L3, and `predicted_frame_described` is the frame with the file's, for comparison.
-    SeenLevel l3_before, l3_after;
+    // the first render and just after the last (kib 0: not chased). On a shared machine it
+    // moves within a minute (22.3 to 4.5 MiB in four descriptions on this project's AMD VM,
+    // 2026-11-28); a large move between the two flags a run whose memory was not the one
+    // the renders began with. With `memory_now` it is also chased at the start of every round,
+    // and the model predicts with `l3_render`, the one chased in the round of the fastest
+    // render (the one measured), in place of the host file's L3; `predicted_frame_described`
+    // is the frame with the file's, for comparison.
+    SeenLevel l3_before, l3_after, l3_render;
+    uint32_t l3_rounds_kib_min = ~0u, l3_rounds_kib_max = 0;  // over the rounds' chases
     double predicted_frame_described = 0.0;
     // From cold caches (SiliconVariant::cold): the renders after reading 256 MiB of other data,
     // which leaves none of the scene in this core's caches, under the same rule; the
@@ -173,16 +176,19 @@ struct SiliconVariant {
 
 // The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
 // every host config must carry op_costs for every kind its scene uses. Each is predicted by the
-// machine model on the trace of its own render; then rounds render every workload that has not
+// machine model on the trace of its own render (before the renders; with `memory_now`, after
+// them); rounds render every workload that has not
 // converged in turn (trace off), once plain and once with the stage clock, until each has
 // converged or spent its budget (`convergence`): every workload's renders span the whole run,
 // so that the drift of a shared machine touches all of them alike, and a slow spell shows as
 // disagreement instead of a bias. Each measured render follows an unmeasured render of its own
 // workload, so that it starts from the caches predict() assumes. A workload asked for `cold` also
 // renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
-// vary placement. `progress(what, done, total)` as it goes. With `memory_now`, every host's
-// last cache level is the one chased just before the predictions (SiliconMeasurement::
-// l3_before), not the file's: the check then predicts the memory the renders meet.
+// vary placement. `progress(what, done, total)` as it goes. With `memory_now`, the L3 is
+// chased at the start of every round, and each workload is predicted after the renders with
+// the one chased in the round of its fastest render as its host's last cache level
+// (SiliconMeasurement::l3_render), not the file's: the check then predicts the memory the
+// render it measured met.
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,
     uint64_t seed = 1, const std::function<void(const std::string&, size_t, size_t)>& progress = {},

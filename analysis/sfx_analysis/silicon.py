@@ -481,8 +481,8 @@ def summary_text(s, isa=None):
              f"({100 * s['converged_share']:.0f} %; only these are scored)",
              f"- frame cycles: MAE {100 * s['frame_mae']:.1f} %, worst {100 * s['frame_worst']:.1f} %"]
     if "frame_mae_described" in s:
-        lines.append(f"  - with the host file's L3 instead of the one chased before the renders "
-                     f"(same renders): MAE {100 * s['frame_mae_described']:.1f} %, worst "
+        lines.append(f"  - with the host file's L3 instead of the one chased in the round of "
+                     f"each fastest render (same renders): MAE {100 * s['frame_mae_described']:.1f} %, worst "
                      f"{100 * s['frame_worst_described']:.1f} %")
     for st in STAGES:
         lines.append(f"- {st}: MAE {100 * s[f'{st}_mae']:.1f} %, worst {100 * s[f'{st}_worst']:.1f} %")
@@ -579,14 +579,18 @@ def l3_text(df):
         return f"{kib / 1024:.1f} MiB (others' fills {fills:.2f} lines/us)" if kib > 0 else \
             "not chased"
     now = bool(r.get("predicted.memory_now", False))
-    held = (f"MOVED (beyond +-{100 * L3_MOVE_LIMIT:.0f} % in size): the renders met another "
-            f"memory than the one predicted" if l3_moved(df) else "held")
+    rounds_max = r.get("measured.l3_kib_rounds_max", 0)
+    held = (f"MOVED (beyond +-{100 * L3_MOVE_LIMIT:.0f} % in size): the renders did not all "
+            f"meet one memory" if l3_moved(df) else "held")
+    rounds = (f"; at the start of each round {r['measured.l3_kib_rounds_min'] / 1024:.1f} to "
+              f"{rounds_max / 1024:.1f} MiB" if rounds_max > 0 else "")
     return (f"- the L3 this core keeps (`last_level_seen`): the host file's "
             f"{level(r.get('host.l3_kib', 0), r.get('host.l3_fill_per_us', 0.0))}; chased just "
-            f"before the predictions {level(r['measured.l3_kib_before'], r['measured.l3_fill_per_us_before'])}, "
+            f"before the first render {level(r['measured.l3_kib_before'], r['measured.l3_fill_per_us_before'])}, "
             f"just after the last render {level(r['measured.l3_kib_after'], r['measured.l3_fill_per_us_after'])}: "
-            f"{held}; the model predicted with "
-            + ("the one chased before (--memory-now)" if now else "the host file's"))
+            f"{held}{rounds}; the model predicted "
+            + ("each workload with the one chased in the round of its fastest render "
+               "(--memory-now)" if now else "with the host file's"))
 
 
 def all_summaries_text(df):

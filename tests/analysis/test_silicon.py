@@ -236,14 +236,16 @@ def test_speed_probe_flags_a_run_unlike_calibration(tmp_path):
 
 
 def test_l3_chased_around_the_renders(tmp_path):
-    # The model predicted with the L3 chased before the renders (16 MiB); the host file's
-    # (8 MiB) would have predicted 20 % and 40 % over. A move of the L3 after the renders
-    # beyond 25 % of its size is flagged; within, it held.
+    # The model predicted with the L3 chased in the rounds of the fastest renders (16 MiB);
+    # the host file's (8 MiB) would have predicted 20 % and 40 % over. A move of the L3 after
+    # the renders beyond 25 % of its size is flagged; within, it held.
     rows = [row("a", 16, 100, 100), row("a", 32, 110, 100)]
     for r, described in zip(rows, (120, 140)):
         r.update({"host.l3_kib": 8192, "host.l3_fill_per_us": 10.0,
                   "measured.l3_kib_before": 16384, "measured.l3_fill_per_us_before": 7.5,
                   "measured.l3_kib_after": 4096, "measured.l3_fill_per_us_after": 5.0,
+                  "measured.l3_kib_render": 16384, "measured.l3_fill_per_us_render": 7.5,
+                  "measured.l3_kib_rounds_min": 3072, "measured.l3_kib_rounds_max": 20480,
                   "predicted.memory_now": True,
                   "predicted.frame_cycles_described": described})
     p = tmp_path / "rows.json"
@@ -256,16 +258,19 @@ def test_l3_chased_around_the_renders(tmp_path):
     assert "with the host file's L3 instead" in silicon.summary_text(s)
     line = [x for x in silicon.measurement_text(df).splitlines() if "L3 this core" in x][0]
     assert "host file's 8.0 MiB (others' fills 10.00" in line
-    assert "before the predictions 16.0 MiB" in line and "after the last render 4.0 MiB" in line
-    assert "MOVED" in line and "--memory-now" in line
+    assert "before the first render 16.0 MiB" in line and "after the last render 4.0 MiB" in line
+    assert "each round 3.0 to 20.0 MiB" in line
+    assert "MOVED" in line and "round of its fastest render (--memory-now)" in line
     for r in rows:
         r["measured.l3_kib_after"] = 18000
+        r["measured.l3_kib_rounds_max"] = 0  # not chased each round
         r["predicted.memory_now"] = False
     p.write_text(json.dumps(rows))
     df = silicon.load_rows(p)
     assert "frame_mae_described" not in silicon.summary(df)
     line = [x for x in silicon.measurement_text(df).splitlines() if "L3 this core" in x][0]
     assert ": held;" in line and "predicted with the host file's" in line
+    assert "each round" not in line
 
 
 def test_traversal_by_loop(tmp_path):

@@ -195,8 +195,9 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(probe > 0);
     HwConfig probed = config;
     probed.speed_probe_cycles = 1000 * probe;
-    // This run also predicts with the L3 chased just before it (memory_now), and keeps the
-    // host file's prediction beside it: the same as the first run's, which used the file.
+    // This run also predicts with the L3 chased in the round of each workload's fastest render
+    // (memory_now), and keeps the host file's prediction beside it: the same as the first
+    // run's, which used the file.
     const std::vector<SiliconMeasurement> again = predict_and_measure(
         {{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}}, rule, 1, {}, true);
     for (size_t v = 0; v < 2; ++v) {
@@ -208,8 +209,18 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     if (read_host_caches().size() >= 2 && config.scene_memory.caches.back().shared) {
         CHECK(again[0].l3_before.kib > 0);
         CHECK(again[0].l3_after.kib > 0);
-        CHECK(again[0].prediction.config.scene_memory.caches.back().kib == again[0].l3_before.kib);
+        for (size_t v = 0; v < 2; ++v) {
+            const SiliconMeasurement& w = again[v];
+            CHECK(w.prediction.config.scene_memory.caches.back().kib == w.l3_render.kib);
+            CHECK(w.prediction.config.scene_memory.caches.back().foreign_fill_per_us ==
+                  w.l3_render.foreign_fill_per_us);
+            CHECK(w.l3_rounds_kib_min > 0);
+            CHECK(w.l3_rounds_kib_min <= w.l3_render.kib);
+            CHECK(w.l3_render.kib <= w.l3_rounds_kib_max);
+        }
     }
+    CHECK(cell[0].l3_render.kib == 0);  // chased each round only with memory_now
+    CHECK(cell[0].l3_rounds_kib_max == 0);
     CHECK(again[0].probe_before == again[1].probe_before);
     CHECK(again[0].probe_after == again[1].probe_after);
     CHECK(again[0].probe_before < -0.95);
