@@ -117,16 +117,30 @@ double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes) 
 
 uint64_t PageRecency::use(uint64_t address) {
     const uint64_t page = address / k_page_bytes;
+    // The most recent page again: no other page since, and its place in the order stands.
+    if (page == m_latest) return 0;
+    m_latest = page;
     if (++m_now >= m_marks.size()) renumber();
+    uint64_t& last = last_use_of(page);
     uint64_t between = k_never;
-    const auto [it, first] = m_last_use.try_emplace(page, m_now);
-    if (!first) {
-        between = marked_through(m_now - 1) - marked_through(it->second);
-        mark(it->second, -1);
-        it->second = m_now;
+    if (last == 0) {
+        ++m_pages;
+    } else {
+        // Every page seen holds one mark, at its last use: those after this page's are the
+        // pages used since.
+        between = m_pages - marked_through(last);
+        mark(last, -1);
     }
+    last = m_now;
     mark(m_now, +1);
     return between;
+}
+
+uint64_t& PageRecency::last_use_of(uint64_t page) {
+    if (page >= k_near_pages) return m_far_last_use[page];
+    if (page >= m_near_last_use.size())
+        m_near_last_use.resize(std::max<size_t>(page + 1, 2 * m_near_last_use.size()), 0);
+    return m_near_last_use[page];
 }
 
 void PageRecency::mark(uint64_t time, int delta) {
@@ -141,15 +155,16 @@ uint64_t PageRecency::marked_through(uint64_t time) const {
 
 void PageRecency::renumber() {
     // Only the order of last uses matters: renumbering keeps the tree as small as the pages.
-    std::vector<std::pair<uint64_t, uint64_t>> by_time;  // (last use, page)
-    by_time.reserve(m_last_use.size());
-    for (const auto& [page, time] : m_last_use)
-        if (time < m_now) by_time.emplace_back(time, page);
+    std::vector<std::pair<uint64_t, uint64_t*>> by_time;  // (last use, where it is kept)
+    by_time.reserve(m_pages);
+    for (uint64_t& time : m_near_last_use)
+        if (time != 0) by_time.emplace_back(time, &time);
+    for (auto& [page, time] : m_far_last_use) by_time.emplace_back(time, &time);
     std::sort(by_time.begin(), by_time.end());
     m_marks.assign(std::max<size_t>(1024, 2 * by_time.size() + 2), 0);
     uint64_t time = 0;
-    for (const auto& [old, page] : by_time) {
-        m_last_use[page] = ++time;
+    for (const auto& [old, kept] : by_time) {
+        *kept = ++time;
         mark(time, +1);
     }
     m_now = time + 1;

@@ -73,10 +73,17 @@ class PageRecency {
     void mark(uint64_t time, int delta);
     uint64_t marked_through(uint64_t time) const;
     void renumber();  // last uses renumbered 1..pages, keeping their order
+    uint64_t& last_use_of(uint64_t page);  // 0: never used
 
-    std::unordered_map<uint64_t, uint64_t> m_last_use;  // page -> time of its last use
-    std::vector<uint32_t> m_marks;                      // Fenwick tree over times 1..size-1
+    // Pages below k_near_pages (a scene's data lies there, from 0) in a vector, others (the
+    // mesh's arrays and the ray buffers, far above) in a map: the time of each one's last use.
+    static constexpr uint64_t k_near_pages = uint64_t(1) << 22;
+    std::vector<uint64_t> m_near_last_use;
+    std::unordered_map<uint64_t, uint64_t> m_far_last_use;
+    std::vector<uint32_t> m_marks;  // Fenwick tree over times 1..size-1
     uint64_t m_now = 0;
+    uint64_t m_pages = 0;         // distinct pages used
+    uint64_t m_latest = k_never;  // the page used last
 };
 
 // The latency of a read from DRAM whose page was used `pages_between` distinct pages ago

@@ -100,6 +100,12 @@ TEST_CASE("Page recency counts the distinct pages used since a page's last use",
     CHECK(pages.use(0) == 2500);
     CHECK(pages.use((10 + 2499) * page) == 1);  // page 0 since
     CHECK(pages.use(2 * page) == 2502);         // all but itself: 0, 1 and the 2500
+    // Pages far above a scene's (a mesh's arrays, the ray buffers) count alike.
+    const uint64_t far = uint64_t(1) << 44;
+    CHECK(pages.use(far) == PageRecency::k_never);
+    for (uint64_t i = 0; i < 3000; ++i) pages.use(far + (1 + i % 1500) * page);
+    CHECK(pages.use(far + 8) == 1500);
+    CHECK(pages.use(2 * page) == 1501);  // the far ones since, and far itself
 }
 
 TEST_CASE("A DRAM read's latency follows the pages used since its page's last use",
