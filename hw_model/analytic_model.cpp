@@ -261,6 +261,13 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const uint64_t groups = (uint64_t(length) + n - 1) / n;
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
         const double gathers = double(p.gather_words.size());
+        // Of the lanes beyond the L1D, those opening a page pay (lanes_opening_pages), here
+        // as expected of a stream of `length` random slots.
+        const double opening_share =
+            beyond_l1 > 0 ? expected_lanes_opening_pages(
+                                length, slots, slot_bytes_of(c.ray_buffer, layout.bytes())) /
+                                double(std::min(length, slots))
+                          : 0.0;
         // The cycle model's pipeline in closed form. Groups spread over the units; each round
         // of them costs the slowest of execution, the access side's issue, and the shared
         // address units and interconnect. An op that partitions holds the next op back: the
@@ -275,7 +282,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const double busy = p.issue_cycles(
                 c.datapath, length, uint32_t(std::lround(pass_rate * length)), lanes,
-                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1);
+                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1 * opening_share);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

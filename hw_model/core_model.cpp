@@ -338,11 +338,19 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     uint32_t passed = 0;
     if (p.measured)
         for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
+    // Of the lanes beyond the L1D, those opening a page pay (lanes_opening_pages).
+    const double beyond_l1 =
+        m_beyond_l1 > 0 && op.slots && t.lanes > 0
+            ? m_beyond_l1 *
+                  lanes_opening_pages(op.slots, t.first, t.lanes,
+                                      slot_bytes_of(m_config.ray_buffer, m_record_bytes)) /
+                  double(t.lanes)
+            : 0.0;
     // Fractional measured cycles: the unit carries the remainder to its next group.
     const double exact =
         m_unit_carry[unit] +
         p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes, passed, t.first == 0,
-                       m_beyond_l1) +
+                       beyond_l1) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
     // The op's mispredicted branches, on its first group.
     const double mispredicted =

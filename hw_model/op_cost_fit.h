@@ -15,7 +15,8 @@
 namespace sfx {
 
 // An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
-// `beyond_l1` of the ray slots outside the L1D; one lane: one_lane_cycles when measured).
+// `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_l1_share; one lane:
+// one_lane_cycles when measured).
 double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes,
                           uint32_t passed, double beyond_l1);
 

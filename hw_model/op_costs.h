@@ -92,11 +92,11 @@ struct OpProfile {
 
     // Cycles a SIMD unit spends issuing one group of `lanes` lanes, `passed` of them passing,
     // of an op of `length` lanes, `op_passed` of them passing (`first`: the op's first group,
-    // which carries a measured per-op cost), with a share `beyond_l1` of the pass's ray slots
-    // outside an l1d buffer. A measured minority cost is the op's, shared by its groups by lanes.
-    // Fractional for measured costs (the caller carries the remainder); instruction-priced
-    // groups cost compute_instructions (programmable), the initiation interval (pipelined) or
-    // the body's modulo-schedule II (cluster).
+    // which carries a measured per-op cost), with a share `beyond_l1` of its lanes paying for
+    // an l1d buffer beyond the L1D (beyond_l1_share, lanes_opening_pages). A measured minority cost
+    // is the op's, shared by its groups by lanes. Fractional for measured costs (the caller carries
+    // the remainder); instruction-priced groups cost compute_instructions (programmable), the
+    // initiation interval (pipelined) or the body's modulo-schedule II (cluster).
     double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_passed,
                         uint32_t lanes, uint32_t passed, bool first, double beyond_l1) const;
     // Cycles an op adds on its first group when it enters the traversal's one-ray or few-ray

@@ -114,6 +114,25 @@ uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 // Ray buffers in a CPU core's L1D (storage l1d): the share of `slots` slots of `slot_bytes`
 // that an L1D of `l1d_kib` cannot hold; a random lane misses it with that probability.
 double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
+// The hardware prefetchers follow a stream of ascending loads within a 4 KiB page and stop
+// at its end ("Does not prefetch across 4K boundary": Intel's Optimization Reference Manual,
+// the streamer; AMD's stride and stream prefetchers likewise train on a page's lines): a lane
+// whose slot starts in another page than the lane before it's (a stream's slots ascend) waits
+// for its line, and the lanes after it in that page find theirs prefetched.
+constexpr uint32_t k_prefetch_page_bytes = 4096;
+// How many of the lanes [first, first + lanes) of a stream of `slots` (ascending) open a page:
+// their slot starts in another page than the slot before it's (the stream's first lane does).
+uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
+                             uint32_t slot_bytes);
+// The same expected of a stream of `lanes` slots drawn at random from `slots` (the pages the
+// stream touches: each page's share untouched is hypergeometric).
+double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t slot_bytes);
+// A random stream's share of lanes that pay for a buffer beyond the L1D, as the op costs' fit
+// prices its microbenchmarks and the closed form a frame's ops: those opening a page
+// (expected), times beyond_l1_fraction. On this project's AMD host (2026-11-28) the dense
+// streams of a frame paid nearly none of what its sparse microbenchmark streams did: priced
+// by beyond_l1_fraction alone, cornell's 64 x 64 frames came out 7-15 % over the measured.
+double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);

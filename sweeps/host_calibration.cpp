@@ -51,7 +51,6 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
-        const double beyond = beyond_l1_fraction(s.slots, stream_slot_bytes(), l1d_kib);
         // One-lane leaf tests at their directly timed cost.
         for (size_t k = 0; k < k_op_kind_count; ++k)
             if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
@@ -74,7 +73,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                 double(o.count) *
                 measured_op_cycles(priced, width, o.lanes,
                                    uint32_t(std::lround(double(o.passed) / double(o.count))),
-                                   beyond);
+                                   beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(), l1d_kib));
         }
         out.push_back(sample);
     }
@@ -171,7 +170,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             continue;
         }
         by_kind[s.kind].push_back(
-            {s.lanes, s.passed, beyond_l1_fraction(s.slots, slot_bytes, l1d), s.cycles});
+            {s.lanes, s.passed, beyond_l1_share(s.lanes, s.slots, slot_bytes, l1d), s.cycles});
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {

@@ -132,15 +132,19 @@ TEST_CASE("A DRAM read's latency follows the pages used since its page's last us
     // Not beyond the span: a chase over more than the scene's data is the span's.
     SceneMemoryModel small(config, 1000.0, 1, nullptr, 4u << 20);
     now = 0;
-    CHECK(small.read(0, 0, 4, now += 10000) - now == 100 + 1);
+    now += 10000;
+    CHECK(small.read(0, 0, 4, now) - now == 100 + 1);
     for (uint64_t p = 1; p <= 8191; ++p) small.read(0, p * page, 4, now += 10000);
-    CHECK(small.read(0, 64, 4, now += 10000) - now == 100 + 1);
+    now += 10000;
+    CHECK(small.read(0, 64, 4, now) - now == 100 + 1);
     // Without a table, one latency for every read however recent its page.
     config.dram_latency_by_span.clear();
     SceneMemoryModel flat(config, 1000.0, 1, nullptr, 64u << 20);
     now = 0;
-    CHECK(flat.read(0, 0, 4, now += 10000) - now == 300 + 1);
-    CHECK(flat.read(0, 64, 4, now += 10000) - now == 300 + 1);
+    now += 10000;
+    CHECK(flat.read(0, 0, 4, now) - now == 300 + 1);
+    now += 10000;
+    CHECK(flat.read(0, 64, 4, now) - now == 300 + 1);
 }
 
 TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",

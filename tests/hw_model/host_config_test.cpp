@@ -40,11 +40,11 @@ WorkloadShape shape() {
 
 // One box test of `lanes` lanes (all passing) on node `node`, per pass, in passes of `slots`
 // ray slots, timed by the machine model.
-FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes,
-                       uint32_t slots = 64, uint32_t node = 3) {
+FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes, uint32_t slots = 64,
+                       uint32_t node = 3, uint32_t stride = 1) {
     SystemcTiming timing({config}, shape());
     std::vector<uint32_t> ids(lanes);
-    for (uint32_t i = 0; i < lanes; ++i) ids[i] = i;
+    for (uint32_t i = 0; i < lanes; ++i) ids[i] = i * stride;
     std::vector<uint8_t> passed(lanes, 1);
     for (uint32_t p = 0; p < passes; ++p) {
         TilePass pass;
@@ -422,9 +422,11 @@ TEST_CASE("The machine model times a host: measured costs, scene data beyond the
     CHECK(two.stalls.partition == 0);
     CHECK(two.actions.busy_cycles[size_t(HwUnit::partition)] == 0);
 
-    // 4096 slots of 64 bytes (256 KiB) behind a 32 KiB L1D: 7/8 of the lanes beyond it, at 8
-    // cycles each: 20 * 7/8 * 8 = 140 more issue cycles.
-    CHECK(time_boxes(host, 1, 20, 4096).cycles == 83 + 18 + 140);
+    // 4096 slots of 64 bytes (256 KiB) behind a 32 KiB L1D: 7/8 of the buffer beyond it, at
+    // 8 cycles a lane that opens a 4 KiB page. Slots 0-19 lie in one page: only the first
+    // lane pays, 7 cycles; slots 64 apart each open one: 20 * 7/8 * 8 = 140.
+    CHECK(time_boxes(host, 1, 20, 4096).cycles == 83 + 18 + 7);
+    CHECK(time_boxes(host, 1, 20, 4096, 3, 64).cycles == 83 + 18 + 140);
 
     // A one-ray stream costs its one-lane cost.
     HwConfig one_lane = host;
@@ -715,4 +717,29 @@ TEST_CASE("DRAM's latency is measured by span, from the first pass after the cac
     const double ns = measure_dram_first_pass_ns(uint64_t(2) << 20, tsc_mhz, 1);
     CHECK(ns > 20.0);
     CHECK(ns < 5000.0);
+}
+
+TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a page", "[host]") {
+    // Slots of 1,000 bytes: slots 0-4 start in page 0, 5-8 in page 1, 9-12 in page 2.
+    const std::vector<uint32_t> dense = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    CHECK(lanes_opening_pages(dense.data(), 0, 10, 1000) == 3);
+    CHECK(lanes_opening_pages(dense.data(), 0, 5, 1000) == 1);  // the stream's first lane
+    CHECK(lanes_opening_pages(dense.data(), 5, 5, 1000) == 2);  // slot 5 opens page 1
+    CHECK(lanes_opening_pages(dense.data(), 6, 3, 1000) == 0);  // 6-8: page 1, after slot 5
+    const std::vector<uint32_t> sparse = {0, 9, 33, 34, 200};
+    CHECK(lanes_opening_pages(sparse.data(), 0, 5, 1000) == 4);  // 33 and 34: page 8
+
+    // Expected of random streams: every page of a full stream, every lane of a one-lane one,
+    // and in between the pages' share touched (one page of k slots: 1 - C(S - k, n) / C(S, n)).
+    CHECK(expected_lanes_opening_pages(4096, 4096, 330) ==
+          Approx(4096.0 * 330 / 4096).epsilon(0.01));
+    CHECK(expected_lanes_opening_pages(1, 4096, 330) == Approx(1.0));
+    CHECK(expected_lanes_opening_pages(2, 4, 2048) == Approx(2 * (1.0 - 1.0 / 6.0)));
+    CHECK(expected_lanes_opening_pages(0, 64, 330) == 0.0);
+    // The share that pays: none within the L1D; beyond it, nearly every lane of a sparse
+    // stream and about one in twelve of a dense one (slots of 330 bytes).
+    CHECK(beyond_l1_share(64, 64, 330, 48) == 0.0);
+    const double f = beyond_l1_fraction(4096, 330, 48);
+    CHECK(beyond_l1_share(16, 4096, 330, 48) == Approx(f).epsilon(0.03));
+    CHECK(beyond_l1_share(4096, 4096, 330, 48) == Approx(f * 330 / 4096).epsilon(0.02));
 }

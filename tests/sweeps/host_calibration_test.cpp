@@ -29,7 +29,8 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     for (const MicrobenchSample& s : run_stream_microbenchmarks(o))
         by_kind[s.kind].push_back(
             {s.lanes, s.passed,
-             beyond_l1_fraction(s.slots, stream_slot_bytes(), host.caches.front().kib), s.cycles});
+             beyond_l1_share(s.lanes, s.slots, stream_slot_bytes(), host.caches.front().kib),
+             s.cycles});
     std::vector<OpCostConfig> costs;
     for (const auto& [kind, samples] : by_kind)
         costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
