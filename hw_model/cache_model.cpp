@@ -139,7 +139,9 @@ uint64_t PageRecency::use(uint64_t address) {
 uint64_t& PageRecency::last_use_of(uint64_t page) {
     if (page >= k_near_pages) return m_far_last_use[page];
     if (page >= m_near_last_use.size())
-        m_near_last_use.resize(std::max<size_t>(page + 1, 2 * m_near_last_use.size()), 0);
+        m_near_last_use.resize(
+            std::min<size_t>(k_near_pages, std::max<size_t>(page + 1, 2 * m_near_last_use.size())),
+            0);
     return m_near_last_use[page];
 }
 
