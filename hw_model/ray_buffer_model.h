@@ -116,7 +116,8 @@ uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
 // The hardware prefetchers follow a stream of ascending loads within a 4 KiB page and stop
 // at its end ("Does not prefetch across 4K boundary": Intel's Optimization Reference Manual,
-// the streamer; AMD's stride and stream prefetchers likewise train on a page's lines): a lane
+// the streamer; AMD's guides say only that theirs fetch lines in ascending or descending
+// order, so the same page is assumed there, not documented): a lane
 // whose slot starts in another page than the lane before it's (a stream's slots ascend) waits
 // for its line, and the lanes after it in that page find theirs prefetched.
 constexpr uint32_t k_prefetch_page_bytes = 4096;
