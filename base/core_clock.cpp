@@ -8,7 +8,10 @@ namespace sfx {
 
 namespace {
 
-// The ruler is always a chain of dependent scalar adds (one a cycle on every x86-64 core).
+// The ruler is always a chain of dependent scalar adds of a register (one a cycle on every
+// x86-64 core). Not adds of an immediate: recent Intel renamers fold a chain of those (on this
+// project's Intel Xeon VM, family 6 model 0xA7 with AMX, `add $1` chains ran 4 links a cycle,
+// reading a 16.8 GHz clock, while `add reg, reg` and a 3-cycle imul chain both read 4.19 GHz).
 // For a vector back end, each group of 8 adds runs beside one vpaddd of a chain in a vector
 // register of the back end's width and one vmulps of another (both chains of at most 4 cycles
 // a link, so neither is ever the critical path): the core runs at the clock it gives code that
@@ -16,19 +19,25 @@ namespace {
 // A chain of the vector adds alone would be no ruler: their latency is 1 cycle on Haswell to
 // Zen 4 but 2 on Zen 5, where such a chain reads half the clock.
 // Eight adds of the ruler beside one link of each vector chain, in the registers R (ymm, zmm);
-// registers 2 and 3 hold 1.0f (so vmulps never meets a denormal), register 1 anything.
-#define SFX_VECTOR_CLOCK_LOOP(R)                                                                \
-    asm volatile("vbroadcastss %0, %%" R "2\n\tvbroadcastss %0, %%" R "3" ::"m"(k_one)          \
-                 : "xmm2", "xmm3");                                                             \
-    start = __rdtsc();                                                                          \
-    for (uint64_t i = 0; i < adds / 8; ++i)                                                     \
-        asm volatile("add $1, %0\n\tvpaddd %%" R "1, %%" R "0, %%" R "0\n\tadd $1, %0\n\t"        \
-                     "vmulps %%" R "3, %%" R "2, %%" R "2\n\tadd $1, %0\n\tadd $1, %0\n\t"       \
-                     "add $1, %0\n\tadd $1, %0\n\tadd $1, %0\n\tadd $1, %0"                      \
-                     : "+r"(x)::"xmm0", "xmm2")
+// registers 2 and 3 hold 1.0f (so vmulps never meets a denormal), register 1 anything; `step`
+// is the ruler's addend.
+#define SFX_VECTOR_CLOCK_LOOP(R)                                                       \
+    asm volatile("vbroadcastss %0, %%" R "2\n\tvbroadcastss %0, %%" R "3" ::"m"(k_one) \
+                 : "xmm2", "xmm3");                                                    \
+    start = __rdtsc();                                                                 \
+    for (uint64_t i = 0; i < adds / 8; ++i)                                            \
+    asm volatile("add %1, %0\n\tvpaddd %%" R "1, %%" R "0, %%" R                       \
+                 "0\n\tadd %1, %0\n\t"                                                 \
+                 "vmulps %%" R "3, %%" R "2, %%" R                                     \
+                 "2\n\tadd %1, %0\n\tadd %1, %0\n\t"                                   \
+                 "add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"                \
+                 : "+r"(x)                                                             \
+                 : "r"(step)                                                           \
+                 : "xmm0", "xmm2")
 
 uint64_t chain_ticks(uint32_t lanes, uint64_t adds, uint64_t seed) {
     uint64_t x = seed;
+    const uint64_t step = seed | 1;
     static const float k_one = 1.0f;
     uint64_t start = 0;
     if (lanes == 16) {
@@ -38,7 +47,9 @@ uint64_t chain_ticks(uint32_t lanes, uint64_t adds, uint64_t seed) {
     } else {
         start = __rdtsc();
         for (uint64_t i = 0; i < adds / 4; ++i)
-            asm volatile("add $1, %0\n\tadd $1, %0\n\tadd $1, %0\n\tadd $1, %0" : "+r"(x));
+            asm volatile("add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"
+                         : "+r"(x)
+                         : "r"(step));
     }
     const uint64_t ticks = __rdtsc() - start;
     // The upper halves of the vector registers are dirty after a wide chain: clean them, so

@@ -6,7 +6,9 @@
 
 #include <linux/perf_event.h>
 #include <unistd.h>
+#include <x86intrin.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cerrno>
 
@@ -18,11 +20,31 @@ using namespace sfx;
 
 namespace {
 
-// Work the region measures: a few hundred thousand dependent adds.
+// Work the region measures: `n` dependent adds of a register (adds of an immediate may be
+// folded at rename, several a cycle).
 uint64_t busy(uint64_t n) {
     uint64_t x = 1;
-    for (uint64_t i = 0; i < n; ++i) asm volatile("add $3, %0" : "+r"(x));
+    const uint64_t step = 3;
+    for (uint64_t i = 0; i < n; ++i) asm volatile("add %1, %0" : "+r"(x) : "r"(step));
     return x;
+}
+
+// TSC ticks a link of a chain of 64-bit multiplies (3 cycles a link on every x86-64 core since
+// Nehalem and Zen), the fastest of `runs`: a second ruler no renamer can fold.
+double tsc_ticks_per_multiply(int runs) {
+    constexpr uint64_t k_links = 16384;
+    uint64_t best = ~0ull;
+    for (int r = 0; r < runs; ++r) {
+        uint64_t x = uint64_t(r) + 1;
+        const uint64_t factor = 3;
+        const uint64_t start = __rdtsc();
+        for (uint64_t i = 0; i < k_links / 4; ++i)
+            asm volatile("imul %1, %0\n\timul %1, %0\n\timul %1, %0\n\timul %1, %0"
+                         : "+r"(x)
+                         : "r"(factor));
+        best = std::min<uint64_t>(best, __rdtsc() - start);
+    }
+    return double(best) / double(k_links);
 }
 
 }  // namespace
@@ -105,4 +127,16 @@ TEST_CASE("Core clock: every back end's chain gives a plausible clock", "[cycles
         // took two cycles (a chain of vpaddd on Zen 5) would read half.
         CHECK(mhz > 0.6 * scalar_mhz);
     }
+}
+
+TEST_CASE("Core clock: the add chain reads the clock a multiply chain reads", "[cycles]") {
+    // The ruler's links take one cycle: a renamer that folded them (as Intel's fold adds of an
+    // immediate) would read a clock several times too fast. Interleaved, fastest of each.
+    double add_ticks = 1e9, multiply_ticks = 1e9;
+    for (int round = 0; round < 5; ++round) {
+        add_ticks = std::min(add_ticks, tsc_ticks_per_core_cycle(5, 1));
+        multiply_ticks = std::min(multiply_ticks, tsc_ticks_per_multiply(5) / 3.0);
+    }
+    INFO("ticks a cycle: add chain " << add_ticks << ", multiply chain " << multiply_ticks);
+    CHECK(add_ticks == Approx(multiply_ticks).epsilon(0.15));
 }
