@@ -68,8 +68,8 @@ double tsc_ticks_per_core_cycle(int runs, uint32_t lanes) {
 }
 
 const char* clock_chain_name(uint32_t lanes) {
-    return lanes == 16 ? "add beside vpaddd/vmulps zmm"
-                       : lanes == 8 ? "add beside vpaddd/vmulps ymm" : "add";
+    return lanes == 16 ? "add reg beside vpaddd/vmulps zmm"
+                       : lanes == 8 ? "add reg beside vpaddd/vmulps ymm" : "add reg";
 }
 
 }  // namespace sfx

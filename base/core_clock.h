@@ -19,7 +19,7 @@ namespace sfx {
 // adds (about 10 us each) of the back end with `lanes` lanes.
 double tsc_ticks_per_core_cycle(int runs = 5, uint32_t lanes = 1);
 
-// What the chain runs: "add", "add beside vpaddd/vmulps ymm" or "... zmm".
+// What the chain runs: "add reg", "add reg beside vpaddd/vmulps ymm" or "... zmm".
 const char* clock_chain_name(uint32_t lanes);
 
 }  // namespace sfx
