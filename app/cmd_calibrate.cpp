@@ -299,6 +299,18 @@ void add_calibrate_command(CLI::App& app) {
                 "traversals, fit error median %.1f%%, worst %.1f%%\n",
                 cal.one_ray_samples.size(), 100 * cal.short_stream_fit_errors.first,
                 100 * cal.short_stream_fit_errors.second);
+            double mispredictions = 0.0, batch_cycles = 0.0;
+            for (const OneRaySample& s : cal.one_ray_samples) {
+                mispredictions += s.modelled_mispredictions;
+                batch_cycles += s.cycles;
+            }
+            const double mispredict = cal.host.branch_predictor.mispredict_cycles;
+            std::printf(
+                "  the model's predictor on those batches: %.0f mispredictions, %.1f%% of "
+                "their cycles at %.1f each, priced before the fit\n",
+                mispredictions,
+                batch_cycles > 0 ? 100 * mispredictions * mispredict / batch_cycles : 0.0,
+                mispredict);
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.op == "box_test")
                     std::printf("entering the one-ray loop %.1f cycles, the few-ray loop %.1f\n",

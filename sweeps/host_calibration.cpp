@@ -43,7 +43,8 @@ bool one_lane_from_filters(OpKind kind) {
 
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
-                                                    uint32_t width, uint32_t l1d_kib) {
+                                                    uint32_t width, uint32_t l1d_kib,
+                                                    double mispredict_cycles) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
         if (const OpKind kind = op_kind_named(o.op); kind != OpKind::count)
@@ -51,6 +52,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
+        sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
         // One-lane leaf tests at their directly timed cost.
         for (size_t k = 0; k < k_op_kind_count; ++k)
             if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
@@ -78,6 +80,27 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         out.push_back(sample);
     }
     return out;
+}
+
+double replay_short_stream_predictor(const TraversalRecorder& others,
+                                     const TraversalRecorder& batch, uint32_t width,
+                                     const std::vector<uint8_t>& node_leaf) {
+    TagePredictor predictor;
+    std::vector<uint32_t> scratch;
+    auto replay = [&](const PassBuffer& trace) {
+        const uint64_t before = predictor.mispredictions();
+        replay_traversal_branches(trace, traversal_loops(trace, width), width, node_leaf, predictor,
+                                  scratch);
+        return predictor.mispredictions() - before;
+    };
+    // The others twice: the first run warms the fresh predictor, as a core's is warm by the
+    // time a batch is timed; the second is the run before the timed one.
+    PassBuffer others_trace, batch_trace;
+    others(others_trace);
+    batch(batch_trace);
+    replay(others_trace);
+    replay(others_trace);
+    return double(replay(batch_trace));
 }
 
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs) {
@@ -179,38 +202,6 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();
     }
-    // Ops of one lane run in the one-ray loop, and a wide back end's box tests of a few lanes in
-    // the few-ray loop, not the filters above: their own fit, of what the samples' other ops
-    // (their leaves' tests) leave when the formula above prices them.
-    c.one_ray_samples = run_one_ray_microbenchmarks(resolved, convergence);
-    for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
-    c.points += uint32_t(c.one_ray_samples.size());
-    const std::vector<OneLaneSample> short_streams =
-        short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d);
-    const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
-    c.short_stream_fit_errors = short_stream_fit_error(short_costs, short_streams);
-    c.filter_costs = c.op_costs;
-    set_short_stream_costs(short_costs, c.op_costs);
-    // The hits' surfaces read beyond the caches: the share of the cache model's latency the
-    // core leaves exposed, for the op that reads them (the emission filter).
-    c.surface_read_samples = run_surface_read_microbenchmarks(resolved, convergence);
-    std::vector<HitReadSample> hit_reads;
-    for (const SurfaceReadSample& s : c.surface_read_samples) {
-        // Replayed: the third repetition's hits after the first two's, which warmed the caches
-        // as the repetitions before any measured one did (which repetition was fastest is not
-        // kept; every repetition draws its hits alike).
-        HitReadSample h;
-        h.triangles = s.triangles;
-        for (uint32_t rep = 0; rep + 1 < std::min(s.repetitions, 3u); ++rep) {
-            const std::vector<uint32_t> prims = surface_read_hits(s, rep);
-            h.warm_prims.insert(h.warm_prims.end(), prims.begin(), prims.end());
-        }
-        h.timed_prims = surface_read_hits(s, std::min(s.repetitions, 3u) - 1);
-        h.extra_cycles = s.cycles - s.resident_cycles;
-        hit_reads.push_back(std::move(h));
-        c.converged_points += s.converged;
-    }
-    c.points += uint32_t(c.surface_read_samples.size());
     // The cost of a misprediction of the model's branch predictor: on a scene of random
     // triangles, what the displaced batches took beyond the cached ones, over the
     // mispredictions the model adds from primed to displaced on the same batches.
@@ -237,6 +228,48 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                     << std::llround(extra_mispredictions[k]) << " mispredictions added";
     branch_note << " (the model's predictor, primed to displaced); no frame";
     c.host.branch_predictor_fit = branch_note.str();
+    // Ops of one lane run in the one-ray loop, and a wide back end's box tests of a few lanes in
+    // the few-ray loop, not the filters above: their own fit, of what the samples' other ops
+    // (their leaves' tests) and the model's mispredictions on them (priced above) leave when
+    // the formula above prices them. Those mispredictions are in the samples' cycles, and the
+    // model adds its own to every traversal: fitted into the costs, a frame paid them twice
+    // (atrium 64 x 64, AVX-512, tile 32, on an Intel Xeon VM, 2026-11-28: 20.9 M cycles
+    // predicted, 17.0 measured, 4.4 M of them the predictor's).
+    const std::vector<uint8_t> one_ray_leaves = bvh_leaves(Bvh(one_ray_microbench_scene()));
+    c.one_ray_samples = run_one_ray_microbenchmarks(
+        resolved, convergence, 1,
+        [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
+            return replay_short_stream_predictor(others, batch, c.host.simd_width, one_ray_leaves);
+        });
+    for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
+    c.points += uint32_t(c.one_ray_samples.size());
+    const std::vector<OneLaneSample> short_streams =
+        short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d,
+                                 c.host.branch_predictor.mispredict_cycles);
+    const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
+    c.short_stream_fit_errors = short_stream_fit_error(short_costs, short_streams);
+    c.filter_costs = c.op_costs;
+    set_short_stream_costs(short_costs, c.op_costs);
+    // The hits' surfaces read beyond the caches: the share of the cache model's latency the
+    // core leaves exposed, for the op that reads them (the emission filter).
+    c.surface_read_samples = run_surface_read_microbenchmarks(resolved, convergence);
+    std::vector<HitReadSample> hit_reads;
+    for (const SurfaceReadSample& s : c.surface_read_samples) {
+        // Replayed: the third repetition's hits after the first two's, which warmed the caches
+        // as the repetitions before any measured one did (which repetition was fastest is not
+        // kept; every repetition draws its hits alike).
+        HitReadSample h;
+        h.triangles = s.triangles;
+        for (uint32_t rep = 0; rep + 1 < std::min(s.repetitions, 3u); ++rep) {
+            const std::vector<uint32_t> prims = surface_read_hits(s, rep);
+            h.warm_prims.insert(h.warm_prims.end(), prims.begin(), prims.end());
+        }
+        h.timed_prims = surface_read_hits(s, std::min(s.repetitions, 3u) - 1);
+        h.extra_cycles = s.cycles - s.resident_cycles;
+        hit_reads.push_back(std::move(h));
+        c.converged_points += s.converged;
+    }
+    c.points += uint32_t(c.surface_read_samples.size());
     c.host.speed_probe_cycles = speed_probe_cycles(resolved, convergence);
     const HwConfig host_config = host_hw_config(c.host, c.op_costs);
     c.hit_read_fit = fit_hit_read_exposed_share(host_config, hit_reads);
@@ -261,7 +294,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "box cost, from " << c.one_ray_samples.size()
          << " batches of traversals (8-32 streams of one ray and 4-32 of 2 to " << k_few_ray_lanes
          << " rays from the root, 8 and 32 entering 3 and 6 levels down, 1 and 4 of 8 to 128) "
-         << "of the same scene, other rays' traversals between repetitions; the hit reads' "
+         << "of the same scene, other rays' traversals between repetitions, less the model's "
+         << "mispredictions on them at mispredict_cycles (the model adds its own to every "
+         << "traversal); the hit reads' "
          << "exposed "
          << "share from " << c.surface_read_samples.size()
          << " streams of 4096 hits on meshes of 416 KiB-52 MiB against a resident one, "

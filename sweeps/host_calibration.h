@@ -82,10 +82,21 @@ struct HostCalibration {
 // The traversal samples as the one- and few-lane fit sees them (fit_short_stream_cycles): each
 // sample's other ops (its leaves' tests, and its stream-loop box tests' lanes) priced by
 // `costs`, the stream formula of a back end of `width` lanes, over the sample's buffer (its
-// slots, the native slot size) beside an L1D of `l1d_kib`.
+// slots, the native slot size) beside an L1D of `l1d_kib`; and the model's mispredictions on
+// its batch (OneRaySample::modelled_mispredictions) at `mispredict_cycles` each, which the
+// model adds to every traversal it times, so that the fitted costs do not hold them twice.
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
-                                                   const std::vector<OpCostConfig>& costs,
-                                                   uint32_t width, uint32_t l1d_kib);
+                                                    const std::vector<OpCostConfig>& costs,
+                                                    uint32_t width, uint32_t l1d_kib,
+                                                    double mispredict_cycles = 0.0);
+
+// The model's branch predictor over a short-stream sample's traversals as the microbenchmark
+// times them: the other rays' traversals (twice, the first warming a fresh predictor), then the
+// batch's; the batch's mispredictions (run_one_ray_microbenchmarks' PredictorReplay, for a back end
+// of `width` lanes in the scene whose tree has leaves `node_leaf`).
+double replay_short_stream_predictor(const TraversalRecorder& others,
+                                     const TraversalRecorder& batch, uint32_t width,
+                                     const std::vector<uint8_t>& node_leaf);
 // The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
 // cost where the traversals measured it (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);

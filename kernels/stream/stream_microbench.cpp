@@ -579,9 +579,14 @@ uint32_t entry_below(const Bvh& bvh, const RayPrecomp& ray, float t_max, uint32_
 
 }  // namespace
 
+Scene one_ray_microbench_scene() {
+    return synthetic_scene(true);
+}
+
 std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const ConvergenceRule& convergence,
-                                                      uint64_t seed) {
-    const Scene scene = synthetic_scene(true);
+                                                      uint64_t seed,
+                                                      const PredictorReplay& predictor_replay) {
+    const Scene scene = one_ray_microbench_scene();
     const Bvh bvh(scene);
     const Isa resolved = resolve_isa(isa);
     const StreamKernels& kernels = stream_kernels(resolved);
@@ -678,12 +683,12 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             // traversals and 29-31 in one of 8192-32768, on an AMD Zen 5 VM, 2026-11-27), and a
             // frame's traversals do not repeat.
             const uint32_t batch_rays = rays * streams;
-            auto displace_predictor = [&] {
+            auto displace_predictor = [&](TraceDetail detail) {
                 std::shuffle(order.begin() + batch_rays, order.end(), rng);
                 other_ids.assign(stride, 0u);
                 for (uint32_t first = batch_rays; first + rays <= k_slots; first += rays) {
                     load_stream(first, other_ids.data());
-                    traverse(other_ids.data(), TraceDetail::none, 0);
+                    traverse(other_ids.data(), detail, 0);
                 }
             };
             OneRaySample sample;
@@ -701,10 +706,30 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             sample.entries = {loops.entries[0], loops.entries[1]};
             job.sink = nullptr;
             job.short_loops = nullptr;
+            if (predictor_replay) {
+                auto recorder = [&](bool others) {
+                    return [&, others](TraceSink& sink) {
+                        TilePass pass;
+                        pass.tile = uint32_t(out.size());
+                        pass.slot_count = k_slots;
+                        sink.begin_pass(pass);
+                        job.sink = &sink;
+                        if (others) {
+                            displace_predictor(TraceDetail::lanes);
+                        } else {
+                            reset();
+                            run(TraceDetail::lanes);
+                        }
+                        job.sink = nullptr;
+                        sink.end_pass(pass);
+                    };
+                };
+                sample.modelled_mispredictions = predictor_replay(recorder(true), recorder(false));
+            }
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
             while (needs_more_samples(times, convergence)) {
-                displace_predictor();
+                displace_predictor(TraceDetail::none);
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);

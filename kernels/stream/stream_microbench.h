@@ -103,7 +103,18 @@ struct OneRaySample {
     double cycles = 0.0;  // core cycles, fastest repetition
     bool converged = false;
     uint32_t repetitions = 0;
+    // The mispredictions the model's branch predictor makes on the batch's traversals, run as
+    // the timed repetitions run them (`predictor_replay` below; 0 without one).
+    double modelled_mispredictions = 0.0;
 };
+// Traces a run of traversals into `sink` (TraceDetail::lanes, one TilePass of the sample's
+// 4096 slots).
+using TraversalRecorder = std::function<void(TraceSink& sink)>;
+// Given one sample's two recorders, the other rays' traversals that precede each timed
+// repetition (one such run) and the batch's traversals, returns the mispredictions the model's
+// branch predictor makes on the batch after the others (OneRaySample::modelled_mispredictions).
+using PredictorReplay =
+    std::function<double(const TraversalRecorder& others, const TraversalRecorder& batch)>;
 // Batches of 8 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
 // 32 streams of 2, 3 and 4 rays; the same streams entering 3 and 6 levels down (8 and 32 of
 // them); and of 1 and 4 streams of 8 to 128 rays, whose first ops run in the stream loop
@@ -111,7 +122,10 @@ struct OneRaySample {
 // each repetition of a batch the other rays are traversed in a new order, so that a branch
 // predictor meets the batch as a frame's traversals, which never repeat.
 std::vector<OneRaySample> run_one_ray_microbenchmarks(
-    Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1);
+    Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1,
+    const PredictorReplay& predictor_replay = {});
+// Their scene: the synthetic scene with its floor cut into 16 x 16 quads and 16 spheres.
+Scene one_ray_microbench_scene();
 
 // The field-read and compress rates by themselves: TSC ticks per lane of the box kernel's read
 // of 7 fields for `lanes` ids over `slots` records (contiguous or random slots) with a box every

@@ -10,6 +10,7 @@
 
 #include "hw_model/ray_buffer_model.h"
 #include "kernels/bvh.h"
+#include "sweeps/point_group.h"
 #include "tests/hw_model/test_hosts.h"
 #include "workloads/scene_loader.h"
 
@@ -35,7 +36,25 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     for (const auto& [kind, samples] : by_kind)
         costs.push_back(fit_op_cost(to_string(kind), host.simd_width, samples));
     // Traversals: only the traversal's kinds, each made, and their fitted cost.
-    const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(isa, microbench_rule(3));
+    // With the model's predictor replayed on each batch after the other rays (displaced) and,
+    // for comparison, right after itself (primed: the batch three times, the last counted).
+    const std::vector<uint8_t> leaves = bvh_leaves(Bvh(one_ray_microbench_scene()));
+    double primed_mispredictions = 0.0;
+    const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(
+        isa, microbench_rule(3), 1,
+        [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
+            primed_mispredictions +=
+                replay_short_stream_predictor(batch, batch, isa_width(isa), leaves);
+            return replay_short_stream_predictor(others, batch, isa_width(isa), leaves);
+        });
+    double displaced_mispredictions = 0.0;
+    for (const OneRaySample& s : one_ray) {
+        CHECK(s.modelled_mispredictions >= 0.0);
+        displaced_mispredictions += s.modelled_mispredictions;
+    }
+    INFO("mispredictions on the batches: primed " << primed_mispredictions << ", displaced "
+                                                  << displaced_mispredictions);
+    CHECK(displaced_mispredictions > 2.0 * primed_mispredictions);
     const bool wide = isa_width(isa) >= k_few_ray_min_width;
     std::map<OpKind, uint64_t> made, few, streamed, streamed_short;
     double one_ray_cycles = 0;
@@ -97,6 +116,12 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(streamed[OpKind::box_test] > 0);
     const std::vector<OneLaneSample> short_streams =
         short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib);
+    // The model's mispredictions priced before the fit, at the cost given.
+    const std::vector<OneLaneSample> net =
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, 50.0);
+    for (size_t i = 0; i < one_ray.size(); ++i)
+        CHECK(net[i].stream_op_cycles == Approx(short_streams[i].stream_op_cycles +
+                                                50.0 * one_ray[i].modelled_mispredictions));
     for (size_t i = 0; i < one_ray.size(); ++i) {
         CHECK((short_streams[i].stream_op_cycles > 0) == !one_ray[i].stream_ops.empty());
         // The stream loop's box tests counted for the fit of their per-op cost, the leaves' not.
