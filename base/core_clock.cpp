@@ -21,19 +21,19 @@ namespace {
 // Eight adds of the ruler beside one link of each vector chain, in the registers R (ymm, zmm);
 // registers 2 and 3 hold 1.0f (so vmulps never meets a denormal), register 1 anything; `step`
 // is the ruler's addend.
-#define SFX_VECTOR_CLOCK_LOOP(R)                                                       \
-    asm volatile("vbroadcastss %0, %%" R "2\n\tvbroadcastss %0, %%" R "3" ::"m"(k_one) \
-                 : "xmm2", "xmm3");                                                    \
-    start = __rdtsc();                                                                 \
-    for (uint64_t i = 0; i < adds / 8; ++i)                                            \
-    asm volatile("add %1, %0\n\tvpaddd %%" R "1, %%" R "0, %%" R                       \
-                 "0\n\tadd %1, %0\n\t"                                                 \
-                 "vmulps %%" R "3, %%" R "2, %%" R                                     \
-                 "2\n\tadd %1, %0\n\tadd %1, %0\n\t"                                   \
-                 "add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"                \
-                 : "+r"(x)                                                             \
-                 : "r"(step)                                                           \
-                 : "xmm0", "xmm2")
+// clang-format off
+#define SFX_VECTOR_CLOCK_LOOP(R)                                                                \
+    asm volatile("vbroadcastss %0, %%" R "2\n\tvbroadcastss %0, %%" R "3" ::"m"(k_one)          \
+                 : "xmm2", "xmm3");                                                             \
+    start = __rdtsc();                                                                          \
+    for (uint64_t i = 0; i < adds / 8; ++i)                                                     \
+        asm volatile("add %1, %0\n\tvpaddd %%" R "1, %%" R "0, %%" R "0\n\tadd %1, %0\n\t"        \
+                     "vmulps %%" R "3, %%" R "2, %%" R "2\n\tadd %1, %0\n\tadd %1, %0\n\t"       \
+                     "add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"                      \
+                     : "+r"(x)                                                                  \
+                     : "r"(step)                                                                \
+                     : "xmm0", "xmm2")
+// clang-format on
 
 uint64_t chain_ticks(uint32_t lanes, uint64_t adds, uint64_t seed) {
     uint64_t x = seed;
