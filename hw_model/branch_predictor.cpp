@@ -225,6 +225,19 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
     }
 }
 
+namespace {
+
+// `pass`'s traversal branches through `predictor`: the mispredictions they add.
+uint64_t mispredictions_replaying(const PassBuffer& pass, const std::vector<TraversalLoop>& loops,
+                                  uint32_t width, const std::vector<uint8_t>& node_leaf,
+                                  TagePredictor& predictor, std::vector<uint32_t>& scratch) {
+    const uint64_t before = predictor.mispredictions();
+    replay_traversal_branches(pass, loops, width, node_leaf, predictor, scratch);
+    return predictor.mispredictions() - before;
+}
+
+}  // namespace
+
 PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& batches,
                                           uint32_t width, const std::vector<uint8_t>& node_leaf,
                                           uint32_t repetitions) {
@@ -233,9 +246,8 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
     TagePredictor predictor;
     std::vector<uint32_t> scratch;
     auto run = [&](size_t b) {
-        const uint64_t before = predictor.mispredictions();
-        replay_traversal_branches(*batches[b], loops[b], width, node_leaf, predictor, scratch);
-        return predictor.mispredictions() - before;
+        return mispredictions_replaying(*batches[b], loops[b], width, node_leaf, predictor,
+                                        scratch);
     };
     PredictorStates states;
     const uint64_t start = predictor.branches();
@@ -264,6 +276,19 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
         states.displaced += fewest;
     }
     return states;
+}
+
+uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& batch, uint32_t width,
+                                  const std::vector<uint8_t>& node_leaf) {
+    TagePredictor predictor;
+    std::vector<uint32_t> scratch;
+    const std::vector<TraversalLoop> others_loops = traversal_loops(others, width);
+    // The others twice: the first run warms the fresh predictor, as a core's is warm by the
+    // time a batch is timed; the second is the run before the timed one.
+    for (int run = 0; run < 2; ++run)
+        mispredictions_replaying(others, others_loops, width, node_leaf, predictor, scratch);
+    return mispredictions_replaying(batch, traversal_loops(batch, width), width, node_leaf,
+                                    predictor, scratch);
 }
 
 double fit_mispredict_cycles(const std::vector<double>& extra_cycles,

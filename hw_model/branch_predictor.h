@@ -87,6 +87,12 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
                                           uint32_t width, const std::vector<uint8_t>& node_leaf,
                                           uint32_t repetitions = 5);
 
+// The model's side of a short-stream microbenchmark sample (run_one_ray_microbenchmarks,
+// kernels/stream/stream_microbench.h): a fresh predictor over the other rays' traversals
+// (twice, the first warming it), then over the batch's; the batch's mispredictions.
+uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& batch, uint32_t width,
+                                  const std::vector<uint8_t>& node_leaf);
+
 // BranchPredictorConfig::mispredict_cycles from the branch microbenchmark: what the displaced
 // batches took beyond the cached ones (the predictor's part, measured) over the mispredictions
 // the model adds from primed to displaced, pooled over the samples (0 where it adds none).

@@ -85,22 +85,10 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
 double replay_short_stream_predictor(const TraversalRecorder& others,
                                      const TraversalRecorder& batch, uint32_t width,
                                      const std::vector<uint8_t>& node_leaf) {
-    TagePredictor predictor;
-    std::vector<uint32_t> scratch;
-    auto replay = [&](const PassBuffer& trace) {
-        const uint64_t before = predictor.mispredictions();
-        replay_traversal_branches(trace, traversal_loops(trace, width), width, node_leaf, predictor,
-                                  scratch);
-        return predictor.mispredictions() - before;
-    };
-    // The others twice: the first run warms the fresh predictor, as a core's is warm by the
-    // time a batch is timed; the second is the run before the timed one.
     PassBuffer others_trace, batch_trace;
     others(others_trace);
     batch(batch_trace);
-    replay(others_trace);
-    replay(others_trace);
-    return double(replay(batch_trace));
+    return double(simulate_displaced_batch(others_trace, batch_trace, width, node_leaf));
 }
 
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs) {

@@ -90,10 +90,9 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                     uint32_t width, uint32_t l1d_kib,
                                                     double mispredict_cycles = 0.0);
 
-// The model's branch predictor over a short-stream sample's traversals as the microbenchmark
-// times them: the other rays' traversals (twice, the first warming a fresh predictor), then the
-// batch's; the batch's mispredictions (run_one_ray_microbenchmarks' PredictorReplay, for a back end
-// of `width` lanes in the scene whose tree has leaves `node_leaf`).
+// run_one_ray_microbenchmarks' PredictorReplay: the sample's traces recorded and run through
+// the model's predictor as the microbenchmark times them (simulate_displaced_batch, for a back
+// end of `width` lanes in the scene whose tree has leaves `node_leaf`).
 double replay_short_stream_predictor(const TraversalRecorder& others,
                                      const TraversalRecorder& batch, uint32_t width,
                                      const std::vector<uint8_t>& node_leaf);
