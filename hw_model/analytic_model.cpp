@@ -217,8 +217,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const double fetch_cycles =
         std::max(0.0, expected_fetch_cycles(memory, c.clock.core_mhz, lines, &global_misses) -
                           double(scene_latency_in_costs(c)));
-    const double beyond_l1 =
-        slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()));
     const double words_per_core_cycle =
         double(c.interconnect.width_words) * c.clock.interconnect_mhz / c.clock.core_mhz;
     const double fill_bank =
@@ -261,13 +259,18 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const uint64_t groups = (uint64_t(length) + n - 1) / n;
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
         const double gathers = double(p.gather_words.size());
-        // Of the lanes beyond the L1D, those opening a page pay (lanes_opening_pages), here
-        // as expected of a stream of `length` random slots.
+        // Of the lanes beyond the L1D, those opening a page of the array the op reads pay
+        // (lanes_opening_pages), here as expected of a stream of `length` random slots.
+        const OpStage op_stage = stage_of(kind);
+        const double beyond_l1 =
+            slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()), op_stage);
         const double opening_share =
-            beyond_l1 > 0 ? expected_lanes_opening_pages(
-                                length, slots, slot_bytes_of(c.ray_buffer, layout.bytes())) /
-                                double(std::min(length, slots))
-                          : 0.0;
+            beyond_l1 > 0
+                ? expected_lanes_opening_pages(
+                      length, slots,
+                      lane_ray_bytes(op_stage, slot_bytes_of(c.ray_buffer, layout.bytes()))) /
+                      double(std::min(length, slots))
+                : 0.0;
         // The cycle model's pipeline in closed form. Groups spread over the units; each round
         // of them costs the slowest of execution, the access side's issue, and the shared
         // address units and interconnect. An op that partitions holds the next op back: the

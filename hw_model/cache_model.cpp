@@ -307,19 +307,23 @@ uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
     return level;
 }
 
-void SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now) {
-    if (bytes == 0) return;
+uint32_t SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t bytes,
+                                       uint64_t now) {
+    if (bytes == 0) return 0;
     const uint32_t levels = level_count();
+    uint32_t farthest = 0;
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line) {
         const uint64_t at = line * m_line_bytes;
         use_page(core, at);
-        if (m_shared)
-            m_shared->level_of(m_reader, at);
-        else
-            first_holding(levels, at, now - std::min(now, m_paused),
-                          [&](uint32_t l) -> SetAssociativeCache& { return instance(l, core); });
+        const uint32_t level = m_shared ? m_shared->level_of(m_reader, at)
+                                        : first_holding(levels, at, now - std::min(now, m_paused),
+                                                        [&](uint32_t l) -> SetAssociativeCache& {
+                                                            return instance(l, core);
+                                                        });
+        farthest = std::max(farthest, level);
     }
+    return farthest;
 }
 
 void SceneMemoryModel::warm(uint32_t core, uint64_t address, uint32_t bytes) {

@@ -158,7 +158,9 @@ class SceneMemoryModel {
     // Lines of other data than the scene's that `core` reads at cycle `now` through the same
     // caches (a CPU core's ray buffers, storage l1d): they take their place in every level as a
     // read's do, and evict scene lines; not counted among the scene's hits and misses, untimed.
-    void touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now);
+    // Returns the farthest level any of them came from (0: every line was in the first level;
+    // level_count(): DRAM).
+    uint32_t touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now);
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
 

@@ -75,6 +75,8 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_group_scene_offset.assign(n, k_none);
     m_group_scene_ready.clear();
     m_group_lane_stall.clear();
+    m_group_beyond_offset.assign(n, k_none);
+    m_group_beyond_lanes.clear();
     m_groups_left.assign(n, 0);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
@@ -95,38 +97,49 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
                                   m_mispredicted);
         for (const uint32_t m : m_mispredicted) m_timing.branch_mispredictions += m;
     }
-    m_beyond_l1 = slots_beyond_l1(m_config.ray_buffer, m_record_bytes, pass->pass().slot_count);
 }
 
-void CoreModel::touch_ray_lines(const StreamOp& op, uint64_t now) {
+void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now) {
     // The ray buffers of a core whose buffers are its L1D (storage l1d: the native tracer's
     // RayBuffers, kernels/stream/stream_tracer.cpp) are read through the same caches as the
-    // scene data, and evict it: a traversal or intersection op reads each lane's traversal
-    // record (16 floats, one line: traversal_field in kernels/stream/stream_kernels.h), a
-    // shading op its whole slot. They lie in an address range of their own, far above any
+    // scene data, and evict it: each lane's lane_ray_bytes (a traversal record, one line, or
+    // a whole slot). They lie in an address range of their own, far above any
     // scene's (SceneDataMap), slot after slot; a line the lane before touched last is not
     // touched again. A tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5
     // core's L2.
     constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
     constexpr uint64_t k_line = 64;
     const bool record = op.stage != OpStage::shading;
-    const uint64_t bytes = record ? k_line : slot_bytes_of(m_config.ray_buffer, m_record_bytes);
-    uint64_t last = ~uint64_t(0);  // the line touched last
+    const uint64_t bytes =
+        lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));
+    // A lane pays for its ray data beyond the L1D (beyond_l1_per_lane_cycles) where the caches
+    // did not hold a line of it in the first level and it opens a 4 KiB page of its array (the
+    // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes); counted
+    // per group. The fit expects the same of its microbenchmarks (beyond_l1_share).
+    const uint32_t n = width();
+    m_group_beyond_offset[index] = m_group_beyond_lanes.size();
+    uint64_t last = ~uint64_t(0), last_page = ~uint64_t(0);  // the line and page touched last
     for (uint32_t i = 0; i < op.length; ++i) {
+        if (i % n == 0) m_group_beyond_lanes.push_back(0);
         const uint64_t address = (record ? k_records : k_slots) + op.slots[i] * bytes;
         const uint64_t first_line = address / k_line, last_line = (address + bytes - 1) / k_line;
         const uint64_t from = first_line == last ? first_line + 1 : first_line;
-        if (from <= last_line)
-            m_scene_memory->touch_other(m_core, from * k_line,
-                                        uint32_t((last_line - from + 1) * k_line), now);
+        const uint32_t level =
+            from <= last_line
+                ? m_scene_memory->touch_other(m_core, from * k_line,
+                                              uint32_t((last_line - from + 1) * k_line), now)
+                : 0;
+        const uint64_t page = address / k_prefetch_page_bytes;
+        if (level > 0 && page != last_page) ++m_group_beyond_lanes.back();
         last = last_line;
+        last_page = page;
     }
 }
 
 void CoreModel::dispatch_op(uint32_t index, uint64_t now) {
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
-    if (m_l1d && op.slots) touch_ray_lines(op, now);
+    if (m_l1d && op.slots) touch_ray_lines(index, op, now);
     const uint32_t n = width();
     const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
     const uint64_t mix_before = m_timing.mix.total();
@@ -338,12 +351,10 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     uint32_t passed = 0;
     if (p.measured)
         for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
-    // Of the lanes beyond the L1D, those opening a page pay (lanes_opening_pages).
+    // The share of its lanes that pay for ray data beyond the L1D (touch_ray_lines).
     const double beyond_l1 =
-        m_beyond_l1 > 0 && op.slots && t.lanes > 0
-            ? m_beyond_l1 *
-                  lanes_opening_pages(op.slots, t.first, t.lanes,
-                                      slot_bytes_of(m_config.ray_buffer, m_record_bytes)) /
+        m_group_beyond_offset[t.op] != k_none && t.lanes > 0
+            ? double(m_group_beyond_lanes[m_group_beyond_offset[t.op] + t.first / width()]) /
                   double(t.lanes)
             : 0.0;
     // Fractional measured cycles: the unit carries the remainder to its next group.

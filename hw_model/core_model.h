@@ -84,7 +84,7 @@ class CoreModel {
     const PassBuffer& pass() const { return *m_pass; }
 
   private:
-    void touch_ray_lines(const StreamOp& op, uint64_t now);
+    void touch_ray_lines(uint32_t op, const StreamOp& stream_op, uint64_t now);
     // Books `words` for `lanes` slots of `buffer` (0: current generation, 1: next), one word's
     // requests per cycle at the earliest, from `issue`; returns the cycle the last word's data
     // is out of its bank.
@@ -108,7 +108,6 @@ class CoreModel {
     bool m_mesh_hits;         // scene_memory.hit_reads mesh
     uint32_t m_record_bytes;  // the scene's ray record (a slot, unless ray_buffer.slot_bytes)
     uint64_t m_scene_hidden;  // scene-data latency already inside measured costs (L1D hit)
-    double m_beyond_l1 = 0.0; // the current pass's share of slots beyond an l1d buffer
     RayBufferModel m_layout;
     BankSchedule m_banks[2];  // the current generation's buffer and the next one's
     CapacityServer m_agu, m_interconnect, m_scratchpad;
@@ -126,6 +125,11 @@ class CoreModel {
     std::vector<uint64_t> m_group_scene_ready;
     // A CPU core (m_l1d) instead: per such group, the cycles its lanes' reads add.
     std::vector<uint64_t> m_group_lane_stall;
+    // Per op whose ray lines a CPU core reads (touch_ray_lines): where its groups' entries start
+    // in m_group_beyond_lanes (k_none otherwise); per such group, its lanes that pay for ray data
+    // beyond the L1D.
+    std::vector<size_t> m_group_beyond_offset;
+    std::vector<uint32_t> m_group_beyond_lanes;
     static constexpr size_t k_none = ~size_t(0);
     // When the scene data a group waits for (its op's, its lanes') has arrived.
     uint64_t scene_ready(const GroupToken& t) const;

@@ -495,20 +495,23 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "# Microarchitecture (cpuid): " << describe(h.microarchitecture) << "\n"
       << "# Measured on CPU " << h.cpu << " (sched_getcpu): check it pinned to the same CPU\n"
       << "version: 1\nname: host\nclock:\n"
-      << "  core_mhz: " << fmt(c.clock.core_mhz, 3)
-      << "  # measured: a chain of dependent " << clock_chain_name(h.simd_width)
-      << " (one a core cycle, the back end's own) against the TSC ("
-      << fmt(h.tsc_mhz, 3) << " MHz, over 0.2 s of the steady clock); op costs are core cycles\n"
+      << "  core_mhz: " << fmt(c.clock.core_mhz, 3) << "  # measured: a chain of dependent "
+      << clock_chain_name(h.simd_width)
+      << " (one a core cycle, the back end's own) against the TSC (" << fmt(h.tsc_mhz, 3)
+      << " MHz, over 0.2 s of the steady clock); op costs are core cycles\n"
       << "  interconnect_mhz: " << fmt(c.clock.core_mhz, 3)
       << "  # one clock (unused: storage l1d has no interconnect)\n"
       << "simd:\n  width: " << h.simd_width << "  # cpuid: " << h.isa << "\n"
       << "  units: 1  # the native tracer runs its filters on one core's vector unit\n"
       << "cores:\n  count: 1  # measured single-threaded, one pinned thread\n"
       << "  op_window: 1  # the native tracer's next op waits for the current op's pass count\n"
-      << "                # (its loop bound); on an AVX2 host's conference cells (2026-11-25) 1, 2\n"
+      << "                # (its loop bound); on an AVX2 host's conference cells (2026-11-25) 1, "
+         "2\n"
       << "                # and 4 gave frame MAE 9.2, 8.6 and 8.5 %, apart by less than the noise\n"
       << "ray_buffer:\n"
-      << "  kib: " << c.ray_buffer.kib << "  # the L1D holds the ray buffers: "
+      << "  kib: " << c.ray_buffer.kib
+      << "  # the L1D holds the ray buffers (the closed form's share beyond it; the cycle level "
+         "asks scene_memory's first level): "
       << (h.caches.empty() ? "assumed" : h.caches.front().source) << "\n"
       << "  banks: 1  # no banks: the L1D serves the filters' loads (storage: l1d)\n"
       << "  line_words: " << c.ray_buffer.line_words << "  # the L1D line\n"

@@ -399,11 +399,12 @@ struct BranchPredictorConfig {
 // hw_model/op_costs.h, the one place an op is priced), fitted
 // by `sfx calibrate --describe-host` on microbenchmarks of the native filters on synthetic
 // streams, never on frames. An op of n lanes in g = ceil(n / simd.width) groups, p passing,
-// whose ray buffer is a fraction f beyond the L1D, with o of its lanes opening a 4 KiB page
-// (their slot in another page than the lane before it's: the prefetchers cover the rest,
-// hw_model/ray_buffer_model.h lanes_opening_pages), costs
+// b of its lanes paying for ray data beyond the L1D (their line not in it, and their slot in
+// another 4 KiB page of the array the op reads than the lane before it's: the prefetchers
+// cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
+// hw_model/ray_buffer_model.h beyond_l1_share), costs
 //   per_op + per_group * g + per_lane * n + per_pass * p + per_minority_lane * min(p, n - p)
-//   + beyond_l1_per_lane * f * o cycles
+//   + beyond_l1_per_lane * b cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
 // predictor's misses, which on outcomes in no order are the lanes of the rarer outcome; the
 // microbenchmarks time streams of mixed outcomes, and of every lane passing and of none),

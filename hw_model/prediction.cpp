@@ -186,6 +186,15 @@ std::vector<Stat> Prediction::stats() const {
         add("branch_predictor.cycles", double(timing.branch_cycles), "cycles",
             "unit-cycles the mispredictions cost (part of the busy cycles)");
     }
+    if (config.ray_buffer.storage == "l1d") {
+        // A CPU core's traversal by the native tracer's loop (TraversalLoop, kernels/trace.h):
+        // what `sfx calibrate --check` compares with the tracer's own clock.
+        const char* loops[3] = {"one_ray", "few_ray", "stream"};
+        for (int l = 0; l < 3; ++l)
+            add(std::string("traversal_loop_cycles.") + loops[l],
+                double(timing.traversal_loop_cycles[l]) * unit_scale, "cycles",
+                std::string("box tests' unit-cycles in the native tracer's ") + loops[l] + " loop");
+    }
     for (size_t i = 0; i < timing.cache_misses.size() && i < config.scene_memory.caches.size(); ++i)
         add("scene_cache." + config.scene_memory.caches[i].name + ".misses",
             double(timing.cache_misses[i]), "accesses",

@@ -94,23 +94,23 @@ double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib)
 }
 
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
-                             uint32_t slot_bytes) {
-    auto page = [&](uint32_t i) { return uint64_t(slots[i]) * slot_bytes / k_prefetch_page_bytes; };
+                             uint32_t lane_bytes) {
+    auto page = [&](uint32_t i) { return uint64_t(slots[i]) * lane_bytes / k_prefetch_page_bytes; };
     uint32_t opening = 0;
     for (uint32_t i = first; i < first + lanes; ++i) opening += i == 0 || page(i) != page(i - 1);
     return opening;
 }
 
-double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t slot_bytes) {
+double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lane_bytes) {
     lanes = std::min(lanes, slots);
-    if (lanes == 0 || slot_bytes == 0) return 0.0;
+    if (lanes == 0 || lane_bytes == 0) return 0.0;
     double pages = 0.0;
     for (uint32_t s = 0; s < slots;) {
         // The slots starting in s's page: untouched with probability C(slots - k, lanes) /
         // C(slots, lanes).
-        const uint64_t page = uint64_t(s) * slot_bytes / k_prefetch_page_bytes;
+        const uint64_t page = uint64_t(s) * lane_bytes / k_prefetch_page_bytes;
         uint32_t k = 0;
-        while (s + k < slots && uint64_t(s + k) * slot_bytes / k_prefetch_page_bytes == page) ++k;
+        while (s + k < slots && uint64_t(s + k) * lane_bytes / k_prefetch_page_bytes == page) ++k;
         double untouched = 1.0;
         for (uint32_t j = 0; j < k && untouched > 0.0; ++j)
             untouched *= std::max(0.0, double(slots) - lanes - j) / double(slots - j);
@@ -120,19 +120,26 @@ double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t slo
     return pages;
 }
 
-double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib) {
+uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes) {
+    return stage == OpStage::shading ? slot_bytes : k_traversal_record_bytes;
+}
+
+double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                       uint32_t l1d_kib) {
     if (lanes == 0) return 0.0;
     return beyond_l1_fraction(slots, slot_bytes, l1d_kib) *
-           expected_lanes_opening_pages(lanes, slots, slot_bytes) / double(std::min(lanes, slots));
+           expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {
     return buffer.slot_bytes ? buffer.slot_bytes : record_bytes;
 }
 
-double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots) {
+double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
+                       OpStage stage) {
     if (buffer.storage != "l1d") return 0.0;
-    return beyond_l1_fraction(slots, slot_bytes_of(buffer, record_bytes), buffer.kib);
+    return beyond_l1_fraction(slots, lane_ray_bytes(stage, slot_bytes_of(buffer, record_bytes)),
+                              buffer.kib);
 }
 
 }  // namespace sfx

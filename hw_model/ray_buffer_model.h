@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "hw_model/hw_config.h"
+#include "kernels/trace.h"
 
 namespace sfx {
 
@@ -121,24 +122,38 @@ double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib)
 // whose slot starts in another page than the lane before it's (a stream's slots ascend) waits
 // for its line, and the lanes after it in that page find theirs prefetched.
 constexpr uint32_t k_prefetch_page_bytes = 4096;
-// How many of the lanes [first, first + lanes) of a stream of `slots` (ascending) open a page:
-// their slot starts in another page than the slot before it's (the stream's first lane does).
+// How many of the lanes [first, first + lanes) of a stream of `slots` (ascending) open a page
+// of an array of `lane_bytes` a slot: their slot starts in another page than the slot before
+// it's (the stream's first lane does).
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
-                             uint32_t slot_bytes);
+                             uint32_t lane_bytes);
 // The same expected of a stream of `lanes` slots drawn at random from `slots` (the pages the
 // stream touches: each page's share untouched is hypergeometric).
-double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t slot_bytes);
-// A random stream's share of lanes that pay for a buffer beyond the L1D, as the op costs' fit
-// prices its microbenchmarks and the closed form a frame's ops: those opening a page
-// (expected), times beyond_l1_fraction. On this project's AMD host (2026-11-28) the dense
-// streams of a frame paid nearly none of what its sparse microbenchmark streams did: priced
-// by beyond_l1_fraction alone, cornell's 64 x 64 frames came out 7-15 % over the measured.
-double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
+double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lane_bytes);
+// The bytes of its slot a lane of an op of `stage` reads on a CPU core (the native tracer's
+// per-slot arrays, kernels/stream/stream_tracer.cpp): a traversal or intersection op its
+// traversal record (16 floats, one line: traversal_field in kernels/stream/stream_kernels.h,
+// which sweeps/host_calibration.cpp checks), a shading op its whole slot (`slot_bytes`). Its
+// pages are those of that array.
+constexpr uint32_t k_traversal_record_bytes = 64;
+uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
+// A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit
+// prices its microbenchmarks: those opening a page of the array of `lane_bytes` a slot the op
+// reads (expected), times beyond_l1_fraction of the whole slots (`slot_bytes`: the
+// microbenchmarks read every array of the buffer before they time, so the L1D holds a share of
+// each). The cycle level asks its caches instead (CoreModel::touch_ray_lines). On this
+// project's AMD host (2026-11-28) the dense streams of a frame paid nearly none of what its
+// sparse microbenchmark streams did: priced by beyond_l1_fraction alone, cornell's 64 x 64
+// frames came out 7-15 % over the measured.
+double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                       uint32_t l1d_kib);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);
-// The same for a configuration's buffer and a pass of `slots` slots of slot_bytes_of; 0 for
-// banked buffers.
-double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots);
+// The closed form's share of a pass's `slots` slots beyond an l1d buffer for an op of `stage`:
+// beyond_l1_fraction of the array it reads (lane_ray_bytes of slot_bytes_of), as if that array
+// alone filled the L1D; 0 for banked buffers.
+double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
+                       OpStage stage);
 
 }  // namespace sfx

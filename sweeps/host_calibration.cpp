@@ -16,12 +16,16 @@
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
+#include "kernels/stream/stream_kernels.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
 
 namespace sfx {
 
 namespace {
+
+// The cost model's traversal record is the native tracer's (hw_model/ray_buffer_model.h).
+static_assert(k_traversal_record_bytes == traversal_field::record * sizeof(float));
 
 // Whose per-op cost in a traversal the traversal samples measure: the box test's. A leaf test
 // follows a box test nearly always in them, so the two per-op costs cannot be told apart (with
@@ -73,9 +77,12 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
             }
             sample.stream_op_cycles +=
                 double(o.count) *
-                measured_op_cycles(priced, width, o.lanes,
-                                   uint32_t(std::lround(double(o.passed) / double(o.count))),
-                                   beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(), l1d_kib));
+                measured_op_cycles(
+                    priced, width, o.lanes,
+                    uint32_t(std::lround(double(o.passed) / double(o.count))),
+                    beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(),
+                                    lane_ray_bytes(stage_of(o.kind), stream_slot_bytes()),
+                                    l1d_kib));
         }
         out.push_back(sample);
     }
@@ -181,7 +188,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             continue;
         }
         by_kind[s.kind].push_back(
-            {s.lanes, s.passed, beyond_l1_share(s.lanes, s.slots, slot_bytes, l1d), s.cycles});
+            {s.lanes, s.passed,
+             beyond_l1_share(s.lanes, s.slots, slot_bytes,
+                             lane_ray_bytes(stage_of(s.kind), slot_bytes), l1d),
+             s.cycles});
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {

@@ -409,24 +409,22 @@ TEST_CASE("The machine model times a host: measured costs, scene data beyond the
     // One box test of 20 lanes (groups of 16 and 4) on node 3, first touched: the line comes
     // from DRAM (81 ns at 1 GHz, then 64 bytes at 25.6 B/cycle: ready at cycle 84), less the
     // L1D hit the measured cost already holds (1): the unit waits 83 cycles, then issues
-    // 10 + 4 and 4 cycles. A second pass finds the node in the L1D: 18 cycles.
+    // 10 + 4 and 4 cycles, and the first lane pays 8 for its traversal record, not yet in the
+    // L1D (the other 19 lie in the same 4 KiB page). A second pass finds the node and the
+    // records in the L1D: 18 cycles.
     const FrameTiming one = time_boxes(host, 1, 20);
-    CHECK(one.cycles == 83 + 18);
+    CHECK(one.cycles == 83 + 18 + 8);
     CHECK(one.stalls.scene_memory == 83);
     CHECK(one.stages[0][size_t(OpStage::traversal)].scene_memory_cycles == 83);
-    CHECK(one.stages[0][size_t(OpStage::traversal)].busy_cycles == 18);
+    CHECK(one.stages[0][size_t(OpStage::traversal)].busy_cycles == 18 + 8);
     const FrameTiming two = time_boxes(host, 2, 20);
-    CHECK(two.cycles == 83 + 18 + 18);
+    CHECK(two.cycles == 83 + 18 + 8 + 18);
     CHECK(two.stalls.scene_memory == 83);
     // Compress partitions inside the groups: no partition pass, no partition stall.
     CHECK(two.stalls.partition == 0);
     CHECK(two.actions.busy_cycles[size_t(HwUnit::partition)] == 0);
-
-    // 4096 slots of 64 bytes (256 KiB) behind a 32 KiB L1D: 7/8 of the buffer beyond it, at
-    // 8 cycles a lane that opens a 4 KiB page. Slots 0-19 lie in one page: only the first
-    // lane pays, 7 cycles; slots 64 apart each open one: 20 * 7/8 * 8 = 140.
-    CHECK(time_boxes(host, 1, 20, 4096).cycles == 83 + 18 + 7);
-    CHECK(time_boxes(host, 1, 20, 4096, 3, 64).cycles == 83 + 18 + 140);
+    // Slots 64 apart: each lane's record opens a page, 20 * 8 = 160 the first time.
+    CHECK(time_boxes(host, 1, 20, 4096, 3, 64).cycles == 83 + 18 + 160);
 
     // A one-ray stream costs its one-lane cost.
     HwConfig one_lane = host;
@@ -468,6 +466,31 @@ TEST_CASE("A host's ray buffers share its caches with the scene data", "[host][s
     CHECK(fat.stages[0][size_t(OpStage::traversal)].scene_memory_cycles == 2 * 83);
 }
 
+TEST_CASE(
+    "A lane pays for ray data beyond the L1D where its caches do not hold its line and it "
+    "opens a page",
+    "[host][systemc]") {
+    // Box tests of 1024 lanes on slots 0-1023: their traversal records, 64 bytes each, fill
+    // 64 KiB in 16 pages. At 8 cycles a paying lane and 4 a group (64 groups), a pass costs
+    // 256 cycles, and 16 * 8 = 128 more wherever the L1D does not hold the records.
+    auto passes = [](uint32_t l1d_kib, uint32_t count) {
+        HwConfig host = host_with({cost("box_test", 0, 4, 0, 0, 8)});
+        host.scene_memory.caches[0].kib = l1d_kib;
+        return time_boxes(host, count, 1024, 1024).stages[0][size_t(OpStage::traversal)];
+    };
+    // A 32 KiB L1D holds half the records: each pass finds none of its lanes' lines (LRU
+    // over a cycle longer than it), so every pass pays for its 16 pages.
+    CHECK(passes(32, 2).busy_cycles == 2 * (256 + 128));
+    // A 128 KiB L1D keeps them: only the first pass pays.
+    CHECK(passes(128, 2).busy_cycles == 2 * 256 + 128);
+    // A shading op reads its whole slot: 16 slots of 64 bytes lie in one page, of 330 bytes
+    // in two, so one lane more pays.
+    const HwConfig host = host_with({cost("emission_filter", 0, 0, 0, 0, 8)});
+    HwConfig fat = host;
+    fat.ray_buffer.slot_bytes = 330;
+    CHECK(time_surfaces(fat).cycles == time_surfaces(host).cycles + 8);
+}
+
 TEST_CASE("Each host knob moves the prediction the way it should", "[host][systemc]") {
     const HwConfig base = host_with({cost("box_test", 10, 4, 1, 0, 8)});
     const uint64_t cycles = time_boxes(base, 3, 40, 4096).cycles;
@@ -477,8 +500,6 @@ TEST_CASE("Each host knob moves the prediction the way it should", "[host][syste
         return time_boxes(c, 3, 40, 4096).cycles;
     };
     CHECK(with([](HwConfig& c) { c.scene_memory.dram_latency_ns = 200; }) > cycles);
-    CHECK(with([](HwConfig& c) { c.ray_buffer.kib = 128; }) < cycles);       // a bigger L1D
-    CHECK(with([](HwConfig& c) { c.ray_buffer.slot_bytes = 128; }) > cycles);  // fatter slots
     CHECK(with([](HwConfig& c) { c.op_costs[0].per_lane_cycles = 2; }) > cycles);
     CHECK(with([](HwConfig& c) { c.simd.width = 8; }) > cycles);  // more groups
     CHECK(with([](HwConfig& c) { c.scene_memory.caches[0].hit_latency_ns = 3; }) < cycles);
@@ -737,9 +758,16 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(expected_lanes_opening_pages(2, 4, 2048) == Approx(2 * (1.0 - 1.0 / 6.0)));
     CHECK(expected_lanes_opening_pages(0, 64, 330) == 0.0);
     // The share that pays: none within the L1D; beyond it, nearly every lane of a sparse
-    // stream and about one in twelve of a dense one (slots of 330 bytes).
-    CHECK(beyond_l1_share(64, 64, 330, 48) == 0.0);
+    // stream and about one in twelve of a dense one (a shading op: slots of 330 bytes).
+    CHECK(beyond_l1_share(64, 64, 330, 330, 48) == 0.0);
     const double f = beyond_l1_fraction(4096, 330, 48);
-    CHECK(beyond_l1_share(16, 4096, 330, 48) == Approx(f).epsilon(0.03));
-    CHECK(beyond_l1_share(4096, 4096, 330, 48) == Approx(f * 330 / 4096).epsilon(0.02));
+    CHECK(beyond_l1_share(16, 4096, 330, 330, 48) == Approx(f).epsilon(0.03));
+    CHECK(beyond_l1_share(4096, 4096, 330, 330, 48) == Approx(f * 330 / 4096).epsilon(0.02));
+    // A box test reads the traversal records, 64 to a page: a dense stream opens one page in
+    // 64 lanes, a sparse one of 16 lanes in 4096 slots (64 pages) still nearly every lane.
+    CHECK(lane_ray_bytes(OpStage::traversal, 330) == 64);
+    CHECK(lane_ray_bytes(OpStage::intersection, 330) == 64);
+    CHECK(lane_ray_bytes(OpStage::shading, 330) == 330);
+    CHECK(beyond_l1_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
+    CHECK(beyond_l1_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
 }

@@ -30,7 +30,9 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     for (const MicrobenchSample& s : run_stream_microbenchmarks(o))
         by_kind[s.kind].push_back(
             {s.lanes, s.passed,
-             beyond_l1_share(s.lanes, s.slots, stream_slot_bytes(), host.caches.front().kib),
+             beyond_l1_share(s.lanes, s.slots, stream_slot_bytes(),
+                             lane_ray_bytes(stage_of(s.kind), stream_slot_bytes()),
+                             host.caches.front().kib),
              s.cycles});
     std::vector<OpCostConfig> costs;
     for (const auto& [kind, samples] : by_kind)
