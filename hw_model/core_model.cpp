@@ -71,6 +71,7 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_pass_start = now;
     const size_t n = pass->size();
     m_scene_ready.assign(n, 0);
+    m_scene_arrival.assign(n, 0);
     m_scene_requested.assign(n, 0);
     m_group_scene_offset.assign(n, k_none);
     m_group_scene_ready.clear();
@@ -190,6 +191,7 @@ void CoreModel::dispatch_op(uint32_t index, uint64_t now) {
 void CoreModel::request_scene(uint32_t index, uint64_t now) {
     if (m_scene_requested[index]) return;  // prefetched: the earlier request stands
     m_scene_requested[index] = 1;
+    m_scene_arrival[index] = now;
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
     const uint32_t* hits = m_pass->lane_hits(index);
@@ -230,7 +232,15 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
     }
     const uint64_t ready =
         m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
+    m_scene_arrival[index] = ready;
     m_scene_ready[index] = std::max(now, ready - std::min(ready, m_scene_hidden));
+}
+
+void CoreModel::request_child_scene(uint32_t producer, uint32_t consumer, uint64_t now) {
+    const StreamOp parent = m_pass->at(producer), child = m_pass->at(consumer);
+    const bool from_index = parent.kind == OpKind::box_test && child.kind == OpKind::box_test &&
+                            child.object == left_child_index(parent.object);
+    request_scene(consumer, from_index ? now : std::max(now, m_scene_arrival[producer]));
 }
 
 uint64_t CoreModel::book_words(uint32_t buffer, const std::vector<uint32_t>& words,

@@ -52,6 +52,12 @@ class CoreModel {
     // Requests op's scene data (a node, primitive or material) at `now`, unless it was
     // requested before (prefetched).
     void request_scene(uint32_t op, uint64_t now);
+    // Requests the scene data of `consumer`, an op `producer`'s partition feeds, when
+    // `producer` is dispatched at `now` (scene_memory.prefetch_children): then if its address
+    // follows from the producer's object (a node's left child, left_child_index), else once the
+    // producer's own scene data has arrived, which holds it (a right child, a leaf's
+    // primitives).
+    void request_child_scene(uint32_t producer, uint32_t consumer, uint64_t now);
 
     // The access side of a group at `now`: id-stream read, address generation, gathers through
     // the banks and the interconnect. Fills token.data_ready and the excess causes; returns the
@@ -117,6 +123,7 @@ class CoreModel {
     const PassBuffer* m_pass = nullptr;
     uint64_t m_pass_start = 0;
     std::vector<uint64_t> m_scene_ready;    // per op
+    std::vector<uint64_t> m_scene_arrival;  // per op: when its own scene data arrived (or now)
     std::vector<uint8_t> m_scene_requested;  // per op: its scene data was requested
     // Per op that reads each lane's hit primitive: where its groups' entries start in
     // m_group_scene_ready, or m_group_lane_stall on a CPU core (k_none otherwise); per such

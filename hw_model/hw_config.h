@@ -299,7 +299,8 @@ struct SceneMemoryConfig {
                 0u, 1024u);
         v.param("prefetch_children", prefetch_children, "",
                 "request the scene data of the ops an op's partition feeds (a node's children, "
-                "a leaf's primitives) when it is dispatched");
+                "a leaf's primitives) when it is dispatched, or, where its scene data holds "
+                "their address (a right child, a leaf's primitives), once that has arrived");
         v.choice("hit_reads", hit_reads, {"primitives", "mesh"},
                  "where a lane's hit primitive is read when its surface is computed: "
                  "primitives (the record its intersection test fetched) or mesh (separate "

@@ -9,6 +9,7 @@
 #include "base/huge_pages.h"
 #include "kernels/intersect.h"
 #include "kernels/ray.h"
+#include "kernels/trace.h"
 #include "workloads/scene.h"
 
 namespace sfx {
@@ -23,7 +24,7 @@ struct alignas(32) BvhNode {
     uint8_t axis = 0;    // interior: split axis, for front-to-back order
 
     bool is_leaf() const { return count > 0; }
-    static uint32_t left(uint32_t index) { return index + 1; }
+    static uint32_t left(uint32_t index) { return left_child_index(index); }
     uint32_t right() const { return first; }
 };
 static_assert(sizeof(BvhNode) == 32, "BvhNode must stay 32 bytes");

@@ -130,6 +130,13 @@ inline bool is_option_kind(OpKind kind) {
 
 constexpr uint32_t k_no_object = 0xffffffffu;
 
+// The tracers' BVH is laid out depth first (kernels/bvh.h): a box test's node's left child is
+// stored right after it, so its index follows from the node's, while the right child's index
+// and a leaf's primitives are read from the node's record.
+constexpr uint32_t left_child_index(uint32_t node) {
+    return node + 1;
+}
+
 // The native tracer's loops by stream length: a stream of one ray runs its whole subtree in the
 // one-ray loop (traverse_one), and, on back ends of k_few_ray_min_width lanes or more, a stream
 // of 2 to k_few_ray_lanes rays in the few-ray loop (traverse_few: the rays' box fields in one

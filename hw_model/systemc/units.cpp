@@ -123,7 +123,7 @@ void Core::dispatch() {
             for (; next_scene <= horizon; ++next_scene) m_model.request_scene(next_scene, now);
             if (children)
                 for (const uint32_t* c = pass->consumers_begin(i); c != pass->consumers_end(i); ++c)
-                    m_model.request_scene(*c, now);
+                    m_model.request_child_scene(i, *c, now);
             m_model.dispatch_op(i, now);
             ++m_outstanding;
             for (uint32_t first = 0; first < op.length; first += width) {

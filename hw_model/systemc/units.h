@@ -12,7 +12,8 @@
 // that does not partition leaves its stream as it was, so the next op's groups flow on: the
 // access side runs ahead of execution, decoupled access/execute). Scene data is requested as an
 // op is dispatched, or scene_memory.prefetch_depth ops earlier, or (prefetch_children) when the
-// op whose partition feeds it is dispatched.
+// op whose partition feeds it is dispatched (or, where that op's scene data holds its address,
+// once that has arrived: CoreModel::request_child_scene).
 
 #include <deque>
 #include <memory>

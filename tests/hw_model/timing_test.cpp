@@ -413,14 +413,15 @@ TEST_CASE("A group's mask is stored when any lane passed (G&R Fig. 5)", "[hw_mod
 // A parent box test on 32 rays (node 1), 16 passing; its front child on those 16 (node 20;
 // half pass, so its own passing stream is a new one); the back child on the parent's 16 again
 // (node 40): the back child's stream comes from the parent, not from the front child.
-std::vector<CraftedOp> parent_and_children() {
+// A box test on node 1, then its children's on nodes `front` and `back`.
+std::vector<CraftedOp> parent_and_children(uint32_t front = 20, uint32_t back = 40) {
     const std::vector<uint32_t> all = consecutive(32), half = consecutive(16);
     std::vector<uint8_t> parent_pass(32, 0), child_pass(16, 0);
     for (uint32_t i = 0; i < 16; ++i) parent_pass[i] = 1;
     for (uint32_t i = 0; i < 16; i += 2) child_pass[i] = 1;
     return {{OpKind::box_test, all, parent_pass, 1},
-            {OpKind::box_test, half, child_pass, 20},
-            {OpKind::box_test, half, child_pass, 40}};
+            {OpKind::box_test, half, child_pass, front},
+            {OpKind::box_test, half, child_pass, back}};
 }
 
 TEST_CASE("An op window releases an op once the partition that produced its stream is done",
@@ -516,20 +517,34 @@ TEST_CASE("A box test's cycles go to the tracer loop its stream entered", "[hw_m
     CHECK(traversal_loop(3, 4, TraversalLoop::stream) == TraversalLoop::stream);
 }
 
-TEST_CASE("Prefetching an op's children requests the back child's node with the front child's",
-          "[hw_model][systemc]") {
-    // Every node first read from DRAM.
-    const std::vector<CraftedOp> ops = parent_and_children();
+TEST_CASE(
+    "Prefetching an op's children requests the back child's node before the front child "
+    "dispatches, once the parent's node, which holds its index, has arrived",
+    "[hw_model][systemc]") {
+    // Every node first read from DRAM. Node 1's left child is node 2 (left_child_index): its
+    // address follows from the parent's; node 40's is read from the parent's record.
+    const std::vector<CraftedOp> ops = parent_and_children(2, 40);
     HwConfig next_op, children;
     for (HwConfig* c : {&next_op, &children})
         c->scene_memory.dram_latency_ns = 2000;  // 1000 cycles: longer than any op here
     next_op.scene_memory.prefetch_depth = 1;
     children.scene_memory.prefetch_children = true;
     const FrameTiming a = time_passes(next_op, {ops}), b = time_passes(children, {ops});
-    // Both request the front child's node as the parent dispatches; only the children's
-    // prefetch requests the back child's node then too, not when the front child dispatches.
+    // Both request the front child's node as the parent dispatches; the children's prefetch
+    // requests the back child's node as the parent's arrives, not when the front child
+    // dispatches.
     CHECK(b.stalls.scene_memory < a.stalls.scene_memory);
     CHECK(b.cycles < a.cycles);
+    // One child: the left one's node arrives with its parent's; a right one's, requested once
+    // the parent's has arrived, a DRAM latency later.
+    auto first_child = [&](uint32_t node) {
+        std::vector<CraftedOp> two = parent_and_children(node, 40);
+        two.pop_back();
+        return time_passes(children, {two});
+    };
+    const FrameTiming left = first_child(2), right = first_child(20);
+    CHECK(right.cycles >= left.cycles + 900);
+    CHECK(right.stalls.scene_memory >= left.stalls.scene_memory + 900);
 }
 
 TEST_CASE("More units, more cores, deeper queues are never slower on the same trace",
