@@ -280,8 +280,11 @@ void add_calibrate_command(CLI::App& app) {
                 describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
                 cal.host.tsc_mhz, cal.host.core_mhz, clock_chain_name(cal.host.simd_width),
                 cal.host.caches.size(), pinned ? ", pinned" : ", NOT pinned");
-            std::printf("microbenchmarks: %u of %u points converged (%s)\n", cal.converged_points,
-                        cal.points, describe(bench_rule).c_str());
+            std::printf(
+                "microbenchmarks: %u of %u points converged (%s in each of %u sweeps, "
+                "judged over all)\n",
+                cal.converged_points, cal.points, describe(bench_rule).c_str(),
+                MicrobenchOptions().visits);
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "minority", "beyondL1", "fit med",
                         "fit max", "one_lane", "few_lane");

@@ -283,7 +283,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "also with every lane passing and with none, for its minority-lane cost), the "
          << "triangle and sphere tests through the traversal's leaf code, the fastest of "
          << "repetitions "
-         << "until " << describe(convergence) << " (" << c.converged_points << " of " << c.points
+         << "until " << describe(convergence) << " in each of " << options.visits
+         << " sweeps over the points, judged over all (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
          << "error; the triangle and sphere tests' one-lane costs their one-lane points' "
          << "median (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width

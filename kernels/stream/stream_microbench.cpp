@@ -252,277 +252,292 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         box_nodes.push_back(BvhNode::left(box_nodes[i]));
         box_nodes.push_back(node.right());
     }
-    uint32_t box_sample = 0;
-
-    for (OpKind kind : kinds) {
-        if (!options.kinds.empty() &&
-            std::find(options.kinds.begin(), options.kinds.end(), kind) == options.kinds.end())
-            continue;
-        for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
-            const uint32_t slots = options.buffer_slots[bi];
-            Buffers& b = buffers[bi];
-            TraversalJob job = traversal_job(bvh, b);  // the leaf tests' buffers
-            std::vector<uint32_t> order(slots), deal(slots);
-            std::iota(order.begin(), order.end(), 0u);
-            std::iota(deal.begin(), deal.end(), 0u);
-            std::vector<uint32_t> streams;
-            // The op of `kind` on the stream ids[0, n) (partitioned in place, as the tracer's
-            // filters leave it): its passing count. box_node: the box test's node.
-            auto run_op = [&](uint32_t* ids, uint32_t n, uint32_t box_node) {
-                uint32_t passed = 0;
-                uint8_t* mask = b.mask.data();
-                uint32_t* scratch = b.scratch.data();
-                NoTrace trace;
-                const uint32_t mat = 0;
-                auto run_filter = [&](auto&& test) {
-                    return filter(kernels, trace, kind, 1, mat, ids, n, mask, scratch, test);
-                };
-                // A made ray is set up for the next generation's traversal (the tracer's
-                // load_rays) by the op that made it, as the op table writes the whole ray
-                // (inverse direction included) with that op.
-                auto set_up = [&](uint32_t id, bool shadow) {
-                    set_up_ray(b.next[id], shadow, id, b.next_any_hit[id], b.next_hit[id],
-                               b.next_pre[id], b.next_trav);
-                    return true;
-                };
-                switch (kind) {
-                    case OpKind::camera:
-                        for (uint32_t i = 0; i < n; ++i) {
-                            const uint32_t slot = ids[i];
-                            PathState& p = b.path[slot];
-                            p = PathState{};
-                            p.key = {1, slot, 0};
-                            b.next[slot] = camera.generate(p.key);
-                            set_up(slot, false);
-                            mask[i] = 1;
-                        }
-                        passed = n;
-                        break;
-                    case OpKind::box_test: {
-                        // The tracer's box_filter with the trace off: the kernel, then
-                        // the failing ids copied back behind the passing ones.
-                        uint32_t negative = 0;
-                        const BvhNode& node = bvh.nodes()[box_node];
-                        passed = kernels.box_filter(b.trav.view(), node.bounds, node.axis, ids, n,
-                                                    ids, scratch, nullptr, negative);
-                        std::copy(scratch, scratch + (n - passed), ids + passed);
-                        break;
-                    }
-                    case OpKind::triangle_test:
-                        // A floor triangle (about half the rays) as a leaf of its own,
-                        // by the tracer's leaf code: the float stage, then the full
-                        // test of each candidate, the hits taken if closer.
-                        job.ids = ids;
-                        job.n = n;
-                        passed = kernels.leaf_tests(job, floor_leaf, 1, n);
-                        break;
-                    case OpKind::sphere_test:
-                        // The large glass sphere as a leaf of its own, likewise: the
-                        // test of each group, then its hits taken if closer.
-                        job.ids = ids;
-                        job.n = n;
-                        passed = kernels.leaf_tests(job, sphere_leaf, 1, n);
-                        break;
-                    case OpKind::shadow_filter:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.any_hit[id]) return false;
-                            finish_shadow(b.path[id], b.hit[id].valid());
-                            return true;
-                        });
-                        break;
-                    case OpKind::miss_filter:
-                        passed = run_filter([&](uint32_t id) {
-                            if (b.hit[id].valid()) return false;
-                            shade_miss(b.path[id], scene);
-                            return true;
-                        });
-                        break;
-                    case OpKind::emission_filter:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.hit[id].valid()) return false;  // misses left earlier
-                            b.surf[id] = surface_at(scene, b.ray[id], b.hit[id]);
-                            const Material& m = scene.materials[b.surf[id].material];
-                            if (!m.emissive()) return false;
-                            shade_emission(b.path[id], m);
-                            return true;
-                        });
-                        break;
-                    case OpKind::depth_filter: {
-                        uint32_t material_rays[4] = {0, 0, 0, 0};
-                        passed = run_filter([&](uint32_t id) {
-                            if (!may_scatter(b.path[id], 3)) return false;
-                            ++material_rays[b.surf[id].material & 3];
-                            return true;
-                        });
-                        break;
-                    }
-                    case OpKind::material_filter:
-                        passed =
-                            run_filter([&](uint32_t id) { return b.surf[id].material == mat; });
-                        break;
-                    case OpKind::ambient:
-                        passed = run_filter([&](uint32_t id) {
-                            add_ambient(b.path[id], scene.materials[b.surf[id].material],
-                                        ambient_scene);
-                            return true;
-                        });
-                        break;
-                    case OpKind::lambertian_choice:
-                        passed = run_filter([&](uint32_t id) {
-                            return lambertian_takes_direct(b.path[id], scene);
-                        });
-                        break;
-                    case OpKind::lambertian_direct:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.hit[id].valid()) return false;
-                            return lambertian_direct(b.path[id], scene, scene.materials[0],
-                                                     b.surf[id], b.next[id]) &&
-                                   set_up(id, true);
-                        });
-                        break;
-                    case OpKind::lambertian_indirect:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.hit[id].valid()) return false;
-                            return lambertian_indirect(b.path[id], scene, scene.materials[0],
-                                                       b.surf[id], b.next[id]) &&
-                                   set_up(id, false);
-                        });
-                        break;
-                    case OpKind::dielectric:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.hit[id].valid()) return false;
-                            return dielectric_scatter(b.path[id], scene.materials[2], b.surf[id],
-                                                      b.ray[id], b.next[id]) &&
-                                   set_up(id, false);
-                        });
-                        break;
-                    case OpKind::glossy:
-                        passed = run_filter([&](uint32_t id) {
-                            if (!b.hit[id].valid()) return false;
-                            return glossy_scatter(b.path[id], scene.materials[1], b.surf[id],
-                                                  b.ray[id], b.next[id]) &&
-                                   set_up(id, false);
-                        });
-                        break;
-                    // Not microbenchmarked (the host's seed-kernel ops); no default, so
-                    // a new kind (a new material's filter) is a compile error here.
-                    case OpKind::frustum_bounds:
-                    case OpKind::frustum_test:
-                    case OpKind::reorder_lod_test:
-                    case OpKind::reorder_key:
-                    case OpKind::reorder_sort:
-                    case OpKind::raygrid_walk:
-                    case OpKind::raygrid_enqueue:
-                    case OpKind::count:
-                        break;
-                }
-                return passed;
-            };
-            // The rays (saved, by index) that this shading op passes and those it fails: its
-            // streams are also timed with every lane passing and with none, since a frame's
-            // shading streams are filtered already and most of their lanes pass, while the
-            // buffer's mix alone fixes only one sum of a tested lane's cost and a passing
-            // one's. The same rays, dealt into the slots with repeats. A mixed stream takes
-            // the buffer's share of passing rays exactly, so that the several short streams
-            // of one timed repetition have the one pass count the sample records.
-            std::vector<uint32_t> passing, failing;
-            std::vector<uint8_t> passes(slots, 0);
-            if (stage_of(kind) == OpStage::shading) {
-                deal_rays(b, deal, true);  // deal is the identity here
-                std::vector<uint32_t> all(slots + k_stream_padding);
-                std::iota(all.begin(), all.begin() + slots, 0u);
-                const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
-                passing.assign(all.begin(), all.begin() + p);
-                failing.assign(all.begin() + p, all.begin() + slots);
-                for (uint32_t ray : passing) passes[ray] = 1;
-            }
-            const bool classified = !passing.empty() && !failing.empty();
-            std::vector<uint32_t> pass_slots, fail_slots;
-            enum class Deal { mixed, all_pass, none_pass };
-            std::vector<Deal> deals = {Deal::mixed};
-            if (classified) deals = {Deal::mixed, Deal::all_pass, Deal::none_pass};
-            for (const Deal dealt : deals)
-                for (uint32_t n : options.lengths) {
-                    if (n > slots) continue;
-                    std::vector<double> times;
+    // Each point's samples over the visits, in core cycles, by the point's place in the sweep
+    // (every visit sweeps the points in one order, the box test's nodes in the same turns).
+    std::vector<std::vector<double>> visited;
+    const uint32_t visits = std::max(1u, options.visits);
+    for (uint32_t visit = 0; visit < visits; ++visit) {
+        const bool last_visit = visit + 1 == visits;
+        uint32_t box_sample = 0;
+        size_t point = 0;
+        for (OpKind kind : kinds) {
+            if (!options.kinds.empty() &&
+                std::find(options.kinds.begin(), options.kinds.end(), kind) == options.kinds.end())
+                continue;
+            for (size_t bi = 0; bi < options.buffer_slots.size(); ++bi) {
+                const uint32_t slots = options.buffer_slots[bi];
+                Buffers& b = buffers[bi];
+                TraversalJob job = traversal_job(bvh, b);  // the leaf tests' buffers
+                std::vector<uint32_t> order(slots), deal(slots);
+                std::iota(order.begin(), order.end(), 0u);
+                std::iota(deal.begin(), deal.end(), 0u);
+                std::vector<uint32_t> streams;
+                // The op of `kind` on the stream ids[0, n) (partitioned in place, as the tracer's
+                // filters leave it): its passing count. box_node: the box test's node.
+                auto run_op = [&](uint32_t* ids, uint32_t n, uint32_t box_node) {
                     uint32_t passed = 0;
-                    const double ticks_per_cycle =
-                        tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(options.isa)));
-                    const uint32_t box_node = box_nodes[box_sample++ % box_nodes.size()];
-                    // Short streams run several times in the timed region (the TSC ticks in steps
-                    // of tens of cycles here), each time on other slots (an op changes its rays:
-                    // a hit tightens t, a shader moves the path on).
-                    const bool exact_mix = classified && dealt == Deal::mixed;
-                    const uint32_t stream_passing =
-                        exact_mix ? std::min<uint32_t>(
-                                        n, uint32_t(std::lround(double(n) * double(passing.size()) /
-                                                                double(slots))))
-                                  : 0;
-                    uint32_t inner = std::max(1u, std::min(256u, slots) / n);
-                    if (exact_mix) {
-                        if (stream_passing > 0)
-                            inner = std::min<uint32_t>(inner, passing.size() / stream_passing);
-                        if (n > stream_passing)
-                            inner =
-                                std::min<uint32_t>(inner, failing.size() / (n - stream_passing));
-                        inner = std::max(inner, 1u);
-                    }
-                    const uint32_t stride = n + k_stream_padding;
-                    streams.assign(size_t(inner) * stride, 0u);
-                    while (needs_more_samples(times, options.convergence)) {
-                        // Fresh random streams: n slots of the buffer each, in increasing order, as
-                        // the tracer's streams are (the camera's, and every stable partition of
-                        // one), with the rays dealt anew; the whole buffer touched in random order
-                        // first, so the L1D holds what a pass over this buffer leaves in it.
-                        std::shuffle(deal.begin(), deal.end(), rng);
-                        if (dealt != Deal::mixed) {
-                            const std::vector<uint32_t>& from =
-                                dealt == Deal::all_pass ? passing : failing;
-                            for (uint32_t& d : deal) d = from[rng() % from.size()];
-                        }
-                        deal_rays(b, deal, stage_of(kind) == OpStage::shading);
-                        std::shuffle(order.begin(), order.end(), rng);
-                        if (exact_mix) {
-                            pass_slots.clear();
-                            fail_slots.clear();
-                            for (uint32_t slot : order)
-                                (passes[deal[slot]] ? pass_slots : fail_slots).push_back(slot);
-                        }
-                        for (uint32_t j = 0; j < inner; ++j) {
-                            uint32_t* stream = streams.data() + size_t(j) * stride;
-                            if (exact_mix) {
-                                const size_t p = size_t(j) * stream_passing,
-                                             f = size_t(j) * (n - stream_passing);
-                                std::copy(pass_slots.begin() + p,
-                                          pass_slots.begin() + p + stream_passing, stream);
-                                std::copy(fail_slots.begin() + f,
-                                          fail_slots.begin() + f + (n - stream_passing),
-                                          stream + stream_passing);
-                            } else {
-                                // inner * n <= slots: the streams are disjoint.
-                                const auto first = order.begin() + size_t(j) * n;
-                                std::copy(first, first + n, stream);
+                    uint8_t* mask = b.mask.data();
+                    uint32_t* scratch = b.scratch.data();
+                    NoTrace trace;
+                    const uint32_t mat = 0;
+                    auto run_filter = [&](auto&& test) {
+                        return filter(kernels, trace, kind, 1, mat, ids, n, mask, scratch, test);
+                    };
+                    // A made ray is set up for the next generation's traversal (the tracer's
+                    // load_rays) by the op that made it, as the op table writes the whole ray
+                    // (inverse direction included) with that op.
+                    auto set_up = [&](uint32_t id, bool shadow) {
+                        set_up_ray(b.next[id], shadow, id, b.next_any_hit[id], b.next_hit[id],
+                                   b.next_pre[id], b.next_trav);
+                        return true;
+                    };
+                    switch (kind) {
+                        case OpKind::camera:
+                            for (uint32_t i = 0; i < n; ++i) {
+                                const uint32_t slot = ids[i];
+                                PathState& p = b.path[slot];
+                                p = PathState{};
+                                p.key = {1, slot, 0};
+                                b.next[slot] = camera.generate(p.key);
+                                set_up(slot, false);
+                                mask[i] = 1;
                             }
-                            std::sort(stream, stream + n);
+                            passed = n;
+                            break;
+                        case OpKind::box_test: {
+                            // The tracer's box_filter with the trace off: the kernel, then
+                            // the failing ids copied back behind the passing ones.
+                            uint32_t negative = 0;
+                            const BvhNode& node = bvh.nodes()[box_node];
+                            passed = kernels.box_filter(b.trav.view(), node.bounds, node.axis, ids,
+                                                        n, ids, scratch, nullptr, negative);
+                            std::copy(scratch, scratch + (n - passed), ids + passed);
+                            break;
                         }
-                        float touch = 0.f;
-                        for (uint32_t id : order)
-                            touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
-                                     b.surf[id].position.x + b.path[id].radiance.x + b.hit[id].t;
-                        if (touch == 12345.f) b.mask[0] = 1;
-
-                        const uint64_t start = __rdtsc();
-                        for (uint32_t again = 0; again < inner; ++again)
-                            passed = run_op(streams.data() + size_t(again) * stride, n, box_node);
-                        const uint64_t end = __rdtsc();
-                        times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
+                        case OpKind::triangle_test:
+                            // A floor triangle (about half the rays) as a leaf of its own,
+                            // by the tracer's leaf code: the float stage, then the full
+                            // test of each candidate, the hits taken if closer.
+                            job.ids = ids;
+                            job.n = n;
+                            passed = kernels.leaf_tests(job, floor_leaf, 1, n);
+                            break;
+                        case OpKind::sphere_test:
+                            // The large glass sphere as a leaf of its own, likewise: the
+                            // test of each group, then its hits taken if closer.
+                            job.ids = ids;
+                            job.n = n;
+                            passed = kernels.leaf_tests(job, sphere_leaf, 1, n);
+                            break;
+                        case OpKind::shadow_filter:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.any_hit[id]) return false;
+                                finish_shadow(b.path[id], b.hit[id].valid());
+                                return true;
+                            });
+                            break;
+                        case OpKind::miss_filter:
+                            passed = run_filter([&](uint32_t id) {
+                                if (b.hit[id].valid()) return false;
+                                shade_miss(b.path[id], scene);
+                                return true;
+                            });
+                            break;
+                        case OpKind::emission_filter:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.hit[id].valid()) return false;  // misses left earlier
+                                b.surf[id] = surface_at(scene, b.ray[id], b.hit[id]);
+                                const Material& m = scene.materials[b.surf[id].material];
+                                if (!m.emissive()) return false;
+                                shade_emission(b.path[id], m);
+                                return true;
+                            });
+                            break;
+                        case OpKind::depth_filter: {
+                            uint32_t material_rays[4] = {0, 0, 0, 0};
+                            passed = run_filter([&](uint32_t id) {
+                                if (!may_scatter(b.path[id], 3)) return false;
+                                ++material_rays[b.surf[id].material & 3];
+                                return true;
+                            });
+                            break;
+                        }
+                        case OpKind::material_filter:
+                            passed =
+                                run_filter([&](uint32_t id) { return b.surf[id].material == mat; });
+                            break;
+                        case OpKind::ambient:
+                            passed = run_filter([&](uint32_t id) {
+                                add_ambient(b.path[id], scene.materials[b.surf[id].material],
+                                            ambient_scene);
+                                return true;
+                            });
+                            break;
+                        case OpKind::lambertian_choice:
+                            passed = run_filter([&](uint32_t id) {
+                                return lambertian_takes_direct(b.path[id], scene);
+                            });
+                            break;
+                        case OpKind::lambertian_direct:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.hit[id].valid()) return false;
+                                return lambertian_direct(b.path[id], scene, scene.materials[0],
+                                                         b.surf[id], b.next[id]) &&
+                                       set_up(id, true);
+                            });
+                            break;
+                        case OpKind::lambertian_indirect:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.hit[id].valid()) return false;
+                                return lambertian_indirect(b.path[id], scene, scene.materials[0],
+                                                           b.surf[id], b.next[id]) &&
+                                       set_up(id, false);
+                            });
+                            break;
+                        case OpKind::dielectric:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.hit[id].valid()) return false;
+                                return dielectric_scatter(b.path[id], scene.materials[2],
+                                                          b.surf[id], b.ray[id], b.next[id]) &&
+                                       set_up(id, false);
+                            });
+                            break;
+                        case OpKind::glossy:
+                            passed = run_filter([&](uint32_t id) {
+                                if (!b.hit[id].valid()) return false;
+                                return glossy_scatter(b.path[id], scene.materials[1], b.surf[id],
+                                                      b.ray[id], b.next[id]) &&
+                                       set_up(id, false);
+                            });
+                            break;
+                        // Not microbenchmarked (the host's seed-kernel ops); no default, so
+                        // a new kind (a new material's filter) is a compile error here.
+                        case OpKind::frustum_bounds:
+                        case OpKind::frustum_test:
+                        case OpKind::reorder_lod_test:
+                        case OpKind::reorder_key:
+                        case OpKind::reorder_sort:
+                        case OpKind::raygrid_walk:
+                        case OpKind::raygrid_enqueue:
+                        case OpKind::count:
+                            break;
                     }
-                    const Convergence c = judge_convergence(times, options.convergence);
-                    out.push_back({kind, slots, n, passed, c.fastest / ticks_per_cycle, c.converged,
-                                   c.samples});
+                    return passed;
+                };
+                // The rays (saved, by index) that this shading op passes and those it fails: its
+                // streams are also timed with every lane passing and with none, since a frame's
+                // shading streams are filtered already and most of their lanes pass, while the
+                // buffer's mix alone fixes only one sum of a tested lane's cost and a passing
+                // one's. The same rays, dealt into the slots with repeats. A mixed stream takes
+                // the buffer's share of passing rays exactly, so that the several short streams
+                // of one timed repetition have the one pass count the sample records.
+                std::vector<uint32_t> passing, failing;
+                std::vector<uint8_t> passes(slots, 0);
+                if (stage_of(kind) == OpStage::shading) {
+                    deal_rays(b, deal, true);  // deal is the identity here
+                    std::vector<uint32_t> all(slots + k_stream_padding);
+                    std::iota(all.begin(), all.begin() + slots, 0u);
+                    const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
+                    passing.assign(all.begin(), all.begin() + p);
+                    failing.assign(all.begin() + p, all.begin() + slots);
+                    for (uint32_t ray : passing) passes[ray] = 1;
                 }
+                const bool classified = !passing.empty() && !failing.empty();
+                std::vector<uint32_t> pass_slots, fail_slots;
+                enum class Deal { mixed, all_pass, none_pass };
+                std::vector<Deal> deals = {Deal::mixed};
+                if (classified) deals = {Deal::mixed, Deal::all_pass, Deal::none_pass};
+                for (const Deal dealt : deals)
+                    for (uint32_t n : options.lengths) {
+                        if (n > slots) continue;
+                        std::vector<double> times;
+                        uint32_t passed = 0;
+                        const double ticks_per_cycle =
+                            tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(options.isa)));
+                        const uint32_t box_node = box_nodes[box_sample++ % box_nodes.size()];
+                        // Short streams run several times in the timed region (the TSC ticks in
+                        // steps of tens of cycles here), each time on other slots (an op changes
+                        // its rays: a hit tightens t, a shader moves the path on).
+                        const bool exact_mix = classified && dealt == Deal::mixed;
+                        const uint32_t stream_passing =
+                            exact_mix
+                                ? std::min<uint32_t>(
+                                      n, uint32_t(std::lround(double(n) * double(passing.size()) /
+                                                              double(slots))))
+                                : 0;
+                        uint32_t inner = std::max(1u, std::min(256u, slots) / n);
+                        if (exact_mix) {
+                            if (stream_passing > 0)
+                                inner = std::min<uint32_t>(inner, passing.size() / stream_passing);
+                            if (n > stream_passing)
+                                inner = std::min<uint32_t>(inner,
+                                                           failing.size() / (n - stream_passing));
+                            inner = std::max(inner, 1u);
+                        }
+                        const uint32_t stride = n + k_stream_padding;
+                        streams.assign(size_t(inner) * stride, 0u);
+                        while (needs_more_samples(times, options.convergence)) {
+                            // Fresh random streams: n slots of the buffer each, in increasing
+                            // order, as the tracer's streams are (the camera's, and every stable
+                            // partition of one), with the rays dealt anew; the whole buffer touched
+                            // in random order first, so the L1D holds what a pass over this buffer
+                            // leaves in it.
+                            std::shuffle(deal.begin(), deal.end(), rng);
+                            if (dealt != Deal::mixed) {
+                                const std::vector<uint32_t>& from =
+                                    dealt == Deal::all_pass ? passing : failing;
+                                for (uint32_t& d : deal) d = from[rng() % from.size()];
+                            }
+                            deal_rays(b, deal, stage_of(kind) == OpStage::shading);
+                            std::shuffle(order.begin(), order.end(), rng);
+                            if (exact_mix) {
+                                pass_slots.clear();
+                                fail_slots.clear();
+                                for (uint32_t slot : order)
+                                    (passes[deal[slot]] ? pass_slots : fail_slots).push_back(slot);
+                            }
+                            for (uint32_t j = 0; j < inner; ++j) {
+                                uint32_t* stream = streams.data() + size_t(j) * stride;
+                                if (exact_mix) {
+                                    const size_t p = size_t(j) * stream_passing,
+                                                 f = size_t(j) * (n - stream_passing);
+                                    std::copy(pass_slots.begin() + p,
+                                              pass_slots.begin() + p + stream_passing, stream);
+                                    std::copy(fail_slots.begin() + f,
+                                              fail_slots.begin() + f + (n - stream_passing),
+                                              stream + stream_passing);
+                                } else {
+                                    // inner * n <= slots: the streams are disjoint.
+                                    const auto first = order.begin() + size_t(j) * n;
+                                    std::copy(first, first + n, stream);
+                                }
+                                std::sort(stream, stream + n);
+                            }
+                            float touch = 0.f;
+                            for (uint32_t id : order)
+                                touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
+                                         b.surf[id].position.x + b.path[id].radiance.x +
+                                         b.hit[id].t;
+                            if (touch == 12345.f) b.mask[0] = 1;
+
+                            const uint64_t start = __rdtsc();
+                            for (uint32_t again = 0; again < inner; ++again)
+                                passed =
+                                    run_op(streams.data() + size_t(again) * stride, n, box_node);
+                            const uint64_t end = __rdtsc();
+                            times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
+                        }
+                        if (visited.size() <= point) visited.resize(point + 1);
+                        std::vector<double>& cycles = visited[point++];
+                        for (const double t : times) cycles.push_back(t / ticks_per_cycle);
+                        if (!last_visit) continue;
+                        // Converged: the fastest k of all the visits' samples agree.
+                        const Convergence c = judge_convergence(cycles, options.convergence);
+                        out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples});
+                    }
+            }
+            if (progress) progress(++done, uint32_t(kinds.size()) * visits);
         }
-        if (progress) progress(++done, uint32_t(kinds.size()));
     }
     return out;
 }

@@ -59,7 +59,14 @@ struct MicrobenchOptions {
     // 16^2, 32^2 and 64^2 ray buffers.
     std::vector<uint32_t> buffer_slots = {64, 256, 1024, 4096};
     std::vector<uint32_t> lengths = {1, 8, 16, 24, 48, 96, 200, 512, 1024, 4096};
-    ConvergenceRule convergence = microbench_rule();  // repetitions per point
+    ConvergenceRule convergence = microbench_rule();  // repetitions per point and visit
+    // A point's repetitions come from this many sweeps over every point (each sweep's until
+    // `convergence` holds; the point's fastest judged over all of them), so that one spell of
+    // a slow machine cannot take all of a point's repetitions: on an Intel VM (2026-11-28) a
+    // spell of tens of milliseconds at a third of the speed took every repetition of a run of
+    // neighbouring points, whose fastest three then agreed (a 16-lane box test 294 cycles in
+    // one sweep, 93 in others).
+    uint32_t visits = 2;
     uint64_t seed = 1;
     std::vector<OpKind> kinds;  // empty: every kind the native tracer has
 };

@@ -61,6 +61,26 @@ TEST_CASE("The stage clock splits the traversal by the loop that runs its short 
     }
 }
 
+TEST_CASE("A microbenchmark point's repetitions come from every visit of the sweep",
+          "[stream][host]") {
+    MicrobenchOptions o;
+    o.buffer_slots = {64, 256};
+    o.lengths = {8, 16};
+    o.kinds = {OpKind::box_test, OpKind::miss_filter};
+    o.convergence = microbench_rule(4);  // 4 to 4 repetitions a visit
+    for (const uint32_t visits : {1u, 3u}) {
+        o.visits = visits;
+        const std::vector<MicrobenchSample> samples = run_stream_microbenchmarks(o);
+        // The same points whatever the visits: box tests 2 x 2, the miss filter's also on
+        // streams that all pass and that none pass.
+        REQUIRE(samples.size() == 4 + 12);
+        for (const MicrobenchSample& m : samples) {
+            CHECK(m.repetitions == 4 * visits);
+            CHECK(m.cycles > 0.0);
+        }
+    }
+}
+
 TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][host]") {
     MicrobenchOptions o;
     o.buffer_slots = {64};
