@@ -119,7 +119,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // per group. The fit expects the same of its microbenchmarks (beyond_l1_share).
     const uint32_t n = width();
     m_group_beyond_offset[index] = m_group_beyond_lanes.size();
-    uint64_t last = ~uint64_t(0), last_page = ~uint64_t(0);  // the line and page touched last
+    uint64_t last = ~uint64_t(0);  // the line touched last
     for (uint32_t i = 0; i < op.length; ++i) {
         if (i % n == 0) m_group_beyond_lanes.push_back(0);
         const uint64_t address = (record ? k_records : k_slots) + op.slots[i] * bytes;
@@ -130,10 +130,8 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
                 ? m_scene_memory->touch_other(m_core, from * k_line,
                                               uint32_t((last_line - from + 1) * k_line), now)
                 : 0;
-        const uint64_t page = address / k_prefetch_page_bytes;
-        if (level > 0 && page != last_page) ++m_group_beyond_lanes.back();
+        if (level > 0 && lane_opens_page(op.slots, i, uint32_t(bytes))) ++m_group_beyond_lanes.back();
         last = last_line;
-        last_page = page;
     }
 }
 

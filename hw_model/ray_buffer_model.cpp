@@ -95,9 +95,8 @@ double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib)
 
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
                              uint32_t lane_bytes) {
-    auto page = [&](uint32_t i) { return uint64_t(slots[i]) * lane_bytes / k_prefetch_page_bytes; };
     uint32_t opening = 0;
-    for (uint32_t i = first; i < first + lanes; ++i) opening += i == 0 || page(i) != page(i - 1);
+    for (uint32_t i = first; i < first + lanes; ++i) opening += lane_opens_page(slots, i, lane_bytes);
     return opening;
 }
 

@@ -122,9 +122,14 @@ double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib)
 // whose slot starts in another page than the lane before it's (a stream's slots ascend) waits
 // for its line, and the lanes after it in that page find theirs prefetched.
 constexpr uint32_t k_prefetch_page_bytes = 4096;
-// How many of the lanes [first, first + lanes) of a stream of `slots` (ascending) open a page
-// of an array of `lane_bytes` a slot: their slot starts in another page than the slot before
-// it's (the stream's first lane does).
+// Whether lane i of a stream of `slots` (ascending) opens a page of an array of `lane_bytes` a
+// slot: its slot starts in another page than the slot before it's (the stream's first lane
+// does).
+inline bool lane_opens_page(const uint32_t* slots, uint32_t i, uint32_t lane_bytes) {
+    auto page = [&](uint32_t j) { return uint64_t(slots[j]) * lane_bytes / k_prefetch_page_bytes; };
+    return i == 0 || page(i) != page(i - 1);
+}
+// How many of the lanes [first, first + lanes) open one (lane_opens_page).
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
                              uint32_t lane_bytes);
 // The same expected of a stream of `lanes` slots drawn at random from `slots` (the pages the
