@@ -284,7 +284,7 @@ void add_calibrate_command(CLI::App& app) {
                 "microbenchmarks: %u of %u points converged (%s in each of %u sweeps, "
                 "judged over all)\n",
                 cal.converged_points, cal.points, describe(bench_rule).c_str(),
-                MicrobenchOptions().visits);
+                cal.microbench_visits);
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "minority", "beyondL1", "fit med",
                         "fit max", "one_lane", "few_lane");

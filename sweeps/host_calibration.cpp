@@ -175,6 +175,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     options.isa = resolved;
     options.convergence = convergence;
     c.samples = run_stream_microbenchmarks(options, progress);
+    c.microbench_visits = options.visits;
     c.rates = run_gather_compress_microbenchmarks(resolved, convergence.budget);
     for (const MicrobenchSample& s : c.samples) c.converged_points += s.converged;
     c.points = uint32_t(c.samples.size());

@@ -76,6 +76,8 @@ struct HostCalibration {
     std::vector<PredictorCheck> branch_samples;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
+    // Sweeps over the filter microbenchmarks' points (MicrobenchOptions::visits).
+    uint32_t microbench_visits = 0;
     std::string yaml;  // host.hw.yaml
 };
 
