@@ -274,7 +274,8 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
       m_span_bytes(span_bytes),
       m_pages(config.dram_latency_by_span.empty() ? 0 : std::max(1u, cores)),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
-      m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz) {
+      m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz),
+      m_fills(k_fills) {
     if (m_shared) m_reader = m_shared->add_reader();
     for (const CacheLevelConfig& level : config.caches) {
         if (!m_shared)
@@ -346,9 +347,12 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
         const uint32_t level = look_up(core, line, now);
         const uint64_t pages_between = use_page(core, line * m_line_bytes);
         uint64_t ready = 0, latency = 0;
+        Fill& fill = m_fills[line % k_fills];
         if (level < level_count()) {
             latency = m_latency[level];
             ready = now + latency;
+            if (fill.line == line && fill.arrival > ready)
+                ready = std::min(fill.arrival, now + (fill.arrival - fill.issued));
         } else {
             ++m_dram_reads;
             const uint64_t dram_latency =
@@ -362,6 +366,7 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
             ready = uint64_t(std::ceil(start + transfer - 1e-9));
             latency = dram_latency + uint64_t(std::ceil(transfer - 1e-9));
         }
+        if (level > 0 && (fill.line != line || ready > fill.arrival)) fill = {line, now, ready};
         arrival = std::max(arrival, ready);
         if (unloaded) *unloaded = std::max(*unloaded, latency);
     }

@@ -145,10 +145,12 @@ class SceneMemoryModel {
 
     // Cycle at which `bytes` at `address`, requested by `core` at cycle `now`, have arrived:
     // each line comes from the nearest level holding it (lines of one request overlap: the
-    // request waits for its slowest line); lines from DRAM queue for its bandwidth.
-    // `unloaded`: the slowest line's latency had DRAM been idle (a CPU core working through its
-    // lanes in turn overlaps a share of each, hit_latency_beyond in hw_model/op_costs.h; the
-    // queue of one op's reads all issued at once is the accelerator's).
+    // request waits for its slowest line); lines from DRAM queue for its bandwidth. A line
+    // still on its way for an earlier read (a fill in flight) arrives with that fill.
+    // `unloaded`: the slowest line's latency had DRAM been idle and no fill been in flight (a
+    // CPU core working through its lanes in turn overlaps a share of each, hit_latency_beyond
+    // in hw_model/op_costs.h; the queue of one op's reads all issued at once is the
+    // accelerator's).
     uint64_t read(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
                   uint64_t* unloaded = nullptr);
     // Touches the lines of a read in the caches only (cache warming: no time, no DRAM traffic;
@@ -184,6 +186,19 @@ class SceneMemoryModel {
     // The nearest level holding `line` for `core` at cycle `now` (level_count(): DRAM), counted.
     uint32_t look_up(uint32_t core, uint64_t line, uint64_t now);
 
+    // A line filled from beyond the first level, for a read at `issued` (the caches hold it
+    // from then on): when it arrives. A later read that finds the line in a cache before then
+    // waits for this fill, as a cache's miss status holding register merges a second miss
+    // into the first; a read timed before `issued` (reads are not always made in time order)
+    // would have missed itself, so it waits at most the fill's own latency.
+    struct Fill {
+        uint64_t line = ~uint64_t(0), issued = 0, arrival = 0;
+    };
+    // Fills by line, direct mapped: the lines in flight at once are few (a core's fill
+    // buffers), so a fill overwritten while still in flight is rare, and then the read finds
+    // the line as the caches say.
+    static constexpr size_t k_fills = 1024;
+
     SceneMemoryConfig m_config;
     std::vector<std::vector<SetAssociativeCache>> m_levels;  // [level][instance]; none if shared
     std::shared_ptr<SharedCacheLookups> m_shared;
@@ -198,6 +213,7 @@ class SceneMemoryModel {
     RateServer m_dram;  // bytes per cycle
     uint64_t m_dram_reads = 0, m_requests = 0;
     uint64_t m_paused = 0;
+    std::vector<Fill> m_fills;  // k_fills
 };
 
 }  // namespace sfx

@@ -153,17 +153,35 @@ TEST_CASE("The hierarchy charges the nearest level's latency and DRAM transfer",
     config.dram_latency_ns = 36.5;  // -> 19 cycles
     config.dram_bandwidth_gbps = 32.0;  // at 500 MHz: 64 bytes per cycle, one cycle per line
     SceneMemoryModel memory(config, 500.0);
-    CHECK(memory.read(4096, 32) == 19 + 1);  // cold: DRAM
-    CHECK(memory.read(4096, 32) == 1);       // now in L1
-    // Straddles into a cold line: the slower one, which also waits for the channel (every read
-    // here is issued at cycle 0, and the first line holds the channel until cycle 20).
-    CHECK(memory.read(4096 + 60, 8) == 19 + 2);
+    CHECK(memory.read(0, 4096, 32, 0) == 19 + 1);     // cold: DRAM
+    CHECK(memory.read(0, 4096, 32, 100) == 100 + 1);  // now in L1
+    // Straddles into a cold line: the slower one.
+    CHECK(memory.read(0, 4096 + 60, 8, 100) == 100 + 19 + 1);
     CHECK(memory.dram_reads() == 2);
     CHECK(memory.hits(0) == 2);  // the warm line, twice
     // Evict from L1 only (32 KiB, 8-way: 64 sets): 9 lines in one L1 set, then re-read.
     const uint64_t l1_set_stride = 64 * 64;
-    for (uint64_t i = 1; i <= 9; ++i) memory.read(4096 + i * l1_set_stride, 4);
-    CHECK(memory.read(4096, 4) == 2);  // from L2
+    for (uint64_t i = 1; i <= 9; ++i) memory.read(0, 4096 + i * l1_set_stride, 4, 200);
+    CHECK(memory.read(0, 4096, 4, 1000) == 1000 + 2);  // from L2
+}
+
+TEST_CASE("A read of a line whose fill is in flight waits for that fill", "[hw_model][cache]") {
+    SceneMemoryConfig config;  // at 500 MHz: l1 1 cycle, l3 7, DRAM 19 + 1 for the transfer
+    config.dram_latency_ns = 36.5;
+    config.dram_bandwidth_gbps = 32.0;
+    SceneMemoryModel memory(config, 500.0, 2);
+    CHECK(memory.read(0, 8192, 4, 100) == 120);  // cold: DRAM
+    // The caches hold the line from the read on; the data is not there before the fill.
+    uint64_t unloaded = 0;
+    CHECK(memory.read(0, 8192 + 32, 4, 105, &unloaded) == 120);
+    CHECK(unloaded == 1);  // the level's own latency: no other read's wait
+    CHECK(memory.hits(0) == 1);
+    CHECK(memory.read(1, 8192 + 8, 4, 110) == 120);  // another core, through the shared L3
+    CHECK(memory.read(0, 8192, 4, 130) == 131);      // arrived: an L1 hit
+    // A read timed before the fill's own (reads are not always made in time order) would
+    // have missed itself: it waits no longer than the fill's latency.
+    CHECK(memory.read(0, 8192 + 16, 4, 90) == 110);
+    CHECK(memory.dram_reads() == 1);
 }
 
 TEST_CASE("DRAM bandwidth is shared: lines queue for the channel", "[hw_model][cache]") {
@@ -255,13 +273,13 @@ TEST_CASE("Other data read through the caches evicts scene lines and is not coun
     memory.dram_latency_ns = 50.0;
     SceneMemoryModel model(memory, 1000.0);
     model.read(0, 0, 4, 0);
-    CHECK(model.read(0, 0, 4, 10) == 10 + 2);           // a hit
-    model.touch_other(0, uint64_t(1) << 44, 2048, 20);  // 32 lines of other data: 2 KiB
+    CHECK(model.read(0, 0, 4, 100) == 100 + 2);          // a hit
+    model.touch_other(0, uint64_t(1) << 44, 2048, 200);  // 32 lines of other data: 2 KiB
     CHECK(model.hits(0) == 1);
     CHECK(model.misses(0) == 1);
     CHECK(model.requests() == 2);
-    CHECK(model.read(0, 0, 4, 30) > 30 + 2);  // evicted: from DRAM again
+    CHECK(model.read(0, 0, 4, 300) > 300 + 2);  // evicted: from DRAM again
     CHECK(model.dram_reads() == 2);
-    model.touch_other(0, 0, 0, 40);  // nothing
-    CHECK(model.read(0, 0, 4, 50) == 50 + 2);
+    model.touch_other(0, 0, 0, 400);  // nothing
+    CHECK(model.read(0, 0, 4, 500) == 500 + 2);
 }
