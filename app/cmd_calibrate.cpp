@@ -523,6 +523,7 @@ void add_calibrate_command(CLI::App& app) {
                 sources += (sources.empty() ? "" : "; ") + m.cycle_source;
             row["stage_clock_overhead"] = m.stage_clock_overhead;
             row["measured.interrupted_renders"] = m.interrupted;
+            row["measured.clock_moved_renders"] = m.clock_moved;
             row["measured.frame_tsc"] = m.measured_frame_tsc;
             for (int sg = 0; sg < 3; ++sg) {
                 row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =

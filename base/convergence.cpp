@@ -38,6 +38,11 @@ double median(std::vector<double> samples) {
     return *middle;
 }
 
+ConvergenceRule after_discarded(ConvergenceRule rule, uint32_t discarded) {
+    rule.budget -= std::min(discarded, rule.budget);
+    return rule;
+}
+
 bool needs_more_samples(const std::vector<double>& samples, const ConvergenceRule& rule) {
     if (samples.size() >= rule.budget) return false;
     if (samples.size() < rule.min_samples) return true;

@@ -33,6 +33,10 @@ struct Convergence {
 // the whole budget, if smaller) and a spread within the tolerance.
 Convergence judge_convergence(const std::vector<double>& samples, const ConvergenceRule& rule);
 
+// The rule for samples beside which `discarded` more were taken and set aside (readings that
+// cannot be trusted): each spent the budget as a sample does.
+ConvergenceRule after_discarded(ConvergenceRule rule, uint32_t discarded);
+
 // Whether to take another sample: fewer than min_samples, or not converged and budget left.
 bool needs_more_samples(const std::vector<double>& samples, const ConvergenceRule& rule);
 

@@ -6,7 +6,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 
 #include "base/core_clock.h"
@@ -87,6 +89,11 @@ CycleSource::CycleSource(uint32_t lanes, double tsc_mhz, const PerfEventOpener& 
 
 CycleSource::~CycleSource() {
     if (m_fd >= 0) ::close(m_fd);
+}
+
+double clock_moved(const CycleReading& r) {
+    const double low = std::min(r.clock_mhz_before, r.clock_mhz_after);
+    return low > 0 ? std::abs(r.clock_mhz_after - r.clock_mhz_before) / low : 0.0;
 }
 
 double CycleSource::clock_mhz() const {

@@ -29,6 +29,13 @@ struct CycleReading {
     double clock_mhz_before = 0.0, clock_mhz_after = 0.0;
 };
 
+// How far the estimate's clock moved over the region: |after - before| over the lower of the
+// two (0 when counted, or with no clock). The estimate takes their mean, but the clock may have
+// changed anywhere in the region (a frequency step: 3584 to 4081 MHz around a render on this
+// project's Intel VM), so its cycles lie anywhere between the two clocks' and the reading is
+// only as good as this.
+double clock_moved(const CycleReading& r);
+
 class CycleSource {
   public:
     // `lanes`: the back end timed (1 scalar, 8 AVX2, 16 AVX-512): its chain measures the clock

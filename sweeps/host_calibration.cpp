@@ -486,8 +486,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
     std::mt19937_64 rng(seed);
     std::vector<uint64_t> others_busy(n, 0), others_total(n, 0);
     const int own_cpu = sched_getcpu();
+    // A render whose estimated cycles rest on a clock that moved by more than the tolerance
+    // (clock_moved) is set aside: it could pass for the fastest (or not) by the clock alone.
+    // It spends the budget as a render does.
+    auto frame_rule = [&](size_t v) { return after_discarded(convergence, out[v].clock_moved); };
     auto needs_more = [&](size_t v) {
-        return needs_more_samples(out[v].frame_samples, convergence) ||
+        return needs_more_samples(out[v].frame_samples, frame_rule(v)) ||
                (variants[v].cold && needs_more_samples(out[v].cold_samples, convergence));
     };
     for (uint32_t round = 1;; ++round) {
@@ -517,6 +521,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
                     others_busy[v] += load_after[c].busy - load_before[c].busy;
                     others_total[v] += load_after[c].total - load_before[c].total;
                 }
+            if (clock_moved(reading) > convergence.tolerance) {
+                ++m.clock_moved;
+                continue;
+            }
             m.frame_samples.push_back(reading.cycles);
             sample_round[v].push_back(round - 1);
             readings[v].push_back(reading);
@@ -552,8 +560,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
         const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
         m.probe_before = probe_before[lanes];
         m.probe_after = probe_after[lanes];
-        m.convergence = judge_convergence(m.frame_samples, convergence);
+        m.convergence = judge_convergence(m.frame_samples, frame_rule(v));
         m.measured_frame = m.convergence.fastest;
+        if (m.frame_samples.empty()) continue;  // every render set aside: nothing measured
         if (variants[v].cold) {
             m.cold_convergence = judge_convergence(m.cold_samples, convergence);
             m.measured_cold_frame = m.cold_convergence.fastest;

@@ -144,6 +144,9 @@ struct SiliconMeasurement {
     std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame
     double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
+    // Unclocked renders set aside because the estimate's clock moved over them by more than
+    // the convergence tolerance (clock_moved, base/cycle_source.h); not among frame_samples.
+    uint32_t clock_moved = 0;
     // The machine's speed during the renders against calibration: the speed probe re-run just
     // before the first render and just after the last, over its cycles at calibration, less 1
     // (NaN: the host file has none). The same for every workload of a back end; a probe beyond

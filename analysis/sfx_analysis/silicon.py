@@ -528,6 +528,13 @@ def measurement_text(df):
                          f"{clocks.min():.0f}-{clocks.max():.0f} MHz, before and after one render "
                          f"apart by {100 * drift.median():.1f} % (median), "
                          f"{100 * drift.max():.1f} % at most")
+    if "measured.clock_moved_renders" in df and not df["measured.cycles_counted"].any():
+        moved = df["measured.clock_moved_renders"]
+        renders = moved + df["measured.renders"]
+        lines.append(f"- renders set aside because the clock moved over them by more than the "
+                     f"convergence tolerance (their cycles could lie anywhere between the two "
+                     f"clocks'): {int(moved.sum())} of {int(renders.sum())}, in "
+                     f"{int((moved > 0).sum())} of {len(df)} workloads")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")

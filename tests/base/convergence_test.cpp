@@ -115,3 +115,19 @@ TEST_CASE("Convergence: degenerate rules and bad flags", "[convergence]") {
         CHECK(e.key() == "--tolerance");
     }
 }
+
+TEST_CASE("Convergence: samples set aside spend the budget", "[convergence]") {
+    const ConvergenceRule r = rule(3, 0.03, 7, 31);
+    CHECK(after_discarded(r, 0).budget == 31);
+    CHECK(after_discarded(r, 10).budget == 21);
+    CHECK(after_discarded(r, 40).budget == 0);
+    CHECK(after_discarded(r, 10).tolerance == r.tolerance);
+    // Samples that never converge: 21 taken beside 10 set aside, then no more.
+    std::vector<double> drift;
+    for (int i = 0; i < 40; ++i) drift.push_back(100.0 * (i + 1));
+    CHECK(sample_until_done(drift, after_discarded(r, 10)).size() == 21);
+    CHECK_FALSE(needs_more_samples({}, after_discarded(r, 31)));
+    // A budget spent below the minimum: what is left is the minimum.
+    CHECK(judge_convergence({100, 100.5, 101, 101, 101}, after_discarded(r, 26)).converged);
+    CHECK_FALSE(judge_convergence({100, 100.5, 101, 101, 101}, r).converged);
+}

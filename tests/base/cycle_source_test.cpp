@@ -140,3 +140,15 @@ TEST_CASE("Core clock: the add chain reads the clock a multiply chain reads", "[
     INFO("ticks a cycle: add chain " << add_ticks << ", multiply chain " << multiply_ticks);
     CHECK(add_ticks == Approx(multiply_ticks).epsilon(0.15));
 }
+
+TEST_CASE("Cycle source: how far the estimate's clock moved over a region", "[cycles]") {
+    CycleReading r;
+    CHECK(clock_moved(r) == 0.0);  // no clock
+    r.clock_mhz_before = r.clock_mhz_after = 4000.0;
+    CHECK(clock_moved(r) == 0.0);  // steady (and every counted reading)
+    r.clock_mhz_before = 3584.0;
+    r.clock_mhz_after = 4081.0;  // a frequency step seen on an Intel VM: 13.9 % of the lower
+    CHECK(clock_moved(r) == Approx(497.0 / 3584.0));
+    std::swap(r.clock_mhz_before, r.clock_mhz_after);
+    CHECK(clock_moved(r) == Approx(497.0 / 3584.0));
+}
