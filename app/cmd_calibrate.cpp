@@ -540,6 +540,15 @@ void add_calibrate_command(CLI::App& app) {
                 row[std::string("measured.traversal_") + loops[l] + "_loop_cycles"] =
                     m.measured_loop[size_t(l)];
             }
+            // The shading stage by op kind, and the ray set-up (measured only).
+            for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                if (m.predicted_shading_op[k] > 0 || m.measured_shading_op[k] > 0) {
+                    row[std::string("predicted.op_cycles.") + k_op_kinds[k].name] =
+                        m.predicted_shading_op[k];
+                    row[std::string("measured.op_cycles.") + k_op_kinds[k].name] =
+                        m.measured_shading_op[k];
+                }
+            row["measured.ray_setup_cycles"] = m.measured_ray_setup;
             // The machine model's stall causes and its scene-data misses per level, as sfx
             // simulate reports them (the page sets the frame's error against the misses).
             for (const Stat& stat : m.prediction.stats())

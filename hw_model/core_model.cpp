@@ -381,9 +381,10 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     const uint64_t result =
         e.start + ceil_cycle(p.result_cycles(m_config.datapath, double(busy)));
     stage.busy_cycles += busy;
+    const uint64_t group_cycles = stage.busy_cycles + stage.stall_cycles - stage_before;
+    m_timing.op_cycles[size_t(op.kind)] += group_cycles;
     if (op.kind == OpKind::box_test)
-        m_timing.traversal_loop_cycles[size_t(m_loop[t.op])] +=
-            stage.busy_cycles + stage.stall_cycles - stage_before;
+        m_timing.traversal_loop_cycles[size_t(m_loop[t.op])] += group_cycles;
     m_unit_free[unit] = e.issue_end;
     // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
     ActionCounts& act = m_timing.actions;

@@ -139,6 +139,9 @@ struct FrameTiming {
     // (TraversalLoop, kernels/trace.h): what the tracer's stage clock splits the traversal
     // into (RenderStats::short_loop_tsc). Cycle-level models only.
     uint64_t traversal_loop_cycles[3] = {0, 0, 0};
+    // Each op kind's unit-cycles (busy and stalled), what the tracer's stage clock splits the
+    // shading stage into (RenderStats::shading_op_tsc). Cycle-level models only.
+    uint64_t op_cycles[k_op_kind_count] = {};
     // A CPU core's branch predictor (HwConfig::branch_predictor): the traversal's branches it
     // mispredicted, and the unit-cycles they cost (part of the busy cycles). Cycle level only.
     uint64_t branch_mispredictions = 0, branch_cycles = 0;
@@ -202,6 +205,10 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
                       "box tests' unit-cycles in the tracer's loop of that name")
               .under("traversal_loop_cycles"),
           a.traversal_loop_cycles[l], b.traversal_loop_cycles[l]);
+    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        f(CounterInfo(k_op_kinds[k].name, "cycles", "the op kind's unit-cycles, busy and stalled")
+              .under("op_cycles"),
+          a.op_cycles[k], b.op_cycles[k]);
     f(CounterInfo("mispredictions", "branches",
                   "traversal branches the core's branch predictor mispredicted")
           .under("branch_predictor"),

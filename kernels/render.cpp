@@ -29,6 +29,8 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     nonfinite_paths += o.nonfinite_paths;
     for (int i = 0; i < 3; ++i) stage_tsc[i] += o.stage_tsc[i];
     for (int i = 0; i < 2; ++i) short_loop_tsc[i] += o.short_loop_tsc[i];
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) shading_op_tsc[k] += o.shading_op_tsc[k];
+    ray_setup_tsc += o.ray_setup_tsc;
     entry_searches += o.entry_searches;
     entry_depth_sum += o.entry_depth_sum;
     batch_queues += o.batch_queues;

@@ -62,6 +62,12 @@ struct RenderStats {
     // of the few-ray loop ([1]) run from the stream loop (kernels/stream), their leaves' not
     // included: where a traversal's short streams go (kernels/trace.h).
     uint64_t short_loop_tsc[2] = {0, 0};
+    // Of stage_tsc[2] (stream tracer, stage clock): the ticks of each shading op kind as the
+    // timing models price it (camera: the camera loop; emission_filter: with the hits'
+    // surfaces, compute_surfaces; material_filter: the sort by material), and of the ray
+    // set-up (load_rays), which they price in the ops that made the rays.
+    uint64_t shading_op_tsc[k_op_kind_count] = {};
+    uint64_t ray_setup_tsc = 0;
 
     uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
     RenderStats& operator+=(const RenderStats& o);

@@ -337,6 +337,9 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
             m.predicted_memory[size_t(s)] += double(st.scene_memory_cycles);
         }
     for (int l = 0; l < 3; ++l) m.predicted_loop[size_t(l)] = double(t.traversal_loop_cycles[l]);
+    for (uint32_t k = 0; k < k_op_kind_count; ++k)
+        if (k_op_kinds[k].stage == OpStage::shading)
+            m.predicted_shading_op[k] = double(t.op_cycles[k]);
     m.predicted_frame = double(t.cycles);
     if (cold)  // from empty caches, as the renders after evict_caches start
         m.predicted_cold_frame =
@@ -448,6 +451,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
     // conference against 15.0/14.5/22.2 % from the same renders.)
     std::vector<std::array<double, 3>> stage_min(n, {1e300, 1e300, 1e300});
     std::vector<std::array<double, 2>> short_loop_min(n, {1e300, 1e300});
+    std::vector<std::array<double, k_op_kind_count>> shading_op_min(n);
+    for (auto& kinds : shading_op_min) kinds.fill(1e300);
+    std::vector<double> ray_setup_min(n, 1e300);
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
     std::vector<std::vector<CycleReading>> readings(n);
     // With memory_now, the L3 chased at the start of each round, and each render's round.
@@ -542,6 +548,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
             for (int l = 0; l < 2; ++l)
                 short_loop_min[v][size_t(l)] =
                     std::min(short_loop_min[v][size_t(l)], double(r.stats.short_loop_tsc[l]));
+            for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                shading_op_min[v][k] =
+                    std::min(shading_op_min[v][k], double(r.stats.shading_op_tsc[k]));
+            ray_setup_min[v] = std::min(ray_setup_min[v], double(r.stats.ray_setup_tsc));
             clocked_totals[v].push_back(clocked.cycles);
             if (variants[v].cold) {
                 evict_caches();
@@ -592,6 +602,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 stages > 0 ? short_loop_min[v][size_t(l)] / stages * m.measured_frame : 0.0;
             m.measured_loop[2] = std::max(0.0, m.measured_loop[2] - m.measured_loop[size_t(l)]);
         }
+        const double tick_cycles = stages > 0 ? m.measured_frame / stages : 0.0;
+        for (uint32_t k = 0; k < k_op_kind_count; ++k)
+            if (k_op_kinds[k].stage == OpStage::shading)
+                m.measured_shading_op[k] = shading_op_min[v][k] * tick_cycles;
+        m.measured_ray_setup = ray_setup_min[v] * tick_cycles;
         m.stage_clock_overhead =
             *std::min_element(clocked_totals[v].begin(), clocked_totals[v].end()) /
                 m.measured_frame -

@@ -122,6 +122,12 @@ struct SiliconMeasurement {
     // few-ray, stream loop), predicted and measured (the stage clock's short-loop ticks,
     // RenderStats::short_loop_tsc, split as the stages are; the stream loop the rest).
     std::array<double, 3> predicted_loop{}, measured_loop{};
+    // The shading stage by op kind (shading kinds only), predicted (FrameTiming::op_cycles) and
+    // measured (the stage clock's RenderStats::shading_op_tsc, the fewest ticks of each, split
+    // as the stages are); and the tracer's ray set-up (load_rays), measured only: the model
+    // prices it in the ops that made the rays.
+    std::array<double, k_op_kind_count> predicted_shading_op{}, measured_shading_op{};
+    double measured_ray_setup = 0.0;
     double predicted_frame = 0.0;
     // Core cycles (base/cycle_source.h: counted by perf_event_open, else the thread's CPU time
     // at the back end's clock measured before and after the render; the TSC alone counts the

@@ -475,6 +475,31 @@ def loops_text(df):
     return "\n".join(lines)
 
 
+def shading_ops_text(df):
+    """Per back end and scene, the shading stage by op kind (the stage clock's ticks of each
+    kind's filter), and the ray set-up the tracer runs apart, which the model prices in the ops
+    that made the rays (rows written before the split carry none)."""
+    if "measured.ray_setup_cycles" not in df:
+        return "These rows carry no shading stage split by op kind."
+    kinds = [c[len("measured.op_cycles."):] for c in df.columns
+             if c.startswith("measured.op_cycles.")]
+    lines = ["| back end | scene | op | predicted Mcyc (sum) | measured Mcyc (sum) | "
+             "error of sum | share of measured shading |", "|---|---|---|---|---|---|---|"]
+    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
+        shading = max(g["measured.shading_cycles"].sum(), 1.0)
+        for kind in kinds:
+            p = g[f"predicted.op_cycles.{kind}"].fillna(0).sum()
+            m = g[f"measured.op_cycles.{kind}"].fillna(0).sum()
+            if max(p, m) < 0.01 * shading:  # an op the scene barely runs: noise
+                continue
+            lines.append(f"| {isa} | {scene} | {kind} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
+                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / shading:.0%} |")
+        m = g["measured.ray_setup_cycles"].sum()
+        lines.append(f"| {isa} | {scene} | ray set-up (in the ops that made the rays) | - | "
+                     f"{m / 1e6:.2f} | - | {m / shading:.0%} |")
+    return "\n".join(lines)
+
+
 def summary_text(s, isa=None):
     at = f" ({isa})" if isa else ""
     lines = [f"- workloads{at}: {s['workloads']}, of which {s['converged']} converged "
@@ -729,6 +754,14 @@ def write_page(df, page, plot_name, header):
         "out), split as the stages are; the stream loop is the rest of the traversal. "
         "Predicted: the model's cycles of the box tests each loop runs (the stage's "
         "end-of-pass tail is in no loop).\n\n" + loops_text(df),
+        "## The shading stage by op\n\nMeasured: the stage clock's ticks of each shading "
+        "op kind's filter (the camera's loop; the emission filter with the hits' surfaces, as "
+        "the model prices it; the material filters as the sort by material the tracer runs "
+        "for them), each its fewest over the clocked renders, split as the stages are, and "
+        "the tracer's set-up of the rays a generation made for the next one's traversal "
+        "(`load_rays`), which the model prices in the ops that made them. Predicted: the "
+        "model's cycles of each kind's ops. The stage's rest (a pass's tail, the sums into "
+        "the image) is in no row.\n\n" + shading_ops_text(df),
     ])
     with open(page, "w") as f:
         f.write(text + "\n")

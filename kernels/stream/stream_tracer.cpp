@@ -469,8 +469,16 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     const uint64_t pass_start = clock ? __rdtsc() : 0;
     uint64_t traverse_tsc = 0;
 
+    // With the stage clock, the ticks of a part of the shading stage (RenderStats::shading_op_tsc).
+    uint64_t part_start = 0;
+    auto start_part = [&] { part_start = clock ? __rdtsc() : 0; };
+    auto end_part = [&](uint64_t& ticks) {
+        if (clock) ticks += __rdtsc() - part_start;
+    };
+
     // Camera: the input buffer gets one primary ray per pixel of the tile.
     int cur = 0;
+    start_part();
     for (uint32_t slot = 0; slot < count; ++slot) {
         const uint32_t x = rect.x0 + slot % w, y = rect.y0 + slot / w;
         PathState& p = path[slot];
@@ -482,6 +490,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     }
     stats.camera_rays += count;
     trace.op(OpKind::camera, 0, k_no_object, ids, count, mask, count);
+    end_part(stats.shading_op_tsc[size_t(OpKind::camera)]);
 
     uint32_t n = count;
     uint16_t generation = 0;
@@ -489,7 +498,9 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
         if (reorder) reorder_stream(ids, n, rays, generation, trace);
+        start_part();
         const uint32_t traversal_rays = load_rays(b, rays, n);
+        end_part(stats.ray_setup_tsc);
         uint32_t entry = 0;
         if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
             entry = primary_entry_point(traversal_rays, stats, trace);
@@ -516,7 +527,11 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         uint32_t* next_ids = b.next_ids.data();
         auto run_filter = [&](OpKind kind, uint32_t object, uint32_t* s, uint32_t len,
                               auto&& test) {
-            return filter(kernels, trace, kind, generation, object, s, len, mask, scratch, test);
+            start_part();
+            const uint32_t passed =
+                filter(kernels, trace, kind, generation, object, s, len, mask, scratch, test);
+            end_part(stats.shading_op_tsc[size_t(kind)]);
+            return passed;
         };
         uint32_t* s = ids;
         uint32_t len = n;
@@ -539,7 +554,9 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         // The hits' surfaces, for the emission filter and the stack below. Timing models
         // price this as part of the emission filter (OpKindInfo::reads_hit_primitive), as the
         // microbenchmarks time it.
+        start_part();
         compute_surfaces(scene, rays, hit, s, len, b.surf.data());
+        end_part(stats.shading_op_tsc[size_t(OpKind::emission_filter)]);
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
             const Material& m = scene.materials[surf[id].material];
             if (!m.emissive()) return false;
@@ -563,6 +580,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             next_ids[pushed++] = id;
             ++(shadow ? stats.shadow_rays : stats.extension_rays);
         };
+        start_part();
         // The material filters below leave the stream stably sorted by material, in
         // `present` order. Without a trace of lanes nothing needs their masks, so one counting
         // sort does it here and each filter's op carries only its counts.
@@ -578,6 +596,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                 std::copy(scratch, scratch + len, s);
             }
         }
+        end_part(stats.shading_op_tsc[size_t(OpKind::material_filter)]);
         // One sub-stack per material (a shader instance: its constants are uniform over the
         // lanes), for the materials this generation hit; the last one is what is left.
         for (size_t j = 0; j < present.size(); ++j) {

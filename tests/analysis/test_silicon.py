@@ -301,6 +301,27 @@ def test_traversal_by_loop(tmp_path):
     assert "no traversal split" in silicon.loops_text(older)
 
 
+def test_shading_by_op(tmp_path):
+    # Two workloads of one scene (each row's measured shading is 50e6): each kind's sums
+    # and error, its share of the measured shading; a kind under 1 % of it on both sides is
+    # left out; the ray set-up is measured only.
+    rows = [row("a", 16, 100e6, 100e6), row("a", 32, 100e6, 100e6)]
+    for r in rows:
+        r.update({"predicted.op_cycles.camera": 1e6, "measured.op_cycles.camera": 2e6,
+                  "predicted.op_cycles.glossy": 0.01e6, "measured.op_cycles.glossy": 0.0,
+                  "measured.ray_setup_cycles": 1.5e6})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    text = silicon.shading_ops_text(df)
+    assert "| avx512 | a | camera | 2.00 | 4.00 | -50.0 % | 4% |" in text
+    assert "glossy" not in text
+    assert "| avx512 | a | ray set-up (in the ops that made the rays) | - | 3.00 | - | 3% |" in text
+    # Rows written before the split carry none, and say so.
+    older = df.drop(columns=[c for c in df.columns if "op_cycles" in c or "ray_setup" in c])
+    assert "no shading stage split" in silicon.shading_ops_text(older)
+
+
 def test_cold_caches(tmp_path):
     # a: silicon pays 2 M for cold caches, the model 8 M; b: cold not converged; c: not asked.
     rows = [row("a", 32, 14e6, 17e6), row("b", 32, 30e6, 33e6), row("c", 32, 5e6, 5e6)]

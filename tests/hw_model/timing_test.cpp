@@ -849,6 +849,7 @@ TEST_CASE("FrameTiming's counters: one visit, unique names with units, sums and 
     CHECK(names.count("stalls.bank_conflict") == 1);
     CHECK(names.count("stages.secondary.shading.busy_cycles") == 1);
     CHECK(names.count("actions.simd_instructions.glossy") == 1);
+    CHECK(names.count("op_cycles.glossy") == 1);
     CHECK(names.count("cache_misses.1") == 1);
     // b = a + a; b - a = a, counter by counter; scaling by 2 doubles each.
     b += a;

@@ -210,6 +210,23 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
           Approx(m.measured_stage[0]));
     CHECK(m.predicted_loop[2] > 0);
     CHECK(m.predicted_loop[0] + m.predicted_loop[1] + m.predicted_loop[2] <= m.predicted_stage[0]);
+    // The shading stage by op kind: the measured parts (each its fewest ticks) and the ray
+    // set-up lie within the measured stage and make most of it; the predicted kinds are the
+    // predicted stage's ops (the stage also holds a pass's tail); no traversal kind is among them.
+    double measured_parts = m.measured_ray_setup, predicted_parts = 0.0;
+    for (uint32_t k = 0; k < k_op_kind_count; ++k) {
+        measured_parts += m.measured_shading_op[k];
+        predicted_parts += m.predicted_shading_op[k];
+    }
+    CHECK(m.measured_shading_op[size_t(OpKind::camera)] > 0);
+    CHECK(m.predicted_shading_op[size_t(OpKind::camera)] > 0);
+    CHECK(m.measured_ray_setup > 0);
+    CHECK(m.measured_shading_op[size_t(OpKind::box_test)] == 0);
+    CHECK(m.predicted_shading_op[size_t(OpKind::box_test)] == 0);
+    CHECK(measured_parts <= m.measured_stage[2] * (1 + 1e-9));
+    CHECK(measured_parts > 0.5 * m.measured_stage[2]);
+    CHECK(predicted_parts <= m.predicted_stage[2] + 1.0);
+    CHECK(predicted_parts > 0.9 * m.predicted_stage[2]);
     // Within a factor of 20 either way: only a broken flow (units, a lost stage) misses that.
     CHECK(m.predicted_frame / m.measured_frame > 0.05);
     CHECK(m.predicted_frame / m.measured_frame < 20);
