@@ -549,6 +549,11 @@ void add_calibrate_command(CLI::App& app) {
                         m.measured_shading_op[k];
                 }
             row["measured.ray_setup_cycles"] = m.measured_ray_setup;
+            std::string making;  // the kinds whose ops make rays, and price their set-up
+            for (uint32_t k = 0; k < k_op_kind_count; ++k)
+                if (k_op_kinds[k].pushes_rays)
+                    making += std::string(making.empty() ? "" : ",") + k_op_kinds[k].name;
+            row["ray_making_ops"] = making;
             // The machine model's stall causes and its scene-data misses per level, as sfx
             // simulate reports them (the page sets the frame's error against the misses).
             for (const Stat& stat : m.prediction.stats())

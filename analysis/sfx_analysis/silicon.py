@@ -494,9 +494,18 @@ def shading_ops_text(df):
                 continue
             lines.append(f"| {isa} | {scene} | {kind} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
                          f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / shading:.0%} |")
-        m = g["measured.ray_setup_cycles"].sum()
+        setup = g["measured.ray_setup_cycles"].sum()
         lines.append(f"| {isa} | {scene} | ray set-up (in the ops that made the rays) | - | "
-                     f"{m / 1e6:.2f} | - | {m / shading:.0%} |")
+                     f"{setup / 1e6:.2f} | - | {setup / shading:.0%} |")
+        if "ray_making_ops" in g:
+            # What the model prices together: the ops that make rays, with their set-up.
+            making = [k for k in str(g["ray_making_ops"].iloc[0]).split(",")
+                      if f"measured.op_cycles.{k}" in g]
+            p = sum(g[f"predicted.op_cycles.{k}"].fillna(0).sum() for k in making)
+            m = setup + sum(g[f"measured.op_cycles.{k}"].fillna(0).sum() for k in making)
+            lines.append(f"| {isa} | {scene} | **the ops that make rays, with their set-up** | "
+                         f"{p / 1e6:.2f} | {m / 1e6:.2f} | "
+                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / shading:.0%} |")
     return "\n".join(lines)
 
 

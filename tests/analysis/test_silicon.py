@@ -309,7 +309,7 @@ def test_shading_by_op(tmp_path):
     for r in rows:
         r.update({"predicted.op_cycles.camera": 1e6, "measured.op_cycles.camera": 2e6,
                   "predicted.op_cycles.glossy": 0.01e6, "measured.op_cycles.glossy": 0.0,
-                  "measured.ray_setup_cycles": 1.5e6})
+                  "measured.ray_setup_cycles": 1.5e6, "ray_making_ops": "camera,glossy,dielectric"})
     p = tmp_path / "rows.json"
     p.write_text(json.dumps(rows))
     df = silicon.load_rows(p)
@@ -317,6 +317,10 @@ def test_shading_by_op(tmp_path):
     assert "| avx512 | a | camera | 2.00 | 4.00 | -50.0 % | 4% |" in text
     assert "glossy" not in text
     assert "| avx512 | a | ray set-up (in the ops that made the rays) | - | 3.00 | - | 3% |" in text
+    # The model prices the set-up in the ops that make rays: compared together (camera and
+    # glossy here; dielectric has no column).
+    assert ("| avx512 | a | **the ops that make rays, with their set-up** | 2.02 | 7.00 | "
+            "-71.1 % | 7% |") in text
     # Rows written before the split carry none, and say so.
     older = df.drop(columns=[c for c in df.columns if "op_cycles" in c or "ray_setup" in c])
     assert "no shading stage split" in silicon.shading_ops_text(older)
