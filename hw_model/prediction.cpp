@@ -196,7 +196,7 @@ std::vector<Stat> Prediction::stats() const {
                 std::string("box tests' unit-cycles in the native tracer's ") + loops[l] + " loop");
         // And its shading stage by op kind, which the tracer's stage clock also splits.
         for (uint32_t k = 0; k < k_op_kind_count; ++k)
-            if (k_op_kinds[k].stage == OpStage::shading && timing.op_cycles[k] > 0)
+            if (stage_of(OpKind(k)) == OpStage::shading && timing.op_cycles[k] > 0)
                 add(std::string("op_cycles.") + k_op_kinds[k].name,
                     double(timing.op_cycles[k]) * unit_scale, "cycles",
                     std::string("unit-cycles of the ") + k_op_kinds[k].name + " ops");

@@ -338,7 +338,7 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
         }
     for (int l = 0; l < 3; ++l) m.predicted_loop[size_t(l)] = double(t.traversal_loop_cycles[l]);
     for (uint32_t k = 0; k < k_op_kind_count; ++k)
-        if (k_op_kinds[k].stage == OpStage::shading)
+        if (stage_of(OpKind(k)) == OpStage::shading)
             m.predicted_shading_op[k] = double(t.op_cycles[k]);
     m.predicted_frame = double(t.cycles);
     if (cold)  // from empty caches, as the renders after evict_caches start
@@ -603,9 +603,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
             m.measured_loop[2] = std::max(0.0, m.measured_loop[2] - m.measured_loop[size_t(l)]);
         }
         const double tick_cycles = stages > 0 ? m.measured_frame / stages : 0.0;
+        // The stage clock times shading kinds only: the others stay 0.
         for (uint32_t k = 0; k < k_op_kind_count; ++k)
-            if (k_op_kinds[k].stage == OpStage::shading)
-                m.measured_shading_op[k] = shading_op_min[v][k] * tick_cycles;
+            m.measured_shading_op[k] = shading_op_min[v][k] * tick_cycles;
         m.measured_ray_setup = ray_setup_min[v] * tick_cycles;
         m.stage_clock_overhead =
             *std::min_element(clocked_totals[v].begin(), clocked_totals[v].end()) /
