@@ -43,6 +43,8 @@ void TraceProfile::op(const StreamOp& op) {
     Bucket& b = m_buckets[Key{op.generation > 0, op.kind, op.length}];
     ++b.ops;
     b.passed += op.pass_count;
+    b.mispredicted += mispredicted_lanes(
+        op.pass_count, op.length, op.passed ? outcome_changes(op.passed, op.length) : op.length);
     const uint32_t bytes = m_scene_bytes[size_t(op.kind)];
     if (op.object == k_no_object || op.length == 0 || bytes == 0) return;
     ++b.fetches;
@@ -284,7 +286,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const double busy = p.issue_cycles(
-                c.datapath, length, uint32_t(std::lround(pass_rate * length)), lanes,
+                c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
                 uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1 * opening_share);
             busy_sum += busy;
             if (l1d) {

@@ -31,6 +31,9 @@ public:
     struct Bucket {
         uint64_t ops = 0;
         uint64_t passed = 0;  // sum of pass counts
+        // Sum of the lanes a filter's branch predictor misses (mispredicted_lanes; the rarer
+        // outcome's where the trace has no lanes).
+        uint64_t mispredicted = 0;
         uint64_t fetches = 0;  // ops with a scene object
     };
     // (secondary, kind, stream length) -> bucket.

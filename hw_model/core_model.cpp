@@ -79,6 +79,7 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_group_beyond_offset.assign(n, k_none);
     m_group_beyond_lanes.clear();
     m_groups_left.assign(n, 0);
+    m_mispredicted_lanes.assign(n, 0);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
     m_partition_free = std::max(m_partition_free, now);
@@ -143,6 +144,11 @@ void CoreModel::dispatch_op(uint32_t index, uint64_t now) {
     const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
     const uint64_t mix_before = m_timing.mix.total();
     m_groups_left[index] = uint32_t(groups);
+    m_mispredicted_lanes[index] =
+        p.measured
+            ? mispredicted_lanes(op.pass_count, op.length,
+                                 op.passed ? outcome_changes(op.passed, op.length) : op.length)
+            : 0;
     StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
     stage.ops += 1;
     stage.lanes += op.length;
@@ -368,8 +374,8 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     // Fractional measured cycles: the unit carries the remainder to its next group.
     const double exact =
         m_unit_carry[unit] +
-        p.issue_cycles(m_config.datapath, op.length, op.pass_count, t.lanes, passed, t.first == 0,
-                       beyond_l1) +
+        p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes, passed,
+                       t.first == 0, beyond_l1) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
     // The op's mispredicted branches, on its first group.
     const double mispredicted =

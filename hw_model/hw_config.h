@@ -404,11 +404,13 @@ struct BranchPredictorConfig {
 // another 4 KiB page of the array the op reads than the lane before it's: the prefetchers
 // cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
 // hw_model/ray_buffer_model.h beyond_l1_share), costs
-//   per_op + per_group * g + per_lane * n + per_pass * p + per_minority_lane * min(p, n - p)
+//   per_op + per_group * g + per_lane * n + per_pass * p + per_minority_lane * m
 //   + beyond_l1_per_lane * b cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
-// predictor's misses, which on outcomes in no order are the lanes of the rarer outcome; the
-// microbenchmarks time streams of mixed outcomes, and of every lane passing and of none),
+// predictor's misses, m = mispredicted_lanes in hw_model/op_costs.h: on outcomes in no order
+// the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
+// streams of mixed outcomes dealt at random, and of every lane passing and of none; on a
+// frame's outcomes in runs, about one a change of outcome, if fewer),
 // except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each (the box test's

@@ -22,7 +22,8 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
         const uint32_t n = std::min(width, lanes - first);
         const uint32_t pass = std::min(n, left);
         left -= pass;
-        cycles += p.issue_cycles(datapath, lanes, passed, n, pass, first == 0, beyond_l1);
+        cycles += p.issue_cycles(datapath, lanes, minority_lanes(passed, lanes), n, pass,
+                                 first == 0, beyond_l1);
     }
     return cycles;
 }

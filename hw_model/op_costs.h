@@ -67,6 +67,22 @@ inline uint32_t minority_lanes(uint32_t passed, uint32_t lanes) {
     passed = std::min(passed, lanes);
     return std::min(passed, lanes - passed);
 }
+// How often a stream's outcomes (`passed`, one per lane, in stream order) change from one lane
+// to the next.
+inline uint32_t outcome_changes(const uint8_t* passed, uint32_t lanes) {
+    uint32_t changes = 0;
+    for (uint32_t i = 1; i < lanes; ++i) changes += (passed[i] != 0) != (passed[i - 1] != 0);
+    return changes;
+}
+// The lanes whose outcome a filter's branch predictor misses: on outcomes in no order, the
+// rarer outcome's lanes (it guesses the commoner one); on outcomes in runs, about one at each
+// change (its history follows a run). The fewer of the two. A frame's streams come in runs
+// where neighbouring pixels agree or a generation's rays were pushed by kind (its shadow rays
+// before its bounces); the microbenchmarks' streams are dealt at random, where the rarer
+// outcome's lanes are the fewer. Without the lanes' order (counts only), the rarer outcome's.
+inline uint32_t mispredicted_lanes(uint32_t passed, uint32_t lanes, uint32_t changes) {
+    return std::min(minority_lanes(passed, lanes), changes);
+}
 
 struct OpProfile {
     std::vector<uint32_t> gather_words;   // gathered for every lane
@@ -91,13 +107,14 @@ struct OpProfile {
     OpCostConfig cost;
 
     // Cycles a SIMD unit spends issuing one group of `lanes` lanes, `passed` of them passing,
-    // of an op of `length` lanes, `op_passed` of them passing (`first`: the op's first group,
+    // of an op of `length` lanes, `op_mispredicted` of them mispredicted (mispredicted_lanes;
+    // `first`: the op's first group,
     // which carries a measured per-op cost), with a share `beyond_l1` of its lanes paying for
     // an l1d buffer beyond the L1D (beyond_l1_share, lanes_opening_pages). A measured minority cost
     // is the op's, shared by its groups by lanes. Fractional for measured costs (the caller carries
     // the remainder); instruction-priced groups cost compute_instructions (programmable), the
     // initiation interval (pipelined) or the body's modulo-schedule II (cluster).
-    double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_passed,
+    double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_mispredicted,
                         uint32_t lanes, uint32_t passed, bool first, double beyond_l1) const;
     // Cycles an op adds on its first group when it enters the traversal's one-ray or few-ray
     // loop from the stream loop (TraversalLoop, kernels/trace.h): a measured box test's loop
@@ -158,8 +175,8 @@ struct SceneDataMap {
 SceneDataMap scene_data_map(const WorkloadShape& shape);
 
 // A CPU core's lane: the reads of its hit primitive `prim` (SceneDataMap::hit_reads) looked up
-// in `memory` at `now`, their latencies beyond `hidden` cycles (an L1D hit, inside measured
-// costs) summed, DRAM taken as idle. CoreModel::request_scene prices a group's lanes with it,
+// in `memory` at `now`, their latencies beyond `hidden` cycles (hit_read_latency_hidden)
+// summed, DRAM taken as idle. CoreModel::request_scene prices a group's lanes with it,
 // and the exposed-share fit (hw_model/op_cost_fit.h) models its microbenchmark with it.
 uint64_t hit_latency_beyond(SceneMemoryModel& memory, const SceneDataMap& map, uint32_t core,
                             uint32_t prim, bool mesh, uint64_t now, uint64_t hidden);

@@ -163,11 +163,11 @@ TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]
     p.cost = c;
     CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 16, 3, true, 0.0) == Approx(10 + 4 + 8 + 6));
     CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 8, 0, false, 0.5) == Approx(4 + 4 + 32));
-    // The op's rarer outcome (10 of 40 pass) costs per minority lane, shared by lanes.
+    // The op's mispredicted lanes (10 of 40) cost per minority lane, shared by lanes.
     p.cost.per_minority_lane_cycles = 3;
     CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 16, 3, true, 0.0) ==
           Approx(10 + 4 + 8 + 6 + 3 * 10 * 16 / 40.0));
-    CHECK(p.issue_cycles(DatapathConfig{}, 40, 30, 8, 8, false, 0.0) ==
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 10, 8, 8, false, 0.0) ==
           Approx(4 + 4 + 16 + 3 * 10 * 8 / 40.0));
     OpCostConfig mixed = c;
     mixed.per_minority_lane_cycles = 3;
@@ -770,4 +770,23 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(lane_ray_bytes(OpStage::shading, 330) == 330);
     CHECK(beyond_l1_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
     CHECK(beyond_l1_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
+}
+
+TEST_CASE("A filter's branch misses the rarer outcome's lanes, or one a change of outcome in runs",
+          "[host]") {
+    // No order (alternating): every change is a lane of the rarer outcome or a neighbour's.
+    const uint8_t alternating[8] = {1, 0, 1, 0, 0, 0, 1, 0};
+    CHECK(outcome_changes(alternating, 8) == 5);
+    CHECK(mispredicted_lanes(3, 8, outcome_changes(alternating, 8)) == 3);
+    // Runs: a block of passing lanes, then failing ones, costs one change, however many pass.
+    const uint8_t runs[8] = {1, 1, 1, 1, 0, 0, 0, 0};
+    CHECK(outcome_changes(runs, 8) == 1);
+    CHECK(mispredicted_lanes(4, 8, outcome_changes(runs, 8)) == 1);
+    // All alike: nothing to miss either way.
+    const uint8_t same[4] = {1, 1, 1, 1};
+    CHECK(outcome_changes(same, 4) == 0);
+    CHECK(mispredicted_lanes(4, 4, 0) == 0);
+    CHECK(outcome_changes(same, 0) == 0);
+    // Without the lanes' order, the rarer outcome's (the closed form's counts-only traces).
+    CHECK(mispredicted_lanes(3, 8, 8) == 3);
 }
