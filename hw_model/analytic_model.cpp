@@ -358,13 +358,13 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             lane_reads += ops * double(length);
         } else if (p.lane_scene_reads) {
             // A CPU core works through its lanes in turn and leaves the measured share of each
-            // read's latency beyond an L1D hit exposed (CoreModel::request_scene). Taken as
+            // read's latency beyond an L2 hit exposed (CoreModel::request_scene). Taken as
             // re-touches in the pass, as above, whichever array hit_reads names; a triangle's
             // mesh record and its vertices are two reads.
             const double reads = c.scene_memory.hit_reads == "mesh" && shape.triangles ? 2.0 : 1.0;
             const double beyond =
                 std::max(0.0, expected_hit_read_cycles(memory, c.clock.core_mhz, lines, 1.0) -
-                                  double(scene_latency_in_costs(c)));
+                                  double(hit_read_latency_hidden(c)));
             lane_stall = p.cost.hit_read_exposed_share * double(length) * reads * beyond;
             lane_reads += ops * double(length) * reads;
         }

@@ -189,6 +189,12 @@ uint64_t scene_latency_in_costs(const HwConfig& c) {
     return ns_to_cycles(c.scene_memory.caches.front().hit_latency_ns, c.clock.core_mhz);
 }
 
+uint64_t hit_read_latency_hidden(const HwConfig& c) {
+    if (c.ray_buffer.storage != "l1d" || c.scene_memory.caches.size() < 2)
+        return scene_latency_in_costs(c);
+    return ns_to_cycles(c.scene_memory.caches[1].hit_latency_ns, c.clock.core_mhz);
+}
+
 bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     const SceneMemoryConfig &x = a.scene_memory, &y = b.scene_memory;
     if (a.cores.count != 1 || b.cores.count != 1 || x.caches.size() != y.caches.size() ||

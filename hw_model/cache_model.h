@@ -102,6 +102,18 @@ uint64_t ns_to_cycles(double ns, double mhz);
 // (the microbenchmarks read their scene data from it) on a CPU core (ray_buffer.storage l1d);
 // nothing for a machine priced from instruction counts.
 uint64_t scene_latency_in_costs(const HwConfig& config);
+// Cycles of each hit-primitive read's latency a CPU core hides whatever the level that holds
+// the line (OpKindInfo::reads_hit_primitive; hit_latency_beyond): a second-level hit's. The
+// tracer's loop over the hits (compute_surfaces) prefetches each hit's triangle 16 hits ahead
+// and its vertices 8 ahead, some hundreds of cycles of work, so a line the L2 holds is there
+// when its hit is shaded; of a farther level's latency, the part beyond the L2's is left to
+// the fitted exposed share (OpCostConfig::hit_read_exposed_share). On the surface-read
+// microbenchmark of an Intel Xeon VM (2026-11-29, scalar) the measured cycles beyond a
+// resident mesh over the cache model's latency beyond an L1D hit were 0.19 with the mesh in
+// the L2, 0.51 in the L3 and 0.42 in DRAM: one share of the latency beyond the L1D, fitted on
+// all three, was 0.26 and priced the frames' hit reads (mostly beyond the L2) 20-35 % under.
+// A core without a second level hides its first's (scene_latency_in_costs).
+uint64_t hit_read_latency_hidden(const HwConfig& config);
 
 // Whether two configurations look up the same scene-data lines in the same order, with caches
 // of the same geometry, so that every lookup finds its line at the same level: one core each

@@ -33,6 +33,7 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_mesh_hits(config.scene_memory.hit_reads == "mesh"),
       m_record_bytes(record_words * 4),
       m_scene_hidden(scene_latency_in_costs(config)),
+      m_hit_read_hidden(hit_read_latency_hidden(config)),
       m_layout(config.ray_buffer, record_words, slot_capacity),
       m_banks{BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer)),
               BankSchedule(config.ray_buffer.banks, bank_occupancy(config.ray_buffer))},
@@ -203,8 +204,9 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
         // Every lane's hit primitive, requested with the op (the address units run ahead of
         // the SIMD units, G&R 4.1; assumed: as soon as the op is dispatched); a group waits
         // for its slowest lane. A CPU core works through its lanes one after another and
-        // overlaps a measured share of their latency beyond an L1D hit (its cost holds the
-        // hit): that share of their sum is what a group adds.
+        // leaves a measured share of their latency beyond an L2 hit exposed (its cost holds an
+        // L1D hit; its prefetches cover an L2 hit, hit_read_latency_hidden): that share of
+        // their sum is what a group adds.
         const uint32_t n = width();
         const double share = p.cost.hit_read_exposed_share;
         m_group_scene_offset[index] =
@@ -216,7 +218,7 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
                 if (hits[i] == k_no_object) continue;
                 if (m_l1d) {
                     beyond_l1 += hit_latency_beyond(*m_scene_memory, m_map, m_core, hits[i],
-                                                    m_mesh_hits, now, m_scene_hidden);
+                                                    m_mesh_hits, now, m_hit_read_hidden);
                     continue;
                 }
                 const uint32_t count = m_map.hit_reads(hits[i], m_mesh_hits, reads);

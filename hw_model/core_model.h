@@ -114,6 +114,7 @@ class CoreModel {
     bool m_mesh_hits;         // scene_memory.hit_reads mesh
     uint32_t m_record_bytes;  // the scene's ray record (a slot, unless ray_buffer.slot_bytes)
     uint64_t m_scene_hidden;  // scene-data latency already inside measured costs (L1D hit)
+    uint64_t m_hit_read_hidden;  // of each hit-primitive read's (hit_read_latency_hidden)
     RayBufferModel m_layout;
     BankSchedule m_banks[2];  // the current generation's buffer and the next one's
     CapacityServer m_agu, m_interconnect, m_scratchpad;

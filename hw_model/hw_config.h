@@ -440,7 +440,8 @@ struct OpCostConfig {
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
     double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
     // An op that reads each lane's hit primitive (the emission filter): the share of those
-    // reads' latency beyond an L1D hit that the core does not overlap with other work, fitted
+    // reads' latency beyond an L2 hit (hit_read_latency_hidden, hw_model/cache_model.h) that
+    // the core does not overlap with other work, fitted
     // on the surface-read microbenchmark (scene arrays beyond the caches) through the same
     // cache model that prices the frames. 0: not measured (the reads cost what the
     // cache-resident microbenchmark saw).
@@ -482,7 +483,7 @@ struct OpCostConfig {
                 "ops (the box test that enters it carries it; 0: not measured)",
                 0.0, 1e9);
         v.param("hit_read_exposed_share", hit_read_exposed_share, "",
-                "share of each lane's hit-primitive read latency beyond an L1D hit that is not "
+                "share of each lane's hit-primitive read latency beyond an L2 hit that is not "
                 "overlapped (0: not measured)",
                 0.0, 100.0);
     }

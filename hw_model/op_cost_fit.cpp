@@ -236,7 +236,7 @@ double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample
     // The mesh as its construction wrote it, in order, then the earlier repetitions' hits.
     for (uint32_t prim = 0; prim < sample.triangles; ++prim) warm_hit(scene, map, 0, prim, true);
     for (uint32_t prim : sample.warm_prims) warm_hit(scene, map, 0, prim, true);
-    const uint64_t hidden = scene_latency_in_costs(host);
+    const uint64_t hidden = hit_read_latency_hidden(host);
     double beyond = 0.0;
     for (uint32_t prim : sample.timed_prims)
         beyond += double(hit_latency_beyond(scene, map, 0, prim, true, 0, hidden));

@@ -83,11 +83,11 @@ struct HitReadSample {
     double extra_cycles = 0.0;
 };
 
-// The cache model's latency beyond an L1D hit of a sample's timed reads from the mesh's arrays,
-// summed, on `host`'s scene memory: hit_latency_beyond (hw_model/op_costs.h), as
-// CoreModel::request_scene prices a CPU core's lanes, one op's lanes requested together,
-// after the mesh (written in order when it was built) and the earlier repetitions' reads
-// warmed the caches.
+// The cache model's latency beyond an L2 hit (hit_read_latency_hidden) of a sample's timed reads
+// from the mesh's arrays, summed, on `host`'s scene memory: hit_latency_beyond
+// (hw_model/op_costs.h), as CoreModel::request_scene prices a CPU core's lanes, one op's lanes
+// requested together, after the mesh (written in order when it was built) and the earlier
+// repetitions' reads warmed the caches.
 double modeled_hit_read_cycles(const HwConfig& host, const HitReadSample& sample);
 
 // OpCostConfig::hit_read_exposed_share: the share s with s x modeled = extra, least squares on
