@@ -201,6 +201,11 @@ double tsc_overhead() {
 
 }  // namespace
 
+bool frame_streams_hold_hits_only(OpKind kind) {
+    return stage_of(kind) == OpStage::shading && kind != OpKind::camera &&
+           kind != OpKind::shadow_filter && kind != OpKind::miss_filter;
+}
+
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress) {
     const Scene scene = synthetic_scene();
@@ -433,6 +438,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 // of one timed repetition have the one pass count the sample records.
                 std::vector<uint32_t> passing, failing;
                 std::vector<uint8_t> passes(slots, 0);
+                const bool hits_only = frame_streams_hold_hits_only(kind);
                 if (stage_of(kind) == OpStage::shading) {
                     deal_rays(b, deal, true);  // deal is the identity here
                     std::vector<uint32_t> all(slots + k_stream_padding);
@@ -440,8 +446,20 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
                     passing.assign(all.begin(), all.begin() + p);
                     failing.assign(all.begin() + p, all.begin() + slots);
+                    if (hits_only) {
+                        auto not_a_hit = [&](uint32_t ray) {
+                            return !b.saved_hit[ray].valid() || b.saved_any_hit[ray];
+                        };
+                        for (auto* rays : {&passing, &failing})
+                            rays->erase(std::remove_if(rays->begin(), rays->end(), not_a_hit),
+                                        rays->end());
+                    }
                     for (uint32_t ray : passing) passes[ray] = 1;
                 }
+                // The rays a stream is dealt from: the whole buffer, or its hits.
+                std::vector<uint32_t> pool = passing;
+                pool.insert(pool.end(), failing.begin(), failing.end());
+                std::sort(pool.begin(), pool.end());
                 const bool classified = !passing.empty() && !failing.empty();
                 std::vector<uint32_t> pass_slots, fail_slots;
                 enum class Deal { mixed, all_pass, none_pass };
@@ -463,16 +481,20 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             exact_mix
                                 ? std::min<uint32_t>(
                                       n, uint32_t(std::lround(double(n) * double(passing.size()) /
-                                                              double(slots))))
+                                                              double(pool.size()))))
                                 : 0;
                         uint32_t inner = std::max(1u, std::min(256u, slots) / n);
                         if (exact_mix) {
+                            // A deal holds each passing and failing ray at least `copies` times.
+                            const size_t copies = hits_only ? slots / pool.size() : 1;
                             if (stream_passing > 0)
-                                inner = std::min<uint32_t>(inner, passing.size() / stream_passing);
+                                inner = std::min<uint32_t>(
+                                    inner, passing.size() * copies / stream_passing);
                             if (n > stream_passing)
-                                inner = std::min<uint32_t>(inner,
-                                                           failing.size() / (n - stream_passing));
-                            inner = std::max(inner, 1u);
+                                inner = std::min<uint32_t>(
+                                    inner, failing.size() * copies / (n - stream_passing));
+                            // A stream longer than a hits-only pool can fill is not timed.
+                            if (inner == 0) continue;
                         }
                         const uint32_t stride = n + k_stream_padding;
                         streams.assign(size_t(inner) * stride, 0u);
@@ -482,6 +504,12 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             // partition of one), with the rays dealt anew; the whole buffer touched
                             // in random order first, so the L1D holds what a pass over this buffer
                             // leaves in it.
+                            if (hits_only && !pool.empty()) {
+                                // Every ray of the pool as often as the next (repeats where
+                                // the pool is smaller than the buffer), so that a deal holds
+                                // at least the pool's passing and failing rays.
+                                for (uint32_t i = 0; i < slots; ++i) deal[i] = pool[i % pool.size()];
+                            }
                             std::shuffle(deal.begin(), deal.end(), rng);
                             if (dealt != Deal::mixed) {
                                 const std::vector<uint32_t>& from =

@@ -71,8 +71,18 @@ struct MicrobenchOptions {
     std::vector<OpKind> kinds;  // empty: every kind the native tracer has
 };
 
-// Every op kind the native tracer has, at every (buffer, length <= buffer). `progress(done,
-// total)` is called after each kind.
+// Whether a frame's streams of `kind` hold only hits that are not shadow rays: the tracer's
+// shading stack runs it after its shadow and miss filters (kernels/stream/stream_tracer.cpp).
+// Its microbenchmark streams hold the same, dealt from the buffer's hits: a lane without a hit
+// leaves such a filter at its first test, and the buffer's misses (a third of its rays) made
+// the lambertian and scattering filters' failing lanes nearly all misses, which no frame has
+// (an Intel Xeon VM, 2026-11-29: lambertian_direct's 1411 failing rays of 4096, 1252 of them
+// misses; fitted so, its frames were priced 20-25 % under on atrium and temple).
+bool frame_streams_hold_hits_only(OpKind kind);
+
+// Every op kind the native tracer has, at every (buffer, length <= buffer; a hits-only kind's
+// mixed streams no longer than its hits can fill). `progress(done, total)` is called after
+// each kind.
 std::vector<MicrobenchSample> run_stream_microbenchmarks(
     const MicrobenchOptions& options, const std::function<void(uint32_t, uint32_t)>& progress = {});
 

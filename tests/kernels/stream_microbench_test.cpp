@@ -83,15 +83,15 @@ TEST_CASE("A microbenchmark point's repetitions come from every visit of the swe
 
 TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][host]") {
     MicrobenchOptions o;
-    o.buffer_slots = {64};
-    o.lengths = {1, 16, 64, 128};  // 128 > 64 slots: skipped
+    o.buffer_slots = {256};
+    o.lengths = {1, 16, 64, 512};  // 512 > 256 slots: skipped
     o.convergence = microbench_rule(1);
     const std::vector<MicrobenchSample> samples = run_stream_microbenchmarks(o);
     std::set<OpKind> kinds;
     for (const MicrobenchSample& m : samples) {
         kinds.insert(m.kind);
-        CHECK(m.slots == 64);
-        CHECK(m.lanes <= 64);
+        CHECK(m.slots == 256);
+        CHECK(m.lanes <= 256);
         CHECK(m.passed <= m.lanes);
         CHECK(m.cycles >= 0.0);
     }
@@ -101,7 +101,7 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     for (uint32_t k = 0; k < k_op_kind_count; ++k) plain_kinds += !is_option_kind(OpKind(k));
     CHECK(kinds.size() == plain_kinds);
     // Three lengths each; a shading op whose buffer has rays it passes and rays it fails also
-    // on streams that all pass and streams that none pass.
+    // on streams that all pass and streams that none pass, after its mixed ones.
     std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
     for (const MicrobenchSample& m : samples) by_kind[m.kind].push_back(&m);
     for (const auto& [kind, of_kind] : by_kind) {
@@ -118,6 +118,13 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     const MicrobenchSample& mixed = *by_kind[OpKind::lambertian_direct][2];
     CHECK(mixed.passed > 0);
     CHECK(mixed.passed < mixed.lanes);
+    // The kinds a frame gives only hits are dealt only hits: a bounce is made from every hit,
+    // so the lambertian bounce has no failing lanes (the buffer's misses failed it before).
+    CHECK(frame_streams_hold_hits_only(OpKind::lambertian_indirect));
+    CHECK_FALSE(frame_streams_hold_hits_only(OpKind::miss_filter));
+    CHECK(by_kind[OpKind::lambertian_indirect].size() == 3);
+    for (const MicrobenchSample* m : by_kind[OpKind::lambertian_indirect])
+        CHECK(m->passed == m->lanes);
     for (OpKind k : kinds) CHECK_FALSE(is_option_kind(k));
     // Some pass and some fail: the synthetic streams exercise both sides of the filters.
     uint64_t lanes = 0, passed = 0;
