@@ -34,6 +34,7 @@ bool TraceProfile::mark(std::vector<uint64_t>& bits, uint64_t line) {
 
 void TraceProfile::begin_pass(const TilePass& p) {
     ++m_passes;
+    m_previous = OpKind::count;
     m_slots = std::max(m_slots, p.slot_count);
     for (uint64_t w : m_pass_touched) m_pass_lines[w] = 0;
     m_pass_touched.clear();
@@ -43,6 +44,8 @@ void TraceProfile::op(const StreamOp& op) {
     Bucket& b = m_buckets[Key{op.generation > 0, op.kind, op.length}];
     ++b.ops;
     b.passed += op.pass_count;
+    b.placed += placed_by_material_sort(op.kind, m_previous);
+    m_previous = op.kind;
     b.mispredicted += mispredicted_lanes(
         op.pass_count, op.length, op.passed ? outcome_changes(op.passed, op.length) : op.length);
     const uint32_t bytes = m_scene_bytes[size_t(op.kind)];
@@ -371,7 +374,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double memory_stall = fetch_stall + lane_stall;
         const double op_cycles = exec + bubble + memory_stall;
 
-        total_cycles += ops * op_cycles;
+        // A CPU core's material filters after a generation's first cost nothing
+        // (placed_by_material_sort): they are timed as no ops.
+        const double timed = l1d && p.measured ? ops - double(bucket.placed) : ops;
+        total_cycles += timed * op_cycles;
         // Action counts, as the cycle-level core model counts them.
         const double passed = double(bucket.passed);
         bank_reads += ops * (double(length) * (1.0 + gathers) + moved_ids);
@@ -393,24 +399,24 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         busy_units[size_t(HwUnit::interconnect)] += ops * word_sum / words_per_core_cycle;
         // Unit-cycles: busy ones issue instructions; the rest are charged to their causes.
         const double busy_units = double(groups) * busy;
-        const double fetch_excess = ops * sharing * std::max(0.0, exec - rounds * busy);
+        const double fetch_excess = timed * sharing * std::max(0.0, exec - rounds * busy);
         const double excess_parts = std::max(1e-9, align + conflict + addr_sum + ic_sum);
         stalls.bank_conflict += fetch_excess * conflict / excess_parts;
         stalls.alignment += fetch_excess * align / excess_parts;
         stalls.address_fetch += fetch_excess * addr_sum / excess_parts;
         stalls.interconnect += fetch_excess * ic_sum / excess_parts;
-        stalls.partition += ops * units * (compare + moves);
-        stalls.scene_memory += ops * units * memory_stall;
+        stalls.partition += timed * units * (compare + moves);
+        stalls.scene_memory += timed * units * memory_stall;
         t.stages[secondary][uint32_t(stage_of(kind))].scene_memory_cycles +=
-            uint64_t(std::llround(ops * units * memory_stall));
-        stalls.pipeline_fill += ops * units * (p.partitions ? first_fetch + tail : 0.0);
-        stalls.unit_idle += ops * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
+            uint64_t(std::llround(timed * units * memory_stall));
+        stalls.pipeline_fill += timed * units * (p.partitions ? first_fetch + tail : 0.0);
+        stalls.unit_idle += timed * ((units - sharing) * exec + sharing * rounds * busy - busy_units);
         StageTiming& stage = t.stages[secondary][uint32_t(stage_of(kind))];
         stage.ops += bucket.ops;
         stage.lanes += bucket.ops * length;
         stage.groups += bucket.ops * groups;
-        stage.busy_cycles += uint64_t(std::llround(ops * busy_units));
-        stage.stall_cycles += uint64_t(std::llround(ops * (op_cycles * units - busy_units)));
+        stage.busy_cycles += uint64_t(std::llround(timed * busy_units));
+        stage.stall_cycles += uint64_t(std::llround(timed * (op_cycles * units - busy_units)));
         t.mix.load += uint64_t(ops * double(groups) * double(1 + p.gather_words.size()) +
                                double(p.scene_bytes ? bucket.fetches : 0));
         t.mix.compute += uint64_t(ops * double(groups) * p.compute_instructions);

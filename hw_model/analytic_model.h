@@ -34,6 +34,8 @@ public:
         // Sum of the lanes a filter's branch predictor misses (mispredicted_lanes; the rarer
         // outcome's where the trace has no lanes).
         uint64_t mispredicted = 0;
+        // Ops whose lanes a CPU core's material sort placed (placed_by_material_sort).
+        uint64_t placed = 0;
         uint64_t fetches = 0;  // ops with a scene object
     };
     // (secondary, kind, stream length) -> bucket.
@@ -72,6 +74,7 @@ private:
     std::vector<uint64_t> m_pass_touched;  // words of m_pass_lines to clear at the next pass
     uint64_t m_passes = 0;
     uint32_t m_slots = 0;
+    OpKind m_previous = OpKind::count;  // the kind of the pass's op before
 };
 
 // `footprint`, when given, is the profile whose scene-data working sets price the fetches

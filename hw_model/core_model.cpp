@@ -81,6 +81,10 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_group_beyond_lanes.clear();
     m_groups_left.assign(n, 0);
     m_mispredicted_lanes.assign(n, 0);
+    m_placed_by_sort.assign(n, 0);
+    for (uint32_t i = 1; i < n; ++i)
+        m_placed_by_sort[i] = m_costs[pass->at(i).kind].measured &&
+                              placed_by_material_sort(pass->at(i).kind, pass->at(i - 1).kind);
     m_op_completion.assign(n, now);
     std::fill(m_unit_free.begin(), m_unit_free.end(), now);
     m_partition_free = std::max(m_partition_free, now);
@@ -140,7 +144,8 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
 void CoreModel::dispatch_op(uint32_t index, uint64_t now) {
     const StreamOp op = m_pass->at(index);
     const OpProfile& p = m_costs[op.kind];
-    if (m_l1d && op.slots) touch_ray_lines(index, op, now);
+    // An op whose lanes the material sort placed does no work (placed_by_material_sort).
+    if (m_l1d && op.slots && !m_placed_by_sort[index]) touch_ray_lines(index, op, now);
     const uint32_t n = width();
     const uint64_t groups = (uint64_t(op.length) + n - 1) / n;
     const uint64_t mix_before = m_timing.mix.total();
@@ -232,7 +237,7 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
                 m_group_scene_ready.push_back(ready);
         }
     }
-    if (!p.scene_bytes || op.object == k_no_object || op.length == 0) {
+    if (!p.scene_bytes || op.object == k_no_object || op.length == 0 || m_placed_by_sort[index]) {
         m_scene_ready[index] = 0;
         return;
     }
@@ -376,7 +381,8 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     // Fractional measured cycles: the unit carries the remainder to its next group.
     const double exact =
         m_unit_carry[unit] +
-        p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes, passed,
+        (m_placed_by_sort[t.op] ? 0.0 : 1.0) *
+            p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes, passed,
                        t.first == 0, beyond_l1) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
     // The op's mispredicted branches, on its first group.

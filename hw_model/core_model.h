@@ -143,6 +143,7 @@ class CoreModel {
     uint64_t scene_ready(const GroupToken& t) const;
     std::vector<uint32_t> m_groups_left;    // per op
     std::vector<uint32_t> m_mispredicted_lanes;  // per op: its filter branch's (mispredicted_lanes)
+    std::vector<uint8_t> m_placed_by_sort;  // per op: a measured placed_by_material_sort op
     std::vector<uint64_t> m_op_completion;  // per op: latest group completion so far
     std::vector<uint64_t> m_unit_free;      // per SIMD unit
     std::vector<double> m_unit_carry;       // per SIMD unit: fractional issue cycles owed

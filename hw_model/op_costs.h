@@ -84,6 +84,17 @@ inline uint32_t mispredicted_lanes(uint32_t passed, uint32_t lanes, uint32_t cha
     return std::min(minority_lanes(passed, lanes), changes);
 }
 
+// A CPU core's tracer (trace off, kernels/stream/stream_tracer.cpp) sorts a generation's
+// stream by material once, at its first material filter (the op right after the depth filter,
+// priced over its lanes as the sort: its microbenchmark times the sort), and the later
+// material filters find their lanes in place: they cost nothing. The trace keeps G&R's
+// filter stack, one partition per material, which a machine priced from instructions runs.
+// On an Intel Xeon VM (2026-11-29) the filters priced as partitions came out 2-4x the sort.
+// `previous`: the kind of the pass's op before.
+inline bool placed_by_material_sort(OpKind kind, OpKind previous) {
+    return kind == OpKind::material_filter && previous != OpKind::depth_filter;
+}
+
 struct OpProfile {
     std::vector<uint32_t> gather_words;   // gathered for every lane
     std::vector<uint32_t> scatter_words;  // scattered for passing lanes

@@ -277,6 +277,16 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::iota(order.begin(), order.end(), 0u);
                 std::iota(deal.begin(), deal.end(), 0u);
                 std::vector<uint32_t> streams;
+                // The material sort's inputs (the depth filter's by-product in the tracer, so
+                // taken before the timed region): per stream, its rays of each material; the
+                // next one's write position.
+                const uint32_t materials = uint32_t(scene.materials.size());
+                std::vector<uint32_t> material_counts, material_next(materials);
+                const uint32_t* counts_now = nullptr;
+                auto count_materials = [&](const uint32_t* ids, uint32_t n, uint32_t* counts) {
+                    std::fill(counts, counts + materials, 0u);
+                    for (uint32_t i = 0; i < n; ++i) ++counts[b.surf[ids[i]].material];
+                };
                 // The op of `kind` on the stream ids[0, n) (partitioned in place, as the tracer's
                 // filters leave it): its passing count. box_node: the box test's node.
                 auto run_op = [&](uint32_t* ids, uint32_t n, uint32_t box_node) {
@@ -367,10 +377,25 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             });
                             break;
                         }
-                        case OpKind::material_filter:
-                            passed =
-                                run_filter([&](uint32_t id) { return b.surf[id].material == mat; });
+                        case OpKind::material_filter: {
+                            // As the tracer runs the material filters with the trace off: one
+                            // counting sort of the stream by material (placed_by_material_sort,
+                            // hw_model/op_costs.h), where the stream holds two materials or more;
+                            // passing: the first material's rays, as the first filter's.
+                            uint32_t start = 0, present = 0;
+                            passed = 0;
+                            for (uint32_t m = 0; m < materials; ++m) {
+                                material_next[m] = start;
+                                start += counts_now[m];
+                                if (counts_now[m] && present++ == 0) passed = counts_now[m];
+                            }
+                            if (present > 1) {
+                                for (uint32_t i = 0; i < n; ++i)
+                                    scratch[material_next[b.surf[ids[i]].material]++] = ids[i];
+                                std::copy(scratch, scratch + n, ids);
+                            }
                             break;
+                        }
                         case OpKind::ambient:
                             passed = run_filter([&](uint32_t id) {
                                 add_ambient(b.path[id], scene.materials[b.surf[id].material],
@@ -443,6 +468,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     deal_rays(b, deal, true);  // deal is the identity here
                     std::vector<uint32_t> all(slots + k_stream_padding);
                     std::iota(all.begin(), all.begin() + slots, 0u);
+                    material_counts.resize(materials);
+                    count_materials(all.data(), slots, material_counts.data());
+                    counts_now = material_counts.data();
                     const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
                     passing.assign(all.begin(), all.begin() + p);
                     failing.assign(all.begin() + p, all.begin() + slots);
@@ -460,7 +488,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::vector<uint32_t> pool = passing;
                 pool.insert(pool.end(), failing.begin(), failing.end());
                 std::sort(pool.begin(), pool.end());
-                const bool classified = !passing.empty() && !failing.empty();
+                // The material sort has no outcome per lane to split its streams by.
+                const bool classified = !passing.empty() && !failing.empty() &&
+                                        kind != OpKind::material_filter;
                 std::vector<uint32_t> pass_slots, fail_slots;
                 enum class Deal { mixed, all_pass, none_pass };
                 std::vector<Deal> deals = {Deal::mixed};
@@ -548,10 +578,17 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                          b.hit[id].t;
                             if (touch == 12345.f) b.mask[0] = 1;
 
+                            material_counts.resize(size_t(inner) * materials);
+                            if (kind == OpKind::material_filter)
+                                for (uint32_t j = 0; j < inner; ++j)
+                                    count_materials(streams.data() + size_t(j) * stride, n,
+                                                    material_counts.data() + size_t(j) * materials);
                             const uint64_t start = __rdtsc();
-                            for (uint32_t again = 0; again < inner; ++again)
+                            for (uint32_t again = 0; again < inner; ++again) {
+                                counts_now = material_counts.data() + size_t(again) * materials;
                                 passed =
                                     run_op(streams.data() + size_t(again) * stride, n, box_node);
+                            }
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
                         }

@@ -3,9 +3,11 @@
 // configuration's knobs (storage l1d, slot_bytes, partition by compress, op_costs).
 
 #include <catch2/catch.hpp>
+#include <functional>
 #include <random>
 
 #include "base/input_error.h"
+#include "hw_model/analytic_model.h"
 #include "hw_model/cache_model.h"
 #include "hw_model/host_description.h"
 #include "hw_model/op_cost_fit.h"
@@ -795,4 +797,59 @@ TEST_CASE("A filter's branch misses the rarer outcome's lanes, or one a change o
     CHECK(outcome_changes(same, 0) == 0);
     // Without the lanes' order, the rarer outcome's (the closed form's counts-only traces).
     CHECK(mispredicted_lanes(3, 8, 8) == 3);
+}
+
+TEST_CASE("A CPU core's material filters after a generation's first cost nothing: its tracer "
+          "sorted their lanes at the first",
+          "[host][systemc]") {
+    CHECK(placed_by_material_sort(OpKind::material_filter, OpKind::lambertian_direct));
+    CHECK_FALSE(placed_by_material_sort(OpKind::material_filter, OpKind::depth_filter));
+    CHECK_FALSE(placed_by_material_sort(OpKind::lambertian_choice, OpKind::material_filter));
+    const HwConfig host = host_with({cost("material_filter", 10, 4, 1, 0, 0),
+                                     cost("lambertian_choice", 10, 4, 1, 0, 0),
+                                     cost("depth_filter", 10, 4, 1, 0, 0)});
+    std::vector<uint32_t> ids(16);
+    for (uint32_t i = 0; i < 16; ++i) ids[i] = i;
+    const std::vector<uint8_t> all(16, 1), half = {1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+    // The depth filter, then the first material's filter (the sort), its stack's op and, with
+    // `second`, the next material's filter over what is left; `first` drops the first filter.
+    auto ops = [&](bool first, bool second) {
+        std::vector<StreamOp> o = {
+            {OpKind::depth_filter, OpStage::shading, 0, k_no_object, 16, 16, ids.data(), all.data()}};
+        if (first)
+            o.push_back({OpKind::material_filter, OpStage::shading, 0, 0, 16, 8, ids.data(),
+                         half.data()});
+        o.push_back(
+            {OpKind::lambertian_choice, OpStage::shading, 0, k_no_object, 8, 8, ids.data(), all.data()});
+        if (second)
+            o.push_back({OpKind::material_filter, OpStage::shading, 0, 1, 8, 4, ids.data() + 8,
+                         half.data()});
+        return o;
+    };
+    auto cycle_level = [&](const std::vector<StreamOp>& o) {
+        SystemcTiming timing({host}, shape());
+        TilePass pass;
+        pass.slot_count = 64;
+        timing.begin_pass(pass);
+        for (const StreamOp& op : o) timing.op(op);
+        timing.end_pass(pass);
+        return timing.timing(0).cycles;
+    };
+    auto closed_form = [&](const std::vector<StreamOp>& o) {
+        TraceProfile profile(shape());
+        TilePass pass;
+        pass.slot_count = 64;
+        profile.begin_pass(pass);
+        for (const StreamOp& op : o) profile.op(op);
+        profile.end_pass(pass);
+        return analytic_timing(host, shape(), profile).cycles;
+    };
+    for (auto timed : {std::function<uint64_t(const std::vector<StreamOp>&)>(cycle_level),
+                       std::function<uint64_t(const std::vector<StreamOp>&)>(closed_form)}) {
+        // The first filter is priced over its lanes (10 + 4 + 16: one group of 16 lanes), and
+        // waits for its material's record...
+        CHECK(timed(ops(true, false)) >= timed(ops(false, false)) + 10 + 4 + 16);
+        // ... the second is placed by the sort and adds nothing.
+        CHECK(timed(ops(true, true)) == timed(ops(true, false)));
+    }
 }
