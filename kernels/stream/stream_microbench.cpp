@@ -468,9 +468,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     deal_rays(b, deal, true);  // deal is the identity here
                     std::vector<uint32_t> all(slots + k_stream_padding);
                     std::iota(all.begin(), all.begin() + slots, 0u);
-                    material_counts.resize(materials);
-                    count_materials(all.data(), slots, material_counts.data());
-                    counts_now = material_counts.data();
+                    if (kind == OpKind::material_filter) {
+                        material_counts.resize(materials);
+                        count_materials(all.data(), slots, material_counts.data());
+                        counts_now = material_counts.data();
+                    }
                     const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
                     passing.assign(all.begin(), all.begin() + p);
                     failing.assign(all.begin() + p, all.begin() + slots);
