@@ -110,7 +110,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // The ray buffers of a core whose buffers are its L1D (storage l1d: the native tracer's
     // RayBuffers, kernels/stream/stream_tracer.cpp) are read through the same caches as the
     // scene data, and evict it: each lane's lane_ray_bytes (a traversal record, one line, or
-    // a whole slot). They lie in an address range of their own, far above any
+    // the rest of a slot). They lie in an address range of their own, far above any
     // scene's (SceneDataMap), slot after slot; a line the lane before touched last is not
     // touched again. A tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5
     // core's L2.
@@ -139,6 +139,14 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
         if (level > 0 && lane_opens_page(op.slots, i, uint32_t(bytes))) ++m_group_beyond_lanes.back();
         last = last_line;
     }
+    // A ray an op makes is set up for the next traversal with the op (its cost holds the
+    // set-up, kernels/stream/stream_microbench.h), which writes the slot's traversal record:
+    // the record's line is the traversal's own (k_records), left in the caches for it.
+    if (record || !op_info(op.kind).pushes_rays || !op.passed) return;
+    for (uint32_t i = 0; i < op.length; ++i)
+        if (op.passed[i])
+            m_scene_memory->touch_other(m_core, k_records + op.slots[i] * k_traversal_record_bytes,
+                                        uint32_t(k_traversal_record_bytes), now);
 }
 
 void CoreModel::dispatch_op(uint32_t index, uint64_t now) {

@@ -120,7 +120,9 @@ double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lan
 }
 
 uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes) {
-    return stage == OpStage::shading ? slot_bytes : k_traversal_record_bytes;
+    if (stage != OpStage::shading) return k_traversal_record_bytes;
+    return slot_bytes > k_traversal_record_bytes ? slot_bytes - k_traversal_record_bytes
+                                                 : slot_bytes;
 }
 
 double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,

@@ -138,8 +138,12 @@ double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lan
 // The bytes of its slot a lane of an op of `stage` reads on a CPU core (the native tracer's
 // per-slot arrays, kernels/stream/stream_tracer.cpp): a traversal or intersection op its
 // traversal record (16 floats, one line: traversal_field in kernels/stream/stream_kernels.h,
-// which sweeps/host_calibration.cpp checks), a shading op its whole slot (`slot_bytes`). Its
-// pages are those of that array.
+// which sweeps/host_calibration.cpp checks), a shading op the rest of its slot (`slot_bytes`
+// less that record, which is the traversal's array: of the shading stage only the set-up of
+// the rays an op makes writes it, CoreModel::touch_ray_lines; until 2026-11-29 a shading lane
+// read its whole slot in an address range of its own, so a frame's ray lines held each record
+// twice, and the model priced 64-pixel tiles 3-7 points dearer against smaller ones than the
+// host ran them). Its pages are those of that array.
 constexpr uint32_t k_traversal_record_bytes = 64;
 uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
 // A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit

@@ -491,12 +491,42 @@ TEST_CASE(
     CHECK(passes(32, 2).busy_cycles == 2 * (256 + 128));
     // A 128 KiB L1D keeps them: only the first pass pays.
     CHECK(passes(128, 2).busy_cycles == 2 * 256 + 128);
-    // A shading op reads its whole slot: 16 slots of 64 bytes lie in one page, of 330 bytes
-    // in two, so one lane more pays.
+    // A shading op reads its slot but the traversal record: 16 slots of 64 bytes lie in one
+    // page, of 400 bytes (336 read) in two, so one lane more pays; of 330 bytes (266 read) the
+    // 16 lanes all start in the first page.
     const HwConfig host = host_with({cost("emission_filter", 0, 0, 0, 0, 8)});
-    HwConfig fat = host;
-    fat.ray_buffer.slot_bytes = 330;
+    HwConfig fat = host, tiny = host;
+    fat.ray_buffer.slot_bytes = 400;
+    tiny.ray_buffer.slot_bytes = 330;
+    CHECK(time_surfaces(tiny).cycles == time_surfaces(host).cycles);
     CHECK(time_surfaces(fat).cycles == time_surfaces(host).cycles + 8);
+}
+
+TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
+          "[host][systemc]") {
+    // A shading op over slots 0-1023, then a box test over them (their records: 16 pages of
+    // 64 KiB). After an op that makes the rays, whose set-up writes the records, the box test
+    // finds them in a 128 KiB L1D; after one that makes none it pays 8 cycles for each page.
+    auto box_after = [](OpKind shading) {
+        HwConfig host = host_with({cost("box_test", 0, 4, 0, 0, 8)});
+        host.scene_memory.caches[0].kib = 128;
+        host.ray_buffer.slot_bytes = 330;
+        SystemcTiming timing({host}, shape());
+        std::vector<uint32_t> ids(1024);
+        for (uint32_t i = 0; i < 1024; ++i) ids[i] = i;
+        const std::vector<uint8_t> passed(1024, 1);
+        TilePass pass;
+        pass.slot_count = 1024;
+        timing.begin_pass(pass);
+        timing.op(
+            {shading, OpStage::shading, 0, k_no_object, 1024, 1024, ids.data(), passed.data()});
+        timing.op(
+            {OpKind::box_test, OpStage::traversal, 1, 3, 1024, 1024, ids.data(), passed.data()});
+        timing.end_pass(pass);
+        return timing.timing(0).stages[1][size_t(OpStage::traversal)].busy_cycles;
+    };
+    CHECK(box_after(OpKind::lambertian_indirect) == 64 * 4);
+    CHECK(box_after(OpKind::emission_filter) == 64 * 4 + 16 * 8);
 }
 
 TEST_CASE("Each host knob moves the prediction the way it should", "[host][systemc]") {
@@ -775,7 +805,7 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     // 64 lanes, a sparse one of 16 lanes in 4096 slots (64 pages) still nearly every lane.
     CHECK(lane_ray_bytes(OpStage::traversal, 330) == 64);
     CHECK(lane_ray_bytes(OpStage::intersection, 330) == 64);
-    CHECK(lane_ray_bytes(OpStage::shading, 330) == 330);
+    CHECK(lane_ray_bytes(OpStage::shading, 330) == 330 - 64);  // the record is the traversal's
     CHECK(beyond_l1_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
     CHECK(beyond_l1_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
 }
