@@ -123,12 +123,17 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // did not hold a line of it in the first level and it opens a 4 KiB page of its array (the
     // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes); counted
     // per group. The fit expects the same of its microbenchmarks (beyond_l1_share).
+    // A slot's traversal record: what a box or leaf test reads, and a made ray's set-up writes.
+    const auto record_address = [](uint32_t slot) {
+        return k_records + uint64_t(slot) * k_traversal_record_bytes;
+    };
     const uint32_t n = width();
     m_group_beyond_offset[index] = m_group_beyond_lanes.size();
     uint64_t last = ~uint64_t(0);  // the line touched last
     for (uint32_t i = 0; i < op.length; ++i) {
         if (i % n == 0) m_group_beyond_lanes.push_back(0);
-        const uint64_t address = (record ? k_records : k_slots) + op.slots[i] * bytes;
+        const uint64_t address =
+            record ? record_address(op.slots[i]) : k_slots + op.slots[i] * bytes;
         const uint64_t first_line = address / k_line, last_line = (address + bytes - 1) / k_line;
         const uint64_t from = first_line == last ? first_line + 1 : first_line;
         const uint32_t level =
@@ -145,8 +150,8 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     if (record || !op_info(op.kind).pushes_rays || !op.passed) return;
     for (uint32_t i = 0; i < op.length; ++i)
         if (op.passed[i])
-            m_scene_memory->touch_other(m_core, k_records + op.slots[i] * k_traversal_record_bytes,
-                                        uint32_t(k_traversal_record_bytes), now);
+            m_scene_memory->touch_other(m_core, record_address(op.slots[i]),
+                                        k_traversal_record_bytes, now);
 }
 
 void CoreModel::dispatch_op(uint32_t index, uint64_t now) {

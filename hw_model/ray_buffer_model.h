@@ -143,7 +143,8 @@ double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lan
 // the rays an op makes writes it, CoreModel::touch_ray_lines; until 2026-11-29 a shading lane
 // read its whole slot in an address range of its own, so a frame's ray lines held each record
 // twice: a small part of why the model prices 64-pixel tiles 3-7 points dearer against
-// smaller ones than the host runs them). Its pages are those of that array.
+// smaller ones than the host runs them; a slot no bigger than a record is read whole). Its
+// pages are those of that array.
 constexpr uint32_t k_traversal_record_bytes = 64;
 uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
 // A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit
