@@ -160,7 +160,8 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     active.fill(true);
     // A column that never varies apart from the constant carries no information. The minority
     // column is told from the lane and pass columns only by streams of many lanes that all
-    // pass and that none pass beside mixed ones (the shading filters' microbenchmarks).
+    // pass and that none pass beside mixed ones (the shading filters' and leaf tests'
+    // microbenchmarks).
     bool any_beyond = false, any_passed = false, all_pass = false, none_pass = false,
          mixed = false;
     std::vector<std::array<double, k_terms>> rows;

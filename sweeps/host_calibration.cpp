@@ -280,8 +280,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
-         << "64/256/1024/4096 slots of " << slot_bytes << " bytes (a shading op's streams "
-         << "also with every lane passing and with none, for its minority-lane cost; the "
+         << "64/256/1024/4096 slots of " << slot_bytes << " bytes (a shading op's and a leaf "
+         << "test's streams also with every lane passing and with none, for a passing lane's "
+         << "and a minority lane's costs; the "
          << "filters a frame runs after the miss and shadow filters dealt only hits of rays "
          << "that are not shadow rays; the material filter timed as the sort by material "
          << "the tracer runs for a generation's material filters), the "

@@ -464,6 +464,24 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::vector<uint32_t> passing, failing;
                 std::vector<uint8_t> passes(slots, 0);
                 const bool hits_only = frame_streams_hold_hits_only(kind);
+                const bool leaf_test = stage_of(kind) == OpStage::intersection;
+                if (leaf_test) {
+                    // A leaf test's lane passes where its ray hits the primitive (from no hit,
+                    // as every deal leaves it), each ray tested alone. Its streams are also
+                    // timed with every lane passing and with none, as a shading op's are: the
+                    // buffer's one share of rays that hit its primitive told a group's cost
+                    // from a passing lane's only by rounding, so that a frame whose leaf tests
+                    // pass more often (furnace's sphere) was priced by whichever split the fit
+                    // fell on (on an Intel Xeon VM, 2026-11-29, AVX2's sphere test 5.7 and
+                    // 23.7 cycles a passing lane in two calibrations of the same code).
+                    deal_rays(b, deal, false);  // deal is the identity here
+                    std::vector<uint32_t> one(1 + k_stream_padding);
+                    for (uint32_t ray = 0; ray < slots; ++ray) {
+                        one[0] = ray;
+                        (run_op(one.data(), 1, box_nodes[0]) > 0 ? passing : failing)
+                            .push_back(ray);
+                    }
+                }
                 if (stage_of(kind) == OpStage::shading) {
                     deal_rays(b, deal, true);  // deal is the identity here
                     std::vector<uint32_t> all(slots + k_stream_padding);
@@ -484,8 +502,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             rays->erase(std::remove_if(rays->begin(), rays->end(), not_a_hit),
                                         rays->end());
                     }
-                    for (uint32_t ray : passing) passes[ray] = 1;
                 }
+                for (uint32_t ray : passing) passes[ray] = 1;
                 // The rays a stream is dealt from: the whole buffer, or its hits.
                 std::vector<uint32_t> pool = passing;
                 pool.insert(pool.end(), failing.begin(), failing.end());
@@ -500,6 +518,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 for (const Deal dealt : deals)
                     for (uint32_t n : options.lengths) {
                         if (n > slots) continue;
+                        // A one-lane leaf test is priced by its one-lane points' median
+                        // (one_lane_cycles), which their mixed deal gives as before.
+                        if (leaf_test && n == 1 && dealt != Deal::mixed) continue;
                         std::vector<double> times;
                         uint32_t passed = 0;
                         const double ticks_per_cycle =
@@ -508,7 +529,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         // Short streams run several times in the timed region (the TSC ticks in
                         // steps of tens of cycles here), each time on other slots (an op changes
                         // its rays: a hit tightens t, a shader moves the path on).
-                        const bool exact_mix = classified && dealt == Deal::mixed;
+                        const bool exact_mix =
+                            classified && dealt == Deal::mixed && !(leaf_test && n == 1);
                         const uint32_t stream_passing =
                             exact_mix
                                 ? std::min<uint32_t>(

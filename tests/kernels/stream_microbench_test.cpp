@@ -100,13 +100,24 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     uint32_t plain_kinds = 0;
     for (uint32_t k = 0; k < k_op_kind_count; ++k) plain_kinds += !is_option_kind(OpKind(k));
     CHECK(kinds.size() == plain_kinds);
-    // Three lengths each; a shading op whose buffer has rays it passes and rays it fails also
-    // on streams that all pass and streams that none pass, after its mixed ones.
+    // Three lengths each; a shading op or a leaf test whose buffer has rays it passes and rays
+    // it fails also on streams that all pass and streams that none pass, after its mixed ones
+    // (a leaf test not on its one-lane stream: 3 + 2 + 2).
     std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
     for (const MicrobenchSample& m : samples) by_kind[m.kind].push_back(&m);
     for (const auto& [kind, of_kind] : by_kind) {
         INFO(to_string(kind));
         if (of_kind.size() == 3) continue;
+        if (stage_of(kind) == OpStage::intersection) {
+            REQUIRE(of_kind.size() == 7);
+            CHECK(of_kind[0]->lanes == 1);
+            for (int i = 0; i < 2; ++i) {
+                CHECK(of_kind[3 + i]->lanes > 1);
+                CHECK(of_kind[3 + i]->passed == of_kind[3 + i]->lanes);
+                CHECK(of_kind[5 + i]->passed == 0);
+            }
+            continue;
+        }
         REQUIRE(of_kind.size() == 9);
         CHECK(stage_of(kind) == OpStage::shading);
         for (int i = 0; i < 3; ++i) {
@@ -114,6 +125,10 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
             CHECK(of_kind[6 + i]->passed == 0);
         }
     }
+    // Both leaf tests are classified (the floor triangle and the sphere each hit by some of
+    // the buffer's rays and missed by others).
+    CHECK(by_kind[OpKind::triangle_test].size() == 7);
+    CHECK(by_kind[OpKind::sphere_test].size() == 7);
     REQUIRE(by_kind[OpKind::lambertian_direct].size() == 9);
     const MicrobenchSample& mixed = *by_kind[OpKind::lambertian_direct][2];
     CHECK(mixed.passed > 0);
