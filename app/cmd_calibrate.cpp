@@ -196,6 +196,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"per_group", k.per_group_cycles},
                                            {"per_lane", k.per_lane_cycles},
                                            {"per_pass", k.per_pass_cycles},
+                                           {"per_fail", k.per_fail_cycles},
                                            {"per_minority_lane", k.per_minority_lane_cycles},
                                            {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                                            {"one_lane", k.one_lane_cycles},
@@ -285,17 +286,17 @@ void add_calibrate_command(CLI::App& app) {
                 "judged over all)\n",
                 cal.converged_points, cal.points, describe(bench_rule).c_str(),
                 cal.microbench_visits);
-            std::printf("%-20s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
-                        "per_group", "per_lane", "per_pass", "minority", "beyondL1", "fit med",
-                        "fit max", "one_lane", "few_lane");
+            std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
+                        "per_group", "per_lane", "per_pass", "per_fail", "minority", "beyondL1",
+                        "fit med", "fit max", "one_lane", "few_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
                 std::printf(
-                    "%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f %9.1f\n",
+                    "%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% %9.1f %9.1f\n",
                     k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
-                    k.per_pass_cycles, k.per_minority_lane_cycles, k.beyond_l1_per_lane_cycles,
-                    100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
-                    k.one_lane_cycles, k.few_lane_cycles);
+                    k.per_pass_cycles, k.per_fail_cycles, k.per_minority_lane_cycles,
+                    k.beyond_l1_per_lane_cycles, 100 * cal.fit_errors[i].first,
+                    100 * cal.fit_errors[i].second, k.one_lane_cycles, k.few_lane_cycles);
             }
             std::printf(
                 "one- and few-lane costs, and the stream loop's per-op box cost: %zu batches of "

@@ -603,6 +603,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", per_group_cycles: " << fmt(o.per_group_cycles, 2)
               << ", per_lane_cycles: " << fmt(o.per_lane_cycles, 2)
               << ", per_pass_cycles: " << fmt(o.per_pass_cycles, 2)
+              << ", per_fail_cycles: " << fmt(o.per_fail_cycles, 2)
               << ", per_minority_lane_cycles: " << fmt(o.per_minority_lane_cycles, 2)
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)

@@ -433,6 +433,7 @@ struct OpCostConfig {
     double per_group_cycles = 0.0;
     double per_lane_cycles = 0.0;
     double per_pass_cycles = 0.0;
+    double per_fail_cycles = 0.0;
     double per_minority_lane_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
@@ -458,6 +459,10 @@ struct OpCostConfig {
                 "cost per lane (per-ray scalar work)", 0.0, 1e9);
         v.param("per_pass_cycles", per_pass_cycles, "cycles",
                 "cost per passing lane (work only passing rays do)", 0.0, 1e9);
+        v.param("per_fail_cycles", per_fail_cycles, "cycles",
+                "cost per failing lane (work only failing rays do: what a lane's cost loses "
+                "when it passes, where the microbenchmarks say so)",
+                0.0, 1e9);
         v.param("per_minority_lane_cycles", per_minority_lane_cycles, "cycles",
                 "cost per lane of the op's rarer outcome (passing or failing): branch "
                 "mispredictions on each lane's outcome",

@@ -260,6 +260,7 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
         return first ? cost.few_lane_cycles : 0.0;
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
            cost.per_lane_cycles * lanes + cost.per_pass_cycles * passed +
+           cost.per_fail_cycles * (lanes - passed) +
            cost.per_minority_lane_cycles * op_mispredicted * lanes / double(length) +
            cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes;
 }

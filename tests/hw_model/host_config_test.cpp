@@ -219,7 +219,25 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK(fit.per_pass_cycles == Approx(40).epsilon(1e-6));
     CHECK(fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
     CHECK(fit.per_minority_lane_cycles == 0.0);  // no stream of many lanes all passed
+    CHECK(fit.per_fail_cycles == 0.0);  // a passing lane costs more: the pass column holds it
     CHECK(fit_error(fit, 16, samples).second < 1e-9);
+
+    // A lane that passes costs less than one that fails (the scalar box test): the passing
+    // lanes' cost would be negative, so the failing lanes' column takes it.
+    OpCostConfig cheaper_pass = cost("box_test", 0, 0, 25, 0, 8);
+    cheaper_pass.per_fail_cycles = 20;
+    std::vector<OpCostSample> boxes;
+    for (uint32_t lanes : {8u, 24u, 96u, 512u, 4096u})
+        for (double beyond : {0.0, 0.5})
+            for (uint32_t passed : {lanes, lanes / 2, lanes / 8})
+                boxes.push_back({lanes, passed, beyond,
+                                 measured_op_cycles(cheaper_pass, 1, lanes, passed, beyond)});
+    const OpCostConfig box_fit = fit_op_cost("box_test", 1, boxes);
+    CHECK(box_fit.per_fail_cycles == Approx(20).epsilon(1e-6));
+    CHECK(box_fit.per_pass_cycles == 0.0);
+    CHECK(box_fit.per_lane_cycles + box_fit.per_group_cycles == Approx(25).epsilon(1e-6));
+    CHECK(box_fit.beyond_l1_per_lane_cycles == Approx(8).epsilon(1e-6));
+    CHECK(fit_error(box_fit, 1, boxes).second < 1e-9);
 
     // Streams that all pass and that none pass, beside mixed ones, tell a minority lane's cost
     // (a branch predictor's misses) from a lane's and a passing lane's.
