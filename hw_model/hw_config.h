@@ -460,8 +460,8 @@ struct OpCostConfig {
         v.param("per_pass_cycles", per_pass_cycles, "cycles",
                 "cost per passing lane (work only passing rays do)", 0.0, 1e9);
         v.param("per_fail_cycles", per_fail_cycles, "cycles",
-                "cost per failing lane (work only failing rays do: what a lane's cost loses "
-                "when it passes, where the microbenchmarks say so)",
+                "cost per failing lane (what a lane's cost loses when it passes): fitted by sfx "
+                "calibrate on the op's microbenchmarks, 0 where a passing lane costs no less",
                 0.0, 1e9);
         v.param("per_minority_lane_cycles", per_minority_lane_cycles, "cycles",
                 "cost per lane of the op's rarer outcome (passing or failing): branch "

@@ -519,8 +519,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     for (uint32_t n : options.lengths) {
                         if (n > slots) continue;
                         // A one-lane leaf test is priced by its one-lane points' median
-                        // (one_lane_cycles), which their mixed deal gives as before.
-                        if (leaf_test && n == 1 && dealt != Deal::mixed) continue;
+                        // (one_lane_cycles): only their mixed deal, of rays drawn at random.
+                        const bool one_lane_leaf = leaf_test && n == 1;
+                        if (one_lane_leaf && dealt != Deal::mixed) continue;
                         std::vector<double> times;
                         uint32_t passed = 0;
                         const double ticks_per_cycle =
@@ -529,8 +530,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         // Short streams run several times in the timed region (the TSC ticks in
                         // steps of tens of cycles here), each time on other slots (an op changes
                         // its rays: a hit tightens t, a shader moves the path on).
-                        const bool exact_mix =
-                            classified && dealt == Deal::mixed && !(leaf_test && n == 1);
+                        const bool exact_mix = classified && dealt == Deal::mixed && !one_lane_leaf;
                         const uint32_t stream_passing =
                             exact_mix
                                 ? std::min<uint32_t>(
