@@ -239,6 +239,20 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     std::vector<Buffers> buffers;
     for (uint32_t slots : options.buffer_slots)
         buffers.push_back(make_buffers(scene, bvh, slots, rng));
+    // A traversal's box and leaf tests run back to back in a frame, thousands to a pass, so
+    // each call finds the filter's code warm. Timed right after the deal and the touch of the
+    // buffer, a call found it cold: on an Intel Xeon VM (2026-11-29), an AVX2 box test of 96
+    // lanes over 4096 records in the L2 took 11-19 cycles a lane alone and 8-10 right after a
+    // box test of 8 to 64 other lanes (6.5 with its records in the L1D), and the fit charged
+    // the difference to the lanes beyond the L1D, which a frame's 64-pixel tiles then paid
+    // (the model's traversal 17-44 % over the host's there, against 3-12 % at 32). So a
+    // traversal op's timed calls follow one call of the same op on k_primer_lanes lanes of a
+    // buffer of its own (a few lines, which leave the measured buffer's cache state as it was).
+    // A shading filter runs once per generation between the others (cold in a frame too).
+    constexpr uint32_t k_primer_lanes = 16;
+    std::mt19937 primer_rng(7);
+    Buffers primer = make_buffers(scene, bvh, 64, primer_rng);
+    TraversalJob primer_job = traversal_job(bvh, primer);
     // The triangle test's floor triangle (primitive 0) at its leaf position.
     auto leaf_position = [&](uint32_t prim) {
         return uint32_t(std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), prim) -
@@ -287,9 +301,10 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     std::fill(counts, counts + materials, 0u);
                     for (uint32_t i = 0; i < n; ++i) ++counts[b.surf[ids[i]].material];
                 };
-                // The op of `kind` on the stream ids[0, n) (partitioned in place, as the tracer's
-                // filters leave it): its passing count. box_node: the box test's node.
-                auto run_op = [&](uint32_t* ids, uint32_t n, uint32_t box_node) {
+                // The op of `kind` on the stream ids[0, n) of buffer `b` (partitioned in place, as
+                // the tracer's filters leave it): its passing count. box_node: the box test's node.
+                auto run_op = [&](Buffers& b, TraversalJob& job, uint32_t* ids, uint32_t n,
+                                  uint32_t box_node) {
                     uint32_t passed = 0;
                     uint8_t* mask = b.mask.data();
                     uint32_t* scratch = b.scratch.data();
@@ -465,6 +480,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::vector<uint8_t> passes(slots, 0);
                 const bool hits_only = frame_streams_hold_hits_only(kind);
                 const bool leaf_test = stage_of(kind) == OpStage::intersection;
+                const bool primed = stage_of(kind) != OpStage::shading;
                 if (leaf_test) {
                     // A leaf test's lane passes where its ray hits the primitive (from no hit,
                     // as every deal leaves it), each ray tested alone. Its streams are also
@@ -478,7 +494,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     std::vector<uint32_t> one(1 + k_stream_padding);
                     for (uint32_t ray = 0; ray < slots; ++ray) {
                         one[0] = ray;
-                        (run_op(one.data(), 1, box_nodes[0]) > 0 ? passing : failing)
+                        (run_op(b, job, one.data(), 1, box_nodes[0]) > 0 ? passing : failing)
                             .push_back(ray);
                     }
                 }
@@ -491,7 +507,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         count_materials(all.data(), slots, material_counts.data());
                         counts_now = material_counts.data();
                     }
-                    const uint32_t p = run_op(all.data(), slots, box_nodes[0]);
+                    const uint32_t p = run_op(b, job, all.data(), slots, box_nodes[0]);
                     passing.assign(all.begin(), all.begin() + p);
                     failing.assign(all.begin() + p, all.begin() + slots);
                     if (hits_only) {
@@ -607,11 +623,17 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 for (uint32_t j = 0; j < inner; ++j)
                                     count_materials(streams.data() + size_t(j) * stride, n,
                                                     material_counts.data() + size_t(j) * materials);
+                            if (primed) {
+                                std::iota(primer.ids.begin(), primer.ids.begin() + k_primer_lanes,
+                                          0u);
+                                run_op(primer, primer_job, primer.ids.data(), k_primer_lanes,
+                                       box_node);
+                            }
                             const uint64_t start = __rdtsc();
                             for (uint32_t again = 0; again < inner; ++again) {
                                 counts_now = material_counts.data() + size_t(again) * materials;
-                                passed =
-                                    run_op(streams.data() + size_t(again) * stride, n, box_node);
+                                passed = run_op(b, job, streams.data() + size_t(again) * stride, n,
+                                                box_node);
                             }
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);

@@ -8,11 +8,15 @@
 // panel, a glass sphere, a light: no shipped scene). Time is the time-stamp counter around one
 // call, the fastest of repetitions that go on until their fastest k agree or a budget runs out
 // (base/convergence.h: a shared machine only ever adds time), in core cycles (the TSC over
-// base/core_clock.h's ticks per core cycle of the back end's own chain, taken just before). An op
-// is timed with all the per-ray work the tracer does for it: the emission filter computes the hits'
-// surfaces (surface_at), and the camera and every shader that makes a ray set it up for the next
-// generation's traversal (set_up_ray, the tracer's load_rays). `sfx calibrate --describe-host` fits
-// the host's per-op costs to these samples (hw_model/op_cost_fit.h), never to frames.
+// base/core_clock.h's ticks per core cycle of the back end's own chain, taken just before). A
+// traversal op (box, triangle and sphere tests) is timed right after one call of itself on a
+// few lanes of a small buffer of its own, so that it finds its code warm, as a frame's back-to-
+// back traversal ops do; a shading filter, which a frame runs once a generation between the
+// others, is timed cold. An op is timed with all the per-ray work the tracer does for it: the
+// emission filter computes the hits' surfaces (surface_at), and the camera and every shader that
+// makes a ray set it up for the next generation's traversal (set_up_ray, the tracer's load_rays).
+// `sfx calibrate --describe-host` fits the host's per-op costs to these samples
+// (hw_model/op_cost_fit.h), never to frames.
 
 #include <algorithm>
 #include <array>
