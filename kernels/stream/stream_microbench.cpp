@@ -245,7 +245,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // lanes over 4096 records in the L2 took 11-19 cycles a lane alone and 8-10 right after a
     // box test of 8 to 64 other lanes (6.5 with its records in the L1D), and the fit charged
     // the difference to the lanes beyond the L1D, which a frame's 64-pixel tiles then paid
-    // (the model's traversal 17-44 % over the host's there, against 3-12 % at 32). So a
+    // (AVX2, atrium, conference and cornell 64 x 64: the model's traversal 17-44 % over the
+    // host's at tile 64, +1 to +23 % at 32). So a
     // traversal op's timed calls follow one call of the same op on k_primer_lanes lanes of a
     // buffer of its own (a few lines, which leave the measured buffer's cache state as it was).
     // A shading filter runs once per generation between the others (cold in a frame too).
