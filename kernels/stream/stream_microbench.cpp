@@ -246,10 +246,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // box test of 8 to 64 other lanes (6.5 with its records in the L1D), and the fit charged
     // the difference to the lanes beyond the L1D, which a frame's 64-pixel tiles then paid
     // (AVX2, atrium, conference and cornell 64 x 64: the model's traversal 17-44 % over the
-    // host's at tile 64, +1 to +23 % at 32). So a
-    // traversal op's timed calls follow one call of the same op on k_primer_lanes lanes of a
-    // buffer of its own (a few lines, which leave the measured buffer's cache state as it was).
-    // A shading filter runs once per generation between the others (cold in a frame too).
+    // host's at tile 64, +1 to +23 % at 32). So a traversal op's timed calls follow one call of
+    // the same op on k_primer_lanes lanes of a buffer of its own: 16 (8, 16 and 64 warmed the
+    // box test alike there), whose 1 KiB of records leaves the measured buffer's cache state as
+    // it was. A shading filter runs once per generation between the others (cold in a frame
+    // too), so it is timed cold.
     constexpr uint32_t k_primer_lanes = 16;
     std::mt19937 primer_rng(7);
     Buffers primer = make_buffers(scene, bvh, 64, primer_rng);
