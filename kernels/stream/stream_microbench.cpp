@@ -250,11 +250,36 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // the same op on k_primer_lanes lanes of a buffer of its own: 16 (8, 16 and 64 warmed the
     // box test alike there), whose 1 KiB of records leaves the measured buffer's cache state as
     // it was. A shading filter runs once per generation between the others (cold in a frame
-    // too), so it is timed cold.
+    // too), so it is timed cold, after a traversal (below).
     constexpr uint32_t k_primer_lanes = 16;
     std::mt19937 primer_rng(7);
     Buffers primer = make_buffers(scene, bvh, 64, primer_rng);
     TraversalJob primer_job = traversal_job(bvh, primer);
+    // A frame's shading filters run right after its generation's traversal, whose vector code
+    // sets the core's clock, and a cycle is the back end's chain clock (base/core_clock.h). On
+    // an Intel Xeon VM with AVX-512 (2026-11-29) the zmm chain clocked 3.68-3.79 GHz, the
+    // scalar one 3.99-4.09, and the shading filters timed right after a traversal of 64 rays
+    // took 6-13 % more TSC time (median over lengths, by kind) than right after the deal and
+    // the touch, which is scalar code: they had run at the scalar clock, and were priced about
+    // a tenth under. AVX2's took 1-3 % more, scalar's 0.5-3 %. So a shading filter's timed
+    // calls follow a traversal of k_rays_before_shading rays of a buffer of their own.
+    constexpr uint32_t k_rays_before_shading = 64;
+    std::mt19937 before_shading_rng(11);
+    Buffers before_shading = make_buffers(scene, bvh, k_rays_before_shading, before_shading_rng);
+    TraversalJob before_shading_job = traversal_job(bvh, before_shading);
+    auto traverse_before_shading = [&] {
+        Buffers& b = before_shading;
+        for (uint32_t i = 0; i < k_rays_before_shading; ++i) {
+            b.ids[i] = i;
+            b.trav.set(i, b.pre[i], b.ray[i].t_max);  // each time from its full t, no hit
+            b.hit[i] = Hit{};
+        }
+        before_shading_job.n = k_rays_before_shading;
+        before_shading_job.ids = b.ids.data();
+        before_shading_job.entry = 0;
+        before_shading_job.shared_origin = nullptr;
+        kernels.traverse[int(TraceDetail::none)](before_shading_job);
+    };
     // The triangle test's floor triangle (primitive 0) at its leaf position.
     auto leaf_position = [&](uint32_t prim) {
         return uint32_t(std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), prim) -
@@ -630,6 +655,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                           0u);
                                 run_op(primer, primer_job, primer.ids.data(), k_primer_lanes,
                                        box_node);
+                            } else {
+                                traverse_before_shading();
                             }
                             const uint64_t start = __rdtsc();
                             for (uint32_t again = 0; again < inner; ++again) {

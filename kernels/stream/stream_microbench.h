@@ -12,11 +12,12 @@
 // traversal op (box, triangle and sphere tests) is timed right after one call of itself on a
 // few lanes of a small buffer of its own, so that it finds its code warm, as a frame's back-to-
 // back traversal ops do; a shading filter, which a frame runs once a generation between the
-// others, is timed cold. An op is timed with all the per-ray work the tracer does for it: the
-// emission filter computes the hits' surfaces (surface_at), and the camera and every shader that
-// makes a ray set it up for the next generation's traversal (set_up_ray, the tracer's load_rays).
-// `sfx calibrate --describe-host` fits the host's per-op costs to these samples
-// (hw_model/op_cost_fit.h), never to frames.
+// others, is timed cold, right after a traversal of other rays, which leaves the core's clock
+// as a frame's traversal leaves it for the shading stage (AVX-512's is lower). An op is timed with
+// all the per-ray work the tracer does for it: the emission filter computes the hits' surfaces
+// (surface_at), and the camera and every shader that makes a ray set it up for the next
+// generation's traversal (set_up_ray, the tracer's load_rays). `sfx calibrate --describe-host` fits
+// the host's per-op costs to these samples (hw_model/op_cost_fit.h), never to frames.
 
 #include <algorithm>
 #include <array>
