@@ -260,9 +260,12 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // an Intel Xeon VM with AVX-512 (2026-11-29) the zmm chain clocked 3.68-3.79 GHz, the
     // scalar one 3.99-4.09, and the shading filters timed right after a traversal of 64 rays
     // took 6-13 % more TSC time (median over lengths, by kind) than right after the deal and
-    // the touch, which is scalar code: they had run at the scalar clock, and were priced about
-    // a tenth under. AVX2's took 1-3 % more, scalar's 0.5-3 %. So a shading filter's timed
-    // calls follow a traversal of k_rays_before_shading rays of a buffer of their own.
+    // the touch, which are scalar code: about what running at the scalar clock instead of the
+    // zmm one gives (no PMU there to count the cycles), and the model had priced AVX-512's
+    // shading about a tenth under. AVX2's took 1-3 % more, scalar's 0.5-3 %; a traversal op,
+    // primed by its own call, took the same after a traversal (within 1 %). So a shading
+    // filter's timed calls follow a traversal of k_rays_before_shading rays of a buffer of
+    // their own.
     constexpr uint32_t k_rays_before_shading = 64;
     std::mt19937 before_shading_rng(11);
     Buffers before_shading = make_buffers(scene, bvh, k_rays_before_shading, before_shading_rng);
