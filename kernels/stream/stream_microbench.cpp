@@ -270,17 +270,14 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     std::mt19937 before_shading_rng(11);
     Buffers before_shading = make_buffers(scene, bvh, k_rays_before_shading, before_shading_rng);
     TraversalJob before_shading_job = traversal_job(bvh, before_shading);
+    std::iota(before_shading.ids.begin(), before_shading.ids.begin() + k_rays_before_shading, 0u);
+    before_shading_job.n = k_rays_before_shading;
+    before_shading_job.ids = before_shading.ids.data();
     auto traverse_before_shading = [&] {
         Buffers& b = before_shading;
-        for (uint32_t i = 0; i < k_rays_before_shading; ++i) {
-            b.ids[i] = i;
-            b.trav.set(i, b.pre[i], b.ray[i].t_max);  // each time from its full t, no hit
-            b.hit[i] = Hit{};
-        }
-        before_shading_job.n = k_rays_before_shading;
-        before_shading_job.ids = b.ids.data();
-        before_shading_job.entry = 0;
-        before_shading_job.shared_origin = nullptr;
+        for (uint32_t i = 0; i < k_rays_before_shading; ++i)  // each time from no hit, as loaded
+            set_up_ray(b.ray[i], b.path[i].kind == RayKind::shadow, i, b.any_hit[i], b.hit[i],
+                       b.pre[i], b.trav);
         kernels.traverse[int(TraceDetail::none)](before_shading_job);
     };
     // The triangle test's floor triangle (primitive 0) at its leaf position.
