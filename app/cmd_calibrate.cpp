@@ -203,6 +203,7 @@ void add_calibrate_command(CLI::App& app) {
                                            {"few_lane", k.few_lane_cycles},
                                            {"one_ray_entry", k.one_ray_entry_cycles},
                                            {"few_ray_entry", k.few_ray_entry_cycles},
+                                           {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
                                            {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                                            {"fit_median_error", cal.fit_errors[i].first},
                                            {"fit_worst_error", cal.fit_errors[i].second}};
@@ -214,7 +215,8 @@ void add_calibrate_command(CLI::App& app) {
                                             {"passed", m.passed},
                                             {"cycles", m.cycles},
                                             {"converged", m.converged},
-                                            {"repetitions", m.repetitions}});
+                                            {"repetitions", m.repetitions},
+                                            {"thin_lens", m.thin_lens}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {

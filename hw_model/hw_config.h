@@ -447,6 +447,11 @@ struct OpCostConfig {
     // cache model that prices the frames. 0: not measured (the reads cost what the
     // cache-resident microbenchmark saw).
     double hit_read_exposed_share = 0.0;
+    // The camera's: what a thin-lens camera's ray adds to a pinhole's (a concentric disk
+    // sample, the focus point and a normalize; kernels/camera.h), fitted on the camera's
+    // microbenchmarks with a lens beside its pinhole ones; paid by every lane of a camera op on
+    // a scene whose camera has an aperture (FeatureSet::thin_lens). 0: not measured.
+    double thin_lens_per_lane_cycles = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -491,6 +496,10 @@ struct OpCostConfig {
                 "share of each lane's hit-primitive read latency beyond an L2 hit that is not "
                 "overlapped (0: not measured)",
                 0.0, 100.0);
+        v.param("thin_lens_per_lane_cycles", thin_lens_per_lane_cycles, "cycles",
+                "the camera's: cost a thin-lens camera adds per ray over a pinhole (0: not "
+                "measured)",
+                0.0, 1e9);
     }
 };
 

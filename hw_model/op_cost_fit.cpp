@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/convergence.h"
 #include "hw_model/cache_model.h"
 #include "hw_model/op_costs.h"
 
@@ -224,6 +225,17 @@ std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};
+}
+
+double fit_thin_lens_per_lane(const OpCostConfig& pinhole, uint32_t width,
+                              const std::vector<OpCostSample>& lens_samples) {
+    std::vector<double> extra;
+    for (const OpCostSample& s : lens_samples)
+        if (s.lanes > 0)
+            extra.push_back(
+                (s.cycles - measured_op_cycles(pinhole, width, s.lanes, s.passed, s.beyond_l1)) /
+                s.lanes);
+    return extra.empty() ? 0.0 : std::max(0.0, median(extra));
 }
 
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,

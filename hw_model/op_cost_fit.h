@@ -33,6 +33,12 @@ struct OpCostSample {
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
                          const std::vector<OpCostSample>& samples);
 
+// What a thin-lens camera adds per ray over a pinhole (OpCostConfig::thin_lens_per_lane_cycles):
+// the median over the lens camera's samples of their cycles beyond the pinhole's fitted cost
+// (`pinhole`), per lane; 0 when there are none, never negative.
+double fit_thin_lens_per_lane(const OpCostConfig& pinhole, uint32_t width,
+                              const std::vector<OpCostSample>& lens_samples);
+
 // The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
 // measured, a measurement under 100 cycles counting as 100 (the clock's steps).
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,

@@ -201,6 +201,9 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
             if (op_kind_named(c.op) == OpKind(k)) {
                 p.measured = true;
                 p.cost = c;
+                // A lens camera's rays cost more than a pinhole's (thin_lens_per_lane_cycles).
+                if (layout.features().thin_lens)
+                    p.cost.per_lane_cycles += c.thin_lens_per_lane_cycles;
             }
     }
 }

@@ -183,21 +183,28 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     std::map<OpKind, std::vector<double>> one_lane;  // a leaf test's one-lane samples
+    std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
     for (const MicrobenchSample& s : c.samples) {
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
             one_lane[s.kind].push_back(s.cycles);
             continue;
         }
-        by_kind[s.kind].push_back(
-            {s.lanes, s.passed,
-             beyond_l1_share(s.lanes, s.slots, slot_bytes,
-                             lane_ray_bytes(stage_of(s.kind), slot_bytes), l1d),
-             s.cycles});
+        const OpCostSample sample{
+            s.lanes, s.passed,
+            beyond_l1_share(s.lanes, s.slots, slot_bytes,
+                            lane_ray_bytes(stage_of(s.kind), slot_bytes), l1d),
+            s.cycles};
+        (s.thin_lens ? lens_camera : by_kind[s.kind]).push_back(sample);
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
         c.op_costs.back().one_lane_cycles = median(one_lane[kind]);
+        if (kind == OpKind::camera) {
+            c.op_costs.back().thin_lens_per_lane_cycles =
+                fit_thin_lens_per_lane(c.op_costs.back(), c.host.simd_width, lens_camera);
+            points += lens_camera.size();
+        }
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();
     }

@@ -231,6 +231,22 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                        OpKind::lambertian_indirect,
                                        OpKind::dielectric,
                                        OpKind::glossy};
+    // The camera is timed twice: on the synthetic scene's pinhole and on a thin lens (atrium's
+    // aperture, focused on the scene's centre), whose difference a lens scene's camera ops pay
+    // (OpCostConfig::thin_lens_per_lane_cycles).
+    struct TimedKind {
+        OpKind kind;
+        bool thin_lens;
+    };
+    std::vector<TimedKind> timed_kinds;
+    for (const OpKind kind : kinds) {
+        timed_kinds.push_back({kind, false});
+        if (kind == OpKind::camera) timed_kinds.push_back({kind, true});
+    }
+    ThinLensCamera lens = scene.camera;
+    lens.aperture_radius = 0.03f;
+    lens.focal_distance = length(lens.look_at - lens.eye);
+    const CameraFrame lens_camera(lens, 64, 64);
     std::vector<MicrobenchSample> out;
     uint32_t done = 0;
     Scene ambient_scene = scene;  // the ambient filter reads scene.ambient
@@ -306,7 +322,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         const bool last_visit = visit + 1 == visits;
         uint32_t box_sample = 0;
         size_t point = 0;
-        for (OpKind kind : kinds) {
+        for (const TimedKind& timed : timed_kinds) {
+            const OpKind kind = timed.kind;
+            const bool thin_lens = timed.thin_lens;
             if (!options.kinds.empty() &&
                 std::find(options.kinds.begin(), options.kinds.end(), kind) == options.kinds.end())
                 continue;
@@ -355,7 +373,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 PathState& p = b.path[slot];
                                 p = PathState{};
                                 p.key = {1, slot, 0};
-                                b.next[slot] = camera.generate(p.key);
+                                b.next[slot] = (thin_lens ? lens_camera : camera).generate(p.key);
                                 set_up(slot, false);
                                 mask[i] = 1;
                             }
@@ -673,10 +691,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         if (!last_visit) continue;
                         // Converged: the fastest k of all the visits' samples agree.
                         const Convergence c = judge_convergence(cycles, options.convergence);
-                        out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples});
+                        out.push_back(
+                            {kind, slots, n, passed, c.fastest, c.converged, c.samples, thin_lens});
                     }
             }
-            if (progress) progress(++done, uint32_t(kinds.size()) * visits);
+            if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);
         }
     }
     return out;

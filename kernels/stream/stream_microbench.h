@@ -46,6 +46,7 @@ struct MicrobenchSample {
     double cycles = 0.0;  // core cycles per call (base/core_clock.h), fastest repetition
     bool converged = false;  // its fastest repetitions agreed (base/convergence.h)
     uint32_t repetitions = 0;
+    bool thin_lens = false;  // the camera's: timed on a thin-lens camera, not the pinhole
 };
 
 // The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.

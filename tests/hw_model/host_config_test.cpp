@@ -204,6 +204,35 @@ TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]
     CHECK(measured_op_cycles(one, 16, 1, 1, 0.0) == Approx(7));
 }
 
+TEST_CASE("A thin-lens camera's rays cost what its microbenchmarks add to the pinhole's",
+          "[host]") {
+    // The fit: the lens samples' cycles beyond the pinhole's fitted cost, per lane (median).
+    const OpCostConfig pinhole = cost("camera", 15, 0, 120, 0, 30);
+    std::vector<OpCostSample> lens;
+    for (uint32_t lanes : {16u, 64u, 256u})
+        lens.push_back({lanes, lanes, 0.25,
+                        measured_op_cycles(pinhole, 8, lanes, lanes, 0.25) + 80.0 * lanes});
+    lens.push_back({32, 32, 0.0, measured_op_cycles(pinhole, 8, 32, 32, 0.0) + 500.0 * 32});
+    CHECK(fit_thin_lens_per_lane(pinhole, 8, lens) == Approx(80));
+    CHECK(fit_thin_lens_per_lane(pinhole, 8, {}) == 0.0);
+    // Never negative: a lens no dearer than the pinhole adds nothing.
+    CHECK(fit_thin_lens_per_lane(pinhole, 8, {{64, 64, 0.0, 100.0}}) == 0.0);
+
+    // The model: every lane of a camera op on a scene with a lens pays it, no other op's.
+    OpCostConfig camera = pinhole;
+    camera.thin_lens_per_lane_cycles = 80;
+    HwConfig host = host_with({camera, cost("box_test", 10, 4, 0, 0, 0)});
+    FeatureSet pinhole_scene, lens_scene;
+    lens_scene.thin_lens = true;
+    const OpCostTable plain(RayRecordLayout(pinhole_scene), host),
+        with_lens(RayRecordLayout(lens_scene), host);
+    const DatapathConfig d;
+    CHECK(with_lens[OpKind::camera].issue_cycles(d, 64, 0, 8, 8, false, 0.0) ==
+          Approx(plain[OpKind::camera].issue_cycles(d, 64, 0, 8, 8, false, 0.0) + 8 * 80));
+    CHECK(with_lens[OpKind::box_test].issue_cycles(d, 64, 0, 8, 8, false, 0.0) ==
+          plain[OpKind::box_test].issue_cycles(d, 64, 0, 8, 8, false, 0.0));
+}
+
 TEST_CASE("The fit recovers costs from exact samples and never goes negative", "[host]") {
     const OpCostConfig truth = cost("triangle_test", 30, 12, 0, 40, 3);
     std::vector<OpCostSample> samples;
