@@ -450,7 +450,11 @@ struct OpCostConfig {
     // The camera's: what a thin-lens camera's ray adds to a pinhole's (a concentric disk
     // sample, the focus point and a normalize; kernels/camera.h), fitted on the camera's
     // microbenchmarks with a lens beside its pinhole ones; paid by every lane of a camera op on
-    // a scene whose camera has an aperture (FeatureSet::thin_lens). 0: not measured.
+    // a scene whose camera has an aperture (FeatureSet::thin_lens). 0: not measured. Fitted on
+    // an AMD Zen 5 VM (2026-12-01): 96.9 / 98.0 / 95.5 cycles a ray (scalar / AVX2 / AVX-512);
+    // held out, atrium's camera stage there ran 78 cycles a ray above the pinhole scenes'
+    // (stage clock, run 24 of docs/silicon-check-amd-avx512.md), so the lens is priced about a
+    // quarter over, about 0.5 % of an atrium frame.
     double thin_lens_per_lane_cycles = 0.0;
 
     template <class V>

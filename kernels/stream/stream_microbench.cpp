@@ -232,7 +232,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                        OpKind::dielectric,
                                        OpKind::glossy};
     // The camera is timed twice: on the synthetic scene's pinhole and on a thin lens (atrium's
-    // aperture, focused on the scene's centre), whose difference a lens scene's camera ops pay
+    // aperture, focused on the scene's centre; any aperture above zero runs the same lens
+    // arithmetic, kernels/camera.h), whose difference a lens scene's camera ops pay
     // (OpCostConfig::thin_lens_per_lane_cycles).
     struct TimedKind {
         OpKind kind;
