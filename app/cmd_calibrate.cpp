@@ -192,21 +192,23 @@ void add_calibrate_command(CLI::App& app) {
                 j["points"] = cal.points;
                 for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                     const OpCostConfig& k = cal.op_costs[i];
-                    j["op_costs"][k.op] = {{"per_op", k.per_op_cycles},
-                                           {"per_group", k.per_group_cycles},
-                                           {"per_lane", k.per_lane_cycles},
-                                           {"per_pass", k.per_pass_cycles},
-                                           {"per_fail", k.per_fail_cycles},
-                                           {"per_minority_lane", k.per_minority_lane_cycles},
-                                           {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
-                                           {"one_lane", k.one_lane_cycles},
-                                           {"few_lane", k.few_lane_cycles},
-                                           {"one_ray_entry", k.one_ray_entry_cycles},
-                                           {"few_ray_entry", k.few_ray_entry_cycles},
-                                           {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
-                                           {"filter_per_op", cal.filter_costs[i].per_op_cycles},
-                                           {"fit_median_error", cal.fit_errors[i].first},
-                                           {"fit_worst_error", cal.fit_errors[i].second}};
+                    j["op_costs"][k.op] = {
+                        {"per_op", k.per_op_cycles},
+                        {"per_group", k.per_group_cycles},
+                        {"per_lane", k.per_lane_cycles},
+                        {"per_pass", k.per_pass_cycles},
+                        {"per_fail", k.per_fail_cycles},
+                        {"per_minority_lane", k.per_minority_lane_cycles},
+                        {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
+                        {"one_lane", k.one_lane_cycles},
+                        {"few_lane", k.few_lane_cycles},
+                        {"one_ray_entry", k.one_ray_entry_cycles},
+                        {"few_ray_entry", k.few_ray_entry_cycles},
+                        {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
+                        {"sphere_light_per_pass", k.sphere_light_per_pass_cycles},
+                        {"filter_per_op", cal.filter_costs[i].per_op_cycles},
+                        {"fit_median_error", cal.fit_errors[i].first},
+                        {"fit_worst_error", cal.fit_errors[i].second}};
                 }
                 for (const MicrobenchSample& m : cal.samples)
                     j["samples"].push_back({{"op", to_string(m.kind)},
@@ -216,7 +218,8 @@ void add_calibrate_command(CLI::App& app) {
                                             {"cycles", m.cycles},
                                             {"converged", m.converged},
                                             {"repetitions", m.repetitions},
-                                            {"thin_lens", m.thin_lens}});
+                                            {"thin_lens", m.thin_lens},
+                                            {"sphere_light", m.sphere_light}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {

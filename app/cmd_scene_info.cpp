@@ -65,6 +65,7 @@ void add_scene_info_command(CLI::App& app) {
             j["features.ambient"] = features.ambient;
             j["features.environment"] = features.environment;
             j["features.light_count"] = features.light_count;
+            j["features.sphere_light_share"] = features.sphere_light_share;
             j["features.max_depth"] = features.max_depth;
             j["ray_record_bytes"] = ray_bytes;
             for (const RayField& f : fields) j["ray_record." + f.name + "_bytes"] = f.bytes;

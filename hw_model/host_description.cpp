@@ -618,6 +618,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.thin_lens_per_lane_cycles > 0
                       ? ", thin_lens_per_lane_cycles: " + fmt(o.thin_lens_per_lane_cycles, 2)
                       : std::string())
+              << (o.sphere_light_per_pass_cycles > 0
+                      ? ", sphere_light_per_pass_cycles: " + fmt(o.sphere_light_per_pass_cycles, 2)
+                      : std::string())
               << "}\n";
     }
     return y.str();

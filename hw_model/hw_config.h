@@ -456,6 +456,13 @@ struct OpCostConfig {
     // (stage clock, run 24 of docs/silicon-check-amd-avx512.md), so the lens is priced about a
     // quarter over, about 0.5 % of an atrium frame.
     double thin_lens_per_lane_cycles = 0.0;
+    // The direct-light filter's: what a passing lane's light sample on a sphere adds to one on a
+    // triangle (a uniform point on the sphere and its error bound, kernels/lights.h; a failing
+    // lane costs the same on either, on a Zen 5 core at AVX2, 2026-12-01), fitted on the
+    // filter's microbenchmarks with a sphere light beside its quad ones; paid by every passing
+    // lane of its ops in proportion to the share of a scene's light samples that land on
+    // spheres (FeatureSet::sphere_light_share: furnace's all, cornell's none). 0: not measured.
+    double sphere_light_per_pass_cycles = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -503,6 +510,10 @@ struct OpCostConfig {
         v.param("thin_lens_per_lane_cycles", thin_lens_per_lane_cycles, "cycles",
                 "the camera's: cost a thin-lens camera adds per ray over a pinhole (0: not "
                 "measured)",
+                0.0, 1e9);
+        v.param("sphere_light_per_pass_cycles", sphere_light_per_pass_cycles, "cycles",
+                "the direct-light filter's: cost a light sample on a sphere adds per passing lane "
+                "over one on a triangle (0: not measured)",
                 0.0, 1e9);
     }
 };

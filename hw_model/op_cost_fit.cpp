@@ -227,14 +227,14 @@ std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
     return {e[e.size() / 2], e.back()};
 }
 
-double fit_thin_lens_per_lane(const OpCostConfig& pinhole, uint32_t width,
-                              const std::vector<OpCostSample>& lens_samples) {
+double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
+                                  const std::vector<OpCostSample>& variant_samples) {
     std::vector<double> extra;
-    for (const OpCostSample& s : lens_samples)
-        if (s.lanes > 0)
+    for (const OpCostSample& s : variant_samples)
+        if (s.passed > 0)
             extra.push_back(
-                (s.cycles - measured_op_cycles(pinhole, width, s.lanes, s.passed, s.beyond_l1)) /
-                s.lanes);
+                (s.cycles - measured_op_cycles(base, width, s.lanes, s.passed, s.beyond_l1)) /
+                s.passed);
     return extra.empty() ? 0.0 : std::max(0.0, median(extra));
 }
 

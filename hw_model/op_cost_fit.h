@@ -33,11 +33,13 @@ struct OpCostSample {
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
                          const std::vector<OpCostSample>& samples);
 
-// What a thin-lens camera adds per ray over a pinhole (OpCostConfig::thin_lens_per_lane_cycles):
-// the median over the lens camera's samples of their cycles beyond the pinhole's fitted cost
-// (`pinhole`), per lane; 0 when there are none, never negative.
-double fit_thin_lens_per_lane(const OpCostConfig& pinhole, uint32_t width,
-                              const std::vector<OpCostSample>& lens_samples);
+// What a variant of an op adds per passing lane over the op's fitted cost (`base`): the median
+// over the variant's samples with passing lanes of their cycles beyond `base`'s, per passing
+// lane; 0 when there are none, never negative. A thin-lens camera over a pinhole (every lane
+// passes: OpCostConfig::thin_lens_per_lane_cycles), a sphere light's direct-light samples over a
+// quad's (sphere_light_per_pass_cycles: a failing lane costs the same on either).
+double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
+                                  const std::vector<OpCostSample>& variant_samples);
 
 // The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
 // measured, a measurement under 100 cycles counting as 100 (the clock's steps).

@@ -204,6 +204,9 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
                 // A lens camera's rays cost more than a pinhole's (thin_lens_per_lane_cycles).
                 if (layout.features().thin_lens)
                     p.cost.per_lane_cycles += c.thin_lens_per_lane_cycles;
+                // A passing lane's light sample on a sphere costs more than one on a triangle.
+                p.cost.per_pass_cycles +=
+                    c.sphere_light_per_pass_cycles * layout.features().sphere_light_share;
             }
     }
 }

@@ -184,6 +184,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     std::map<OpKind, std::vector<double>> one_lane;  // a leaf test's one-lane samples
     std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
+    std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
     for (const MicrobenchSample& s : c.samples) {
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
             one_lane[s.kind].push_back(s.cycles);
@@ -194,7 +195,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             beyond_l1_share(s.lanes, s.slots, slot_bytes,
                             lane_ray_bytes(stage_of(s.kind), slot_bytes), l1d),
             s.cycles};
-        (s.thin_lens ? lens_camera : by_kind[s.kind]).push_back(sample);
+        (s.thin_lens      ? lens_camera
+         : s.sphere_light ? sphere_light
+                          : by_kind[s.kind])
+            .push_back(sample);
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
@@ -202,8 +206,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.op_costs.back().one_lane_cycles = median(one_lane[kind]);
         if (kind == OpKind::camera) {
             c.op_costs.back().thin_lens_per_lane_cycles =
-                fit_thin_lens_per_lane(c.op_costs.back(), c.host.simd_width, lens_camera);
+                fit_extra_per_passing_lane(c.op_costs.back(), c.host.simd_width, lens_camera);
             points += lens_camera.size();
+        }
+        if (kind == OpKind::lambertian_direct) {
+            c.op_costs.back().sphere_light_per_pass_cycles =
+                fit_extra_per_passing_lane(c.op_costs.back(), c.host.simd_width, sphere_light);
+            points += sphere_light.size();
         }
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();

@@ -103,6 +103,13 @@ FeatureSet Scene::features() const {
     f.ambient = !is_black(ambient);
     f.environment = !is_black(environment);
     f.light_count = uint32_t(lights.size());
+    for (const AreaLight& light : lights) {
+        float sphere_area = 0.f;
+        for (const uint32_t p : light.primitives)
+            if (is_sphere(p)) sphere_area += primitive_area(p);
+        if (light.area > 0.f)
+            f.sphere_light_share += sphere_area / light.area / float(lights.size());
+    }
     f.max_depth = max_depth;
     return f;
 }

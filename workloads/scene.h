@@ -73,6 +73,9 @@ struct FeatureSet {
     bool ambient = false;
     bool environment = false;
     uint32_t light_count = 0;
+    // The share of light samples (sample_light, kernels/lights.h: a light at random, then a
+    // primitive of it by area) that land on a sphere.
+    float sphere_light_share = 0.f;
     uint32_t max_depth = 0;
 
     // The flag of one material kind; a switch without default, so a new kind cannot be missed.

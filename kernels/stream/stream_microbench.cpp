@@ -188,6 +188,17 @@ void deal_rays(Buffers& b, const std::vector<uint32_t>& deal, bool hits) {
     }
 }
 
+// The rays an op made, ids[0, n) (the passing lanes, first after its partition), set up for the
+// next generation's traversal in a loop of their own after the op, as the tracer's load_rays
+// does (stream_tracer.cpp): a frame never sets a ray up in the loop that made it.
+void set_up_made(Buffers& b, const uint32_t* ids, uint32_t n, bool shadow) {
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t id = ids[i];
+        set_up_ray(b.next[id], shadow, id, b.next_any_hit[id], b.next_hit[id], b.next_pre[id],
+                   b.next_trav);
+    }
+}
+
 // TSC ticks of an empty timed region (subtracted from every measurement).
 double tsc_overhead() {
     std::vector<double> t;
@@ -234,15 +245,29 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // The camera is timed twice: on the synthetic scene's pinhole and on a thin lens (atrium's
     // aperture, focused on the scene's centre; any aperture above zero runs the same lens
     // arithmetic, kernels/camera.h), whose difference a lens scene's camera ops pay
-    // (OpCostConfig::thin_lens_per_lane_cycles).
+    // (OpCostConfig::thin_lens_per_lane_cycles). The direct-light filter likewise: on the quad
+    // light and on a sphere light (the glass sphere, emitting), whose samples take a point on a
+    // sphere (sin and cos, kernels/lights.h) where a triangle's take a barycentric one
+    // (OpCostConfig::sphere_light_per_pass_cycles).
     struct TimedKind {
         OpKind kind;
-        bool thin_lens;
+        bool thin_lens = false, sphere_light = false;
     };
     std::vector<TimedKind> timed_kinds;
     for (const OpKind kind : kinds) {
-        timed_kinds.push_back({kind, false});
-        if (kind == OpKind::camera) timed_kinds.push_back({kind, true});
+        timed_kinds.push_back({kind});
+        if (kind == OpKind::camera) timed_kinds.push_back({kind, true, false});
+        if (kind == OpKind::lambertian_direct) timed_kinds.push_back({kind, false, true});
+    }
+    Scene sphere_light_scene = scene;
+    {
+        const uint32_t sphere = scene.triangle_count();  // the glass sphere
+        AreaLight light;
+        light.primitives = {sphere};
+        light.area = scene.primitive_area(sphere);
+        light.area_cdf = {light.area};
+        light.emission = scene.lights.front().emission;
+        sphere_light_scene.lights = {light};
     }
     ThinLensCamera lens = scene.camera;
     lens.aperture_radius = 0.03f;
@@ -326,6 +351,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         for (const TimedKind& timed : timed_kinds) {
             const OpKind kind = timed.kind;
             const bool thin_lens = timed.thin_lens;
+            const Scene& lit = timed.sphere_light ? sphere_light_scene : scene;
             if (!options.kinds.empty() &&
                 std::find(options.kinds.begin(), options.kinds.end(), kind) == options.kinds.end())
                 continue;
@@ -337,6 +363,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 std::iota(order.begin(), order.end(), 0u);
                 std::iota(deal.begin(), deal.end(), 0u);
                 std::vector<uint32_t> streams;
+                std::vector<uint32_t> made;  // per call of a timed sample: the rays it made
+                bool all_hits = true;        // the stream's lanes are all hits
                 // The material sort's inputs (the depth filter's by-product in the tracer, so
                 // taken before the timed region): per stream, its rays of each material; the
                 // next one's write position.
@@ -359,14 +387,6 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                     auto run_filter = [&](auto&& test) {
                         return filter(kernels, trace, kind, 1, mat, ids, n, mask, scratch, test);
                     };
-                    // A made ray is set up for the next generation's traversal (the tracer's
-                    // load_rays) by the op that made it, as the op table writes the whole ray
-                    // (inverse direction included) with that op.
-                    auto set_up = [&](uint32_t id, bool shadow) {
-                        set_up_ray(b.next[id], shadow, id, b.next_any_hit[id], b.next_hit[id],
-                                   b.next_pre[id], b.next_trav);
-                        return true;
-                    };
                     switch (kind) {
                         case OpKind::camera:
                             for (uint32_t i = 0; i < n; ++i) {
@@ -375,7 +395,6 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 p = PathState{};
                                 p.key = {1, slot, 0};
                                 b.next[slot] = (thin_lens ? lens_camera : camera).generate(p.key);
-                                set_up(slot, false);
                                 mask[i] = 1;
                             }
                             passed = n;
@@ -420,9 +439,21 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             });
                             break;
                         case OpKind::emission_filter:
+                            // As the tracer runs it: the hits' surfaces in a loop of their own
+                            // (compute_surfaces, with its prefetches), then the filter on them.
+                            // A timed stream holds hits only (frame_streams_hold_hits_only); the
+                            // buffer's classification, untimed, holds misses too.
+                            if (all_hits) {
+                                compute_surfaces(scene, b.ray.data(), b.hit.data(), ids, n,
+                                                 b.surf.data());
+                            } else {
+                                for (uint32_t i = 0; i < n; ++i)
+                                    if (b.hit[ids[i]].valid())
+                                        b.surf[ids[i]] =
+                                            surface_at(scene, b.ray[ids[i]], b.hit[ids[i]]);
+                            }
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;  // misses left earlier
-                                b.surf[id] = surface_at(scene, b.ray[id], b.hit[id]);
                                 const Material& m = scene.materials[b.surf[id].material];
                                 if (!m.emissive()) return false;
                                 shade_emission(b.path[id], m);
@@ -472,33 +503,29 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         case OpKind::lambertian_direct:
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;
-                                return lambertian_direct(b.path[id], scene, scene.materials[0],
-                                                         b.surf[id], b.next[id]) &&
-                                       set_up(id, true);
+                                return lambertian_direct(b.path[id], lit, scene.materials[0],
+                                                         b.surf[id], b.next[id]);
                             });
                             break;
                         case OpKind::lambertian_indirect:
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;
                                 return lambertian_indirect(b.path[id], scene, scene.materials[0],
-                                                           b.surf[id], b.next[id]) &&
-                                       set_up(id, false);
+                                                           b.surf[id], b.next[id]);
                             });
                             break;
                         case OpKind::dielectric:
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;
                                 return dielectric_scatter(b.path[id], scene.materials[2],
-                                                          b.surf[id], b.ray[id], b.next[id]) &&
-                                       set_up(id, false);
+                                                          b.surf[id], b.ray[id], b.next[id]);
                             });
                             break;
                         case OpKind::glossy:
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;
                                 return glossy_scatter(b.path[id], scene.materials[1], b.surf[id],
-                                                      b.ray[id], b.next[id]) &&
-                                       set_up(id, false);
+                                                      b.ray[id], b.next[id]);
                             });
                             break;
                         // Not microbenchmarked (the host's seed-kernel ops); no default, so
@@ -553,7 +580,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         count_materials(all.data(), slots, material_counts.data());
                         counts_now = material_counts.data();
                     }
+                    all_hits = false;
                     const uint32_t p = run_op(b, job, all.data(), slots, box_nodes[0]);
+                    all_hits = true;
                     passing.assign(all.begin(), all.begin() + p);
                     failing.assign(all.begin() + p, all.begin() + slots);
                     if (hits_only) {
@@ -614,6 +643,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         }
                         const uint32_t stride = n + k_stream_padding;
                         streams.assign(size_t(inner) * stride, 0u);
+                        made.assign(inner, 0u);
                         while (needs_more_samples(times, options.convergence)) {
                             // Fresh random streams: n slots of the buffer each, in increasing
                             // order, as the tracer's streams are (the camera's, and every stable
@@ -682,7 +712,12 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 counts_now = material_counts.data() + size_t(again) * materials;
                                 passed = run_op(b, job, streams.data() + size_t(again) * stride, n,
                                                 box_node);
+                                made[again] = passed;
                             }
+                            if (op_info(kind).pushes_rays)
+                                for (uint32_t again = 0; again < inner; ++again)
+                                    set_up_made(b, streams.data() + size_t(again) * stride,
+                                                made[again], kind == OpKind::lambertian_direct);
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
                         }
@@ -692,8 +727,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         if (!last_visit) continue;
                         // Converged: the fastest k of all the visits' samples agree.
                         const Convergence c = judge_convergence(cycles, options.convergence);
-                        out.push_back(
-                            {kind, slots, n, passed, c.fastest, c.converged, c.samples, thin_lens});
+                        out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples,
+                                       thin_lens, timed.sphere_light});
                     }
             }
             if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);

@@ -15,8 +15,11 @@
 // others, is timed cold, right after a traversal of other rays, which leaves the core's clock
 // as a frame's traversal leaves it for the shading stage (AVX-512's is lower). An op is timed with
 // all the per-ray work the tracer does for it: the emission filter computes the hits' surfaces
-// (surface_at), and the camera and every shader that makes a ray set it up for the next
-// generation's traversal (set_up_ray, the tracer's load_rays). `sfx calibrate --describe-host` fits
+// (surface_at), and the rays that the camera and every shader make are set up for the next
+// generation's traversal (set_up_ray, the tracer's load_rays) in a loop of their own after the
+// op's calls, as the tracer sets them up (set up in the loop that made it, a pinhole camera's ray
+// cost 131 cycles on a Zen 5 core at AVX2, against 78 for the frame's camera loop and set-up
+// together, 2026-12-01). `sfx calibrate --describe-host` fits
 // the host's per-op costs to these samples (hw_model/op_cost_fit.h), never to frames.
 
 #include <algorithm>
@@ -47,6 +50,7 @@ struct MicrobenchSample {
     bool converged = false;  // its fastest repetitions agreed (base/convergence.h)
     uint32_t repetitions = 0;
     bool thin_lens = false;  // the camera's: timed on a thin-lens camera, not the pinhole
+    bool sphere_light = false;  // the direct-light filter's: timed on a sphere light, not the quad
 };
 
 // The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.

@@ -15,6 +15,7 @@
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
 #include "tests/hw_model/test_hosts.h"
+#include "workloads/scene_loader.h"
 
 using namespace sfx;
 
@@ -213,10 +214,10 @@ TEST_CASE("A thin-lens camera's rays cost what its microbenchmarks add to the pi
         lens.push_back({lanes, lanes, 0.25,
                         measured_op_cycles(pinhole, 8, lanes, lanes, 0.25) + 80.0 * lanes});
     lens.push_back({32, 32, 0.0, measured_op_cycles(pinhole, 8, 32, 32, 0.0) + 500.0 * 32});
-    CHECK(fit_thin_lens_per_lane(pinhole, 8, lens) == Approx(80));
-    CHECK(fit_thin_lens_per_lane(pinhole, 8, {}) == 0.0);
+    CHECK(fit_extra_per_passing_lane(pinhole, 8, lens) == Approx(80));
+    CHECK(fit_extra_per_passing_lane(pinhole, 8, {}) == 0.0);
     // Never negative: a lens no dearer than the pinhole adds nothing.
-    CHECK(fit_thin_lens_per_lane(pinhole, 8, {{64, 64, 0.0, 100.0}}) == 0.0);
+    CHECK(fit_extra_per_passing_lane(pinhole, 8, {{64, 64, 0.0, 100.0}}) == 0.0);
 
     // The model: every lane of a camera op on a scene with a lens pays it, no other op's.
     OpCostConfig camera = pinhole;
@@ -231,6 +232,42 @@ TEST_CASE("A thin-lens camera's rays cost what its microbenchmarks add to the pi
           Approx(plain[OpKind::camera].issue_cycles(d, 64, 0, 8, 8, false, 0.0) + 8 * 80));
     CHECK(with_lens[OpKind::box_test].issue_cycles(d, 64, 0, 8, 8, false, 0.0) ==
           plain[OpKind::box_test].issue_cycles(d, 64, 0, 8, 8, false, 0.0));
+}
+
+TEST_CASE("A passing direct-light lane pays a sphere light's extra in the share on spheres",
+          "[host]") {
+    OpCostConfig direct = cost("lambertian_direct", 10, 0, 150, 0, 30);
+    direct.sphere_light_per_pass_cycles = 60;
+    HwConfig host = host_with({direct, cost("lambertian_indirect", 10, 0, 150, 0, 30)});
+    FeatureSet quad, half, sphere;
+    half.sphere_light_share = 0.5f;
+    sphere.sphere_light_share = 1.f;
+    const OpCostTable on_quad(RayRecordLayout(quad), host), on_half(RayRecordLayout(half), host),
+        on_sphere(RayRecordLayout(sphere), host);
+    const DatapathConfig d;
+    // A group of 8 lanes, 5 passing.
+    auto issue = [&](const OpCostTable& t, OpKind k) {
+        return t[k].issue_cycles(d, 64, 0, 8, 5, false, 0.0);
+    };
+    CHECK(issue(on_half, OpKind::lambertian_direct) ==
+          Approx(issue(on_quad, OpKind::lambertian_direct) + 5 * 30));
+    CHECK(issue(on_sphere, OpKind::lambertian_direct) ==
+          Approx(issue(on_quad, OpKind::lambertian_direct) + 5 * 60));
+    CHECK(issue(on_sphere, OpKind::lambertian_indirect) ==
+          issue(on_quad, OpKind::lambertian_indirect));
+    // The fit: the sphere light's samples beyond the quad's cost, per passing lane; a stream
+    // none of whose lanes pass tells nothing.
+    std::vector<OpCostSample> on_spheres;
+    for (uint32_t lanes : {16u, 64u, 256u})
+        on_spheres.push_back(
+            {lanes, lanes / 2, 0.0,
+             measured_op_cycles(direct, 8, lanes, lanes / 2, 0.0) + 60.0 * (lanes / 2)});
+    on_spheres.push_back({64, 0, 0.0, measured_op_cycles(direct, 8, 64, 0, 0.0)});
+    CHECK(fit_extra_per_passing_lane(direct, 8, on_spheres) == Approx(60));
+
+    // The share: a light picked at random, then a primitive of it by area.
+    CHECK(load_scene("furnace").features().sphere_light_share == Approx(1.f));
+    CHECK(load_scene("cornell").features().sphere_light_share == 0.f);
 }
 
 TEST_CASE("The fit recovers costs from exact samples and never goes negative", "[host]") {

@@ -103,13 +103,19 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     // Three lengths each; a shading op or a leaf test whose buffer has rays it passes and rays
     // it fails also on streams that all pass and streams that none pass, after its mixed ones
     // (a leaf test not on its one-lane stream: 3 + 2 + 2).
-    // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles); no other kind's.
+    // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles), and the direct-light
+    // filter's on a sphere light (sphere_light_per_pass_cycles); no other kind's.
     std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
-    std::vector<const MicrobenchSample*> lens;
-    for (const MicrobenchSample& m : samples) (m.thin_lens ? lens : by_kind[m.kind]).push_back(&m);
+    std::vector<const MicrobenchSample*> lens, sphere_light;
+    for (const MicrobenchSample& m : samples)
+        (m.thin_lens ? lens : m.sphere_light ? sphere_light : by_kind[m.kind]).push_back(&m);
     REQUIRE(lens.size() == 3);
     for (const MicrobenchSample* m : lens) CHECK(m->kind == OpKind::camera);
     CHECK(by_kind[OpKind::camera].size() == 3);
+    // Mixed streams, and all-passing and none-passing ones where the sphere light's samples
+    // both pass and fail.
+    CHECK((sphere_light.size() == 3 || sphere_light.size() == 9));
+    for (const MicrobenchSample* m : sphere_light) CHECK(m->kind == OpKind::lambertian_direct);
     for (const auto& [kind, of_kind] : by_kind) {
         INFO(to_string(kind));
         if (of_kind.size() == 3) continue;
