@@ -451,10 +451,11 @@ struct OpCostConfig {
     // sample, the focus point and a normalize; kernels/camera.h), fitted on the camera's
     // microbenchmarks with a lens beside its pinhole ones; paid by every lane of a camera op on
     // a scene whose camera has an aperture (FeatureSet::thin_lens). 0: not measured. Fitted on
-    // an AMD Zen 5 VM (2026-12-01): 96.9 / 98.0 / 95.5 cycles a ray (scalar / AVX2 / AVX-512);
-    // held out, atrium's camera stage there ran 78 cycles a ray above the pinhole scenes'
-    // (stage clock, run 24 of docs/silicon-check-amd-avx512.md), so the lens is priced about a
-    // quarter over, about 0.5 % of an atrium frame.
+    // an AMD Zen 5 VM (2026-12-01): 96.9 / 98.0 / 95.5 cycles a ray (scalar / AVX2 / AVX-512)
+    // with each ray set up in the camera's own loop (session 44), 72-76 with the set-up in a
+    // loop of its own as the tracer runs it (session 45; run 27's scalar calibration, 130, was
+    // an outlier); held out, atrium's camera stage there ran 78 cycles a ray above the pinhole
+    // scenes' (stage clock, run 24 of docs/silicon-check-amd-avx512.md): now within about 5 %.
     double thin_lens_per_lane_cycles = 0.0;
     // The direct-light filter's: what a passing lane's light sample on a sphere adds to one on a
     // triangle (a uniform point on the sphere and its error bound, kernels/lights.h; a failing
