@@ -463,6 +463,12 @@ struct OpCostConfig {
     // filter's microbenchmarks with a sphere light beside its quad ones; paid by every passing
     // lane of its ops in proportion to the share of a scene's light samples that land on
     // spheres (FeatureSet::sphere_light_share: furnace's all, cornell's none). 0: not measured.
+    // Fitted on an AMD Zen 5 VM (2026-12-01, run 27 of docs/silicon-check-amd-avx512.md): 95.8
+    // / 95.8 / 104.8 cycles a passing lane (scalar / AVX2 / AVX-512). Held out, furnace's frames
+    // (AVX2, 128x128, tile 32, the same session's quick checks): its shading stage -16 %
+    // without it, -9 % with it (the emission filter's change in that run lowers the prediction
+    // too, so this cost's own part is larger); the direct-light op alone reads +13 %, but its
+    // prediction holds its shadow rays' set-up, which the frame's stage clock books apart.
     double sphere_light_per_pass_cycles = 0.0;
 
     template <class V>

@@ -442,16 +442,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             // As the tracer runs it: the hits' surfaces in a loop of their own
                             // (compute_surfaces, with its prefetches), then the filter on them.
                             // A timed stream holds hits only (frame_streams_hold_hits_only); the
-                            // buffer's classification, untimed, holds misses too.
-                            if (all_hits) {
+                            // buffer's classification, untimed, holds misses too and reads the
+                            // surfaces the deal restored (make_buffers computed them).
+                            if (all_hits)
                                 compute_surfaces(scene, b.ray.data(), b.hit.data(), ids, n,
                                                  b.surf.data());
-                            } else {
-                                for (uint32_t i = 0; i < n; ++i)
-                                    if (b.hit[ids[i]].valid())
-                                        b.surf[ids[i]] =
-                                            surface_at(scene, b.ray[ids[i]], b.hit[ids[i]]);
-                            }
                             passed = run_filter([&](uint32_t id) {
                                 if (!b.hit[id].valid()) return false;  // misses left earlier
                                 const Material& m = scene.materials[b.surf[id].material];
@@ -728,7 +723,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         // Converged: the fastest k of all the visits' samples agree.
                         const Convergence c = judge_convergence(cycles, options.convergence);
                         out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples,
-                                       thin_lens, timed.sphere_light});
+                                       timed.thin_lens, timed.sphere_light});
                     }
             }
             if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);

@@ -51,6 +51,8 @@ struct MicrobenchSample {
     uint32_t repetitions = 0;
     bool thin_lens = false;  // the camera's: timed on a thin-lens camera, not the pinhole
     bool sphere_light = false;  // the direct-light filter's: timed on a sphere light, not the quad
+    // A variant's samples price only its extra over the plain op (fit_extra_per_passing_lane).
+    bool variant() const { return thin_lens || sphere_light; }
 };
 
 // The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.

@@ -28,7 +28,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     o.convergence = microbench_rule(3);
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     for (const MicrobenchSample& s : run_stream_microbenchmarks(o))
-        if (!s.thin_lens)  // the camera's on a lens: its extra, which a pinhole frame does not pay
+        if (!s.variant())  // a lens camera's or a sphere light's: extras this frame does not pay
             by_kind[s.kind].push_back(
                 {s.lanes, s.passed,
                  beyond_l1_share(s.lanes, s.slots, stream_slot_bytes(),
