@@ -272,8 +272,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double opening_share =
             beyond_l1 > 0
                 ? expected_lanes_opening_pages(
-                      length, slots,
-                      lane_ray_bytes(op_stage, slot_bytes_of(c.ray_buffer, layout.bytes()))) /
+                      length, slots, lane_page_bytes_of(c.ray_buffer, layout.bytes(), op_stage)) /
                       double(std::min(length, slots))
                 : 0.0;
         // The cycle model's pipeline in closed form. Groups spread over the units; each round

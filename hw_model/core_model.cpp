@@ -119,11 +119,13 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     const bool record = op.stage != OpStage::shading;
     const uint64_t bytes =
         lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));
+    const uint32_t page_bytes = lane_page_bytes_of(m_config.ray_buffer, m_record_bytes, op.stage);
     // A lane pays for its ray data beyond the L1D (beyond_l1_per_lane_cycles) where the caches
-    // did not hold a line of it in the first level and it opens a 4 KiB page of its array (the
-    // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes); counted
-    // per group. The fit expects the same of its microbenchmarks (beyond_l1_share).
-    // A slot's traversal record: what a box or leaf test reads, and a made ray's set-up writes.
+    // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays (the
+    // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes; a slot's
+    // arrays: lane_page_bytes); counted per group. The fit expects the same of its microbenchmarks
+    // (beyond_l1_share). A slot's traversal record: what a box or leaf test reads, and a made ray's
+    // set-up writes.
     const auto record_address = [](uint32_t slot) {
         return k_records + uint64_t(slot) * k_traversal_record_bytes;
     };
@@ -141,7 +143,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
                 ? m_scene_memory->touch_other(m_core, from * k_line,
                                               uint32_t((last_line - from + 1) * k_line), now)
                 : 0;
-        if (level > 0 && lane_opens_page(op.slots, i, uint32_t(bytes))) ++m_group_beyond_lanes.back();
+        if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) ++m_group_beyond_lanes.back();
         last = last_line;
     }
     // A ray an op makes is set up for the next traversal with the op (its cost holds the

@@ -446,6 +446,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     c.ray_buffer.banks = 1;
     c.ray_buffer.storage = "l1d";
     c.ray_buffer.slot_bytes = h.slot_bytes;
+    c.ray_buffer.slot_arrays = std::max(1u, h.slot_arrays);
     c.ray_buffer.line_words = (h.caches.empty() ? 64 : h.caches.front().line_bytes) / 4;
     c.partition.kind = "compress";
     c.scene_memory.caches.clear();
@@ -517,6 +518,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  line_words: " << c.ray_buffer.line_words << "  # the L1D line\n"
       << "  storage: l1d\n"
       << "  slot_bytes: " << h.slot_bytes << "  # the native tracer's ray slot (kernels/stream)\n"
+      << "  slot_arrays: " << c.ray_buffer.slot_arrays
+      << "  # the arrays a slot indexes beyond its traversal record (kernels/stream)\n"
       << "partition:\n  kind: compress  # vpcompressd (AVX-512) or a permutation table (AVX2)\n"
       << "scene_memory:\n  caches:\n";
     for (size_t i = 0; i < c.scene_memory.caches.size(); ++i) {

@@ -87,6 +87,7 @@ struct HostDescription {
     // (measure_dram_first_pass_ns): SceneMemoryConfig::dram_latency_by_span.
     std::vector<std::pair<double, double>> dram_span_latencies;
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
+    uint32_t slot_arrays = 1;        // the arrays it lies in beyond its traversal record
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
     // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine
     // one CPU's L3 may not be another's (a neighbour's load on its physical core): the check

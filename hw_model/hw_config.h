@@ -112,6 +112,10 @@ struct RayBufferConfig {
     // 0: a slot is the ray record of the scene's features (hw_model/op_costs.h). l1d: the
     // bytes one ray slot of the native tracer occupies (what the L1D must hold per ray).
     uint32_t slot_bytes = 0;
+    // l1d: the arrays a slot's bytes beyond its traversal record are spread over (the native
+    // tracer's structure of arrays: a lane opens a page of each of them where a sparse stream's
+    // lane opens pages of all: lane_page_bytes, hw_model/ray_buffer_model.h); 1: one array.
+    uint32_t slot_arrays = 1;
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
@@ -135,6 +139,10 @@ struct RayBufferConfig {
                 "bytes of one ray slot (0: the scene's ray record); sets the share of a pass's "
                 "slots beyond an l1d buffer",
                 0u, 1u << 16);
+        v.param("slot_arrays", slot_arrays, "arrays",
+                "arrays a slot's bytes beyond its traversal record are spread over (l1d; sets "
+                "how often a dense stream's lane opens a page of one)",
+                1u, 64u);
     }
 };
 

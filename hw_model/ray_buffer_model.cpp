@@ -125,6 +125,12 @@ uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes) {
                                                  : slot_bytes;
 }
 
+uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_arrays) {
+    const uint32_t bytes = lane_ray_bytes(stage, slot_bytes);
+    if (stage != OpStage::shading || slot_arrays <= 1) return bytes;
+    return std::max(1u, bytes / slot_arrays);
+}
+
 double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                        uint32_t l1d_kib) {
     if (lanes == 0) return 0.0;
@@ -134,6 +140,10 @@ double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint
 
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {
     return buffer.slot_bytes ? buffer.slot_bytes : record_bytes;
+}
+
+uint32_t lane_page_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes, OpStage stage) {
+    return lane_page_bytes(stage, slot_bytes_of(buffer, record_bytes), buffer.slot_arrays);
 }
 
 double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,

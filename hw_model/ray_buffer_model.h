@@ -147,9 +147,19 @@ double expected_lanes_opening_pages(uint32_t lanes, uint32_t slots, uint32_t lan
 // pages are those of that array.
 constexpr uint32_t k_traversal_record_bytes = 64;
 uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
+// The bytes a slot holds in each array a lane of `stage` reads, as the page geometry above
+// sees them (lane_opens_page): a traversal record is one array; a shading lane's bytes
+// (lane_ray_bytes) lie in `slot_arrays` arrays of the native tracer's structure of arrays
+// (RayBufferConfig::slot_arrays), taken as of equal size. A lane then opens a page of one
+// array about as often as it opens a page of each, and pays beyond_l1_per_lane_cycles, which
+// the microbenchmarks' sparse lanes (a new page of every array) fix, where that happens. On an
+// AMD Zen 5 VM (2026-12-02), priced as one array of its 266 bytes, a frame's dense shading
+// streams paid a sparse lane's cost at every 15th lane: cornell's shading at tile 32 came out
+// 3-6 % over tile 16's where the host ran it no dearer, and its tile ranking upside down.
+uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_arrays);
 // A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit
-// prices its microbenchmarks: those opening a page of the array of `lane_bytes` a slot the op
-// reads (expected), times beyond_l1_fraction of the whole slots (`slot_bytes`: the
+// prices its microbenchmarks: those opening a page of an array of `lane_bytes` a slot the op
+// reads (lane_page_bytes; expected), times beyond_l1_fraction of the whole slots (`slot_bytes`: the
 // microbenchmarks read every array of the buffer before they time, so the L1D holds a share of
 // each). The cycle level asks its caches instead (CoreModel::touch_ray_lines). On this
 // project's AMD host (2026-11-28) the dense streams of a frame paid nearly none of what its
@@ -160,6 +170,8 @@ double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);
+// lane_page_bytes of a configuration's buffer (slot_bytes_of, ray_buffer.slot_arrays).
+uint32_t lane_page_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes, OpStage stage);
 // The closed form's share of a pass's `slots` slots beyond an l1d buffer for an op of `stage`:
 // beyond_l1_fraction of the array it reads (lane_ray_bytes of slot_bytes_of), as if that array
 // alone filled the L1D; 0 for banked buffers.

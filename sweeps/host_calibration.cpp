@@ -81,7 +81,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                     priced, width, o.lanes,
                     uint32_t(std::lround(double(o.passed) / double(o.count))),
                     beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(),
-                                    lane_ray_bytes(stage_of(o.kind), stream_slot_bytes()),
+                                    lane_page_bytes(stage_of(o.kind), stream_slot_bytes(),
+                                                    stream_slot_arrays()),
                                     l1d_kib));
         }
         out.push_back(sample);
@@ -171,6 +172,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.host.memory_source = memory_source;
     }
     c.host.slot_bytes = stream_slot_bytes();
+    c.host.slot_arrays = stream_slot_arrays();
     MicrobenchOptions options;
     options.isa = resolved;
     options.convergence = convergence;
@@ -193,7 +195,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         const OpCostSample sample{
             s.lanes, s.passed,
             beyond_l1_share(s.lanes, s.slots, slot_bytes,
-                            lane_ray_bytes(stage_of(s.kind), slot_bytes), l1d),
+                            lane_page_bytes(stage_of(s.kind), slot_bytes, stream_slot_arrays()),
+                            l1d),
             s.cycles};
         (s.thin_lens      ? lens_camera
          : s.sphere_light ? sphere_light

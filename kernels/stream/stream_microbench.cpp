@@ -29,6 +29,10 @@ uint32_t stream_slot_bytes() {
                     sizeof(Hit) + 1 + sizeof(SurfaceHit) + 6 * sizeof(uint32_t) + 1);
 }
 
+uint32_t stream_slot_arrays() {
+    return 7;  // path, ray[0], ray[1], pre, hit, any_hit, surf (stream_tracer.cpp's RayBuffers)
+}
+
 namespace {
 
 // A floor (Lambertian), a glossy panel, a glass sphere and a light over them. `dense`: the

@@ -40,6 +40,11 @@ struct Scene;
 // Bytes of the stream tracer's ray buffers per slot (every per-slot array of a pass): what a
 // pass of n slots asks the L1D to hold.
 uint32_t stream_slot_bytes();
+// The arrays those bytes beyond the traversal record lie in that a slot indexes: path state,
+// the two ray generations, the full tests' constants, hit, any-hit flag and surface (the id
+// lists and the mask are indexed by stream position, which ascends: RayBufferConfig::
+// slot_arrays).
+uint32_t stream_slot_arrays();
 
 struct MicrobenchSample {
     OpKind kind = OpKind::box_test;

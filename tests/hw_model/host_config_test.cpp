@@ -584,6 +584,10 @@ TEST_CASE(
     tiny.ray_buffer.slot_bytes = 330;
     CHECK(time_surfaces(tiny).cycles == time_surfaces(host).cycles);
     CHECK(time_surfaces(fat).cycles == time_surfaces(host).cycles + 8);
+    // The 336 bytes in 7 arrays of 48 bytes a slot: the 16 slots lie in one page of each.
+    HwConfig arrays = fat;
+    arrays.ray_buffer.slot_arrays = 7;
+    CHECK(time_surfaces(arrays).cycles == time_surfaces(host).cycles);
 }
 
 TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
@@ -647,6 +651,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.one_ray_entry_cycles = 8;
     box.few_ray_entry_cycles = 9.5;
     HostDescription host = small_host();
+    host.slot_arrays = 7;
     host.caches.push_back({3, "unified", 32768, 64, 16, true, "test"});
     host.latency_ns = {1.0, 5.0, 15.5, 81.0};
     host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
@@ -666,6 +671,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     const HwConfig c = parse_hw_config(yaml, "host.hw.yaml");
     CHECK(c.ray_buffer.storage == "l1d");
     CHECK(c.ray_buffer.kib == 32);
+    CHECK(c.ray_buffer.slot_arrays == 7);
     CHECK(c.partition.kind == "compress");
     CHECK(c.simd.width == 16);
     CHECK(c.simd.units == 1);
@@ -892,6 +898,15 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(lane_ray_bytes(OpStage::shading, 330) == 330 - 64);  // the record is the traversal's
     CHECK(beyond_l1_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
     CHECK(beyond_l1_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
+    // A shading lane's 266 bytes in 7 arrays of 38: a dense stream opens a page of one about
+    // once in 108 lanes, a seventh as often as a page of one array of 266 bytes; 16 random
+    // lanes of 4096 slots (38 pages of 108) still open 13.2 pages (37.9 (1 - (1 - 108 /
+    // 4096)^16)), against 15.6 pages of one array of 266 bytes.
+    CHECK(lane_page_bytes(OpStage::traversal, 330, 7) == 64);
+    CHECK(lane_page_bytes(OpStage::shading, 330, 1) == 266);
+    CHECK(lane_page_bytes(OpStage::shading, 330, 7) == 38);
+    CHECK(beyond_l1_share(4096, 4096, 330, 38, 48) == Approx(f * 38 / 4096).epsilon(0.02));
+    CHECK(beyond_l1_share(16, 4096, 330, 38, 48) == Approx(f * 13.2 / 16).epsilon(0.02));
 }
 
 TEST_CASE("A filter's branch misses the rarer outcome's lanes, or one a change of outcome in runs",
