@@ -21,6 +21,7 @@
 #include "app/commands.h"
 #include "app/progress.h"
 #include "base/core_clock.h"
+#include "base/core_contention.h"
 #include "base/input_error.h"
 #include "base/strict_number.h"
 #include "base/user_files.h"
@@ -189,6 +190,8 @@ void add_calibrate_command(CLI::App& app) {
                 j["microarchitecture"] = describe(cal.host.microarchitecture);
                 j["convergence_rule"] = describe(bench_rule);
                 j["converged_points"] = cal.converged_points;
+                j["contended_samples"] = core_contention().waits();
+                j["unshared_adds_per_tick"] = core_contention().best();
                 j["points"] = cal.points;
                 for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                     const OpCostConfig& k = cal.op_costs[i];
@@ -291,6 +294,10 @@ void add_calibrate_command(CLI::App& app) {
                 "judged over all)\n",
                 cal.converged_points, cal.points, describe(bench_rule).c_str(),
                 cal.microbench_visits);
+            std::printf(
+                "core shared with another hardware thread after %u samples, which were set "
+                "aside and the core waited for (independent adds: %.2f a TSC tick unshared)\n",
+                core_contention().waits(), core_contention().best());
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "per_fail", "minority", "beyondL1",
                         "fit med", "fit max", "one_lane", "few_lane");
@@ -530,6 +537,7 @@ void add_calibrate_command(CLI::App& app) {
             row["stage_clock_overhead"] = m.stage_clock_overhead;
             row["measured.interrupted_renders"] = m.interrupted;
             row["measured.clock_moved_renders"] = m.clock_moved;
+            row["measured.contended_renders"] = m.contended;
             row["measured.frame_tsc"] = m.measured_frame_tsc;
             for (int sg = 0; sg < 3; ++sg) {
                 row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =

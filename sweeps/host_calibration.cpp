@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "base/convergence.h"
+#include "base/core_contention.h"
 #include "base/cpu_load.h"
 #include "base/cycle_source.h"
 #include "base/huge_pages.h"
@@ -561,10 +562,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
                     std::min(shading_op_min[v][k], double(r.stats.shading_op_tsc[k]));
             ray_setup_min[v] = std::min(ray_setup_min[v], double(r.stats.ray_setup_tsc));
             clocked_totals[v].push_back(clocked.cycles);
+            core_contention().wait();
             const std::vector<CpuTimes> load_before = read_cpu_times();
             const auto [reading, ticks] = timed_render(scene, bvh, settings[v], false,
                                                        source_of(v), tsc_mhz, r, m.interrupted);
             const std::vector<CpuTimes> load_after = read_cpu_times();
+            const bool shared = core_contention().contended();
             for (size_t c = 0; c < load_before.size() && c < load_after.size(); ++c)
                 if (int(c) != own_cpu) {
                     others_busy[v] += load_after[c].busy - load_before[c].busy;
@@ -572,6 +575,13 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 }
             if (clock_moved(reading) > convergence.tolerance) {
                 ++m.clock_moved;
+                continue;
+            }
+            // One after which another hardware thread shared the core (base/core_contention.h;
+            // the core is waited for before each render) is set aside too and taken again, at
+            // most the budget's number of times.
+            if (shared && m.contended < convergence.budget) {
+                ++m.contended;
                 continue;
             }
             m.frame_samples.push_back(reading.cycles);

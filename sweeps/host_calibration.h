@@ -153,6 +153,9 @@ struct SiliconMeasurement {
     // Unclocked renders set aside because the estimate's clock moved over them by more than
     // the convergence tolerance (clock_moved, base/cycle_source.h); not among frame_samples.
     uint32_t clock_moved = 0;
+    // Renders after which the core was found shared with another hardware thread, set aside
+    // and taken again, at most the budget of them (base/core_contention.h).
+    uint32_t contended = 0;
     // The machine's speed during the renders against calibration: the speed probe re-run just
     // before the first render and just after the last, over its cycles at calibration, less 1
     // (NaN: the host file has none). The same for every workload of a back end; a probe beyond

@@ -569,6 +569,14 @@ def measurement_text(df):
                      f"convergence tolerance (their cycles could lie anywhere between the two "
                      f"clocks'): {int(moved.sum())} of {int(renders.sum())}, in "
                      f"{int((moved > 0).sum())} of {len(df)} workloads")
+    if "measured.contended_renders" in df:
+        shared = df["measured.contended_renders"]
+        renders = shared + df["measured.renders"] + df.get("measured.clock_moved_renders", 0)
+        lines.append(f"- renders set aside because another hardware thread shared the core after "
+                     f"them (base/core_contention.h: its rate of independent adds below the "
+                     f"best seen; the core waited for before each render): {int(shared.sum())} "
+                     f"of {int(renders.sum())}, in {int((shared > 0).sum())} of {len(df)} "
+                     f"workloads")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")

@@ -10,6 +10,7 @@
 
 #include "base/convergence.h"
 #include "base/core_clock.h"
+#include "base/core_contention.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
 #include "kernels/intersect.h"
@@ -643,6 +644,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         const uint32_t stride = n + k_stream_padding;
                         streams.assign(size_t(inner) * stride, 0u);
                         made.assign(inner, 0u);
+                        uint32_t set_aside = 0;  // samples after which the core was shared
                         while (needs_more_samples(times, options.convergence)) {
                             // Fresh random streams: n slots of the buffer each, in increasing
                             // order, as the tracer's streams are (the camera's, and every stable
@@ -719,6 +721,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                                 made[again], kind == OpKind::lambertian_direct);
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
+                            set_aside += set_aside < options.convergence.budget &&
+                                         set_aside_if_contended({&times});
                         }
                         if (visited.size() <= point) visited.resize(point + 1);
                         std::vector<double>& cycles = visited[point++];
@@ -937,12 +941,14 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             }
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
+            uint32_t set_aside = 0;
             while (needs_more_samples(times, convergence)) {
                 displace_predictor(TraceDetail::none);
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
                 times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+                set_aside += set_aside < convergence.budget && set_aside_if_contended({&times});
             }
             const Convergence c = judge_convergence(times, convergence);
             sample.cycles = c.fastest / ticks_per_cycle;
@@ -1069,6 +1075,7 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
         // Interleaved: the mesh's stream, then the resident one, each time anew.
         std::vector<double> times, resident_times;
         float sink = 0.f;
+        uint32_t set_aside = 0;
         for (uint32_t rep = 0; needs_more_samples(times, convergence) ||
                                needs_more_samples(resident_times, convergence);
              ++rep) {
@@ -1083,6 +1090,8 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
             compute_surfaces(resident, rays.data(), hits.data(), ids.data(), k_lanes, surf.data());
             resident_times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
             sink += surf[k_lanes / 2].position.x;
+            set_aside +=
+                set_aside < convergence.budget && set_aside_if_contended({&times, &resident_times});
         }
         if (sink == 12345.f) out.clear();  // keeps the surfaces computed
         const Convergence c = judge_convergence(times, convergence);
@@ -1223,6 +1232,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
             bool converged = true;
             auto timed = [&](Before before) {
                 std::vector<double> times;
+                uint32_t set_aside = 0;
                 while (needs_more_samples(times, convergence)) {
                     if (before == Before::others_traversals) {
                         for (uint32_t o = 0; o < k_tiles; ++o)
@@ -1254,6 +1264,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                     const uint64_t start = __rdtsc();
                     traverse(t, TraceDetail::none);
                     times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+                    set_aside += set_aside < convergence.budget && set_aside_if_contended({&times});
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;

@@ -1,0 +1,82 @@
+#include "base/core_contention.h"
+
+#include <x86intrin.h>
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+namespace sfx {
+
+double independent_adds_per_tick(int runs) {
+    constexpr uint64_t k_rounds = 2048;  // of six adds
+    uint64_t best = ~0ull;
+    for (int r = 0; r < runs; ++r) {
+        uint64_t x0 = 1, x1 = 2, x2 = 3, x3 = 4, x4 = 5, x5 = 6;
+        const uint64_t step = uint64_t(r) | 1;
+        const uint64_t start = __rdtsc();
+        for (uint64_t i = 0; i < k_rounds; ++i)
+            asm volatile(
+                "add %6, %0\n\tadd %6, %1\n\tadd %6, %2\n\tadd %6, %3\n\tadd %6, %4\n\tadd %6, %5"
+                : "+r"(x0), "+r"(x1), "+r"(x2), "+r"(x3), "+r"(x4), "+r"(x5)
+                : "r"(step));
+        best = std::min<uint64_t>(best, __rdtsc() - start);
+    }
+    return double(6 * k_rounds) / double(std::max<uint64_t>(best, 1));
+}
+
+CoreContention::CoreContention(double tolerance, std::function<double()> rate,
+                               std::function<void(double)> sleep_ms)
+    : m_tolerance(tolerance), m_rate(std::move(rate)), m_sleep_ms(std::move(sleep_ms)) {
+    if (!m_rate) m_rate = [] { return independent_adds_per_tick(); };
+    if (!m_sleep_ms)
+        m_sleep_ms = [](double ms) {
+            std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(ms));
+        };
+}
+
+double CoreContention::sample() {
+    const double r = m_rate();
+    m_best = std::max(m_best, r);
+    return r;
+}
+
+bool CoreContention::contended() {
+    if (!m_settled) {
+        m_settled = true;
+        for (int i = 0; i < k_settle; ++i) {
+            sample();
+            m_sleep_ms(10.0);
+        }
+    }
+    return sample() < (1.0 - m_tolerance) * m_best;
+}
+
+bool CoreContention::wait(double budget_ms) {
+    if (!contended()) return true;
+    ++m_waits;
+    double best_of_wait = 0.0;
+    for (double waited = 0.0; waited < budget_ms; waited += 10.0) {
+        m_sleep_ms(10.0);
+        const double r = sample();
+        if (r >= (1.0 - m_tolerance) * m_best) return true;
+        best_of_wait = std::max(best_of_wait, r);
+    }
+    m_best = best_of_wait;
+    return false;
+}
+
+CoreContention& core_contention() {
+    static CoreContention gate;
+    return gate;
+}
+
+bool set_aside_if_contended(std::vector<std::vector<double>*> series, CoreContention& gate) {
+    if (!gate.contended()) return false;
+    for (std::vector<double>* s : series)
+        if (!s->empty()) s->pop_back();
+    gate.wait();
+    return true;
+}
+
+}  // namespace sfx

@@ -1,0 +1,67 @@
+#pragma once
+// Whether another hardware thread shares this core now. On a cloud virtual machine a core's
+// sibling thread may run another tenant's load, in spells: on this project's AMD Zen 5 VM
+// (2026-12-02, 20 s sampled every 0.2 s) the box test's lane group took 29 cycles alone and
+// 41-47 in spells of 0.4-2 s, about a third of the time, while the core's clock (a chain of
+// dependent adds, base/core_clock.h, which a sibling does not slow) read the same. A
+// microbenchmark point or a render that falls wholly in a spell converges there (its fastest
+// samples agree) and reads 1.5 times the core's cost: the box test's fitted group cost came
+// out 29 and 44 cycles in calibrations an hour apart, with the same speed probe. A sibling
+// takes the core's ALUs: six chains of independent adds ran 6.2 adds a TSC tick alone and 4-5
+// in those spells. So a measurement that must be the core's own waits for the core (wait) and
+// sets aside a sample after which it finds it shared (contended).
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace sfx {
+
+// Independent adds (six chains of register adds, 12 288 in all, about 3 us) a TSC tick now:
+// the fastest of `runs` timings.
+double independent_adds_per_tick(int runs = 3);
+
+class CoreContention {
+  public:
+    // `rate`: the core's rate now (independent_adds_per_tick by default); `sleep_ms`: how
+    // waiting passes (the thread sleeps by default). A rate more than `tolerance` below the
+    // best seen is a shared core's.
+    explicit CoreContention(double tolerance = 0.15, std::function<double()> rate = {},
+                            std::function<void(double)> sleep_ms = {});
+
+    // The core is shared now. The first call samples the rate every 10 ms over `k_settle`
+    // samples first, so that the best seen is an unshared core's unless a spell outlasts
+    // them.
+    bool contended();
+    // Waits in steps of 10 ms until the core is not shared, at most `budget_ms`; returns true
+    // if it is not. A spell that outlasts the budget is the core's state now: the best seen
+    // falls to the best rate of the wait, so that a lasting state is measured, not waited on.
+    bool wait(double budget_ms = 2000.0);
+
+    double best() const { return m_best; }
+    uint32_t waits() const { return m_waits; }  // wait() calls that found the core shared
+
+    static constexpr int k_settle = 30;
+
+  private:
+    double sample();
+
+    double m_tolerance;
+    std::function<double()> m_rate;
+    std::function<void(double)> m_sleep_ms;
+    double m_best = 0.0;
+    bool m_settled = false;
+    uint32_t m_waits = 0;
+};
+
+// The process's one gate (microbenchmarks and renders of sfx calibrate share its best rate).
+CoreContention& core_contention();
+
+// After a timed sample: if the core is shared now, the last sample of each series timed
+// together is set aside and the core waited for; returns whether they were. The caller takes
+// another in its place, and sets aside at most its rule's budget of them (the wait ends a
+// spell or takes a lasting one as the core's state, so few follow one another).
+bool set_aside_if_contended(std::vector<std::vector<double>*> series,
+                            CoreContention& gate = core_contention());
+
+}  // namespace sfx

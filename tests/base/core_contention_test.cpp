@@ -1,0 +1,87 @@
+// The core-contention gate on synthetic rates (an unshared core's, a shared one's in spells,
+// a lasting drop) with a clock that only counts the waits; and the rate probe on this core.
+
+#include "base/core_contention.h"
+
+#include <catch2/catch.hpp>
+#include <deque>
+
+using namespace sfx;
+
+namespace {
+
+// Rates from a script (its last one repeated), and waiting that only adds up.
+struct Script {
+    std::deque<double> rates;
+    double slept_ms = 0.0;
+    CoreContention gate() {
+        return CoreContention(
+            0.15,
+            [this] {
+                const double r = rates.front();
+                if (rates.size() > 1) rates.pop_front();
+                return r;
+            },
+            [this](double ms) { slept_ms += ms; });
+    }
+};
+
+}  // namespace
+
+TEST_CASE("A core reads shared where its rate falls below the best seen", "[contention]") {
+    Script s;
+    s.rates.assign(CoreContention::k_settle, 6.0);  // settling: an unshared core
+    s.rates.push_back(5.5);                         // 8 % below: noise
+    s.rates.push_back(4.2);                         // 30 % below: shared
+    s.rates.push_back(6.1);
+    CoreContention gate = s.gate();
+    CHECK_FALSE(gate.contended());  // settles first: k_settle samples, 10 ms apart
+    CHECK(gate.best() == 6.0);
+    CHECK(s.slept_ms == 10.0 * CoreContention::k_settle);
+    CHECK(gate.contended());
+    CHECK_FALSE(gate.contended());
+    CHECK(gate.best() == 6.1);
+}
+
+TEST_CASE("Waiting for the core ends with its spell, or takes a lasting state as the core's",
+          "[contention]") {
+    Script spell;
+    spell.rates.assign(CoreContention::k_settle, 6.0);
+    for (double r : {4.0, 4.1, 4.0, 5.9}) spell.rates.push_back(r);  // shared, then not
+    CoreContention gate = spell.gate();
+    const double settled_ms = 10.0 * CoreContention::k_settle;
+    CHECK(gate.wait());
+    CHECK(gate.waits() == 1);
+    CHECK(spell.slept_ms == settled_ms + 30.0);  // three steps: 4.1, 4.0, then 5.9
+    CHECK(gate.wait());                          // not shared now: no wait
+    CHECK(gate.waits() == 1);
+
+    Script lasting;
+    lasting.rates.assign(CoreContention::k_settle, 6.0);
+    lasting.rates.push_back(3.0);  // from here on: a drop that outlasts the budget
+    CoreContention slow = lasting.gate();
+    CHECK_FALSE(slow.wait(100.0));
+    CHECK(lasting.slept_ms == settled_ms + 100.0);
+    CHECK(slow.best() == 3.0);  // measured from now on, not waited on
+    CHECK_FALSE(slow.contended());
+}
+
+TEST_CASE("A sample after which the core was shared is set aside", "[contention]") {
+    Script s;
+    s.rates.assign(CoreContention::k_settle, 6.0);
+    for (double r : {6.0, 3.0, 3.0, 6.0}) s.rates.push_back(r);
+    CoreContention gate = s.gate();
+    std::vector<double> times = {10.0, 11.0}, resident = {5.0, 5.5};
+    CHECK_FALSE(set_aside_if_contended({&times, &resident}, gate));  // 6.0
+    CHECK(times.size() == 2);
+    CHECK(set_aside_if_contended({&times, &resident}, gate));  // 3.0; waits out 3.0, 6.0
+    CHECK(times == std::vector<double>{10.0});
+    CHECK(resident == std::vector<double>{5.0});
+    CHECK(gate.waits() == 1);
+}
+
+TEST_CASE("This core's rate of independent adds is a few a TSC tick", "[contention]") {
+    const double rate = independent_adds_per_tick();
+    CHECK(rate > 0.2);   // at least: one add a cycle at a core clock of a fifth of the TSC's
+    CHECK(rate < 40.0);  // at most: eight adds a cycle at five times the TSC's
+}
