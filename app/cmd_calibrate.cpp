@@ -190,7 +190,7 @@ void add_calibrate_command(CLI::App& app) {
                 j["microarchitecture"] = describe(cal.host.microarchitecture);
                 j["convergence_rule"] = describe(bench_rule);
                 j["converged_points"] = cal.converged_points;
-                j["contended_samples"] = core_contention().waits();
+                j["contended_samples"] = core_contention().set_aside();
                 j["unshared_adds_per_tick"] = core_contention().best();
                 j["points"] = cal.points;
                 for (size_t i = 0; i < cal.op_costs.size(); ++i) {
@@ -297,7 +297,7 @@ void add_calibrate_command(CLI::App& app) {
             std::printf(
                 "core shared with another hardware thread after %u samples, which were set "
                 "aside and the core waited for (independent adds: %.2f a TSC tick unshared)\n",
-                core_contention().waits(), core_contention().best());
+                core_contention().set_aside(), core_contention().best());
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "per_fail", "minority", "beyondL1",
                         "fit med", "fit max", "one_lane", "few_lane");

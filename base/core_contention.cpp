@@ -71,11 +71,12 @@ CoreContention& core_contention() {
     return gate;
 }
 
-bool set_aside_if_contended(std::vector<std::vector<double>*> series, CoreContention& gate) {
-    if (!gate.contended()) return false;
+bool CoreContention::set_aside_if_contended(std::vector<std::vector<double>*> series) {
+    if (!contended()) return false;
     for (std::vector<double>* s : series)
         if (!s->empty()) s->pop_back();
-    gate.wait();
+    ++m_set_aside;
+    wait();
     return true;
 }
 

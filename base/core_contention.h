@@ -38,8 +38,15 @@ class CoreContention {
     // falls to the best rate of the wait, so that a lasting state is measured, not waited on.
     bool wait(double budget_ms = 2000.0);
 
+    // After a timed sample: if the core is shared now, the last sample of each series timed
+    // together is set aside and the core waited for; returns whether they were. The caller
+    // takes another in its place, and sets aside at most its rule's budget of them (the wait
+    // ends a spell or takes a lasting one as the core's state, so few follow one another).
+    bool set_aside_if_contended(std::vector<std::vector<double>*> series);
+
     double best() const { return m_best; }
-    uint32_t waits() const { return m_waits; }  // wait() calls that found the core shared
+    uint32_t waits() const { return m_waits; }          // wait() calls that found it shared
+    uint32_t set_aside() const { return m_set_aside; }  // samples set aside
 
     static constexpr int k_settle = 30;
 
@@ -51,17 +58,10 @@ class CoreContention {
     std::function<void(double)> m_sleep_ms;
     double m_best = 0.0;
     bool m_settled = false;
-    uint32_t m_waits = 0;
+    uint32_t m_waits = 0, m_set_aside = 0;
 };
 
 // The process's one gate (microbenchmarks and renders of sfx calibrate share its best rate).
 CoreContention& core_contention();
-
-// After a timed sample: if the core is shared now, the last sample of each series timed
-// together is set aside and the core waited for; returns whether they were. The caller takes
-// another in its place, and sets aside at most its rule's budget of them (the wait ends a
-// spell or takes a lasting one as the core's state, so few follow one another).
-bool set_aside_if_contended(std::vector<std::vector<double>*> series,
-                            CoreContention& gate = core_contention());
 
 }  // namespace sfx

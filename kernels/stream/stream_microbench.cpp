@@ -722,7 +722,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
                             set_aside += set_aside < options.convergence.budget &&
-                                         set_aside_if_contended({&times});
+                                         core_contention().set_aside_if_contended({&times});
                         }
                         if (visited.size() <= point) visited.resize(point + 1);
                         std::vector<double>& cycles = visited[point++];
@@ -948,7 +948,8 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
                 times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
-                set_aside += set_aside < convergence.budget && set_aside_if_contended({&times});
+                set_aside += set_aside < convergence.budget &&
+                             core_contention().set_aside_if_contended({&times});
             }
             const Convergence c = judge_convergence(times, convergence);
             sample.cycles = c.fastest / ticks_per_cycle;
@@ -1090,8 +1091,8 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
             compute_surfaces(resident, rays.data(), hits.data(), ids.data(), k_lanes, surf.data());
             resident_times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
             sink += surf[k_lanes / 2].position.x;
-            set_aside +=
-                set_aside < convergence.budget && set_aside_if_contended({&times, &resident_times});
+            set_aside += set_aside < convergence.budget &&
+                         core_contention().set_aside_if_contended({&times, &resident_times});
         }
         if (sink == 12345.f) out.clear();  // keeps the surfaces computed
         const Convergence c = judge_convergence(times, convergence);
@@ -1264,7 +1265,8 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                     const uint64_t start = __rdtsc();
                     traverse(t, TraceDetail::none);
                     times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
-                    set_aside += set_aside < convergence.budget && set_aside_if_contended({&times});
+                    set_aside += set_aside < convergence.budget &&
+                                 core_contention().set_aside_if_contended({&times});
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;

@@ -72,12 +72,13 @@ TEST_CASE("A sample after which the core was shared is set aside", "[contention]
     for (double r : {6.0, 3.0, 3.0, 6.0}) s.rates.push_back(r);
     CoreContention gate = s.gate();
     std::vector<double> times = {10.0, 11.0}, resident = {5.0, 5.5};
-    CHECK_FALSE(set_aside_if_contended({&times, &resident}, gate));  // 6.0
+    CHECK_FALSE(gate.set_aside_if_contended({&times, &resident}));  // 6.0
     CHECK(times.size() == 2);
-    CHECK(set_aside_if_contended({&times, &resident}, gate));  // 3.0; waits out 3.0, 6.0
+    CHECK(gate.set_aside_if_contended({&times, &resident}));  // 3.0; waits out 3.0, 6.0
     CHECK(times == std::vector<double>{10.0});
     CHECK(resident == std::vector<double>{5.0});
     CHECK(gate.waits() == 1);
+    CHECK(gate.set_aside() == 1);
 }
 
 TEST_CASE("This core's rate of independent adds is a few a TSC tick", "[contention]") {
