@@ -192,6 +192,7 @@ void add_calibrate_command(CLI::App& app) {
                 j["converged_points"] = cal.converged_points;
                 j["contended_samples"] = core_contention().set_aside();
                 j["unshared_adds_per_tick"] = core_contention().best();
+                j["contention_gate_spent"] = core_contention().open();
                 j["points"] = cal.points;
                 for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                     const OpCostConfig& k = cal.op_costs[i];
@@ -298,6 +299,10 @@ void add_calibrate_command(CLI::App& app) {
                 "core shared with another hardware thread after %u samples, which were set "
                 "aside and the core waited for (independent adds: %.2f a TSC tick unshared)\n",
                 core_contention().set_aside(), core_contention().best());
+            if (core_contention().open())
+                std::printf(
+                    "  the gate's total wait was spent: later samples were taken as "
+                    "they came\n");
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "per_fail", "minority", "beyondL1",
                         "fit med", "fit max", "one_lane", "few_lane");

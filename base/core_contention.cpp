@@ -26,8 +26,11 @@ double independent_adds_per_tick(int runs) {
 }
 
 CoreContention::CoreContention(double tolerance, std::function<double()> rate,
-                               std::function<void(double)> sleep_ms)
-    : m_tolerance(tolerance), m_rate(std::move(rate)), m_sleep_ms(std::move(sleep_ms)) {
+                               std::function<void(double)> sleep_ms, double total_wait_ms)
+    : m_tolerance(tolerance),
+      m_rate(std::move(rate)),
+      m_sleep_ms(std::move(sleep_ms)),
+      m_total_wait_ms(total_wait_ms) {
     if (!m_rate) m_rate = [] { return independent_adds_per_tick(); };
     if (!m_sleep_ms)
         m_sleep_ms = [](double ms) {
@@ -42,6 +45,7 @@ double CoreContention::sample() {
 }
 
 bool CoreContention::contended() {
+    if (open()) return false;
     if (!m_settled) {
         m_settled = true;
         for (int i = 0; i < k_settle; ++i) {
@@ -57,7 +61,9 @@ bool CoreContention::wait(double budget_ms) {
     ++m_waits;
     double best_of_wait = 0.0;
     for (double waited = 0.0; waited < budget_ms; waited += 10.0) {
+        if (open()) return true;
         m_sleep_ms(10.0);
+        m_waited_ms += 10.0;
         const double r = sample();
         if (r >= (1.0 - m_tolerance) * m_best) return true;
         best_of_wait = std::max(best_of_wait, r);

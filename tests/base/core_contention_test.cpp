@@ -66,6 +66,30 @@ TEST_CASE("Waiting for the core ends with its spell, or takes a lasting state as
     CHECK_FALSE(slow.contended());
 }
 
+TEST_CASE("A core shared for longer than the gate's total wait is measured as it is",
+          "[contention]") {
+    Script s;
+    s.rates.assign(CoreContention::k_settle, 6.0);
+    for (int i = 0; i < 40; ++i) s.rates.push_back(3.0);
+    s.rates.push_back(6.0);  // never reached: the gate opens first
+    CoreContention gate(
+        0.15,
+        [&] {
+            const double r = s.rates.front();
+            if (s.rates.size() > 1) s.rates.pop_front();
+            return r;
+        },
+        [&](double ms) { s.slept_ms += ms; }, 50.0);
+    std::vector<double> times = {10.0};
+    CHECK(gate.set_aside_if_contended({&times}));  // waits 50 ms of its 2 s, then opens
+    CHECK(times.empty());
+    CHECK(gate.open());
+    CHECK(s.slept_ms == 10.0 * CoreContention::k_settle + 50.0);
+    times.push_back(11.0);
+    CHECK_FALSE(gate.set_aside_if_contended({&times}));  // open: taken as it is
+    CHECK(times.size() == 1);
+}
+
 TEST_CASE("A sample after which the core was shared is set aside", "[contention]") {
     Script s;
     s.rates.assign(CoreContention::k_settle, 6.0);
