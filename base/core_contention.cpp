@@ -77,8 +77,10 @@ CoreContention& core_contention() {
     return gate;
 }
 
-bool CoreContention::set_aside_if_contended(std::vector<std::vector<double>*> series) {
-    if (!contended()) return false;
+bool CoreContention::set_aside_if_contended(std::vector<std::vector<double>*> series,
+                                            uint32_t& set_aside, uint32_t most) {
+    if (set_aside >= most || !contended()) return false;
+    ++set_aside;
     for (std::vector<double>* s : series)
         if (!s->empty()) s->pop_back();
     ++m_set_aside;

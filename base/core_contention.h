@@ -25,10 +25,12 @@ class CoreContention {
   public:
     // `rate`: the core's rate now (independent_adds_per_tick by default); `sleep_ms`: how
     // waiting passes (the thread sleeps by default). A rate more than `tolerance` below the
-    // best seen is a shared core's. At most `total_wait_ms` is spent waiting over the gate's
-    // life: on a core shared most of the time, after that the gate is open (contended() is
-    // false) and measurements take what they get, as they did without it (on the AMD VM a
-    // scalar calibration that set aside 2250 samples took 334 s against 18 s, an AVX2 one
+    // best seen is a shared core's: 0.15 lies between the unshared rate's spread (1924-1976
+    // TSC ticks for the probe on the AMD VM, 2026-12-02) and a spell's drop (2500-3000), and
+    // a wait of 2 s outlasts the longest spell seen there. At most `total_wait_ms` is spent waiting
+    // over the gate's life: on a core shared most of the time, after that the gate is open
+    // (contended() is false) and measurements take what they get, as they did without it (on the
+    // AMD VM a scalar calibration that set aside 2250 samples took 334 s against 18 s, an AVX2 one
     // 545 s). The test runner allows 30 s (tests/test_main.cpp).
     explicit CoreContention(double tolerance = 0.15, std::function<double()> rate = {},
                             std::function<void(double)> sleep_ms = {},
@@ -44,11 +46,13 @@ class CoreContention {
     // falls to the best rate of the wait, so that a lasting state is measured, not waited on.
     bool wait(double budget_ms = 2000.0);
 
-    // After a timed sample: if the core is shared now, the last sample of each series timed
-    // together is set aside and the core waited for; returns whether they were. The caller
-    // takes another in its place, and sets aside at most its rule's budget of them (the wait
-    // ends a spell or takes a lasting one as the core's state, so few follow one another).
-    bool set_aside_if_contended(std::vector<std::vector<double>*> series);
+    // After a timed sample: if the core is shared now and fewer than `most` samples of this
+    // measurement were set aside (`set_aside`, which it counts), the last sample of each series
+    // timed together is set aside and the core waited for; returns whether they were. The
+    // caller takes another in its place (the wait ends a spell or takes a lasting one as the
+    // core's state, so few follow one another).
+    bool set_aside_if_contended(std::vector<std::vector<double>*> series, uint32_t& set_aside,
+                                uint32_t most);
 
     double best() const { return m_best; }
     uint32_t waits() const { return m_waits; }          // wait() calls that found it shared

@@ -114,7 +114,9 @@ struct RayBufferConfig {
     uint32_t slot_bytes = 0;
     // l1d: the arrays a slot's bytes beyond its traversal record are spread over (the native
     // tracer's structure of arrays: a lane opens a page of each of them where a sparse stream's
-    // lane opens pages of all: lane_page_bytes, hw_model/ray_buffer_model.h); 1: one array.
+    // lane opens pages of all: lane_page_bytes, hw_model/ray_buffer_model.h, which takes them
+    // as of equal size, an assumption); 1: one array, as before it existed. A host file's 7 is
+    // counted from the native tracer's code (stream_slot_arrays), not fitted.
     uint32_t slot_arrays = 1;
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }

@@ -155,7 +155,7 @@ uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
 // the microbenchmarks' sparse lanes (a new page of every array) fix, where that happens. On an
 // AMD Zen 5 VM (2026-12-02), priced as one array of its 266 bytes, a frame's dense shading
 // streams paid a sparse lane's cost at every 15th lane: cornell's shading at tile 32 came out
-// 3-6 % over tile 16's where the host ran it no dearer, and its tile ranking upside down.
+// 3-4 % over tile 16's where the host ran it no dearer, and its tile ranking upside down.
 uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_arrays);
 // A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit
 // prices its microbenchmarks: those opening a page of an array of `lane_bytes` a slot the op

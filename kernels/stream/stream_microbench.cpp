@@ -3,6 +3,7 @@
 #include <x86intrin.h>
 
 #include <algorithm>
+#include <iterator>
 #include <map>
 #include <numeric>
 #include <random>
@@ -21,17 +22,26 @@
 
 namespace sfx {
 
+namespace {
+
+// The element bytes of the stream tracer's RayBuffers (stream_tracer.cpp) that a slot indexes,
+// its traversal record apart: path state, two ray generations, the full tests' constants, hit,
+// any-hit flag, surface. Both figures below come from this one list.
+constexpr uint32_t k_slot_array_bytes[] = {sizeof(PathState),  sizeof(Ray), sizeof(Ray),
+                                           sizeof(RayPrecomp), sizeof(Hit), 1,
+                                           sizeof(SurfaceHit)};
+
+}  // namespace
+
 uint32_t stream_slot_bytes() {
-    // The per-slot arrays of the stream tracer's RayBuffers (stream_tracer.cpp): path state,
-    // two ray generations, the filters' fields, the full tests' constants, hit, any-hit flag,
-    // surface, six id lists and a mask.
-    return uint32_t(sizeof(PathState) + 2 * sizeof(Ray) +
-                    uint32_t(traversal_field::record) * sizeof(float) + sizeof(RayPrecomp) +
-                    sizeof(Hit) + 1 + sizeof(SurfaceHit) + 6 * sizeof(uint32_t) + 1);
+    // Those arrays, the filters' fields (the traversal record), six id lists and a mask.
+    uint32_t bytes = uint32_t(traversal_field::record) * sizeof(float) + 6 * sizeof(uint32_t) + 1;
+    for (const uint32_t b : k_slot_array_bytes) bytes += b;
+    return bytes;
 }
 
 uint32_t stream_slot_arrays() {
-    return 7;  // path, ray[0], ray[1], pre, hit, any_hit, surf (stream_tracer.cpp's RayBuffers)
+    return uint32_t(std::size(k_slot_array_bytes));
 }
 
 namespace {
@@ -721,8 +731,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                                 made[again], kind == OpKind::lambertian_direct);
                             const uint64_t end = __rdtsc();
                             times.push_back(std::max(0.0, double(end - start) - overhead) / inner);
-                            set_aside += set_aside < options.convergence.budget &&
-                                         core_contention().set_aside_if_contended({&times});
+                            core_contention().set_aside_if_contended({&times}, set_aside,
+                                                                     options.convergence.budget);
                         }
                         if (visited.size() <= point) visited.resize(point + 1);
                         std::vector<double>& cycles = visited[point++];
@@ -948,8 +958,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
                 times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
-                set_aside += set_aside < convergence.budget &&
-                             core_contention().set_aside_if_contended({&times});
+                core_contention().set_aside_if_contended({&times}, set_aside, convergence.budget);
             }
             const Convergence c = judge_convergence(times, convergence);
             sample.cycles = c.fastest / ticks_per_cycle;
@@ -1091,8 +1100,8 @@ std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,
             compute_surfaces(resident, rays.data(), hits.data(), ids.data(), k_lanes, surf.data());
             resident_times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
             sink += surf[k_lanes / 2].position.x;
-            set_aside += set_aside < convergence.budget &&
-                         core_contention().set_aside_if_contended({&times, &resident_times});
+            core_contention().set_aside_if_contended({&times, &resident_times}, set_aside,
+                                                     convergence.budget);
         }
         if (sink == 12345.f) out.clear();  // keeps the surfaces computed
         const Convergence c = judge_convergence(times, convergence);
@@ -1265,8 +1274,8 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                     const uint64_t start = __rdtsc();
                     traverse(t, TraceDetail::none);
                     times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
-                    set_aside += set_aside < convergence.budget &&
-                                 core_contention().set_aside_if_contended({&times});
+                    core_contention().set_aside_if_contended({&times}, set_aside,
+                                                             convergence.budget);
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;

@@ -81,12 +81,14 @@ TEST_CASE("A core shared for longer than the gate's total wait is measured as it
         },
         [&](double ms) { s.slept_ms += ms; }, 50.0);
     std::vector<double> times = {10.0};
-    CHECK(gate.set_aside_if_contended({&times}));  // waits 50 ms of its 2 s, then opens
+    uint32_t set_aside = 0;
+    CHECK(
+        gate.set_aside_if_contended({&times}, set_aside, 9));  // waits 50 ms of its 2 s, then opens
     CHECK(times.empty());
     CHECK(gate.open());
     CHECK(s.slept_ms == 10.0 * CoreContention::k_settle + 50.0);
     times.push_back(11.0);
-    CHECK_FALSE(gate.set_aside_if_contended({&times}));  // open: taken as it is
+    CHECK_FALSE(gate.set_aside_if_contended({&times}, set_aside, 9));  // open: taken as it is
     CHECK(times.size() == 1);
 }
 
@@ -96,9 +98,11 @@ TEST_CASE("A sample after which the core was shared is set aside", "[contention]
     for (double r : {6.0, 3.0, 3.0, 6.0}) s.rates.push_back(r);
     CoreContention gate = s.gate();
     std::vector<double> times = {10.0, 11.0}, resident = {5.0, 5.5};
-    CHECK_FALSE(gate.set_aside_if_contended({&times, &resident}));  // 6.0
+    uint32_t set_aside = 0;
+    CHECK_FALSE(gate.set_aside_if_contended({&times, &resident}, set_aside, 9));  // 6.0
     CHECK(times.size() == 2);
-    CHECK(gate.set_aside_if_contended({&times, &resident}));  // 3.0; waits out 3.0, 6.0
+    CHECK(
+        gate.set_aside_if_contended({&times, &resident}, set_aside, 9));  // 3.0; waits out 3.0, 6.0
     CHECK(times == std::vector<double>{10.0});
     CHECK(resident == std::vector<double>{5.0});
     CHECK(gate.waits() == 1);
