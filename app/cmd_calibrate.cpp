@@ -210,6 +210,7 @@ void add_calibrate_command(CLI::App& app) {
                         {"few_ray_entry", k.few_ray_entry_cycles},
                         {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
                         {"sphere_light_per_pass", k.sphere_light_per_pass_cycles},
+                        {"per_failed_candidate", k.per_failed_candidate_cycles},
                         {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                         {"fit_median_error", cal.fit_errors[i].first},
                         {"fit_worst_error", cal.fit_errors[i].second}};
@@ -223,7 +224,9 @@ void add_calibrate_command(CLI::App& app) {
                                             {"converged", m.converged},
                                             {"repetitions", m.repetitions},
                                             {"thin_lens", m.thin_lens},
-                                            {"sphere_light", m.sphere_light}});
+                                            {"sphere_light", m.sphere_light},
+                                            {"failing_candidates", m.failing_candidates},
+                                            {"failed_candidates", m.failed_candidates}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (const OneRaySample& s : cal.one_ray_samples) {
@@ -236,7 +239,8 @@ void add_calibrate_command(CLI::App& app) {
                         stream_ops.push_back({{"op", to_string(o.kind)},
                                               {"lanes", o.lanes},
                                               {"count", o.count},
-                                              {"passed", o.passed}});
+                                              {"passed", o.passed},
+                                              {"failed_candidates", o.failed_candidates}});
                     j["one_ray_samples"].push_back({{"rays", s.rays},
                                                     {"streams", s.streams},
                                                     {"entry_depth", s.entry_depth},
@@ -315,6 +319,12 @@ void add_calibrate_command(CLI::App& app) {
                     k.beyond_l1_per_lane_cycles, 100 * cal.fit_errors[i].first,
                     100 * cal.fit_errors[i].second, k.one_lane_cycles, k.few_lane_cycles);
             }
+            for (const OpCostConfig& k : cal.op_costs)
+                if (k.per_failed_candidate_cycles > 0)
+                    std::printf(
+                        "%s: a candidate that fails its full test adds %.1f cycles to a "
+                        "lane the float stage rejects\n",
+                        k.op.c_str(), k.per_failed_candidate_cycles);
             std::printf(
                 "one- and few-lane costs, and the stream loop's per-op box cost: %zu batches of "
                 "traversals, fit error median %.1f%%, worst %.1f%%\n",

@@ -44,6 +44,7 @@ void TraceProfile::op(const StreamOp& op) {
     Bucket& b = m_buckets[Key{op.generation > 0, op.kind, op.length}];
     ++b.ops;
     b.passed += op.pass_count;
+    b.failed_candidates += op.failed_candidates;
     b.placed += placed_by_material_sort(op.kind, m_previous);
     m_previous = op.kind;
     b.mispredicted += mispredicted_lanes(
@@ -289,7 +290,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
             const double busy = p.issue_cycles(
                 c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
-                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1 * opening_share);
+                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1 * opening_share,
+                double(bucket.failed_candidates) / ops);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

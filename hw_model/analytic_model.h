@@ -31,6 +31,7 @@ public:
     struct Bucket {
         uint64_t ops = 0;
         uint64_t passed = 0;  // sum of pass counts
+        uint64_t failed_candidates = 0;  // sum of StreamOp::failed_candidates
         // Sum of the lanes a filter's branch predictor misses (mispredicted_lanes; the rarer
         // outcome's where the trace has no lanes).
         uint64_t mispredicted = 0;

@@ -399,7 +399,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
         (m_placed_by_sort[t.op]
              ? 0.0
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
-                              passed, t.first == 0, beyond_l1)) +
+                              passed, t.first == 0, beyond_l1, op.failed_candidates)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0);
     // The op's mispredicted branches, on its first group.
     const double mispredicted =

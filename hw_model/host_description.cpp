@@ -624,6 +624,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.sphere_light_per_pass_cycles > 0
                       ? ", sphere_light_per_pass_cycles: " + fmt(o.sphere_light_per_pass_cycles, 2)
                       : std::string())
+              << (o.per_failed_candidate_cycles > 0
+                      ? ", per_failed_candidate_cycles: " + fmt(o.per_failed_candidate_cycles, 2)
+                      : std::string())
               << "}\n";
     }
     return y.str();

@@ -413,9 +413,10 @@ struct BranchPredictorConfig {
 // b of its lanes paying for ray data beyond the L1D (their line not in it, and their slot in
 // another 4 KiB page of the array the op reads than the lane before it's: the prefetchers
 // cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
-// hw_model/ray_buffer_model.h beyond_l1_share), costs
-//   per_op + per_group * g + per_lane * n + per_pass * p + per_minority_lane * m
-//   + beyond_l1_per_lane * b cycles
+// hw_model/ray_buffer_model.h beyond_l1_share), and c failing lanes that ran its full test
+// (a triangle test's failed candidates, StreamOp::failed_candidates), costs
+//   per_op + per_group * g + per_lane * n + per_pass * p + per_fail * (n - p)
+//   + per_minority_lane * m + beyond_l1_per_lane * b + per_failed_candidate * c cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
 // predictor's misses, m = mispredicted_lanes in hw_model/op_costs.h: on outcomes in no order
 // the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
@@ -446,6 +447,16 @@ struct OpCostConfig {
     double per_fail_cycles = 0.0;
     double per_minority_lane_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
+    // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
+    // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
+    // microbenchmark's failing lanes are (its rays start from no hit: nearly every candidate
+    // passes). Fitted on the test's microbenchmark of failing candidates, half of them behind
+    // the origin and half beyond a closer hit: their exits differ by about a tenth (a Zen 5 VM,
+    // 2026-12-02: 29 and 33 TSC ticks a lane at AVX2, a passing candidate 40, a rejected lane 4),
+    // and a frame's secondary rays fail in both ways about equally (cornell, 128x128, depth 3:
+    // 0.15 and 0.17 a lane at the first bounce; temple 0.11 and 0.10; conference 0.12 and 0.06).
+    // A primary ray's candidates nearly all pass. 0: not measured.
+    double per_failed_candidate_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
     double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
@@ -503,6 +514,10 @@ struct OpCostConfig {
         v.param("beyond_l1_per_lane_cycles", beyond_l1_per_lane_cycles, "cycles",
                 "extra cost per lane when the ray buffer is wholly beyond the L1D (scaled by "
                 "the fraction beyond)",
+                0.0, 1e9);
+        v.param("per_failed_candidate_cycles", per_failed_candidate_cycles, "cycles",
+                "the triangle test's: extra cost per failing lane that ran the full test (a "
+                "candidate behind the origin or beyond a closer hit; 0: not measured)",
                 0.0, 1e9);
         v.param("one_lane_cycles", one_lane_cycles, "cycles",
                 "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "

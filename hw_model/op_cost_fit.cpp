@@ -10,8 +10,8 @@
 
 namespace sfx {
 
-double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes,
-                          uint32_t passed, double beyond_l1) {
+double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
+                          double beyond_l1, double failed_candidates) {
     OpProfile p;
     p.measured = true;
     p.cost = cost;
@@ -24,7 +24,7 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
         const uint32_t pass = std::min(n, left);
         left -= pass;
         cycles += p.issue_cycles(datapath, lanes, minority_lanes(passed, lanes), n, pass,
-                                 first == 0, beyond_l1);
+                                 first == 0, beyond_l1, failed_candidates);
     }
     return cycles;
 }
@@ -227,24 +227,42 @@ std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
     return {e[e.size() / 2], e.back()};
 }
 
+namespace {
+// The median over the samples with units (`units_of`) of their cycles beyond `base`'s price,
+// per unit; 0 when there are none, never negative.
+template <class Units>
+double median_extra(const OpCostConfig& base, uint32_t width,
+                    const std::vector<OpCostSample>& samples, Units units_of) {
+    std::vector<double> extra;
+    for (const OpCostSample& s : samples)
+        if (const uint32_t units = units_of(s); units > 0)
+            extra.push_back((s.cycles - measured_op_cycles(base, width, s.lanes, s.passed,
+                                                           s.beyond_l1, s.failed_candidates)) /
+                            units);
+    return extra.empty() ? 0.0 : std::max(0.0, median(extra));
+}
+}  // namespace
+
 double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
                                   const std::vector<OpCostSample>& variant_samples) {
-    std::vector<double> extra;
-    for (const OpCostSample& s : variant_samples)
-        if (s.passed > 0)
-            extra.push_back(
-                (s.cycles - measured_op_cycles(base, width, s.lanes, s.passed, s.beyond_l1)) /
-                s.passed);
-    return extra.empty() ? 0.0 : std::max(0.0, median(extra));
+    return median_extra(base, width, variant_samples,
+                        [](const OpCostSample& s) { return s.passed; });
+}
+
+double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
+                                      const std::vector<OpCostSample>& variant_samples) {
+    return median_extra(base, width, variant_samples,
+                        [](const OpCostSample& s) { return s.failed_candidates; });
 }
 
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples) {
     std::vector<double> e;
     for (const OpCostSample& s : samples)
-        e.push_back(
-            std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1) - s.cycles) /
-            std::max(s.cycles, k_resolution));
+        e.push_back(std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1,
+                                                s.failed_candidates) -
+                             s.cycles) /
+                    std::max(s.cycles, k_resolution));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};

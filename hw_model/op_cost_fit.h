@@ -15,16 +15,18 @@
 namespace sfx {
 
 // An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
-// `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_l1_share; one lane:
+// `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_l1_share;
+// `failed_candidates` of the failing lanes candidates that ran the full test; one lane:
 // one_lane_cycles when measured).
-double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes,
-                          uint32_t passed, double beyond_l1);
+double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
+                          double beyond_l1, double failed_candidates = 0.0);
 
 // One microbenchmark run of an op kind: what the cost formula sees, and the cycles measured.
 struct OpCostSample {
     uint32_t lanes = 0, passed = 0;
     double beyond_l1 = 0.0;
     double cycles = 0.0;  // per op
+    uint32_t failed_candidates = 0;  // StreamOp::failed_candidates
 };
 
 // Fits an op kind's cost profile to its samples: least squares on relative error, every
@@ -40,6 +42,11 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
 // quad's (sphere_light_per_pass_cycles: a failing lane costs the same on either).
 double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
                                   const std::vector<OpCostSample>& variant_samples);
+// Likewise per failed candidate: the triangle test's microbenchmark of failing candidates over
+// the op's fitted cost, whose failing lanes are lanes the float stage rejects
+// (OpCostConfig::per_failed_candidate_cycles).
+double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
+                                      const std::vector<OpCostSample>& variant_samples);
 
 // The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
 // measured, a measurement under 100 cycles counting as 100 (the clock's steps).

@@ -51,11 +51,13 @@ void CountingSink::end_pass(const TilePass& p) {
 }
 
 void TraceSink::ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
-                              uint32_t count, uint32_t passed) {
+                              uint32_t count, uint32_t passed, uint32_t failed_candidates) {
     StreamOp o{kind, stage, generation, k_no_object, length};
-    for (uint32_t i = 0; i < count; ++i) {  // the passes fill the ops in turn
+    for (uint32_t i = 0; i < count; ++i) {  // the passes and failed candidates fill the ops in turn
         o.pass_count = std::min(passed, length);
         passed -= o.pass_count;
+        o.failed_candidates = std::min(failed_candidates, length - o.pass_count);
+        failed_candidates -= o.failed_candidates;
         op(o);
     }
 }
@@ -67,11 +69,12 @@ uint32_t bounce_slot(uint32_t generation) {
 }  // namespace
 
 void CountingSink::op(const StreamOp& op) {
-    CountingSink::ops_of_length(op.kind, op.stage, op.generation, op.length, 1, op.pass_count);
+    CountingSink::ops_of_length(op.kind, op.stage, op.generation, op.length, 1, op.pass_count,
+                                op.failed_candidates);
 }
 
 void CountingSink::ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
-                                 uint32_t count, uint32_t passed) {
+                                 uint32_t count, uint32_t passed, uint32_t) {
     if (count == 0 || length == 0) return;
     const uint64_t lanes = uint64_t(count) * length;
     StageCounts& s = m_stages[generation > 0][uint32_t(stage)];
@@ -175,7 +178,8 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
 //           u32 reorder_lod_ppm u8 batching u32 batching_queue batching_cell_prims)
 //   pass:   u8 'P' u32 tile x0 y0 x1 y1 sample slot_count
 //   op:     u8 'O' u8 kind u8 stage u16 generation u32 object length pass_count
-//           u32 slots[length] u8 passed_bits[ceil(length/8)] (bit i of byte i/8, LSB first)
+//           failed_candidates (version 4 on) u32 slots[length] u8 passed_bits[ceil(length/8)] (bit
+//           i of byte i/8, LSB first)
 //   end:    u8 'E' u32 generations        (end of pass)
 //   frame:  u8 'F'                         (end of file)
 
@@ -228,6 +232,7 @@ void TraceFileWriter::op(const StreamOp& op) {
     put(m_bits, op.object);
     put(m_bits, op.length);
     put(m_bits, op.pass_count);
+    put(m_bits, op.failed_candidates);
     write(m_bits.data(), m_bits.size());
     write(op.slots, size_t(op.length) * 4);
     m_bits.assign((op.length + 7) / 8, 0);
@@ -351,7 +356,10 @@ TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
             op.object = r.get<uint32_t>();
             op.length = r.get<uint32_t>();
             op.pass_count = r.get<uint32_t>();
+            if (h.version >= 4) op.failed_candidates = r.get<uint32_t>();
             if (op.length > pass.slot_count) r.fail("an operation longer than its tile pass");
+            if (op.failed_candidates > op.length - std::min(op.pass_count, op.length))
+                r.fail("more failed candidates than failing lanes");
             if (uint64_t(op.length) * 4 > r.size - r.offset)
                 r.fail("truncated");  // before allocating
             slots.resize(op.length);
@@ -391,8 +399,8 @@ void TraceRecorder::begin_pass(const TilePass& p) {
 }
 
 void TraceRecorder::op(const StreamOp& op) {
-    m_ops.push_back(
-        {op.kind, op.stage, op.generation, op.object, op.length, op.pass_count, m_slots.size()});
+    m_ops.push_back({op.kind, op.stage, op.generation, op.object, op.length, op.pass_count,
+                     op.failed_candidates, m_slots.size()});
     m_slots.insert(m_slots.end(), op.slots, op.slots + op.length);
     m_passed.insert(m_passed.end(), op.passed, op.passed + op.length);
 }
@@ -411,6 +419,7 @@ void TraceRecorder::replay(TraceSink& sink) const {
         op.object = r.object;
         op.length = r.length;
         op.pass_count = r.pass_count;
+        op.failed_candidates = r.failed_candidates;
         op.slots = m_slots.data() + r.offset;
         op.passed = m_passed.data() + r.offset;
         sink.op(op);

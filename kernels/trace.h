@@ -175,6 +175,12 @@ struct StreamOp {
     uint32_t pass_count = 0;          // how many slots passed
     const uint32_t* slots = nullptr;  // ray slots in stream order (slot < TilePass::slot_count)
     const uint8_t* passed = nullptr;  // per position in `slots`: 1 passed, 0 failed
+    // Failing lanes that ran the op's full test: a triangle test's candidates (lanes its float
+    // edge stage did not reject: the ray's line crosses the triangle) that found no closer hit,
+    // behind the origin (a secondary ray's own surface) or beyond the ray's hit so far. They
+    // cost nearly a passing lane's work (OpCostConfig::per_failed_candidate_cycles); 0 for
+    // every other kind.
+    uint32_t failed_candidates = 0;
 };
 
 // One tile pass: one sample of every pixel of a tile, traced breadth-first to the end.
@@ -241,9 +247,10 @@ struct TraceFrame {
 
 // What a trace is of; written at the head of a trace file. Version 2 added the seed papers'
 // options (primary_entry, reorder, reorder_lod_ppm), version 3 RayGrid batching (batching,
-// batching_queue, batching_cell_prims); an older file reads with the later fields' defaults.
+// batching_queue, batching_cell_prims), version 4 each op's failed candidates; an older file
+// reads with the later fields' defaults (an op's failed candidates 0).
 struct TraceHeader : TraceFrame {
-    static constexpr uint32_t k_version = 3;
+    static constexpr uint32_t k_version = 4;
     uint32_t version = k_version;
     uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
 };
@@ -256,13 +263,14 @@ class TraceSink {
     virtual void begin_pass(const TilePass&) {}
     virtual void op(const StreamOp&) = 0;
     // `count` ops of kind `kind` and `length` lanes each (length > 0), with `passed` passing
-    // lanes among them, in place of `count` op() calls: the stream tracer sends a traversal's
+    // lanes and `failed_candidates` (StreamOp::failed_candidates) among them, in place of
+    // `count` op() calls: the stream tracer sends a traversal's
     // ops this way, at the traversal's end, to a sink that reads counts only (counts_only),
     // which can add them at once. Their objects, their places in the op order and how the passes
-    // split among them are left unsaid; the traversal's first op still comes first, by op().
-    // The default calls op() for each.
+    // and failed candidates split among them are left unsaid; the traversal's first op still comes
+    // first, by op(). The default calls op() for each.
     virtual void ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
-                               uint32_t count, uint32_t passed);
+                               uint32_t count, uint32_t passed, uint32_t failed_candidates);
     virtual void end_pass(const TilePass&) {}
     virtual void end_frame() {}
     // True if the sink reads counts only: never an op's slots or pass flags, nor the frame
@@ -292,7 +300,7 @@ class CountingSink : public TraceSink {
     void begin_pass(const TilePass&) override;
     void op(const StreamOp& op) override;
     void ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
-                       uint32_t count, uint32_t passed) override;
+                       uint32_t count, uint32_t passed, uint32_t failed_candidates) override;
     void end_pass(const TilePass&) override;
     bool counts_only() const override { return true; }
 
@@ -379,7 +387,7 @@ class TraceRecorder : public TraceSink {
         OpKind kind;
         OpStage stage;
         uint16_t generation;
-        uint32_t object, length, pass_count;
+        uint32_t object, length, pass_count, failed_candidates;
         size_t offset;
     };
     TilePass m_pass;

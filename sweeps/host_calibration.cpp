@@ -84,7 +84,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                     beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(),
                                     lane_page_bytes(stage_of(o.kind), stream_slot_bytes(),
                                                     stream_slot_arrays()),
-                                    l1d_kib));
+                                    l1d_kib),
+                    double(o.failed_candidates) / double(o.count));
         }
         out.push_back(sample);
     }
@@ -188,6 +189,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::map<OpKind, std::vector<double>> one_lane;  // a leaf test's one-lane samples
     std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
     std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
+    std::vector<OpCostSample> failing_candidates;    // the triangle test's
     for (const MicrobenchSample& s : c.samples) {
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
             one_lane[s.kind].push_back(s.cycles);
@@ -198,10 +200,11 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             beyond_l1_share(s.lanes, s.slots, slot_bytes,
                             lane_page_bytes(stage_of(s.kind), slot_bytes, stream_slot_arrays()),
                             l1d),
-            s.cycles};
-        (s.thin_lens      ? lens_camera
-         : s.sphere_light ? sphere_light
-                          : by_kind[s.kind])
+            s.cycles, s.failed_candidates};
+        (s.thin_lens            ? lens_camera
+         : s.sphere_light       ? sphere_light
+         : s.failing_candidates ? failing_candidates
+                                : by_kind[s.kind])
             .push_back(sample);
     }
     size_t points = 0;
@@ -217,6 +220,11 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             c.op_costs.back().sphere_light_per_pass_cycles =
                 fit_extra_per_passing_lane(c.op_costs.back(), c.host.simd_width, sphere_light);
             points += sphere_light.size();
+        }
+        if (kind == OpKind::triangle_test) {
+            c.op_costs.back().per_failed_candidate_cycles = fit_extra_per_failed_candidate(
+                c.op_costs.back(), c.host.simd_width, failing_candidates);
+            points += failing_candidates.size();
         }
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();

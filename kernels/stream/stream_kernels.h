@@ -106,10 +106,10 @@ inline bool set_up_ray(const Ray& r, bool shadow, uint32_t slot, uint8_t& any_hi
 // writes whole vectors.
 constexpr uint32_t k_stream_padding = 16;
 
-// The size of TraversalJob::op_tally for streams of up to n rays: an op count and a pass count
-// per kind (box, triangle and sphere tests) and length (0 to n).
+// The size of TraversalJob::op_tally for streams of up to n rays: an op count, a pass count and
+// a failed-candidate count per kind (box, triangle and sphere tests) and length (0 to n).
 constexpr size_t op_tally_size(uint32_t n) {
-    return 2 * 3 * (size_t(n) + 1);
+    return 3 * 3 * (size_t(n) + 1);
 }
 
 // Triangles a leaf_candidates call takes at most (the default leaf size).

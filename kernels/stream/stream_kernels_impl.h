@@ -310,11 +310,12 @@ uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scr
 // Reports one op of the traversal to job.sink at the detail asked for.
 template <TraceDetail Detail>
 SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage, uint32_t object,
-                             const uint32_t* ids, uint32_t n, const uint8_t* mask,
-                             uint32_t passed) {
+                             const uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t passed,
+                             uint32_t failed_candidates) {
     if constexpr (Detail != TraceDetail::none) {
         if constexpr (Detail != TraceDetail::lanes) ids = nullptr, mask = nullptr;
-        job.sink->op(StreamOp{kind, stage, job.generation, object, n, passed, ids, mask});
+        job.sink->op(
+            StreamOp{kind, stage, job.generation, object, n, passed, ids, mask, failed_candidates});
     }
 }
 
@@ -324,8 +325,8 @@ struct SinkReporter {
     const TraversalJob& job;
     SFX_LANES_INLINE void operator()(OpKind kind, OpStage stage, uint32_t object,
                                      const uint32_t* ids, uint32_t n, const uint8_t* mask,
-                                     uint32_t passed) const {
-        report<Detail>(job, kind, stage, object, ids, n, mask, passed);
+                                     uint32_t passed, uint32_t failed_candidates) const {
+        report<Detail>(job, kind, stage, object, ids, n, mask, passed, failed_candidates);
     }
 };
 
@@ -339,20 +340,25 @@ struct OpTally {
     bool first = true;
     uint32_t longest[3] = {0, 0, 0};  // per kind: the longest op tallied
 
-    // job.op_tally: op counts [kind][length], then pass counts [kind][length].
+    // job.op_tally: op counts [kind][length], then pass counts [kind][length], then failed
+    // candidates [kind][length].
     SFX_LANES_INLINE uint32_t* ops(int k) const { return job.op_tally + size_t(k) * (job.n + 1); }
     SFX_LANES_INLINE uint32_t* passes(int k) const { return ops(k) + 3 * (size_t(job.n) + 1); }
+    SFX_LANES_INLINE uint32_t* failed(int k) const { return ops(k) + 6 * (size_t(job.n) + 1); }
 
     SFX_LANES_INLINE void operator()(OpKind kind, OpStage stage, uint32_t object, const uint32_t*,
-                                     uint32_t n, const uint8_t*, uint32_t pass) {
+                                     uint32_t n, const uint8_t*, uint32_t pass,
+                                     uint32_t failed_candidates) {
         if (first) {
             first = false;
-            job.sink->op(StreamOp{kind, stage, job.generation, object, n, pass, nullptr, nullptr});
+            job.sink->op(StreamOp{kind, stage, job.generation, object, n, pass, nullptr, nullptr,
+                                  failed_candidates});
             return;
         }
         const int k = kind == OpKind::box_test ? 0 : kind == OpKind::triangle_test ? 1 : 2;
         ++ops(k)[n];
         passes(k)[n] += pass;
+        failed(k)[n] += failed_candidates;
         longest[k] = n > longest[k] ? n : longest[k];
     }
     // Sends the tallies and zeros them.
@@ -360,12 +366,12 @@ struct OpTally {
         const OpKind kinds[3] = {OpKind::box_test, OpKind::triangle_test, OpKind::sphere_test};
         const OpStage stages[3] = {job.box_stage, job.triangle_stage, job.sphere_stage};
         for (int k = 0; k < 3; ++k) {
-            uint32_t *count = ops(k), *passed = passes(k);
+            uint32_t *count = ops(k), *passed = passes(k), *failed_candidates = failed(k);
             for (uint32_t n = 1; n <= longest[k]; ++n) {
                 if (count[n] == 0) continue;
-                job.sink->ops_of_length(kinds[k], stages[k], job.generation, n, count[n],
-                                        passed[n]);
-                count[n] = passed[n] = 0;
+                job.sink->ops_of_length(kinds[k], stages[k], job.generation, n, count[n], passed[n],
+                                        failed_candidates[n]);
+                count[n] = passed[n] = failed_candidates[n] = 0;
             }
         }
     }
@@ -463,7 +469,7 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
     for (uint32_t i = node.first; i < end;) {
         if (leaf[i].prim >= job.triangle_count) {
             const uint32_t passed = sphere_leaf<Width, Detail>(job, leaf[i].prim, k);
-            report_op(OpKind::sphere_test, job.sphere_stage, leaf[i].prim, ids, k, mask, passed);
+            report_op(OpKind::sphere_test, job.sphere_stage, leaf[i].prim, ids, k, mask, passed, 0);
             ++i;
             continue;
         }
@@ -487,8 +493,8 @@ SFX_LANES_INLINE void traverse_leaf(const TraversalJob& job, const BvhNode& node
                 ++passed;
                 if constexpr (Detail == TraceDetail::lanes) mask[at] = 1;
             }
-            report_op(OpKind::triangle_test, job.triangle_stage, leaf[i].prim, ids, k, mask,
-                      passed);
+            report_op(OpKind::triangle_test, job.triangle_stage, leaf[i].prim, ids, k, mask, passed,
+                      found[j] - passed);
         }
     }
 }
@@ -505,7 +511,7 @@ uint32_t leaf_tests(const TraversalJob& job, uint32_t first, uint32_t count, uin
     leaf.count = uint16_t(count);
     uint32_t passed = 0;
     auto add_passed = [&](OpKind, OpStage, uint32_t, const uint32_t*, uint32_t, const uint8_t*,
-                          uint32_t op_passed) { passed += op_passed; };
+                          uint32_t op_passed, uint32_t) { passed += op_passed; };
     if (k == 1)
         traverse_leaf<1, TraceDetail::none>(job, leaf, 1, add_passed);
     else
@@ -569,7 +575,7 @@ SFX_LANES_INLINE void traverse_one(const TraversalJob& job, uint32_t root, Repor
         float t0;  // t: the leaves below tighten it
         const bool pass = slab_test<1>(org, inv_dir, record[f::t], node.bounds, t0);
         if constexpr (Detail == TraceDetail::lanes) job.mask[0] = uint8_t(pass);
-        report_op(OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask, pass);
+        report_op(OpKind::box_test, job.box_stage, node_index, job.ids, 1, job.mask, pass, 0);
         if (!pass) continue;
         if (node.is_leaf()) {
             timed_leaf<1, Detail>(job, node, 1, report_op);
@@ -631,7 +637,7 @@ SFX_LANES_INLINE void traverse_few(const TraversalJob& job, uint32_t root, uint3
         const uint32_t pass =
             bits<W>(slab_test<W>(ray.org, ray.inv_dir, ray.t, node.bounds, t0)) & top.lanes;
         const uint32_t k = uint32_t(__builtin_popcount(pass));
-        report_op(OpKind::box_test, job.box_stage, top.node, nullptr, n, nullptr, k);
+        report_op(OpKind::box_test, job.box_stage, top.node, nullptr, n, nullptr, k, 0);
         if (k == 0) continue;
         if (node.is_leaf()) {
             uint32_t m = 0;
@@ -683,7 +689,7 @@ void traverse(const TraversalJob& job) {
             front = box_filter<Width>(view, node.bounds, node.axis, ids, len, job.scratch,
                                       job.scratch2, job.mask, negative);
             back = len - front;
-            report(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front);
+            report(OpKind::box_test, job.box_stage, node_index, ids, len, job.mask, front, 0);
             copy_ids(ids, job.scratch, front);
             copy_ids(ids + front, job.scratch2, back);
         } else {
@@ -692,7 +698,7 @@ void traverse(const TraversalJob& job) {
             back = len - front;
             // Always, even if none passed: the whole-vector stores wrote over ids.
             copy_ids(ids + front, job.scratch, back);
-            report(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front);
+            report(OpKind::box_test, job.box_stage, node_index, ids, len, nullptr, front, 0);
         }
         const uint32_t k = front;
         if (k == 0) continue;

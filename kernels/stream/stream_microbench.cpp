@@ -263,16 +263,21 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // (OpCostConfig::thin_lens_per_lane_cycles). The direct-light filter likewise: on the quad
     // light and on a sphere light (the glass sphere, emitting), whose samples take a point on a
     // sphere (sin and cos, kernels/lights.h) where a triangle's take a barycentric one
-    // (OpCostConfig::sphere_light_per_pass_cycles).
+    // (OpCostConfig::sphere_light_per_pass_cycles). The triangle test likewise: on rays from
+    // no hit, where nearly every candidate (a lane its float stage does not reject) passes, and
+    // on candidates that fail, half of them behind their origin (a secondary ray's own surface)
+    // and half beyond a closer hit, as a frame's secondary rays fail
+    // (OpCostConfig::per_failed_candidate_cycles).
     struct TimedKind {
         OpKind kind;
-        bool thin_lens = false, sphere_light = false;
+        bool thin_lens = false, sphere_light = false, failing_candidates = false;
     };
     std::vector<TimedKind> timed_kinds;
     for (const OpKind kind : kinds) {
         timed_kinds.push_back({kind});
         if (kind == OpKind::camera) timed_kinds.push_back({kind, true, false});
         if (kind == OpKind::lambertian_direct) timed_kinds.push_back({kind, false, true});
+        if (kind == OpKind::triangle_test) timed_kinds.push_back({kind, false, false, true});
     }
     Scene sphere_light_scene = scene;
     {
@@ -343,6 +348,25 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         bvh.prim_ids().begin());
     };
     const uint32_t floor_leaf = leaf_position(0);
+    const LeafPrimitive& floor_triangle = bvh.leaf_primitives()[floor_leaf];
+    // The failing-candidate variant's rays: dealt from those that hit the floor triangle, then
+    // each turned round (`behind`: its line still crosses the triangle, behind its origin) or
+    // given a closer hit (t = 1: its origin is 4 or more above the floor). One way for a whole
+    // point, the other for the next: a frame's op fails its candidates mostly one way (a
+    // secondary ray's own surface's leaf behind them all), and lanes dealt both ways at random
+    // mispredicted the test's exit (AVX2 on a Zen 5 VM, 2026-12-02: 67-90 cycles a lane against
+    // 41-42 where the ways alternated lane by lane, and 65-97 for passing candidates).
+    auto make_candidates_fail = [](Buffers& b, uint32_t slots, bool behind) {
+        for (uint32_t i = 0; i < slots; ++i) {
+            if (!behind) {
+                b.trav.t(i) = 1.f;
+                continue;
+            }
+            b.ray[i].dir = -1.f * b.ray[i].dir;
+            b.pre[i] = RayPrecomp(b.ray[i]);
+            b.trav.set(i, b.pre[i], b.ray[i].t_max);
+        }
+    };
     // The sphere test's sphere (the scene's first, the large one) likewise.
     const uint32_t sphere_leaf = leaf_position(scene.triangle_count());
     // The box test's nodes: the root (every ray passes) and the nodes below it, breadth first
@@ -616,6 +640,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 enum class Deal { mixed, all_pass, none_pass };
                 std::vector<Deal> deals = {Deal::mixed};
                 if (classified) deals = {Deal::mixed, Deal::all_pass, Deal::none_pass};
+                if (timed.failing_candidates) deals = {Deal::all_pass};
                 for (const Deal dealt : deals)
                     for (uint32_t n : options.lengths) {
                         if (n > slots) continue;
@@ -674,6 +699,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 for (uint32_t& d : deal) d = from[rng() % from.size()];
                             }
                             deal_rays(b, deal, stage_of(kind) == OpStage::shading);
+                            if (timed.failing_candidates)  // by the point's place in the sweep
+                                make_candidates_fail(b, slots, point % 2 == 0);
                             std::shuffle(order.begin(), order.end(), rng);
                             if (exact_mix) {
                                 pass_slots.clear();
@@ -738,10 +765,26 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         std::vector<double>& cycles = visited[point++];
                         for (const double t : times) cycles.push_back(t / ticks_per_cycle);
                         if (!last_visit) continue;
+                        // The triangle test's failed candidates, counted by the tracer's float
+                        // stage on the last repetition's streams (it does not depend on t).
+                        uint32_t failed_candidates = 0;
+                        if (kind == OpKind::triangle_test) {
+                            uint64_t candidates = 0, made_sum = 0;
+                            for (uint32_t j = 0; j < inner; ++j) {
+                                candidates += kernels.triangle_candidates(
+                                    b.trav.view(), floor_triangle.p0, floor_triangle.p1,
+                                    floor_triangle.p2, streams.data() + size_t(j) * stride, n,
+                                    b.positions.data());
+                                made_sum += made[j];
+                            }
+                            failed_candidates = uint32_t(std::lround(
+                                double(candidates - std::min(candidates, made_sum)) / inner));
+                        }
                         // Converged: the fastest k of all the visits' samples agree.
                         const Convergence c = judge_convergence(cycles, options.convergence);
                         out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples,
-                                       timed.thin_lens, timed.sphere_light});
+                                       timed.thin_lens, timed.sphere_light,
+                                       timed.failing_candidates, failed_candidates});
                     }
             }
             if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);
@@ -755,13 +798,15 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
 class OpLengthTally : public TraceSink {
   public:
     void op(const StreamOp& o) override {
-        ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count);
+        ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count,
+                      o.failed_candidates);
     }
     void ops_of_length(OpKind kind, OpStage, uint16_t, uint32_t length, uint32_t count,
-                       uint32_t passed) override {
-        auto& t = m_tally[{kind, length}];
-        t.first += count;
-        t.second += passed;
+                       uint32_t passed, uint32_t failed_candidates) override {
+        OpsOfLength& t = m_tally[{kind, length}];
+        t.count += count;
+        t.passed += passed;
+        t.failed_candidates += failed_candidates;
     }
     bool counts_only() const override { return true; }
     // Into a sample: one-lane ops, the few-ray loop's box tests (a wide back end's), the rest.
@@ -769,16 +814,16 @@ class OpLengthTally : public TraceSink {
         for (const auto& [key, t] : m_tally) {
             const auto [kind, length] = key;
             if (length == 1)
-                s.ops[size_t(kind)] += t.first;
+                s.ops[size_t(kind)] += t.count;
             else if (runs_in_few_ray_loop(kind, length, width))
-                s.few_ops[size_t(kind)] += t.first;
+                s.few_ops[size_t(kind)] += t.count;
             else
-                s.stream_ops.push_back({kind, length, t.first, t.second});
+                s.stream_ops.push_back({kind, length, t.count, t.passed, t.failed_candidates});
         }
     }
 
   private:
-    std::map<std::pair<OpKind, uint32_t>, std::pair<uint64_t, uint64_t>> m_tally;
+    std::map<std::pair<OpKind, uint32_t>, OpsOfLength> m_tally;  // its kind and lanes unset
 };
 
 namespace {

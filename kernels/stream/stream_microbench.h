@@ -56,8 +56,15 @@ struct MicrobenchSample {
     uint32_t repetitions = 0;
     bool thin_lens = false;  // the camera's: timed on a thin-lens camera, not the pinhole
     bool sphere_light = false;  // the direct-light filter's: timed on a sphere light, not the quad
-    // A variant's samples price only its extra over the plain op (fit_extra_per_passing_lane).
-    bool variant() const { return thin_lens || sphere_light; }
+    // The triangle test's: timed on candidates that fail (OpCostConfig::
+    // per_failed_candidate_cycles).
+    bool failing_candidates = false;
+    // The triangle test's: lanes the float stage did not reject that failed the full test
+    // (StreamOp::failed_candidates), counted by the tracer's own float stage on the timed streams.
+    uint32_t failed_candidates = 0;
+    // A variant's samples price only its extra over the plain op (fit_extra_per_passing_lane,
+    // fit_extra_per_failed_candidate).
+    bool variant() const { return thin_lens || sphere_light || failing_candidates; }
 };
 
 // The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.
@@ -116,6 +123,7 @@ struct OpsOfLength {
     OpKind kind = OpKind::box_test;
     uint32_t lanes = 0;
     uint64_t count = 0, passed = 0;  // ops, and passing lanes summed over them
+    uint64_t failed_candidates = 0;  // summed over them (StreamOp::failed_candidates)
 };
 struct OneRaySample {
     uint32_t rays = 0;         // per stream

@@ -234,6 +234,35 @@ TEST_CASE("A thin-lens camera's rays cost what its microbenchmarks add to the pi
           plain[OpKind::box_test].issue_cycles(d, 64, 0, 8, 8, false, 0.0));
 }
 
+TEST_CASE("A triangle test's failed candidates cost what their microbenchmark adds", "[host]") {
+    // The fit: the failing candidates' cycles beyond the plain test's fitted cost (which
+    // prices them as failing lanes), per failed candidate (median).
+    const OpCostConfig plain = cost("triangle_test", 20, 6, 3, 40, 2);
+    std::vector<OpCostSample> failing;
+    for (uint32_t lanes : {16u, 64u, 256u})
+        failing.push_back(
+            {lanes, 0, 0.0, measured_op_cycles(plain, 8, lanes, 0, 0.0) + 35.0 * lanes, lanes});
+    failing.push_back({32, 0, 0.0, measured_op_cycles(plain, 8, 32, 0, 0.0) + 90.0 * 32, 32});
+    CHECK(fit_extra_per_failed_candidate(plain, 8, failing) == Approx(35));
+    // Samples without failed candidates tell nothing; never negative.
+    CHECK(fit_extra_per_failed_candidate(plain, 8, {{64, 0, 0.0, 5000.0, 0}}) == 0.0);
+    CHECK(fit_extra_per_failed_candidate(plain, 8, {{64, 0, 0.0, 1.0, 64}}) == 0.0);
+
+    // The model: an op's failed candidates, shared by its groups by lanes.
+    OpCostConfig priced = plain;
+    priced.per_failed_candidate_cycles = 35;
+    CHECK(measured_op_cycles(priced, 8, 40, 10, 0.0, 12) ==
+          Approx(measured_op_cycles(plain, 8, 40, 10, 0.0) + 35 * 12));
+    OpProfile p;
+    p.measured = true;
+    p.cost = priced;
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 0, 8, 2, false, 0.0, 12) ==
+          Approx(p.issue_cycles(DatapathConfig{}, 40, 0, 8, 2, false, 0.0) + 35 * 12 * 8 / 40.0));
+    // A one-lane op keeps its own timed cost.
+    priced.one_lane_cycles = 50;
+    CHECK(measured_op_cycles(priced, 8, 1, 0, 0.0, 1) == Approx(50));
+}
+
 TEST_CASE("A passing direct-light lane pays a sphere light's extra in the share on spheres",
           "[host]") {
     OpCostConfig direct = cost("lambertian_direct", 10, 0, 150, 0, 30);
@@ -981,4 +1010,53 @@ TEST_CASE("A CPU core's material filters after a generation's first cost nothing
         // ... the second is placed by the sort and adds nothing.
         CHECK(timed(ops(true, true)) == timed(ops(true, false)));
     }
+}
+
+TEST_CASE("Both timing models price a triangle op's failed candidates", "[host][systemc]") {
+    OpCostConfig triangle = cost("triangle_test", 10, 4, 1, 20, 0);
+    triangle.per_failed_candidate_cycles = 30;
+    const HwConfig host = host_with({triangle});
+    std::vector<uint32_t> ids(16);
+    for (uint32_t i = 0; i < 16; ++i) ids[i] = i;
+    const std::vector<uint8_t> some = {1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    // A triangle test of 16 lanes, 2 passing and `failed` of the other 14 failed candidates.
+    auto op = [&](uint32_t failed) {
+        return StreamOp{OpKind::triangle_test,
+                        OpStage::intersection,
+                        1,
+                        0,
+                        16,
+                        2,
+                        ids.data(),
+                        some.data(),
+                        failed};
+    };
+    // Priced as the same cycles spread over the op's lanes: 6 * 30 / 16 a lane more.
+    OpCostConfig dearer_lanes = triangle;
+    dearer_lanes.per_failed_candidate_cycles = 0;
+    dearer_lanes.per_lane_cycles += 6 * 30 / 16.0;
+    const HwConfig same = host_with({dearer_lanes});
+    auto cycle_level = [&](const HwConfig& host, const StreamOp& o) {
+        SystemcTiming timing({host}, shape());
+        TilePass pass;
+        pass.slot_count = 64;
+        timing.begin_pass(pass);
+        timing.op(o);
+        timing.end_pass(pass);
+        return timing.timing(0).cycles;
+    };
+    auto closed_form = [&](const HwConfig& host, const StreamOp& o) {
+        TraceProfile profile(shape());
+        TilePass pass;
+        pass.slot_count = 64;
+        profile.begin_pass(pass);
+        profile.op(o);
+        profile.end_pass(pass);
+        return analytic_timing(host, shape(), profile).cycles;
+    };
+    // The cycle level waits for the triangle's line, then issues: 6 * 30 more.
+    CHECK(cycle_level(host, op(6)) == cycle_level(host, op(0)) + 6 * 30);
+    CHECK(cycle_level(host, op(6)) == cycle_level(same, op(0)));
+    CHECK(closed_form(host, op(6)) > closed_form(host, op(0)));
+    CHECK(closed_form(host, op(6)) == closed_form(same, op(0)));
 }

@@ -103,12 +103,26 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     // Three lengths each; a shading op or a leaf test whose buffer has rays it passes and rays
     // it fails also on streams that all pass and streams that none pass, after its mixed ones
     // (a leaf test not on its one-lane stream: 3 + 2 + 2).
-    // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles), and the direct-light
-    // filter's on a sphere light (sphere_light_per_pass_cycles); no other kind's.
+    // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles), the direct-light
+    // filter's on a sphere light (sphere_light_per_pass_cycles), and the triangle test's on
+    // candidates that fail (per_failed_candidate_cycles); no other kind's.
     std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
-    std::vector<const MicrobenchSample*> lens, sphere_light;
+    std::vector<const MicrobenchSample*> lens, sphere_light, failing;
     for (const MicrobenchSample& m : samples)
-        (m.thin_lens ? lens : m.sphere_light ? sphere_light : by_kind[m.kind]).push_back(&m);
+        (m.thin_lens            ? lens
+         : m.sphere_light       ? sphere_light
+         : m.failing_candidates ? failing
+                                : by_kind[m.kind])
+            .push_back(&m);
+    // Streams of every lane failing, no one-lane one: each lane's ray turned round or given a
+    // closer hit still crosses the triangle (the tracer's float stage counts it a candidate).
+    REQUIRE(failing.size() == 2);
+    for (const MicrobenchSample* m : failing) {
+        CHECK(m->kind == OpKind::triangle_test);
+        CHECK(m->lanes > 1);
+        CHECK(m->passed == 0);
+        CHECK(m->failed_candidates == m->lanes);
+    }
     REQUIRE(lens.size() == 3);
     for (const MicrobenchSample* m : lens) CHECK(m->kind == OpKind::camera);
     CHECK(by_kind[OpKind::camera].size() == 3);
@@ -126,6 +140,8 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
                 CHECK(of_kind[3 + i]->lanes > 1);
                 CHECK(of_kind[3 + i]->passed == of_kind[3 + i]->lanes);
                 CHECK(of_kind[5 + i]->passed == 0);
+                // From no hit, a ray whose line crosses the triangle hits it.
+                CHECK(of_kind[3 + i]->failed_candidates == 0);
             }
             continue;
         }

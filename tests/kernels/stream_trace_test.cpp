@@ -8,13 +8,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 
 #include "base/input_error.h"
 #include "kernels/bvh.h"
 #include "kernels/camera.h"
+#include "kernels/intersect.h"
+#include "kernels/simd/isa.h"
 #include "kernels/stream/stream_tracer.h"
 #include "tests/kernels/count_checks.h"
 #include "tests/temp_dir.h"
+#include "workloads/scene_loader.h"
 
 using namespace sfx;
 
@@ -197,8 +201,8 @@ TEST_CASE("Counting sink: ops_of_length adds what as many op() calls add", "[str
     CountingSink batched({1, 8, 12, 16}), single({1, 8, 12, 16});
     auto both = [&](OpKind kind, uint16_t generation, uint32_t length, uint32_t count,
                     uint32_t passed) {
-        batched.ops_of_length(kind, stage_of(kind), generation, length, count, passed);
-        single.TraceSink::ops_of_length(kind, stage_of(kind), generation, length, count, passed);
+        batched.ops_of_length(kind, stage_of(kind), generation, length, count, passed, 0);
+        single.TraceSink::ops_of_length(kind, stage_of(kind), generation, length, count, passed, 0);
     };
     auto op = [&](OpKind kind, uint16_t generation, uint32_t len, uint32_t pass) {
         const StreamOp o{kind, stage_of(kind), generation, k_no_object, len, pass};
@@ -221,6 +225,84 @@ TEST_CASE("Counting sink: ops_of_length adds what as many op() calls add", "[str
     CHECK(batched.rays() == 1 + 9 + 5);  // each generation's first box test: its lanes
     CHECK(batched.kind_ops(OpKind::box_test) == 7 + 1 + 3 + 1 + 11 + 3);
     test::check_same_counts(batched, single);
+}
+
+namespace {
+// Checks each triangle op of a pass against the rays it tested: its passing lanes and failed
+// candidates are the lanes whose ray's line the float edge stage does not reject. A
+// generation's traversal ops come before its rays are observed, and those before its shading
+// ops, so a generation's triangle ops are checked at its first shading op.
+struct CandidateCheck : TraceSink, RayObserver {
+    const Scene& scene;
+    uint32_t width = 0, x0 = 0, y0 = 0, tile_width = 0;
+    std::vector<StreamOp> pending;
+    std::vector<std::vector<uint32_t>> pending_slots;
+    std::map<uint32_t, Ray> rays;  // by slot, this generation's
+    uint64_t ops = 0, mismatches = 0, failed[2] = {0, 0}, passed[2] = {0, 0};
+    CandidateCheck(const Scene& s, uint32_t w) : scene(s), width(w) {}
+    void begin_pass(const TilePass& p) override { x0 = p.x0, y0 = p.y0, tile_width = p.x1 - p.x0; }
+    void op(const StreamOp& o) override {
+        if (o.kind != OpKind::triangle_test) {
+            if (o.kind != OpKind::box_test && o.kind != OpKind::sphere_test) check();
+            CHECK(o.failed_candidates == 0);
+            return;
+        }
+        pending.push_back(o);
+        pending_slots.emplace_back(o.slots, o.slots + o.length);
+    }
+    void ray(const PathState& p, const Ray& r, const Hit&, bool) override {
+        const uint32_t px = p.key.pixel % width, py = p.key.pixel / width;
+        rays[(py - y0) * tile_width + (px - x0)] = r;
+    }
+    void end_pass(const TilePass&) override { check(); }
+    void check() {
+        for (size_t k = 0; k < pending.size(); ++k) {
+            const StreamOp& o = pending[k];
+            const Triangle& t = scene.triangles[o.object];
+            const Vec3 &p0 = scene.positions[t.v0], &p1 = scene.positions[t.v1],
+                       &p2 = scene.positions[t.v2];
+            uint32_t candidates = 0;
+            for (uint32_t slot : pending_slots[k]) {
+                const RayPrecomp r(rays.at(slot));
+                const float org[3] = {r.org.x, r.org.y, r.org.z};
+                candidates += !edges_reject<1>(
+                    shear_triangle<1>(org, r.kx, r.ky, r.kz, r.sx, r.sy, p0, p1, p2));
+            }
+            ++ops;
+            mismatches += candidates != o.pass_count + o.failed_candidates;
+            failed[o.generation > 0] += o.failed_candidates;
+            passed[o.generation > 0] += o.pass_count;
+        }
+        pending.clear();
+        pending_slots.clear();
+        rays.clear();
+    }
+};
+}  // namespace
+
+TEST_CASE("A triangle op's failed candidates are the lanes its float stage keeps that miss",
+          "[stream]") {
+    // Cornell's walls are quads, each ray's line crossing one of their two triangles: a primary
+    // ray's candidates take their hit, a secondary ray's fail on its own surface's leaf (behind
+    // its origin) and on leaves beyond its hit.
+    const Scene s = load_scene("cornell");
+    const Bvh bvh(s);
+    for (const Isa isa : supported_isas()) {
+        INFO("back end " << isa_name(isa));
+        RenderSettings r = settings_for(s, 16, 1, 8);
+        r.isa = isa;
+        StreamTracer tracer(s, bvh, r);
+        CandidateCheck check(s, r.width);
+        RenderStats stats;
+        std::vector<Vec3> sums(64);
+        const std::vector<TileRect> tiles = make_tiles(r.width, r.height, r.tile);
+        for (uint32_t i = 0; i < tiles.size(); ++i)
+            tracer.trace_pass(tiles[i], i, 0, sums.data(), stats, &check, &check);
+        CHECK(check.ops > 0);
+        CHECK(check.mismatches == 0);
+        CHECK(check.failed[0] < check.passed[0] / 10);
+        CHECK(check.failed[1] > check.passed[1]);
+    }
 }
 
 TEST_CASE("Table 7: tile 1 and width 1 give recursive tracing's op counts", "[stream]") {
@@ -289,6 +371,20 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     const std::vector<uint32_t> widths{4, 8, 16};
     CountingSink direct(widths);
     const RenderResult a = render_stream(s, bvh, r, &direct);
+    // The failed candidates the tracer tallies for a counts-only sink (ops_of_length), and
+    // below the ones each op of the file carries.
+    struct FailedCandidates : TraceSink {
+        bool counts = true;
+        uint64_t sum = 0;
+        void op(const StreamOp& o) override { sum += o.failed_candidates; }
+        void ops_of_length(OpKind, OpStage, uint16_t, uint32_t, uint32_t, uint32_t,
+                           uint32_t failed_candidates) override {
+            sum += failed_candidates;
+        }
+        bool counts_only() const override { return counts; }
+    } tallied, from_file;
+    render_stream(s, bvh, r, &tallied);
+    CHECK(tallied.sum > 0);
     CHECK(direct.passes() == 9 * 2);
     CHECK(direct.rays() == a.stats.rays());
     CHECK(direct.kind_ops(OpKind::shadow_filter) > 0);
@@ -311,6 +407,9 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CHECK(b1.size() > 1000);
     CHECK(b1 == b2);
 
+    from_file.counts = false;
+    read_trace_file(p1, from_file);
+    CHECK(from_file.sum == tallied.sum);
     CountingSink replayed(widths);
     const TraceHeader h = read_trace_file(p1, replayed);
     CHECK(h.scene_hash == scene_hash(s));
@@ -368,7 +467,7 @@ std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_co
 }
 }  // namespace
 
-TEST_CASE("Trace file version 3: the header carries the whole frame, the seed papers' options too",
+TEST_CASE("Trace file version 4: the header carries the whole frame, the seed papers' options too",
           "[stream]") {
     const Scene s = cluster_scene(true);
     const Bvh bvh(s);
@@ -387,7 +486,7 @@ TEST_CASE("Trace file version 3: the header carries the whole frame, the seed pa
     }
     CountingSink sink({8});
     const TraceHeader h = read_trace_file(path, sink);
-    CHECK(h.version == 3);
+    CHECK(h.version == 4);
     CHECK(h.width == r.width);
     CHECK(h.height == r.height);
     CHECK(h.spp == r.spp);
