@@ -450,12 +450,14 @@ struct OpCostConfig {
     // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
     // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
     // microbenchmark's failing lanes are (its rays start from no hit: nearly every candidate
-    // passes). Fitted on the test's microbenchmark of failing candidates, half of them behind
-    // the origin and half beyond a closer hit: their exits differ by about a tenth (a Zen 5 VM,
-    // 2026-12-02: 29 and 33 TSC ticks a lane at AVX2, a passing candidate 40, a rejected lane 4),
-    // and a frame's secondary rays fail in both ways about equally (cornell, 128x128, depth 3:
-    // 0.15 and 0.17 a lane at the first bounce; temple 0.11 and 0.10; conference 0.12 and 0.06).
-    // A primary ray's candidates nearly all pass. 0: not measured.
+    // passes). Fitted (the median over its points) on the test's microbenchmark of failing
+    // candidates, its points by turns behind their origin and beyond a closer hit, whose exits
+    // differ (a Zen 5 VM at AVX2, 2026-12-02: 38-43 and 47-52 cycles a lane on streams of 16 to
+    // 200, against 65-97 where every candidate passes and 6-12 where none is one), and a
+    // frame's secondary rays fail both ways about equally (cornell, 128x128, depth 3: 0.15 and
+    // 0.17 a lane at the first bounce; temple 0.11 and 0.10; conference 0.12 and 0.06). A
+    // primary ray's candidates nearly all pass. A one-lane op keeps its one_lane_cycles.
+    // 0: not measured.
     double per_failed_candidate_cycles = 0.0;
     double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
     double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies

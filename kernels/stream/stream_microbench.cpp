@@ -265,9 +265,9 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // sphere (sin and cos, kernels/lights.h) where a triangle's take a barycentric one
     // (OpCostConfig::sphere_light_per_pass_cycles). The triangle test likewise: on rays from
     // no hit, where nearly every candidate (a lane its float stage does not reject) passes, and
-    // on candidates that fail, half of them behind their origin (a secondary ray's own surface)
-    // and half beyond a closer hit, as a frame's secondary rays fail
-    // (OpCostConfig::per_failed_candidate_cycles).
+    // on candidates that fail, point by point behind their origin (as on a secondary ray's own
+    // surface) and beyond a closer hit, the two ways a frame's secondary rays fail about
+    // equally often (OpCostConfig::per_failed_candidate_cycles).
     struct TimedKind {
         OpKind kind;
         bool thin_lens = false, sphere_light = false, failing_candidates = false;
