@@ -16,7 +16,8 @@ namespace sfx {
 
 // An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
 // `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_l1_share;
-// `failed_candidates` of the failing lanes candidates that ran the full test; one lane:
+// `failed_candidates` of the failing lanes candidates that ran the full test (0: none; a mean
+// where the ops of a traversal sample are priced by their kind and length); one lane:
 // one_lane_cycles when measured).
 double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
                           double beyond_l1, double failed_candidates = 0.0);

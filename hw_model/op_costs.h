@@ -122,7 +122,8 @@ struct OpProfile {
     // `first`: the op's first group,
     // which carries a measured per-op cost), with a share `beyond_l1` of its lanes paying for
     // an l1d buffer beyond the L1D (beyond_l1_share, lanes_opening_pages), `op_failed_candidates`
-    // of the op's lanes failing candidates (StreamOp::failed_candidates). A measured minority
+    // of the op's lanes failing candidates (StreamOp::failed_candidates; 0: none, or a mean
+    // over ops where the closed form prices a bucket of them). A measured minority
     // cost and failed candidates' cost are the op's, shared by its groups by lanes (the trace
     // does not say which lanes they are). Fractional for measured costs (the caller carries
     // the remainder); instruction-priced groups cost compute_instructions (programmable), the

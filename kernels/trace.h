@@ -177,9 +177,9 @@ struct StreamOp {
     const uint8_t* passed = nullptr;  // per position in `slots`: 1 passed, 0 failed
     // Failing lanes that ran the op's full test: a triangle test's candidates (lanes its float
     // edge stage did not reject: the ray's line crosses the triangle) that found no closer hit,
-    // behind the origin (a secondary ray's own surface) or beyond the ray's hit so far. They
-    // cost nearly a passing lane's work (OpCostConfig::per_failed_candidate_cycles); 0 for
-    // every other kind.
+    // behind the origin (a secondary ray's own surface) or beyond the ray's hit so far. Each
+    // does about two thirds of a passing lane's work (OpCostConfig::
+    // per_failed_candidate_cycles); 0 for every other kind.
     uint32_t failed_candidates = 0;
 };
 
@@ -264,11 +264,11 @@ class TraceSink {
     virtual void op(const StreamOp&) = 0;
     // `count` ops of kind `kind` and `length` lanes each (length > 0), with `passed` passing
     // lanes and `failed_candidates` (StreamOp::failed_candidates) among them, in place of
-    // `count` op() calls: the stream tracer sends a traversal's
-    // ops this way, at the traversal's end, to a sink that reads counts only (counts_only),
-    // which can add them at once. Their objects, their places in the op order and how the passes
-    // and failed candidates split among them are left unsaid; the traversal's first op still comes
-    // first, by op(). The default calls op() for each.
+    // `count` op() calls: the stream tracer sends a traversal's ops this way, at the
+    // traversal's end, to a sink that reads counts only (counts_only), which can add them at
+    // once. Their objects, their places in the op order and how the passes and failed
+    // candidates split among them are left unsaid; the traversal's first op still comes first,
+    // by op(). The default calls op() for each.
     virtual void ops_of_length(OpKind kind, OpStage stage, uint16_t generation, uint32_t length,
                                uint32_t count, uint32_t passed, uint32_t failed_candidates);
     virtual void end_pass(const TilePass&) {}
