@@ -454,8 +454,9 @@ struct OpCostConfig {
     // candidates, its points by turns behind their origin and beyond a closer hit, whose exits
     // differ (a Zen 5 VM at AVX2, 2026-12-02: 38-43 and 47-52 cycles a lane on streams of 16 to
     // 1024, against 65-97 where every candidate passes and 6-12 where none is one), and a
-    // frame's secondary rays fail both ways about equally (cornell, 128x128, depth 3: 0.15 and
-    // 0.17 a lane at the first bounce; temple 0.11 and 0.10; conference 0.12 and 0.06). A
+    // frame's secondary rays fail both ways (behind and beyond, a lane at the first bounce,
+    // depth 3, tile 32: cornell 128x128 0.15 and 0.17; temple 64x64 0.11 and 0.10; conference
+    // 128x128 0.12 and 0.06: the median of the two ways' points fits cornell and temple best). A
     // primary ray's candidates nearly all pass. A one-lane op keeps its one_lane_cycles.
     // 0: not measured.
     double per_failed_candidate_cycles = 0.0;

@@ -266,8 +266,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // (OpCostConfig::sphere_light_per_pass_cycles). The triangle test likewise: on rays from
     // no hit, where nearly every candidate (a lane its float stage does not reject) passes, and
     // on candidates that fail, point by point behind their origin (as on a secondary ray's own
-    // surface) and beyond a closer hit, the two ways a frame's secondary rays fail about
-    // equally often (OpCostConfig::per_failed_candidate_cycles).
+    // surface) and beyond a closer hit, the two ways a frame's secondary rays fail
+    // (OpCostConfig::per_failed_candidate_cycles).
     struct TimedKind {
         OpKind kind;
         bool thin_lens = false, sphere_light = false, failing_candidates = false;
@@ -352,10 +352,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // The failing-candidate variant's rays: dealt from those that hit the floor triangle, then
     // each turned round (`behind`: its line still crosses the triangle, behind its origin) or
     // given a closer hit (t = 1: its origin is 4 or more above the floor). One way for a whole
-    // point, the other for the next: a frame's op fails its candidates mostly one way (a
-    // secondary ray's own surface's leaf behind them all), and lanes dealt both ways at random
-    // mispredicted the test's exit (AVX2 on a Zen 5 VM, 2026-12-02: 67-90 cycles a lane against
-    // 41-42 where the ways alternated lane by lane, and 65-97 for passing candidates).
+    // point, the other for the next: a frame's op most likely fails its candidates mostly one
+    // way (a secondary ray's own surface's leaf behind them all; not counted per op), and lanes
+    // dealt both ways at random cost more, most likely the test's exit mispredicted (no PMU to
+    // count it; AVX2 on a Zen 5 VM, 2026-12-02: 67-90 cycles a lane against 41-42 where the
+    // ways alternated lane by lane, and 65-97 for passing candidates).
     auto make_candidates_fail = [](Buffers& b, uint32_t slots, bool behind) {
         for (uint32_t i = 0; i < slots; ++i) {
             if (!behind) {
