@@ -205,6 +205,8 @@ void add_calibrate_command(CLI::App& app) {
                         {"per_minority_lane", k.per_minority_lane_cycles},
                         {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                         {"one_lane", k.one_lane_cycles},
+                        {"one_lane_pass", k.one_lane_pass_cycles},
+                        {"one_lane_failed_candidate", k.one_lane_failed_candidate_cycles},
                         {"few_lane", k.few_lane_cycles},
                         {"one_ray_entry", k.one_ray_entry_cycles},
                         {"few_ray_entry", k.few_ray_entry_cycles},
@@ -325,6 +327,13 @@ void add_calibrate_command(CLI::App& app) {
                         "%s: a candidate that fails its full test adds %.1f cycles to a "
                         "lane the float stage rejects\n",
                         k.op.c_str(), k.per_failed_candidate_cycles);
+            for (const OpCostConfig& k : cal.op_costs)
+                if (k.one_lane_pass_cycles > 0 || k.one_lane_failed_candidate_cycles > 0)
+                    std::printf(
+                        "%s: one lane that fails costs %.1f cycles; passing adds %.1f, a failed "
+                        "candidate %.1f\n",
+                        k.op.c_str(), k.one_lane_cycles, k.one_lane_pass_cycles,
+                        k.one_lane_failed_candidate_cycles);
             std::printf(
                 "one- and few-lane costs, and the stream loop's per-op box cost: %zu batches of "
                 "traversals, fit error median %.1f%%, worst %.1f%%\n",

@@ -288,10 +288,12 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         double busy_sum = 0.0;  // the op's issue cycles, all groups
         for (uint64_t g = 0; g < groups; ++g) {
             const uint32_t lanes = std::min<uint32_t>(n, length - uint32_t(g * n));
+            // A one-lane op's pass is priced by the bucket's pass rate (rounded, one lane
+            // would pass all or none of the bucket).
+            const double passing = length == 1 ? pass_rate : double(std::lround(pass_rate * lanes));
             const double busy = p.issue_cycles(
                 c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
-                uint32_t(std::lround(pass_rate * lanes)), g == 0, beyond_l1 * opening_share,
-                double(bucket.failed_candidates) / ops);
+                passing, g == 0, beyond_l1 * opening_share, double(bucket.failed_candidates) / ops);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

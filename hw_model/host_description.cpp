@@ -610,6 +610,13 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", per_minority_lane_cycles: " << fmt(o.per_minority_lane_cycles, 2)
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
+              << (o.one_lane_pass_cycles > 0
+                      ? ", one_lane_pass_cycles: " + fmt(o.one_lane_pass_cycles, 2)
+                      : std::string())
+              << (o.one_lane_failed_candidate_cycles > 0
+                      ? ", one_lane_failed_candidate_cycles: " +
+                            fmt(o.one_lane_failed_candidate_cycles, 2)
+                      : std::string())
               << ", few_lane_cycles: " << fmt(o.few_lane_cycles, 2)
               << (o.one_ray_entry_cycles > 0 || o.few_ray_entry_cycles > 0
                       ? ", one_ray_entry_cycles: " + fmt(o.one_ray_entry_cycles, 2) +

@@ -426,7 +426,9 @@ struct BranchPredictorConfig {
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each (the box test's
 // fitted on one-ray traversals of the same synthetic scene, the leaf tests' timed on one lane
-// by the one-ray loop's leaf code); and a box test of 2 to k_few_ray_lanes lanes
+// by the one-ray loop's leaf code: on a lane that fails, plus one_lane_pass_cycles if it
+// passes and one_lane_failed_candidate_cycles if it is a triangle test's failed candidate);
+// and a box test of 2 to k_few_ray_lanes lanes
 // when few_lane_cycles is set: on a back end of k_few_ray_min_width lanes or more the tracer runs
 // such a stream in its few-ray loop (traverse_few, kernels/trace.h), not the stream loop, so its
 // box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene. The box
@@ -460,7 +462,18 @@ struct OpCostConfig {
     // primary ray's candidates nearly all pass. A one-lane op keeps its one_lane_cycles.
     // 0: not measured.
     double per_failed_candidate_cycles = 0.0;
-    double one_lane_cycles = 0.0;  // 0: not measured, one lane costs the formula above
+    // A one-lane op's cost (0: not measured, one lane costs the formula above). A leaf test's is
+    // timed on one-lane calls of the one-ray loop's leaf code whose lane fails (a triangle
+    // test's: the float edge stage rejects it), and the two below add to it what a lane that
+    // passes, and a triangle test's candidate that fails its full test, cost more: a frame's
+    // one-lane leaf tests are mostly secondary rays' that fail (temple 64x64 at the first
+    // bounce, depth 3, tile 32: 0.19 of its lanes pass, 0.21 are failed candidates), and the
+    // one-ray loop's leaf code took 47 TSC ticks on a rejected lane against 93-102 on a failed
+    // candidate and 111 on a passing one (a Zen 5 VM at AVX2, 2026-12-02). Host files written
+    // before 2026-12-02 hold the median over one-lane calls on random rays, and no extras.
+    double one_lane_cycles = 0.0;
+    double one_lane_pass_cycles = 0.0;              // a leaf test's (0: not measured)
+    double one_lane_failed_candidate_cycles = 0.0;  // the triangle test's (0: not measured)
     double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
     double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
@@ -525,6 +538,14 @@ struct OpCostConfig {
         v.param("one_lane_cycles", one_lane_cycles, "cycles",
                 "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "
                 "formula above applies)",
+                0.0, 1e9);
+        v.param("one_lane_pass_cycles", one_lane_pass_cycles, "cycles",
+                "a leaf test's: what a one-lane op whose lane passes costs beyond one_lane_cycles "
+                "(0: not measured)",
+                0.0, 1e9);
+        v.param("one_lane_failed_candidate_cycles", one_lane_failed_candidate_cycles, "cycles",
+                "the triangle test's: what a one-lane op whose lane is a failed candidate costs "
+                "beyond one_lane_cycles (0: not measured)",
                 0.0, 1e9);
         v.param("few_lane_cycles", few_lane_cycles, "cycles",
                 "cost of an op of 2 to 4 lanes in the few-ray traversal loop (0: not measured; "

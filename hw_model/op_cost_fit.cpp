@@ -255,6 +255,25 @@ double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
                         [](const OpCostSample& s) { return s.failed_candidates; });
 }
 
+void fit_one_lane_by_outcome(OpCostConfig& cost, const std::vector<OpCostSample>& one_lane) {
+    std::vector<double> failing, passing, failed_candidate, every;
+    for (const OpCostSample& s : one_lane) {
+        (s.passed > 0              ? passing
+         : s.failed_candidates > 0 ? failed_candidate
+                                   : failing)
+            .push_back(s.cycles);
+        every.push_back(s.cycles);
+    }
+    cost.one_lane_cycles = median(failing.empty() ? every : failing);
+    cost.one_lane_pass_cycles = cost.one_lane_failed_candidate_cycles = 0.0;
+    if (failing.empty()) return;
+    if (!passing.empty())
+        cost.one_lane_pass_cycles = std::max(0.0, median(passing) - cost.one_lane_cycles);
+    if (!failed_candidate.empty())
+        cost.one_lane_failed_candidate_cycles =
+            std::max(0.0, median(failed_candidate) - cost.one_lane_cycles);
+}
+
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples) {
     std::vector<double> e;

@@ -49,6 +49,13 @@ double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
 double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
                                       const std::vector<OpCostSample>& variant_samples);
 
+// A leaf test's one-lane costs from its one-lane samples, by the lane's outcome: one_lane_cycles
+// is the median of those whose lane fails (of every sample where none fails),
+// one_lane_pass_cycles and one_lane_failed_candidate_cycles the medians of those whose lane
+// passes and of those whose lane is a failed candidate beyond it (0 where either side has no
+// sample; never negative). The rest of `cost` is kept.
+void fit_one_lane_by_outcome(OpCostConfig& cost, const std::vector<OpCostSample>& one_lane);
+
 // The fit's relative error on its own samples: (median, worst) of |predicted - measured| /
 // measured, a measurement under 100 cycles counting as 100 (the clock's steps).
 std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,

@@ -253,14 +253,16 @@ ModuloSchedule modulo_schedule(const UnitClassCounts& body, const UnitClassCount
 }
 
 double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_t op_mispredicted,
-                               uint32_t lanes, uint32_t passed, bool first, double beyond_l1,
+                               uint32_t lanes, double passed, bool first, double beyond_l1,
                                double op_failed_candidates) const {
     if (!measured) {
         if (cluster(d)) return double(schedule.ii);
         return programmable(d) ? double(compute_instructions) : double(d.initiation_interval);
     }
     // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
-    if (length == 1 && cost.one_lane_cycles > 0) return cost.one_lane_cycles;
+    if (length == 1 && cost.one_lane_cycles > 0)
+        return cost.one_lane_cycles + cost.one_lane_pass_cycles * passed +
+               cost.one_lane_failed_candidate_cycles * op_failed_candidates;
     // A stream of a few rays runs in the few-ray loop (traverse_few): one group, one cost.
     if (length >= 2 && length <= k_few_ray_lanes && cost.few_lane_cycles > 0)
         return first ? cost.few_lane_cycles : 0.0;

@@ -117,8 +117,9 @@ struct OpProfile {
     bool measured = false;
     OpCostConfig cost;
 
-    // Cycles a SIMD unit spends issuing one group of `lanes` lanes, `passed` of them passing,
-    // of an op of `length` lanes, `op_mispredicted` of them mispredicted (mispredicted_lanes;
+    // Cycles a SIMD unit spends issuing one group of `lanes` lanes, `passed` of them passing
+    // (the pass rate where the closed form prices a bucket of one-lane ops), of an op of
+    // `length` lanes, `op_mispredicted` of them mispredicted (mispredicted_lanes;
     // `first`: the op's first group,
     // which carries a measured per-op cost), with a share `beyond_l1` of its lanes paying for
     // an l1d buffer beyond the L1D (beyond_l1_share, lanes_opening_pages), `op_failed_candidates`
@@ -129,7 +130,7 @@ struct OpProfile {
     // the remainder); instruction-priced groups cost compute_instructions (programmable), the
     // initiation interval (pipelined) or the body's modulo-schedule II (cluster).
     double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_mispredicted,
-                        uint32_t lanes, uint32_t passed, bool first, double beyond_l1,
+                        uint32_t lanes, double passed, bool first, double beyond_l1,
                         double op_failed_candidates = 0.0) const;
     // Cycles an op adds on its first group when it enters the traversal's one-ray or few-ray
     // loop from the stream loop (TraversalLoop, kernels/trace.h): a measured box test's loop

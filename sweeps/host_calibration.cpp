@@ -58,10 +58,14 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
         sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
-        // One-lane leaf tests at their directly timed cost.
+        // One-lane leaf tests at their directly timed cost, by outcome.
         for (size_t k = 0; k < k_op_kind_count; ++k)
             if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
-                sample.stream_op_cycles += double(sample.ops[k]) * cost_of[k]->one_lane_cycles;
+                const OpCostConfig& cost = *cost_of[k];
+                sample.stream_op_cycles +=
+                    double(sample.ops[k]) * cost.one_lane_cycles +
+                    double(s.one_lane_passed[k]) * cost.one_lane_pass_cycles +
+                    double(s.one_lane_failed_candidates[k]) * cost.one_lane_failed_candidate_cycles;
                 sample.ops[k] = 0;
             }
         // The stream loop's ops priced by the formula; the box tests' per-op cost left to the
@@ -186,13 +190,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     const uint32_t l1d = c.host.caches.empty() ? 32 : c.host.caches.front().kib;
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
-    std::map<OpKind, std::vector<double>> one_lane;  // a leaf test's one-lane samples
+    std::map<OpKind, std::vector<OpCostSample>> one_lane;  // a leaf test's one-lane samples
     std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
     std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
     std::vector<OpCostSample> failing_candidates;    // the triangle test's
     for (const MicrobenchSample& s : c.samples) {
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
-            one_lane[s.kind].push_back(s.cycles);
+            one_lane[s.kind].push_back({1, s.passed, 0.0, s.cycles, s.failed_candidates});
             continue;
         }
         const OpCostSample sample{
@@ -210,7 +214,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
-        c.op_costs.back().one_lane_cycles = median(one_lane[kind]);
+        fit_one_lane_by_outcome(c.op_costs.back(), one_lane[kind]);
         if (kind == OpKind::camera) {
             c.op_costs.back().thin_lens_per_lane_cycles =
                 fit_extra_per_passing_lane(c.op_costs.back(), c.host.simd_width, lens_camera);

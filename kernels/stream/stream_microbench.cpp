@@ -645,10 +645,11 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                 for (const Deal dealt : deals)
                     for (uint32_t n : options.lengths) {
                         if (n > slots) continue;
-                        // A one-lane leaf test is priced by its one-lane points' median
-                        // (one_lane_cycles): only their mixed deal, of rays drawn at random.
+                        // A one-lane leaf test is priced by its lane's outcome (one_lane_cycles
+                        // and the extras of OpCostConfig): its points are of one outcome each, a
+                        // passing or a failing lane (or a failed candidate), not mixed.
                         const bool one_lane_leaf = leaf_test && n == 1;
-                        if (one_lane_leaf && dealt != Deal::mixed) continue;
+                        if (one_lane_leaf && classified && dealt == Deal::mixed) continue;
                         std::vector<double> times;
                         uint32_t passed = 0;
                         const double ticks_per_cycle =
@@ -814,9 +815,11 @@ class OpLengthTally : public TraceSink {
     void fill(OneRaySample& s, uint32_t width) const {
         for (const auto& [key, t] : m_tally) {
             const auto [kind, length] = key;
-            if (length == 1)
+            if (length == 1) {
                 s.ops[size_t(kind)] += t.count;
-            else if (runs_in_few_ray_loop(kind, length, width))
+                s.one_lane_passed[size_t(kind)] += t.passed;
+                s.one_lane_failed_candidates[size_t(kind)] += t.failed_candidates;
+            } else if (runs_in_few_ray_loop(kind, length, width))
                 s.few_ops[size_t(kind)] += t.count;
             else
                 s.stream_ops.push_back({kind, length, t.count, t.passed, t.failed_candidates});

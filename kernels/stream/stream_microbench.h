@@ -140,6 +140,9 @@ struct OneRaySample {
     // few-ray loop's ops (box tests of 2 to k_few_ray_lanes lanes on a wide back end); every
     // other op by kind and length (priced by the stream formula).
     std::array<uint64_t, k_op_kind_count> ops{};
+    // The one-lane ops' passing lanes and failed candidates (one_lane_pass_cycles,
+    // one_lane_failed_candidate_cycles).
+    std::array<uint64_t, k_op_kind_count> one_lane_passed{}, one_lane_failed_candidates{};
     std::array<uint64_t, k_op_kind_count> few_ops{};
     std::vector<OpsOfLength> stream_ops;
     double cycles = 0.0;  // core cycles, fastest repetition

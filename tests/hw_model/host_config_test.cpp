@@ -42,6 +42,26 @@ WorkloadShape shape() {
     return triangle_shape(8);
 }
 
+// `ops` in one pass of 64 slots, timed by the cycle-level model and by the closed form.
+uint64_t cycle_level_cycles(const HwConfig& host, const std::vector<StreamOp>& ops) {
+    SystemcTiming timing({host}, shape());
+    TilePass pass;
+    pass.slot_count = 64;
+    timing.begin_pass(pass);
+    for (const StreamOp& op : ops) timing.op(op);
+    timing.end_pass(pass);
+    return timing.timing(0).cycles;
+}
+uint64_t closed_form_cycles(const HwConfig& host, const std::vector<StreamOp>& ops) {
+    TraceProfile profile(shape());
+    TilePass pass;
+    pass.slot_count = 64;
+    profile.begin_pass(pass);
+    for (const StreamOp& op : ops) profile.op(op);
+    profile.end_pass(pass);
+    return analytic_timing(host, shape(), profile).cycles;
+}
+
 // One box test of `lanes` lanes (all passing) on node `node`, per pass, in passes of `slots`
 // ray slots, timed by the machine model.
 FrameTiming time_boxes(const HwConfig& config, uint32_t passes, uint32_t lanes, uint32_t slots = 64,
@@ -261,6 +281,50 @@ TEST_CASE("A triangle test's failed candidates cost what their microbenchmark ad
     // A one-lane op keeps its own timed cost.
     priced.one_lane_cycles = 50;
     CHECK(measured_op_cycles(priced, 8, 1, 0, 0.0, 1) == Approx(50));
+}
+
+TEST_CASE("A one-lane leaf test costs what its lane's outcome cost on one lane", "[host]") {
+    // The fit: the failing lane's median, and the passing lane's and the failed candidate's
+    // medians beyond it.
+    OpCostConfig triangle = cost("triangle_test", 20, 6, 3, 40, 2);
+    std::vector<OpCostSample> one_lane;
+    for (double cycles : {60.0, 66.0, 64.0}) one_lane.push_back({1, 0, 0.0, cycles, 0});
+    for (double cycles : {150.0, 154.0, 400.0}) one_lane.push_back({1, 1, 0.0, cycles, 0});
+    for (double cycles : {130.0, 135.0, 500.0}) one_lane.push_back({1, 0, 0.0, cycles, 1});
+    fit_one_lane_by_outcome(triangle, one_lane);
+    CHECK(triangle.one_lane_cycles == Approx(64));
+    CHECK(triangle.one_lane_pass_cycles == Approx(154 - 64));
+    CHECK(triangle.one_lane_failed_candidate_cycles == Approx(135 - 64));
+    CHECK(triangle.per_pass_cycles == 40);  // the rest kept
+    // Where no lane failed, the median of all and no extras; never negative.
+    OpCostConfig sphere = cost("sphere_test", 20, 6, 3, 40, 2);
+    fit_one_lane_by_outcome(sphere,
+                            {{1, 1, 0.0, 90.0, 0}, {1, 1, 0.0, 95.0, 0}, {1, 1, 0.0, 99.0, 0}});
+    CHECK(sphere.one_lane_cycles == Approx(95));
+    CHECK(sphere.one_lane_pass_cycles == 0.0);
+    fit_one_lane_by_outcome(sphere, {{1, 0, 0.0, 90.0, 0}, {1, 1, 0.0, 80.0, 0}});
+    CHECK(sphere.one_lane_cycles == Approx(90));
+    CHECK(sphere.one_lane_pass_cycles == 0.0);
+
+    // The price: the failing lane's, plus the passing lane's or the failed candidate's extra;
+    // the closed form's bucket of one-lane ops at its mean pass rate and failed candidates.
+    CHECK(measured_op_cycles(triangle, 8, 1, 0, 0.0) == Approx(64));
+    CHECK(measured_op_cycles(triangle, 8, 1, 1, 0.0) == Approx(154));
+    CHECK(measured_op_cycles(triangle, 8, 1, 0, 0.0, 1) == Approx(135));
+    OpProfile p;
+    p.measured = true;
+    p.cost = triangle;
+    CHECK(p.issue_cycles(DatapathConfig{}, 1, 0, 1, 0.25, true, 0.0, 0.5) ==
+          Approx(64 + 0.25 * 90 + 0.5 * 71));
+    // A host file of one price (written before the extras) prices every outcome alike.
+    OpCostConfig old_file = cost("triangle_test", 20, 6, 3, 40, 2);
+    old_file.one_lane_cycles = 123;
+    CHECK(measured_op_cycles(old_file, 8, 1, 1, 0.0) == Approx(123));
+    CHECK(measured_op_cycles(old_file, 8, 1, 0, 0.0, 1) == Approx(123));
+    const HwConfig parsed = parse_hw_config(host_hw_yaml(small_host(), {triangle}, "t"), "t.yaml");
+    REQUIRE(parsed.op_costs.size() == 1);
+    CHECK(parsed.op_costs[0].one_lane_pass_cycles == Approx(90));
+    CHECK(parsed.op_costs[0].one_lane_failed_candidate_cycles == Approx(71));
 }
 
 TEST_CASE("A passing direct-light lane pays a sphere light's extra in the share on spheres",
@@ -984,24 +1048,8 @@ TEST_CASE("A CPU core's material filters after a generation's first cost nothing
                          half.data()});
         return o;
     };
-    auto cycle_level = [&](const std::vector<StreamOp>& o) {
-        SystemcTiming timing({host}, shape());
-        TilePass pass;
-        pass.slot_count = 64;
-        timing.begin_pass(pass);
-        for (const StreamOp& op : o) timing.op(op);
-        timing.end_pass(pass);
-        return timing.timing(0).cycles;
-    };
-    auto closed_form = [&](const std::vector<StreamOp>& o) {
-        TraceProfile profile(shape());
-        TilePass pass;
-        pass.slot_count = 64;
-        profile.begin_pass(pass);
-        for (const StreamOp& op : o) profile.op(op);
-        profile.end_pass(pass);
-        return analytic_timing(host, shape(), profile).cycles;
-    };
+    auto cycle_level = [&](const std::vector<StreamOp>& o) { return cycle_level_cycles(host, o); };
+    auto closed_form = [&](const std::vector<StreamOp>& o) { return closed_form_cycles(host, o); };
     for (auto timed : {std::function<uint64_t(const std::vector<StreamOp>&)>(cycle_level),
                        std::function<uint64_t(const std::vector<StreamOp>&)>(closed_form)}) {
         // The first filter is priced over its lanes (10 + 4 + 16: one group of 16 lanes), and
@@ -1036,27 +1084,52 @@ TEST_CASE("Both timing models price a triangle op's failed candidates", "[host][
     dearer_lanes.per_failed_candidate_cycles = 0;
     dearer_lanes.per_lane_cycles += 6 * 30 / 16.0;
     const HwConfig same = host_with({dearer_lanes});
-    auto cycle_level = [&](const HwConfig& host, const StreamOp& o) {
-        SystemcTiming timing({host}, shape());
-        TilePass pass;
-        pass.slot_count = 64;
-        timing.begin_pass(pass);
-        timing.op(o);
-        timing.end_pass(pass);
-        return timing.timing(0).cycles;
+    auto cycle_level = [](const HwConfig& host, const StreamOp& o) {
+        return cycle_level_cycles(host, {o});
     };
-    auto closed_form = [&](const HwConfig& host, const StreamOp& o) {
-        TraceProfile profile(shape());
-        TilePass pass;
-        pass.slot_count = 64;
-        profile.begin_pass(pass);
-        profile.op(o);
-        profile.end_pass(pass);
-        return analytic_timing(host, shape(), profile).cycles;
+    auto closed_form = [](const HwConfig& host, const StreamOp& o) {
+        return closed_form_cycles(host, {o});
     };
     // The cycle level waits for the triangle's line, then issues: 6 * 30 more.
     CHECK(cycle_level(host, op(6)) == cycle_level(host, op(0)) + 6 * 30);
     CHECK(cycle_level(host, op(6)) == cycle_level(same, op(0)));
     CHECK(closed_form(host, op(6)) > closed_form(host, op(0)));
     CHECK(closed_form(host, op(6)) == closed_form(same, op(0)));
+}
+
+TEST_CASE("Both timing models price a one-lane triangle op by its lane's outcome",
+          "[host][systemc]") {
+    OpCostConfig triangle = cost("triangle_test", 10, 4, 1, 20, 0);
+    triangle.one_lane_cycles = 60;
+    triangle.one_lane_pass_cycles = 90;
+    triangle.one_lane_failed_candidate_cycles = 70;
+    const HwConfig host = host_with({triangle});
+    // The same mean price on every lane: a failing lane at 60 + (90 + 70) / 2.
+    OpCostConfig flat = triangle;
+    flat.one_lane_cycles = 60 + (90 + 70) / 2.0;
+    flat.one_lane_pass_cycles = flat.one_lane_failed_candidate_cycles = 0;
+    const HwConfig same = host_with({flat});
+    const uint32_t id = 0;
+    const uint8_t pass = 1, fail = 0;
+    auto op = [&](bool passed, uint32_t failed) {
+        return StreamOp{OpKind::triangle_test,
+                        OpStage::intersection,
+                        1,
+                        0,
+                        1,
+                        passed ? 1u : 0u,
+                        &id,
+                        passed ? &pass : &fail,
+                        failed};
+    };
+    const uint64_t failing = cycle_level_cycles(host, {op(false, 0)});
+    CHECK(cycle_level_cycles(host, {op(true, 0)}) == failing + 90);
+    CHECK(cycle_level_cycles(host, {op(false, 1)}) == failing + 70);
+    // One passing and one failed candidate cost what two lanes at the mean do; the closed
+    // form prices them from its bucket's means.
+    const std::vector<StreamOp> both = {op(true, 0), op(false, 1)};
+    const std::vector<StreamOp> neither = {op(false, 0), op(false, 0)};
+    CHECK(cycle_level_cycles(host, both) == cycle_level_cycles(same, neither));
+    CHECK(closed_form_cycles(host, both) == closed_form_cycles(same, neither));
+    CHECK(closed_form_cycles(host, both) > closed_form_cycles(host, neither));
 }

@@ -102,7 +102,7 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     CHECK(kinds.size() == plain_kinds);
     // Three lengths each; a shading op or a leaf test whose buffer has rays it passes and rays
     // it fails also on streams that all pass and streams that none pass, after its mixed ones
-    // (a leaf test not on its one-lane stream: 3 + 2 + 2).
+    // (a leaf test's one-lane stream only all passing and none passing: 2 + 3 + 3).
     // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles), the direct-light
     // filter's on a sphere light (sphere_light_per_pass_cycles), and the triangle test's on
     // candidates that fail (per_failed_candidate_cycles); no other kind's.
@@ -114,12 +114,13 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
          : m.failing_candidates ? failing
                                 : by_kind[m.kind])
             .push_back(&m);
-    // Streams of every lane failing, no one-lane one: each lane's ray turned round or given a
-    // closer hit still crosses the triangle (the tracer's float stage counts it a candidate).
-    REQUIRE(failing.size() == 2);
+    // Streams of every lane failing, one lane long too (one_lane_failed_candidate_cycles): each
+    // lane's ray turned round or given a closer hit still crosses the triangle (the tracer's
+    // float stage counts it a candidate).
+    REQUIRE(failing.size() == 3);
+    CHECK(failing[0]->lanes == 1);
     for (const MicrobenchSample* m : failing) {
         CHECK(m->kind == OpKind::triangle_test);
-        CHECK(m->lanes > 1);
         CHECK(m->passed == 0);
         CHECK(m->failed_candidates == m->lanes);
     }
@@ -134,14 +135,17 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
         INFO(to_string(kind));
         if (of_kind.size() == 3) continue;
         if (stage_of(kind) == OpStage::intersection) {
-            REQUIRE(of_kind.size() == 7);
-            CHECK(of_kind[0]->lanes == 1);
-            for (int i = 0; i < 2; ++i) {
-                CHECK(of_kind[3 + i]->lanes > 1);
-                CHECK(of_kind[3 + i]->passed == of_kind[3 + i]->lanes);
+            REQUIRE(of_kind.size() == 8);
+            for (int i = 0; i < 2; ++i) CHECK(of_kind[i]->lanes > 1);
+            CHECK(of_kind[2]->lanes == 1);
+            CHECK(of_kind[5]->lanes == 1);
+            for (int i = 0; i < 3; ++i) {
+                CHECK(of_kind[2 + i]->passed == of_kind[2 + i]->lanes);
                 CHECK(of_kind[5 + i]->passed == 0);
-                // From no hit, a ray whose line crosses the triangle hits it.
-                CHECK(of_kind[3 + i]->failed_candidates == 0);
+                // From no hit, a ray whose line crosses the triangle hits it; a ray the
+                // triangle fails is not a candidate.
+                CHECK(of_kind[2 + i]->failed_candidates == 0);
+                CHECK(of_kind[5 + i]->failed_candidates == 0);
             }
             continue;
         }
@@ -154,8 +158,8 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     }
     // Both leaf tests are classified (the floor triangle and the sphere each hit by some of
     // the buffer's rays and missed by others).
-    CHECK(by_kind[OpKind::triangle_test].size() == 7);
-    CHECK(by_kind[OpKind::sphere_test].size() == 7);
+    CHECK(by_kind[OpKind::triangle_test].size() == 8);
+    CHECK(by_kind[OpKind::sphere_test].size() == 8);
     REQUIRE(by_kind[OpKind::lambertian_direct].size() == 9);
     const MicrobenchSample& mixed = *by_kind[OpKind::lambertian_direct][2];
     CHECK(mixed.passed > 0);

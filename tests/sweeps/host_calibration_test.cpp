@@ -130,20 +130,34 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         // The stream loop's box tests counted for the fit of their per-op cost, the leaves' not.
         CHECK(short_streams[i].stream_ops[size_t(OpKind::triangle_test)] == 0u);
     }
-    // A leaf test's one-lane cost timed directly prices its one-lane ops before the fit.
+    // A leaf test's one-lane cost timed directly prices its one-lane ops before the fit, by
+    // their lanes' outcomes (some of the batches' one-lane triangle tests pass; their rays
+    // start from no surface, and a one-ray traversal culls boxes beyond its hit, so they have
+    // few failed candidates or none).
     std::vector<OpCostConfig> direct = costs;
     for (OpCostConfig& o : direct)
-        if (o.op == "triangle_test") o.one_lane_cycles = 131;
+        if (o.op == "triangle_test") {
+            o.one_lane_cycles = 131;
+            o.one_lane_pass_cycles = 20;
+            o.one_lane_failed_candidate_cycles = 10;
+        }
     const std::vector<OneLaneSample> priced =
         short_stream_fit_samples(one_ray, direct, host.simd_width, host.caches.front().kib);
+    const size_t tri = size_t(OpKind::triangle_test);
+    uint64_t one_lane_passed = 0;
     for (size_t i = 0; i < one_ray.size(); ++i) {
-        const size_t tri = size_t(OpKind::triangle_test);
         CHECK(priced[i].ops[tri] == 0u);
         CHECK(priced[i].ops[size_t(OpKind::box_test)] ==
               short_streams[i].ops[size_t(OpKind::box_test)]);
-        CHECK(priced[i].stream_op_cycles == Approx(short_streams[i].stream_op_cycles +
-                                                   131.0 * double(short_streams[i].ops[tri])));
+        CHECK(one_ray[i].one_lane_passed[tri] + one_ray[i].one_lane_failed_candidates[tri] <=
+              one_ray[i].ops[tri]);
+        CHECK(priced[i].stream_op_cycles ==
+              Approx(short_streams[i].stream_op_cycles + 131.0 * double(short_streams[i].ops[tri]) +
+                     20.0 * double(one_ray[i].one_lane_passed[tri]) +
+                     10.0 * double(one_ray[i].one_lane_failed_candidates[tri])));
+        one_lane_passed += one_ray[i].one_lane_passed[tri];
     }
+    CHECK(one_lane_passed > 0);
     const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
     CHECK(short_costs.one_lane[size_t(OpKind::box_test)] > 0);
     CHECK((short_costs.few_lane[size_t(OpKind::box_test)] > 0) == wide);
