@@ -231,7 +231,9 @@ void add_calibrate_command(CLI::App& app) {
                                             {"failed_candidates", m.failed_candidates}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
-                for (const OneRaySample& s : cal.one_ray_samples) {
+                for (size_t i = 0; i < cal.one_ray_samples.size(); ++i) {
+                    const OneRaySample& s = cal.one_ray_samples[i];
+                    const OneLaneSample& fitted = cal.short_stream_samples[i];
                     nlohmann::json ops, few_ops, stream_ops = nlohmann::json::array();
                     for (uint32_t k = 0; k < k_op_kind_count; ++k) {
                         if (s.ops[k]) ops[to_string(OpKind(k))] = s.ops[k];
@@ -243,16 +245,23 @@ void add_calibrate_command(CLI::App& app) {
                                               {"count", o.count},
                                               {"passed", o.passed},
                                               {"failed_candidates", o.failed_candidates}});
-                    j["one_ray_samples"].push_back({{"rays", s.rays},
-                                                    {"streams", s.streams},
-                                                    {"entry_depth", s.entry_depth},
-                                                    {"entries", {s.entries[0], s.entries[1]}},
-                                                    {"ops", ops},
-                                                    {"few_ops", few_ops},
-                                                    {"stream_ops", stream_ops},
-                                                    {"cycles", s.cycles},
-                                                    {"converged", s.converged},
-                                                    {"repetitions", s.repetitions}});
+                    j["one_ray_samples"].push_back(
+                        {{"rays", s.rays},
+                         {"streams", s.streams},
+                         {"entry_depth", s.entry_depth},
+                         {"entries", {s.entries[0], s.entries[1]}},
+                         {"ops", ops},
+                         {"few_ops", few_ops},
+                         {"stream_ops", stream_ops},
+                         {"cycles", s.cycles},
+                         {"converged", s.converged},
+                         {"repetitions", s.repetitions},
+                         {"modelled_mispredictions", s.modelled_mispredictions},
+                         // Priced before the fit (the leaf tests,
+                         // the stream loop's groups and lanes, the
+                         // mispredictions), and all the fit's price.
+                         {"priced_cycles", fitted.stream_op_cycles},
+                         {"fitted_cycles", short_stream_cycles(cal.short_stream_costs, fitted)}});
                 }
                 j["hit_read_exposed_share"] = cal.hit_read_fit.share;
                 j["hit_read_fit_median_error"] = cal.hit_read_fit.error.first;

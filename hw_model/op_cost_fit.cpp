@@ -149,6 +149,8 @@ std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
     return row;
 }
 
+}  // namespace
+
 double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s) {
     double cycles = s.stream_op_cycles;
     for (size_t k = 0; k < k_op_kind_count; ++k)
@@ -157,8 +159,6 @@ double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s
     for (size_t l = 0; l < 2; ++l) cycles += double(s.entries[l]) * costs.entry[l];
     return cycles;
 }
-
-}  // namespace
 
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
                          const std::vector<OpCostSample>& samples) {

@@ -92,6 +92,8 @@ struct ShortStreamCosts {
     std::array<double, 2> entry{};
 };
 ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
+// A sample's cycles as the fitted costs price it.
+double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& sample);
 
 // That fit's (median, worst) relative error on its own samples (of their whole cycles).
 std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,

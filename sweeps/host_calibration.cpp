@@ -274,13 +274,14 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         });
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());
-    const std::vector<OneLaneSample> short_streams =
+    c.short_stream_samples =
         short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d,
                                  c.host.branch_predictor.mispredict_cycles);
-    const ShortStreamCosts short_costs = fit_short_stream_cycles(short_streams);
-    c.short_stream_fit_errors = short_stream_fit_error(short_costs, short_streams);
+    c.short_stream_costs = fit_short_stream_cycles(c.short_stream_samples);
+    c.short_stream_fit_errors =
+        short_stream_fit_error(c.short_stream_costs, c.short_stream_samples);
     c.filter_costs = c.op_costs;
-    set_short_stream_costs(short_costs, c.op_costs);
+    set_short_stream_costs(c.short_stream_costs, c.op_costs);
     // The hits' surfaces read beyond the caches: the share of the cache model's latency the
     // core leaves exposed, for the op that reads them (the emission filter).
     c.surface_read_samples = run_surface_read_microbenchmarks(resolved, convergence);
@@ -323,8 +324,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "until " << describe(convergence) << " in each of " << options.visits
          << " sweeps over the points, judged over all (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
-         << "error; the triangle and sphere tests' one-lane costs their one-lane points' "
-         << "median (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
+         << "error; the triangle and sphere tests' one-lane costs by the lane's outcome, the "
+         << "medians of their one-lane points that fail, pass and (the triangle test's) fail as "
+         << "candidates (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
          << "+ lanes) few-lane box "
          << "costs, the one-ray and few-ray loops' entry costs and the stream loop's per-op "
          << "box cost, from " << c.one_ray_samples.size()

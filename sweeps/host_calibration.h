@@ -66,6 +66,9 @@ struct HostCalibration {
     // end's box test, and the box test's per_op_cycles in the stream loop).
     std::vector<OneRaySample> one_ray_samples;
     std::pair<double, double> short_stream_fit_errors{};
+    // The same samples as that fit sees them, and what it fitted (for the report's residuals).
+    std::vector<OneLaneSample> short_stream_samples;
+    ShortStreamCosts short_stream_costs;
     // The hits' surfaces read beyond the caches, and the fitted share of their modelled latency
     // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
     std::vector<SurfaceReadSample> surface_read_samples;
