@@ -459,7 +459,8 @@ struct OpCostConfig {
     // frame's secondary rays fail both ways (behind and beyond, a lane at the first bounce,
     // depth 3, tile 32: cornell 128x128 0.15 and 0.17; temple 64x64 0.11 and 0.10; conference
     // 128x128 0.12 and 0.06: the median of the two ways' points fits cornell and temple best). A
-    // primary ray's candidates nearly all pass. A one-lane op keeps its one_lane_cycles.
+    // primary ray's candidates nearly all pass. A one-lane op pays
+    // one_lane_failed_candidate_cycles instead.
     // 0: not measured.
     double per_failed_candidate_cycles = 0.0;
     // A one-lane op's cost (0: not measured, one lane costs the formula above). A leaf test's is
@@ -469,7 +470,8 @@ struct OpCostConfig {
     // one-lane leaf tests are mostly secondary rays' that fail (temple 64x64 at the first
     // bounce, depth 3, tile 32: 0.19 of its lanes pass, 0.21 are failed candidates), and the
     // one-ray loop's leaf code took 47 TSC ticks on a rejected lane against 93-102 on a failed
-    // candidate and 111 on a passing one (a Zen 5 VM at AVX2, 2026-12-02). Host files written
+    // candidate and 111 on a passing one (a Zen 5 VM at AVX2, 2026-12-02; fitted there, 61.9
+    // cycles failing, 78.5 more passing, 55.7 more a failed candidate). Host files written
     // before 2026-12-02 hold the median over one-lane calls on random rays, and no extras.
     double one_lane_cycles = 0.0;
     double one_lane_pass_cycles = 0.0;              // a leaf test's (0: not measured)
