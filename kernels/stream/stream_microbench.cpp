@@ -1013,6 +1013,24 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             sample.cycles = c.fastest / ticks_per_cycle;
             sample.converged = c.converged;
             sample.repetitions = c.samples;
+            std::vector<double> leaf_shares, loop_shares[2];
+            for (uint32_t rep = 0; rep < 5; ++rep) {
+                displace_predictor(TraceDetail::none);
+                reset();
+                uint64_t leaf_ticks = 0;
+                ShortLoopClock clock;
+                job.leaf_tsc = &leaf_ticks;
+                job.short_loops = &clock;
+                const uint64_t start = __rdtsc();
+                run(TraceDetail::none);
+                const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
+                job.leaf_tsc = nullptr;
+                job.short_loops = nullptr;
+                leaf_shares.push_back(double(leaf_ticks) / spent);
+                for (int l = 0; l < 2; ++l) loop_shares[l].push_back(double(clock.ticks[l]) / spent);
+            }
+            sample.leaf_share = median(leaf_shares);
+            for (int l = 0; l < 2; ++l) sample.short_loop_share[l] = median(loop_shares[l]);
             out.push_back(sample);
             if (shape.bundle)
                 for (uint32_t i = 0; i < batch_rays; ++i) {

@@ -151,6 +151,12 @@ struct OneRaySample {
     // The mispredictions the model's branch predictor makes on the batch's traversals, run as
     // the timed repetitions run them (`predictor_replay` below; 0 without one).
     double modelled_mispredictions = 0.0;
+    // Where a repetition's time went, by the stage clock a frame's traversal is split with
+    // (TraversalJob::leaf_tsc, ShortLoopClock): the shares of the leaves and of the one-ray and
+    // few-ray loops less their leaves (the median of 5 repetitions, each displaced as the timed
+    // ones are; the clock's reads are in them). Reported, not fitted.
+    double leaf_share = 0.0;
+    std::array<double, 2> short_loop_share{};
 };
 // Traces a run of traversals into `sink` (TraceDetail::lanes, one TilePass of the sample's
 // 4096 slots).

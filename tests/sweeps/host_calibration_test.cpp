@@ -80,6 +80,11 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(s.cycles >= 0);
         one_ray_cycles += s.cycles;
         CHECK(s.slots == s.rays * s.streams);  // the batch's footprint
+        // The stage clock's split: shares of one repetition, the few-ray loop's only where it
+        // runs.
+        CHECK(s.leaf_share >= 0.0);
+        CHECK(s.leaf_share + s.short_loop_share[0] + s.short_loop_share[1] <= 1.0);
+        CHECK((wide || s.short_loop_share[1] == 0.0));
         CHECK((s.rays > 1 || s.streams >= 8));  // one-ray streams by the 8 at least, as frames
         for (uint32_t k = 0; k < k_op_kind_count; ++k) {
             if (s.ops[k]) made[OpKind(k)] += s.ops[k];
