@@ -231,14 +231,6 @@ void add_calibrate_command(CLI::App& app) {
                                             {"failed_candidates", m.failed_candidates}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
-                // The leaf tests alone as the fit prices them (the box test's cost left out,
-                // no mispredictions), against the stage clock's leaf share.
-                std::vector<OpCostConfig> leaf_costs;
-                for (const OpCostConfig& o : cal.op_costs)
-                    if (o.op != "box_test") leaf_costs.push_back(o);
-                const std::vector<OneLaneSample> leaves = short_stream_fit_samples(
-                    cal.one_ray_samples, leaf_costs, cal.host.simd_width,
-                    cal.host.caches.empty() ? 32 : cal.host.caches.front().kib);
                 for (size_t i = 0; i < cal.one_ray_samples.size(); ++i) {
                     const OneRaySample& s = cal.one_ray_samples[i];
                     const OneLaneSample& fitted = cal.short_stream_samples[i];
@@ -270,7 +262,9 @@ void add_calibrate_command(CLI::App& app) {
                          {"modelled_mispredictions", s.modelled_mispredictions},
                          {"one_lane_passed", one_lane_passed},
                          {"leaf_share", s.leaf_share},
-                         {"leaf_priced_cycles", leaves[i].stream_op_cycles},
+                         // The leaf tests as the fit prices them, against the stage
+                         // clock's leaf share.
+                         {"leaf_priced_cycles", fitted.leaf_op_cycles},
                          {"one_ray_loop_share", s.short_loop_share[0]},
                          {"few_ray_loop_share", s.short_loop_share[1]},
                          // Priced before the fit (the leaf tests,

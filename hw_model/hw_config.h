@@ -473,6 +473,11 @@ struct OpCostConfig {
     // candidate and 111 on a passing one (a Zen 5 VM at AVX2, 2026-12-02; fitted there, 61.9
     // cycles failing, 78.5 more passing, 55.7 more a failed candidate). Host files written
     // before 2026-12-02 hold the median over one-lane calls on random rays, and no extras.
+    // All three fitted by sfx calibrate (fit_one_lane_by_outcome): medians over the one-lane
+    // microbenchmark points (the synthetic scene's floor triangle and spheres, buffers of 64 to
+    // 4096 slots) whose lane fails, whose lane passes, and (the triangle test's) whose lane is
+    // a failed candidate, by turns behind its origin and beyond a closer hit; the extras as
+    // their medians beyond the failing one's. No frame.
     double one_lane_cycles = 0.0;
     double one_lane_pass_cycles = 0.0;              // a leaf test's (0: not measured)
     double one_lane_failed_candidate_cycles = 0.0;  // the triangle test's (0: not measured)

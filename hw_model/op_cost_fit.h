@@ -75,6 +75,7 @@ struct OneLaneSample {
     double stream_op_cycles = 0.0;
     std::array<uint64_t, k_op_kind_count> stream_ops{};
     std::array<uint64_t, 2> entries{};  // the one-ray and few-ray loops entered (TraversalLoop)
+    double leaf_op_cycles = 0.0;  // the leaf tests' part of stream_op_cycles (reported)
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::

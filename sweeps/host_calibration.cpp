@@ -62,7 +62,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         for (size_t k = 0; k < k_op_kind_count; ++k)
             if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
                 const OpCostConfig& cost = *cost_of[k];
-                sample.stream_op_cycles +=
+                sample.leaf_op_cycles +=
                     double(sample.ops[k]) * cost.one_lane_cycles +
                     double(s.one_lane_passed[k]) * cost.one_lane_pass_cycles +
                     double(s.one_lane_failed_candidates[k]) * cost.one_lane_failed_candidate_cycles;
@@ -80,7 +80,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                 priced.per_op_cycles = 0.0;
                 sample.stream_ops[size_t(o.kind)] += o.count;
             }
-            sample.stream_op_cycles +=
+            (o.kind == OpKind::box_test ? sample.stream_op_cycles : sample.leaf_op_cycles) +=
                 double(o.count) *
                 measured_op_cycles(
                     priced, width, o.lanes,
@@ -91,6 +91,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                     l1d_kib),
                     double(o.failed_candidates) / double(o.count));
         }
+        sample.stream_op_cycles += sample.leaf_op_cycles;
         out.push_back(sample);
     }
     return out;
