@@ -79,6 +79,7 @@ void add_calibrate_command(CLI::App& app) {
         uint32_t min_repeat = 7;
         uint32_t fastest = 3;
         std::string tolerance = "0.03";
+        std::string contention_wait = "600";
         std::string scenes = "cornell,furnace,atrium,conference,temple";
         std::string tiles = "16,32,64";
         std::string res = "64x64,128x128";
@@ -112,6 +113,10 @@ void add_calibrate_command(CLI::App& app) {
     c->add_option("--tolerance", o->tolerance,
                   "converged: the K-th fastest within (1 + this) x the fastest (0.03: 3 %)")
         ->capture_default_str();
+    c->add_option("--contention-wait", o->contention_wait,
+                  "seconds spent in all waiting for a core no other hardware thread shares "
+                  "(base/core_contention.h); after that, samples are taken as they come")
+        ->capture_default_str();
     c->add_option("--min-repeat", o->min_repeat, "--check: renders per workload at least")
         ->capture_default_str();
     c->add_option("--scenes", o->scenes, "--check: comma-separated scenes")->capture_default_str();
@@ -142,6 +147,12 @@ void add_calibrate_command(CLI::App& app) {
             throw InputError("command line", 0, "--tolerance",
                              "expected a fraction from 0 to 1 (0.03 is 3 %), got '" +
                                  o->tolerance + "'");
+        double contention_wait = 0.0;
+        if (!parse_finite(o->contention_wait, contention_wait) || contention_wait < 0.0 ||
+            contention_wait > 86400.0)
+            throw InputError("command line", 0, "--contention-wait",
+                             "expected seconds from 0 to 86400, got '" + o->contention_wait + "'");
+        core_contention().set_total_wait_ms(1000.0 * contention_wait);
         if (o->fastest < 1 || o->fastest > o->repeat || (o->describe && o->fastest > o->repeats))
             throw InputError("command line", 0, "--fastest",
                              "expected 1 to the budget (--repeat, --microbench-repeats), got " +

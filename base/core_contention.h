@@ -31,7 +31,8 @@ class CoreContention {
     // over the gate's life: on a core shared most of the time, after that the gate is open
     // (contended() is false) and measurements take what they get, as they did without it (on the
     // AMD VM a scalar calibration that set aside 2250 samples took 334 s against 18 s, an AVX2 one
-    // 545 s). The test runner allows 30 s (tests/test_main.cpp).
+    // 545 s). `sfx calibrate --contention-wait` sets it; the test runner allows 30 s
+    // (tests/test_main.cpp).
     explicit CoreContention(double tolerance = 0.15, std::function<double()> rate = {},
                             std::function<void(double)> sleep_ms = {},
                             double total_wait_ms = 600000.0);
