@@ -607,6 +607,11 @@ void add_calibrate_command(CLI::App& app) {
                     m.predicted_loop[size_t(l)];
                 row[std::string("measured.traversal_") + loops[l] + "_loop_cycles"] =
                     m.measured_loop[size_t(l)];
+                // What the loop's prediction is made of besides its ops' own costs.
+                row[std::string("predicted.traversal_") + loops[l] + "_loop_branch_cycles"] =
+                    double(m.prediction.timing.traversal_loop_branch_cycles[l]);
+                row[std::string("predicted.traversal_") + loops[l] + "_loop_memory_cycles"] =
+                    double(m.prediction.timing.traversal_loop_memory_cycles[l]);
             }
             // The shading stage by op kind, and the ray set-up (measured only).
             for (uint32_t k = 0; k < k_op_kind_count; ++k)

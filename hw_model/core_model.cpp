@@ -371,6 +371,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     StageTiming& stage = m_timing.stages[op.generation > 0][uint32_t(op.stage)];
     Executed e;
     const uint64_t stage_before = stage.busy_cycles + stage.stall_cycles;
+    const uint64_t scene_memory_before = stage.scene_memory_cycles;
     e.start = std::max(now, t.data_ready);
     e.start = std::max(e.start, scene_ready(t));
     charge_idle(m_unit_free[unit], e.start, t, stage);
@@ -413,8 +414,13 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     stage.busy_cycles += busy;
     const uint64_t group_cycles = stage.busy_cycles + stage.stall_cycles - stage_before;
     m_timing.op_cycles[size_t(op.kind)] += group_cycles;
-    if (op.kind == OpKind::box_test)
+    if (op.kind == OpKind::box_test) {
         m_timing.traversal_loop_cycles[size_t(m_loop[t.op])] += group_cycles;
+        m_timing.traversal_loop_branch_cycles[size_t(m_loop[t.op])] +=
+            uint64_t(std::llround(mispredicted));
+        m_timing.traversal_loop_memory_cycles[size_t(m_loop[t.op])] +=
+            stage.scene_memory_cycles - scene_memory_before;
+    }
     m_unit_free[unit] = e.issue_end;
     // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
     ActionCounts& act = m_timing.actions;

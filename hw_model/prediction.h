@@ -139,6 +139,11 @@ struct FrameTiming {
     // (TraversalLoop, kernels/trace.h): what the tracer's stage clock splits the traversal
     // into (RenderStats::short_loop_tsc). Cycle-level models only.
     uint64_t traversal_loop_cycles[3] = {0, 0, 0};
+    // Of those, what the box tests' mispredicted branches cost (branch_cycles by loop), and
+    // their wait for scene data (stall_cycles.scene_memory by loop): what each loop's
+    // prediction is made of, beside its ops' own costs.
+    uint64_t traversal_loop_branch_cycles[3] = {0, 0, 0};
+    uint64_t traversal_loop_memory_cycles[3] = {0, 0, 0};
     // Each op kind's unit-cycles (busy and stalled), what the tracer's stage clock splits the
     // shading stage into (RenderStats::shading_op_tsc). Cycle-level models only.
     uint64_t op_cycles[k_op_kind_count] = {};
@@ -205,6 +210,15 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
                       "box tests' unit-cycles in the tracer's loop of that name")
               .under("traversal_loop_cycles"),
           a.traversal_loop_cycles[l], b.traversal_loop_cycles[l]);
+    for (int l = 0; l < 3; ++l)
+        f(CounterInfo(loops[l], "cycles",
+                      "of those, what the box tests' mispredicted branches cost")
+              .under("traversal_loop_branch_cycles"),
+          a.traversal_loop_branch_cycles[l], b.traversal_loop_branch_cycles[l]);
+    for (int l = 0; l < 3; ++l)
+        f(CounterInfo(loops[l], "cycles", "of those, the box tests' wait for scene data")
+              .under("traversal_loop_memory_cycles"),
+          a.traversal_loop_memory_cycles[l], b.traversal_loop_memory_cycles[l]);
     for (uint32_t k = 0; k < k_op_kind_count; ++k)
         f(CounterInfo(k_op_kinds[k].name, "cycles", "the op kind's unit-cycles, busy and stalled")
               .under("op_cycles"),

@@ -461,8 +461,13 @@ def loops_text(df):
     stage clock's short-loop ticks; rows written before it carry none)."""
     if "measured.traversal_stream_loop_cycles" not in df:
         return "These rows carry no traversal split by loop."
+    # The prediction's parts (rows written before them carry none): its mispredictions and its
+    # wait for scene data; the rest is its ops' own costs.
+    parts = "predicted.traversal_stream_loop_branch_cycles" in df
     lines = ["| back end | scene | loop | predicted Mcyc (sum) | measured Mcyc (sum) | "
-             "error of sum | share of measured traversal |", "|---|---|---|---|---|---|---|"]
+             "error of sum | share of measured traversal |"
+             + (" of the prediction: mispredictions | scene data |" if parts else ""),
+             "|---|---|---|---|---|---|---|" + ("---|---|" if parts else "")]
     for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
         traversal = g["measured.traversal_cycles"].sum()
         for key, name in LOOPS:
@@ -470,8 +475,13 @@ def loops_text(df):
             m = g[f"measured.traversal_{key}_loop_cycles"].sum()
             if max(p, m) < 0.01 * traversal:  # a loop the scene barely runs: noise
                 continue
-            lines.append(f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
-                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / max(traversal, 1):.0%} |")
+            line = (f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
+                    f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / max(traversal, 1):.0%} |")
+            if parts:
+                for part in ("branch", "memory"):
+                    c = g[f"predicted.traversal_{key}_loop_{part}_cycles"].sum()
+                    line += f" {c / max(p, 1):.0%} |"
+            lines.append(line)
     return "\n".join(lines)
 
 
@@ -770,7 +780,9 @@ def write_page(df, page, plot_name, header):
         "stream loop. Measured: the stage clock's ticks in the short loops (their leaves left "
         "out), split as the stages are; the stream loop is the rest of the traversal. "
         "Predicted: the model's cycles of the box tests each loop runs (the stage's "
-        "end-of-pass tail is in no loop).\n\n" + loops_text(df),
+        "end-of-pass tail is in no loop), and the shares of them its branch predictor's "
+        "mispredictions and its wait for scene data take (the rest is the ops' own costs)."
+        "\n\n" + loops_text(df),
         "## The shading stage by op\n\nMeasured: the stage clock's ticks of each shading "
         "op kind's filter (the camera's loop; the emission filter with the hits' surfaces, as "
         "the model prices it; the material filters as the sort by material the tracer runs "

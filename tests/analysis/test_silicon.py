@@ -299,6 +299,16 @@ def test_traversal_by_loop(tmp_path):
     # Rows written before the loop clock carry no split, and say so.
     older = df.drop(columns=[c for c in df.columns if "_loop_" in c])
     assert "no traversal split" in silicon.loops_text(older)
+    # The prediction's parts: its mispredictions' and its scene-data wait's shares of it.
+    for r in rows:
+        for key in ("one_ray", "few_ray", "stream"):
+            p_loop = r[f"predicted.traversal_{key}_loop_cycles"]
+            r[f"predicted.traversal_{key}_loop_branch_cycles"] = 0.25 * p_loop
+            r[f"predicted.traversal_{key}_loop_memory_cycles"] = 0.5 * p_loop
+    p.write_text(json.dumps(rows))
+    parts = silicon.loops_text(silicon.load_rows(p))
+    assert "| avx512 | a | one-ray loop | 1.50 | 3.00 | -50.0 % | 9% | 25% | 50% |" in parts
+    assert "mispredictions | scene data |" in parts
 
 
 def test_shading_by_op(tmp_path):

@@ -585,6 +585,9 @@ TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
         return t.stages[0][size_t(OpStage::traversal)].busy_cycles;
     };
     CHECK(busy(tage) == busy(none) + tage.branch_cycles);
+    // Every op is a one-ray stream's: the one-ray loop's prediction holds them all.
+    CHECK(tage.traversal_loop_branch_cycles[size_t(TraversalLoop::one_ray)] == tage.branch_cycles);
+    CHECK(none.traversal_loop_branch_cycles[size_t(TraversalLoop::one_ray)] == 0);
     CHECK(HwConfig().branch_predictor.kind == "none");  // the paper's machine: no branches
 }
 
@@ -602,6 +605,9 @@ TEST_CASE("The machine model times a host: measured costs, scene data beyond the
     CHECK(one.stalls.scene_memory == 83);
     CHECK(one.stages[0][size_t(OpStage::traversal)].scene_memory_cycles == 83);
     CHECK(one.stages[0][size_t(OpStage::traversal)].busy_cycles == 18 + 8);
+    // A 20-lane box test runs in the stream loop: its wait is that loop's.
+    CHECK(one.traversal_loop_memory_cycles[size_t(TraversalLoop::stream)] == 83);
+    CHECK(one.traversal_loop_memory_cycles[size_t(TraversalLoop::one_ray)] == 0);
     const FrameTiming two = time_boxes(host, 2, 20);
     CHECK(two.cycles == 83 + 18 + 8 + 18);
     CHECK(two.stalls.scene_memory == 83);
