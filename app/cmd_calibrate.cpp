@@ -11,6 +11,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -198,6 +199,10 @@ void add_calibrate_command(CLI::App& app) {
                 j["tsc_mhz"] = cal.host.tsc_mhz;
                 j["simd_width"] = cal.host.simd_width;
                 j["pinned"] = pinned;
+                j["speed_probe_start_cycles"] = cal.speed_probe_start_cycles;
+                j["speed_probe_cycles"] = cal.host.speed_probe_cycles;
+                j["speed_probe_drift"] =
+                    speed_probe_drift(cal.host.speed_probe_cycles, cal.speed_probe_start_cycles);
                 j["microarchitecture"] = describe(cal.host.microarchitecture);
                 j["convergence_rule"] = describe(bench_rule);
                 j["converged_points"] = cal.converged_points;
@@ -339,6 +344,15 @@ void add_calibrate_command(CLI::App& app) {
                 std::printf(
                     "  the gate's total wait was spent: later samples were taken as "
                     "they came\n");
+            const double drift =
+                speed_probe_drift(cal.host.speed_probe_cycles, cal.speed_probe_start_cycles);
+            std::printf(
+                "speed probe: %.0f cycles before the microbenchmarks, %.0f after (drift %+.1f "
+                "%%)%s\n",
+                cal.speed_probe_start_cycles, cal.host.speed_probe_cycles, 100.0 * drift,
+                std::abs(drift) > k_speed_probe_tolerance
+                    ? ": the machine moved during calibration, calibrate again"
+                    : "");
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",
                         "per_group", "per_lane", "per_pass", "per_fail", "minority", "beyondL1",
                         "fit med", "fit max", "one_lane", "few_lane");

@@ -180,6 +180,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     }
     c.host.slot_bytes = stream_slot_bytes();
     c.host.slot_arrays = stream_slot_arrays();
+    c.speed_probe_start_cycles = speed_probe_cycles(resolved, convergence);
     MicrobenchOptions options;
     options.isa = resolved;
     options.convergence = convergence;
@@ -422,6 +423,10 @@ double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence) {
     return cycles;
 }
 
+double speed_probe_drift(double cycles, double reference) {
+    return reference > 0 ? cycles / reference - 1.0 : std::nan("");
+}
+
 SeenLevel chase_last_level_now(double tsc_mhz) {
     HostDescription h;
     h.caches = read_host_caches();
@@ -518,11 +523,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
             const uint32_t lanes = isa_width(resolve_isa(settings[v].isa));
             const double at_calibration = variants[v].host->speed_probe_cycles;
             if (!probes.count(lanes))
-                probes[lanes] = at_calibration > 0 ? speed_probe_cycles(settings[v].isa,
-                                                                        microbench_rule()) /
-                                                             at_calibration -
-                                                         1.0
-                                                   : std::nan("");
+                probes[lanes] =
+                    at_calibration > 0
+                        ? speed_probe_drift(speed_probe_cycles(settings[v].isa, microbench_rule()),
+                                            at_calibration)
+                        : std::nan("");
         }
     };
     probe_all(probe_before);

@@ -77,6 +77,10 @@ struct HostCalibration {
     // timed) and the model's mispredictions on its batches, on which
     // HostDescription::branch_predictor's cost is fitted.
     std::vector<PredictorCheck> branch_samples;
+    // The speed probe before the microbenchmarks (HostDescription::speed_probe_cycles is the
+    // one after them): a calibration whose probe moved between the two measured a machine
+    // that changed under it.
+    double speed_probe_start_cycles = 0.0;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     // Sweeps over the filter microbenchmarks' points (MicrobenchOptions::visits).
@@ -188,6 +192,11 @@ struct SiliconMeasurement {
 // slots), their fastest cycles summed. Measured at calibration (HwConfig::speed_probe_cycles)
 // and around a check's renders: their ratio says whether the machine runs as calibrated.
 double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence);
+// The probe's `cycles` now against `reference` (at calibration): +0.1 is 10 % slower; NaN
+// without a reference. Beyond k_speed_probe_tolerance either way the machine is not the one
+// measured then (scripts/silicon-check calibrates again).
+double speed_probe_drift(double cycles, double reference);
+constexpr double k_speed_probe_tolerance = 0.10;
 
 // One workload of a silicon check: its scene, render settings and the host configuration (whose
 // SIMD width is the back end's, settings.isa) that predicts it.

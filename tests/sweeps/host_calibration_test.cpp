@@ -291,6 +291,12 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(again[0].probe_before < -0.95);
     CHECK(again[0].probe_after < -0.95);
     CHECK(again[0].probe_before > -1.0);
+    // The drift is the probe's cycles over the reference's, less one: 10 % more cycles is
+    // +0.1 (past the tolerance at 0.11), and no reference gives NaN, never 0.
+    CHECK(speed_probe_drift(110, 100) == Approx(0.1));
+    CHECK(speed_probe_drift(89, 100) < -k_speed_probe_tolerance);
+    CHECK(std::abs(speed_probe_drift(105, 100)) < k_speed_probe_tolerance);
+    CHECK(std::isnan(speed_probe_drift(100, 0)));
     // The host file keeps it.
     HostDescription probed_host = host;
     probed_host.speed_probe_cycles = 12345;
