@@ -657,6 +657,8 @@ void add_calibrate_command(CLI::App& app) {
                         const BranchPredictorConfig& b = variants[i].host->branch_predictor;
                         const std::string model = "predicted.predictor." + kind;
                         row[model + "branches"] = c.modelled.branches;
+                        row[model + "mispredict_cycles"] =
+                            b.kind == "none" ? 0.0 : b.mispredict_cycles;
                         row[model + "primed_mispredictions"] = c.modelled.primed;
                         row[model + "displaced_mispredictions"] = c.modelled.displaced;
                         row[model + "extra_cycles"] =
@@ -666,6 +668,23 @@ void add_calibrate_command(CLI::App& app) {
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
                         row[model + "cold_cycles"] = memory.cold;
                         row[model + "warm_cycles"] = memory.warm;
+                        for (int l = 0; l < 3; ++l) {
+                            const std::string loop = std::string(".") + loops[l];
+                            row[model + "primed_loop_mispredictions" + loop] =
+                                c.modelled.primed_by_loop[size_t(l)];
+                            row[model + "displaced_loop_mispredictions" + loop] =
+                                c.modelled.displaced_by_loop[size_t(l)];
+                            row[model + "cold_loop_cycles" + loop] = memory.cold_loop[size_t(l)];
+                            row[model + "warm_loop_cycles" + loop] = memory.warm_loop[size_t(l)];
+                        }
+                    }
+                    for (int l = 0; l < 3; ++l) {
+                        const std::string loop = std::string(".") + loops[l];
+                        row[key + "primed_loop_cycles" + loop] = p.primed_loop_cycles[size_t(l)];
+                        row[key + "cached_loop_cycles" + loop] = p.cached_loop_cycles[size_t(l)];
+                        row[key + "displaced_loop_cycles" + loop] =
+                            p.displaced_loop_cycles[size_t(l)];
+                        row[key + "evicted_loop_cycles" + loop] = p.evicted_loop_cycles[size_t(l)];
                     }
                     row[key + "primed_cycles"] = p.primed_cycles;
                     row[key + "evicted_cycles"] = p.evicted_cycles;

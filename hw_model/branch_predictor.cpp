@@ -249,6 +249,11 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
         return mispredictions_replaying(*batches[b], loops[b], width, node_leaf, predictor,
                                         scratch);
     };
+    // The box tests' mispredictions of the run just made (`scratch`), by their loop.
+    auto by_loop = [&](size_t b, std::array<uint64_t, 3>& sum) {
+        for (size_t i = 0; i < scratch.size(); ++i)
+            if (batches[b]->at(i).kind == OpKind::box_test) sum[size_t(loops[b][i])] += scratch[i];
+    };
     PredictorStates states;
     const uint64_t start = predictor.branches();
     for (size_t b = 0; b < batches.size(); ++b) run(b);
@@ -258,22 +263,35 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
     // learned what it will; the microbenchmark keeps its fastest sample), at most 16.
     for (size_t b = 0; b < batches.size(); ++b) {
         uint64_t fewest = ~uint64_t(0);
+        std::array<uint64_t, 3> fewest_by_loop{};
         for (uint32_t r = 0, steady = 0; r < 16 && (r < repetitions || steady < 2); ++r) {
             run(b);
             const uint64_t m = run(b);
             steady = m < fewest ? 0 : steady + 1;
+            if (m < fewest) {
+                fewest_by_loop = {};
+                by_loop(b, fewest_by_loop);
+            }
             fewest = std::min(fewest, m);
         }
         states.primed += fewest;
+        for (size_t l = 0; l < 3; ++l) states.primed_by_loop[l] += fewest_by_loop[l];
     }
     for (size_t b = 0; b < batches.size(); ++b) {
         uint64_t fewest = ~uint64_t(0);
+        std::array<uint64_t, 3> fewest_by_loop{};
         for (uint32_t r = 0; r < repetitions; ++r) {
             for (size_t o = 0; o < batches.size(); ++o)
                 if (o != b) run(o);
-            fewest = std::min(fewest, run(b));
+            const uint64_t m = run(b);
+            if (m < fewest) {
+                fewest_by_loop = {};
+                by_loop(b, fewest_by_loop);
+            }
+            fewest = std::min(fewest, m);
         }
         states.displaced += fewest;
+        for (size_t l = 0; l < 3; ++l) states.displaced_by_loop[l] += fewest_by_loop[l];
     }
     return states;
 }

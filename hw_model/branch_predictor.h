@@ -81,6 +81,9 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
 // `repetitions`), as the microbenchmark keeps the fastest sample; summed over the batches.
 struct PredictorStates {
     uint64_t primed = 0, displaced = 0;
+    // Of those, the box tests' by the loop that runs them (TraversalLoop: one-ray, few-ray,
+    // stream), as the model prices them in FrameTiming::traversal_loop_branch_cycles.
+    std::array<uint64_t, 3> primed_by_loop{}, displaced_by_loop{};
     uint64_t branches = 0;  // one pass over the batches
 };
 PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& batches,

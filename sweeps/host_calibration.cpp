@@ -156,13 +156,19 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     for (const auto& batch : sample.batches) {
         SystemcTiming timing({config}, sample.shape);
         uint64_t before = 0;
+        std::array<uint64_t, 3> loops_before{};
         for (int run = 0; run < 2; ++run) {
             timing.begin_pass(batch->pass());
             for (size_t i = 0; i < batch->size(); ++i) timing.op(batch->at(i));
             timing.end_pass(batch->pass());
-            const uint64_t cycles = timing.timing(0).cycles;
-            (run == 0 ? out.cold : out.warm) += double(cycles - before);
-            before = cycles;
+            const FrameTiming t = timing.timing(0);
+            (run == 0 ? out.cold : out.warm) += double(t.cycles - before);
+            before = t.cycles;
+            for (size_t l = 0; l < 3; ++l) {
+                (run == 0 ? out.cold_loop : out.warm_loop)[l] +=
+                    double(t.traversal_loop_cycles[l] - loops_before[l]);
+                loops_before[l] = t.traversal_loop_cycles[l];
+            }
         }
     }
     return out;

@@ -48,6 +48,8 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
 // prices scene data from DRAM, held out against the evicted batches.
 struct BatchMemoryCycles {
     double cold = 0.0, warm = 0.0;
+    // Of those, the box tests' by the loop that runs them (FrameTiming::traversal_loop_cycles).
+    std::array<double, 3> cold_loop{}, warm_loop{};
 };
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
 

@@ -456,6 +456,45 @@ def dram_text(df):
 LOOPS = (("one_ray", "one-ray loop"), ("few_ray", "few-ray loop"), ("stream", "stream loop"))
 
 
+def predictor_loops_text(df):
+    """Per back end, scene, rays and loop: the predictor microbenchmark's batches split by the
+    loop that ran them (the stage clock, as a frame's traversal is split): displaced over
+    cached (what the branch predictor saves, measured) beside the model's mispredictions added
+    from primed to displaced in that loop at the host's price, and evicted over primed (the
+    scene read from DRAM, measured; the code, TLB and page tables the read evicts are in it)
+    beside the model's cold over warm in that loop (rows written before the split carry none)."""
+    if "measured.predictor.camera.displaced_loop_cycles.stream" not in df:
+        return "These rows carry no branch-predictor batches split by loop."
+    lines = ["| back end | scene | rays | loop | share of cached | predictor, measured "
+             "(displaced - cached), Mcyc | model's mispredictions added, Mcyc | DRAM, measured "
+             "(evicted - primed), Mcyc | model (cold - warm), Mcyc |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for isa in isas(df):
+        for scene, h in df[df["isa"] == isa].groupby("scene", sort=False):
+            r = h.iloc[0]
+            for rays in ("camera", "bounce"):
+                m, p = f"measured.predictor.{rays}.", f"predicted.predictor.{rays}."
+                cached_all = sum(r[f"{m}cached_loop_cycles.{k}"] for k, _ in LOOPS)
+                for key, name in LOOPS:
+                    cached = r[f"{m}cached_loop_cycles.{key}"]
+                    if cached < 0.01 * max(cached_all, 1):  # a loop the batches barely run
+                        continue
+                    price = r.get(p + "mispredict_cycles", float("nan"))
+                    if pd.isna(price):  # rows without it: the price the extra cycles imply
+                        added_all = (r[p + "displaced_mispredictions"]
+                                     - r[p + "primed_mispredictions"])
+                        price = r[p + "extra_cycles"] / added_all if added_all else 0.0
+                    added = price * (r[f"{p}displaced_loop_mispredictions.{key}"]
+                                     - r[f"{p}primed_loop_mispredictions.{key}"])
+                    dram = r[f"{m}evicted_loop_cycles.{key}"] - r[f"{m}primed_loop_cycles.{key}"]
+                    model_dram = r[f"{p}cold_loop_cycles.{key}"] - r[f"{p}warm_loop_cycles.{key}"]
+                    lines.append(
+                        f"| {isa} | {scene} | {rays} | {name} | {cached / cached_all:.0%} | "
+                        f"{(r[f'{m}displaced_loop_cycles.{key}'] - cached) / 1e6:.2f} | "
+                        f"{added / 1e6:.2f} | {dram / 1e6:.2f} | {model_dram / 1e6:.2f} |")
+    return "\n".join(lines)
+
+
 def loops_text(df):
     """Per back end and scene, the traversal by the tracer's loop that runs its box tests (the
     stage clock's short-loop ticks; rows written before it carry none)."""
@@ -782,7 +821,10 @@ def write_page(df, page, plot_name, header):
         "Predicted: the model's cycles of the box tests each loop runs (the stage's "
         "end-of-pass tail is in no loop), and the shares of them its branch predictor's "
         "mispredictions and its wait for scene data take (the rest is the ops' own costs)."
-        "\n\n" + loops_text(df),
+        "\n\n" + loops_text(df) + "\n\nThe same split on the branch predictor's batches "
+        "(the tables above), each state's fastest cycles split by the shares of 5 clocked "
+        "repetitions: what the predictor and a scene read from DRAM cost each loop, measured, "
+        "beside the model's parts of the same loop.\n\n" + predictor_loops_text(df),
         "## The shading stage by op\n\nMeasured: the stage clock's ticks of each shading "
         "op kind's filter (the camera's loop; the emission filter with the hits' surfaces, as "
         "the model prices it; the material filters as the sort by material the tracer runs "

@@ -1307,37 +1307,44 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
         enum class Before { itself, itself_and_others_lines, others_traversals, itself_evicted };
         for (uint32_t t = 0; t < k_tiles; ++t) {
             bool converged = true;
-            auto timed = [&](Before before) {
+            // What runs before each timed traversal of the batch, as `before` says.
+            auto prepare = [&](Before before) {
+                if (before == Before::others_traversals) {
+                    for (uint32_t o = 0; o < k_tiles; ++o)
+                        if (o != t) traverse(o, TraceDetail::none);
+                } else {
+                    traverse(t, TraceDetail::none);
+                    if (before == Before::itself_and_others_lines)
+                        for (uint32_t o = 0; o < k_tiles; ++o)
+                            if (o != t)
+                                for (const uint64_t* line : lines[o]) touched += *line;
+                    if (before == Before::itself_evicted) {
+                        for (size_t i = 0; i < other_data.size(); i += 8) touched += other_data[i];
+                        // The batch's own data back in the caches, as primed: only the
+                        // scene's lines stay in DRAM (traverse writes its rays' fields).
+                        const size_t n = batches[t].size() + k_stream_padding;
+                        for (const uint32_t id : batches[t]) {
+                            touched += touch_lines(&b.pre[id], sizeof(RayPrecomp));
+                            touched += b.any_hit[id];
+                        }
+                        for (const std::vector<uint32_t>* v : {&b.ids, &b.scratch, &b.scratch2})
+                            touched += touch_lines(v->data(), n * sizeof(uint32_t));
+                        touched += touch_lines(
+                            b.positions.data(),
+                            std::min(b.positions.size(), k_leaf_batch * n) * sizeof(uint32_t));
+                        touched += touch_lines(b.mask.data(), n);
+                    }
+                }
+            };
+            // The batch's fastest cycles in a state, and their split by the loop that ran them
+            // (the stage clock a frame's traversal is split with, TraversalJob::leaf_tsc and
+            // ShortLoopClock: the median shares of 5 clocked repetitions, each prepared as the
+            // timed ones are; the leaves in no loop).
+            auto timed = [&](Before before, std::array<double, 3>& loops) {
                 std::vector<double> times;
                 uint32_t set_aside = 0;
                 while (needs_more_samples(times, convergence)) {
-                    if (before == Before::others_traversals) {
-                        for (uint32_t o = 0; o < k_tiles; ++o)
-                            if (o != t) traverse(o, TraceDetail::none);
-                    } else {
-                        traverse(t, TraceDetail::none);
-                        if (before == Before::itself_and_others_lines)
-                            for (uint32_t o = 0; o < k_tiles; ++o)
-                                if (o != t)
-                                    for (const uint64_t* line : lines[o]) touched += *line;
-                        if (before == Before::itself_evicted) {
-                            for (size_t i = 0; i < other_data.size(); i += 8)
-                                touched += other_data[i];
-                            // The batch's own data back in the caches, as primed: only the
-                            // scene's lines stay in DRAM (traverse writes its rays' fields).
-                            const size_t n = batches[t].size() + k_stream_padding;
-                            for (const uint32_t id : batches[t]) {
-                                touched += touch_lines(&b.pre[id], sizeof(RayPrecomp));
-                                touched += b.any_hit[id];
-                            }
-                            for (const std::vector<uint32_t>* v : {&b.ids, &b.scratch, &b.scratch2})
-                                touched += touch_lines(v->data(), n * sizeof(uint32_t));
-                            touched += touch_lines(
-                                b.positions.data(),
-                                std::min(b.positions.size(), k_leaf_batch * n) * sizeof(uint32_t));
-                            touched += touch_lines(b.mask.data(), n);
-                        }
-                    }
+                    prepare(before);
                     const uint64_t start = __rdtsc();
                     traverse(t, TraceDetail::none);
                     times.push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
@@ -1346,12 +1353,35 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;
-                return c.fastest / ticks_per_cycle;
+                std::vector<double> shares[3];  // one-ray loop, few-ray loop, leaves
+                for (uint32_t rep = 0; rep < 5; ++rep) {
+                    prepare(before);
+                    uint64_t leaf_ticks = 0;
+                    ShortLoopClock clock;
+                    job.leaf_tsc = &leaf_ticks;
+                    job.short_loops = &clock;
+                    const uint64_t start = __rdtsc();
+                    traverse(t, TraceDetail::none);
+                    const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
+                    job.leaf_tsc = nullptr;
+                    job.short_loops = nullptr;
+                    for (int l = 0; l < 2; ++l) shares[l].push_back(double(clock.ticks[l]) / spent);
+                    shares[2].push_back(double(leaf_ticks) / spent);
+                }
+                const double cycles = c.fastest / ticks_per_cycle;
+                const double one = median(shares[0]), few = median(shares[1]);
+                loops[0] += cycles * one;
+                loops[1] += cycles * few;
+                loops[2] += cycles * std::max(0.0, 1.0 - one - few - median(shares[2]));
+                return cycles;
             };
-            sample.primed_cycles += timed(Before::itself);
-            sample.cached_cycles += timed(Before::itself_and_others_lines);
-            sample.displaced_cycles += timed(Before::others_traversals);
-            if (time_evicted) sample.evicted_cycles += timed(Before::itself_evicted);
+            sample.primed_cycles += timed(Before::itself, sample.primed_loop_cycles);
+            sample.cached_cycles +=
+                timed(Before::itself_and_others_lines, sample.cached_loop_cycles);
+            sample.displaced_cycles +=
+                timed(Before::others_traversals, sample.displaced_loop_cycles);
+            if (time_evicted)
+                sample.evicted_cycles += timed(Before::itself_evicted, sample.evicted_loop_cycles);
             sample.converged_batches += converged;
         }
         if (touched == 1) out.clear();  // keeps the reads of the others' lines

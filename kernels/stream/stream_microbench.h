@@ -234,6 +234,10 @@ struct PredictorSample {
     uint64_t box_tests = 0, lines = 0;  // summed over the batches (lines: each one's distinct)
     double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
     double evicted_cycles = 0.0;
+    // Each state's cycles by the loop that ran them (one-ray, few-ray, stream; leaves in none),
+    // as the stage clock splits a frame's traversal.
+    std::array<double, 3> primed_loop_cycles{}, cached_loop_cycles{}, displaced_loop_cycles{},
+        evicted_loop_cycles{};
     uint32_t converged_batches = 0;  // in every state timed (base/convergence.h)
 };
 std::vector<PredictorSample> run_predictor_microbenchmarks(

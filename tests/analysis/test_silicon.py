@@ -426,6 +426,36 @@ def test_branch_predictor(tmp_path):
     p.write_text(json.dumps(rows))
     assert ("| avx512 | a | camera | +160.0 % | 0.50 Mcyc | +110.0 % | +50.0 % | 1.10 | 1.00 |"
             in silicon.dram_text(silicon.load_rows(p)))
+    # Split by loop: the stream loop 3/4 of the cached batches, the one-ray loop 1/4, the
+    # few-ray loop none (left out); the model's mispredictions added at 100 cycles each (its
+    # price implied by its extra cycles when the rows do not carry it).
+    assert "no branch-predictor batches split" in silicon.predictor_loops_text(
+        silicon.load_rows(p))
+    for r in rows:
+        for rays in ("camera", "bounce"):
+            m, q = f"measured.predictor.{rays}.", f"predicted.predictor.{rays}."
+            for key, part in (("one_ray", 0.25), ("few_ray", 0.0), ("stream", 0.75)):
+                r.update({f"{m}primed_loop_cycles.{key}": part * 1e6,
+                          f"{m}cached_loop_cycles.{key}": part * 1.2e6,
+                          f"{m}displaced_loop_cycles.{key}": part * 2e6,
+                          f"{m}evicted_loop_cycles.{key}": part * 3e6,
+                          f"{q}primed_loop_mispredictions.{key}": 0,
+                          f"{q}displaced_loop_mispredictions.{key}": part * 4000,
+                          f"{q}cold_loop_cycles.{key}": part * 6e6,
+                          f"{q}warm_loop_cycles.{key}": part * 2e6})
+            r[q + "mispredict_cycles"] = 100.0
+    p.write_text(json.dumps(rows))
+    text = silicon.predictor_loops_text(silicon.load_rows(p))
+    assert "| avx512 | a | camera | one-ray loop | 25% | 0.20 | 0.10 | 0.50 | 1.00 |" in text
+    assert "| avx512 | a | bounce | stream loop | 75% | 0.60 | 0.30 | 1.50 | 3.00 |" in text
+    assert "few-ray loop" not in text
+    for r in rows:
+        for rays in ("camera", "bounce"):
+            del r[f"predicted.predictor.{rays}.mispredict_cycles"]
+            r[f"predicted.predictor.{rays}.extra_cycles"] = 50.0 * (1234 - 3)
+    p.write_text(json.dumps(rows))
+    assert ("| avx512 | a | camera | one-ray loop | 25% | 0.20 | 0.05 |"
+            in silicon.predictor_loops_text(silicon.load_rows(p)))
     # Rows from before the predictor microbenchmarks: said so.
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
     assert "no branch-predictor" in silicon.predictor_text(silicon.load_rows(p))

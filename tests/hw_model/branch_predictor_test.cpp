@@ -113,6 +113,10 @@ TEST_CASE("A batch mispredicts less after itself than after others", "[branch]")
     CHECK(s.branches > 8 * 2000);
     CHECK(s.primed < s.displaced);
     CHECK(s.primed < s.branches / 20);
+    // Every op is a one-ray box test: the one-ray loop holds every misprediction.
+    CHECK(s.primed_by_loop[size_t(TraversalLoop::one_ray)] == s.primed);
+    CHECK(s.displaced_by_loop[size_t(TraversalLoop::one_ray)] == s.displaced);
+    CHECK(s.displaced_by_loop[size_t(TraversalLoop::stream)] == 0);
 
     CHECK(fit_mispredict_cycles({100, 200}, {2, 2}) == Approx(75));
     CHECK(fit_mispredict_cycles({100}, {0}) == 0.0);

@@ -3,6 +3,7 @@
 
 #include "kernels/stream/stream_microbench.h"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <map>
@@ -250,6 +251,14 @@ TEST_CASE("The branch predictor's part is timed on a scene's tile batches in thr
             CHECK(s.cached_cycles > 0.0);
             CHECK(s.displaced_cycles > 0.0);
             CHECK(s.converged_batches == s.batches);  // the fastest 1 of 1 agrees with itself
+            // Each state split by loop: the loops' parts are its cycles less the leaves'.
+            for (const auto& [loops, cycles] : {std::pair{s.primed_loop_cycles, s.primed_cycles},
+                                                {s.cached_loop_cycles, s.cached_cycles},
+                                                {s.displaced_loop_cycles, s.displaced_cycles}}) {
+                CHECK(loops[0] + loops[1] + loops[2] > 0.0);
+                CHECK(loops[0] + loops[1] + loops[2] <= 1.0001 * cycles);
+                CHECK(std::all_of(loops.begin(), loops.end(), [](double c) { return c >= 0; }));
+            }
         }
     }
     // The evicted state, and each batch's trace to the caller's sink: 16 camera batches, then

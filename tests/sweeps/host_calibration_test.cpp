@@ -369,6 +369,10 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     const BatchMemoryCycles m = model_batch_memory(host, sample);
     CHECK(m.warm == Approx(2 * 200 * 5).margin(4));
     CHECK(m.cold > m.warm + 2 * 200 * 20);  // 81 ns DRAM at 1 GHz, less what prefetch hides
+    // Every box test is a one-ray stream's: the one-ray loop holds all of both states.
+    CHECK(m.warm_loop[size_t(TraversalLoop::one_ray)] == Approx(m.warm).margin(4));
+    CHECK(m.cold_loop[size_t(TraversalLoop::one_ray)] == Approx(m.cold).margin(4));
+    CHECK(m.cold_loop[size_t(TraversalLoop::stream)] == 0.0);
     // Each batch from its own empty caches; its branches never priced.
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 1000;
