@@ -249,10 +249,16 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
         return mispredictions_replaying(*batches[b], loops[b], width, node_leaf, predictor,
                                         scratch);
     };
-    // The box tests' mispredictions of the run just made (`scratch`), by their loop.
-    auto by_loop = [&](size_t b, std::array<uint64_t, 3>& sum) {
+    // Keeps batch b's run just made (`m` mispredictions, op by op in `scratch`) if it is the
+    // fewest yet, with its box tests' by their loop.
+    auto keep_fewest = [&](size_t b, uint64_t m, uint64_t& fewest,
+                           std::array<uint64_t, 3>& fewest_by_loop) {
+        if (m >= fewest) return;
+        fewest = m;
+        fewest_by_loop = {};
         for (size_t i = 0; i < scratch.size(); ++i)
-            if (batches[b]->at(i).kind == OpKind::box_test) sum[size_t(loops[b][i])] += scratch[i];
+            if (batches[b]->at(i).kind == OpKind::box_test)
+                fewest_by_loop[size_t(loops[b][i])] += scratch[i];
     };
     PredictorStates states;
     const uint64_t start = predictor.branches();
@@ -268,11 +274,7 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
             run(b);
             const uint64_t m = run(b);
             steady = m < fewest ? 0 : steady + 1;
-            if (m < fewest) {
-                fewest_by_loop = {};
-                by_loop(b, fewest_by_loop);
-            }
-            fewest = std::min(fewest, m);
+            keep_fewest(b, m, fewest, fewest_by_loop);
         }
         states.primed += fewest;
         for (size_t l = 0; l < 3; ++l) states.primed_by_loop[l] += fewest_by_loop[l];
@@ -283,12 +285,7 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
         for (uint32_t r = 0; r < repetitions; ++r) {
             for (size_t o = 0; o < batches.size(); ++o)
                 if (o != b) run(o);
-            const uint64_t m = run(b);
-            if (m < fewest) {
-                fewest_by_loop = {};
-                by_loop(b, fewest_by_loop);
-            }
-            fewest = std::min(fewest, m);
+            keep_fewest(b, run(b), fewest, fewest_by_loop);
         }
         states.displaced += fewest;
         for (size_t l = 0; l < 3; ++l) states.displaced_by_loop[l] += fewest_by_loop[l];

@@ -405,7 +405,8 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     // The op's mispredicted branches, on its first group.
     const double mispredicted =
         t.first == 0 ? m_config.branch_predictor.mispredict_cycles * m_mispredicted[t.op] : 0.0;
-    m_timing.branch_cycles += uint64_t(std::llround(mispredicted));
+    const uint64_t branch_cycles = uint64_t(std::llround(mispredicted));
+    m_timing.branch_cycles += branch_cycles;
     const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact + mispredicted)));
     m_unit_carry[unit] = exact + mispredicted - double(busy);
     e.issue_end = e.start + busy;
@@ -416,8 +417,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     m_timing.op_cycles[size_t(op.kind)] += group_cycles;
     if (op.kind == OpKind::box_test) {
         m_timing.traversal_loop_cycles[size_t(m_loop[t.op])] += group_cycles;
-        m_timing.traversal_loop_branch_cycles[size_t(m_loop[t.op])] +=
-            uint64_t(std::llround(mispredicted));
+        m_timing.traversal_loop_branch_cycles[size_t(m_loop[t.op])] += branch_cycles;
         m_timing.traversal_loop_memory_cycles[size_t(m_loop[t.op])] +=
             stage.scene_memory_cycles - scene_memory_before;
     }

@@ -832,6 +832,31 @@ class OpLengthTally : public TraceSink {
 
 namespace {
 
+// The stage clock's split of a traversal (`traverse`, each repetition after `prepare`): the
+// shares of its time in the one-ray loop, the few-ray loop (their leaves left out) and the
+// leaves (TraversalJob::leaf_tsc, ShortLoopClock), each the median of 5 clocked repetitions
+// (the clock's reads are in them).
+template <class Prepare, class Traverse>
+std::array<double, 3> clocked_loop_shares(TraversalJob& job, Prepare&& prepare,
+                                          Traverse&& traverse) {
+    std::vector<double> shares[3];
+    for (uint32_t rep = 0; rep < 5; ++rep) {
+        prepare();
+        uint64_t leaf_ticks = 0;
+        ShortLoopClock clock;
+        job.leaf_tsc = &leaf_ticks;
+        job.short_loops = &clock;
+        const uint64_t start = __rdtsc();
+        traverse();
+        const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
+        job.leaf_tsc = nullptr;
+        job.short_loops = nullptr;
+        for (int l = 0; l < 2; ++l) shares[l].push_back(double(clock.ticks[l]) / spent);
+        shares[2].push_back(double(leaf_ticks) / spent);
+    }
+    return {median(shares[0]), median(shares[1]), median(shares[2])};
+}
+
 // The node `depth` levels below the root on a ray's way down (the left child if the ray enters
 // its box, else the right), or the last it reached.
 uint32_t entry_below(const Bvh& bvh, const RayPrecomp& ray, float t_max, uint32_t depth) {
@@ -1013,24 +1038,15 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             sample.cycles = c.fastest / ticks_per_cycle;
             sample.converged = c.converged;
             sample.repetitions = c.samples;
-            std::vector<double> leaf_shares, loop_shares[2];
-            for (uint32_t rep = 0; rep < 5; ++rep) {
-                displace_predictor(TraceDetail::none);
-                reset();
-                uint64_t leaf_ticks = 0;
-                ShortLoopClock clock;
-                job.leaf_tsc = &leaf_ticks;
-                job.short_loops = &clock;
-                const uint64_t start = __rdtsc();
-                run(TraceDetail::none);
-                const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
-                job.leaf_tsc = nullptr;
-                job.short_loops = nullptr;
-                leaf_shares.push_back(double(leaf_ticks) / spent);
-                for (int l = 0; l < 2; ++l) loop_shares[l].push_back(double(clock.ticks[l]) / spent);
-            }
-            sample.leaf_share = median(leaf_shares);
-            for (int l = 0; l < 2; ++l) sample.short_loop_share[l] = median(loop_shares[l]);
+            const std::array<double, 3> shares = clocked_loop_shares(
+                job,
+                [&] {
+                    displace_predictor(TraceDetail::none);
+                    reset();
+                },
+                [&] { run(TraceDetail::none); });
+            sample.short_loop_share = {shares[0], shares[1]};
+            sample.leaf_share = shares[2];
             out.push_back(sample);
             if (shape.bundle)
                 for (uint32_t i = 0; i < batch_rays; ++i) {
@@ -1337,9 +1353,8 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                 }
             };
             // The batch's fastest cycles in a state, and their split by the loop that ran them
-            // (the stage clock a frame's traversal is split with, TraversalJob::leaf_tsc and
-            // ShortLoopClock: the median shares of 5 clocked repetitions, each prepared as the
-            // timed ones are; the leaves in no loop).
+            // (clocked_loop_shares, each repetition prepared as the timed ones are; the leaves
+            // in no loop).
             auto timed = [&](Before before, std::array<double, 3>& loops) {
                 std::vector<double> times;
                 uint32_t set_aside = 0;
@@ -1353,26 +1368,12 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;
-                std::vector<double> shares[3];  // one-ray loop, few-ray loop, leaves
-                for (uint32_t rep = 0; rep < 5; ++rep) {
-                    prepare(before);
-                    uint64_t leaf_ticks = 0;
-                    ShortLoopClock clock;
-                    job.leaf_tsc = &leaf_ticks;
-                    job.short_loops = &clock;
-                    const uint64_t start = __rdtsc();
-                    traverse(t, TraceDetail::none);
-                    const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
-                    job.leaf_tsc = nullptr;
-                    job.short_loops = nullptr;
-                    for (int l = 0; l < 2; ++l) shares[l].push_back(double(clock.ticks[l]) / spent);
-                    shares[2].push_back(double(leaf_ticks) / spent);
-                }
+                const std::array<double, 3> shares = clocked_loop_shares(
+                    job, [&] { prepare(before); }, [&] { traverse(t, TraceDetail::none); });
                 const double cycles = c.fastest / ticks_per_cycle;
-                const double one = median(shares[0]), few = median(shares[1]);
-                loops[0] += cycles * one;
-                loops[1] += cycles * few;
-                loops[2] += cycles * std::max(0.0, 1.0 - one - few - median(shares[2]));
+                loops[0] += cycles * shares[0];
+                loops[1] += cycles * shares[1];
+                loops[2] += cycles * std::max(0.0, 1.0 - shares[0] - shares[1] - shares[2]);
                 return cycles;
             };
             sample.primed_cycles += timed(Before::itself, sample.primed_loop_cycles);
