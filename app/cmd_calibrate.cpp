@@ -316,6 +316,24 @@ void add_calibrate_command(CLI::App& app) {
                          {"branches", b.modelled.branches},
                          {"primed_mispredictions", b.modelled.primed},
                          {"displaced_mispredictions", b.modelled.displaced}});
+                j["node_read_exposed_share"] = cal.node_read_fit.share;
+                j["node_read_fit_median_error"] = cal.node_read_fit.error.first;
+                j["node_read_fit_worst_error"] = cal.node_read_fit.error.second;
+                for (size_t i = 0; i < cal.branch_samples.size(); ++i) {
+                    const PredictorSample& m = cal.branch_samples[i].measured;
+                    j["node_read_samples"].push_back(
+                        {{"bounce", m.bounce},
+                         {"evicted_loop_cycles", m.evicted_loop_cycles},
+                         {"primed_loop_cycles", m.primed_loop_cycles},
+                         {"measured_extra_cycles", cal.node_read_fit.measured[i]},
+                         {"modeled_whole_extra_cycles", cal.node_read_fit.modeled_whole[i]},
+                         {"modeled_extra_cycles", cal.node_read_fit.modeled[i]}});
+                }
+                for (const PredictorSample& b : cal.eviction_baseline)
+                    j["eviction_baseline"].push_back(
+                        {{"bounce", b.bounce},
+                         {"evicted_loop_cycles", b.evicted_loop_cycles},
+                         {"primed_loop_cycles", b.primed_loop_cycles}});
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
                                           {"slots", r.slots},
@@ -419,6 +437,20 @@ void add_calibrate_command(CLI::App& app) {
                     b.measured.converged_batches, b.measured.batches,
                     (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
                     (unsigned long long)b.modelled.displaced);
+            std::printf(
+                "node reads of the one-ray and few-ray loops: exposed share %.3f of "
+                "the model's latency beyond an L1D hit, fit error median %.1f%%, worst "
+                "%.1f%%\n",
+                cal.node_read_fit.share, 100 * cal.node_read_fit.error.first,
+                100 * cal.node_read_fit.error.second);
+            for (size_t i = 0; i < cal.branch_samples.size(); ++i)
+                std::printf(
+                    "  %-7s from DRAM, short loops: measured +%.0f cycles beyond the "
+                    "synthetic scene's; model +%.0f with the whole latency, +%.0f at the "
+                    "share\n",
+                    cal.branch_samples[i].measured.bounce ? "bounces" : "camera",
+                    cal.node_read_fit.measured[i], cal.node_read_fit.modeled_whole[i],
+                    cal.node_read_fit.modeled[i]);
             std::printf("hit reads beyond the caches: exposed share %.3f of the cache model's "
                         "latency, fit error median %.1f%%, worst %.1f%%\n",
                         cal.hit_read_fit.share, 100 * cal.hit_read_fit.error.first,

@@ -259,7 +259,12 @@ void CoreModel::request_scene(uint32_t index, uint64_t now) {
     const uint64_t ready =
         m_scene_memory->read(m_core, m_map.address(op.kind, op.object), p.scene_bytes, now);
     m_scene_arrival[index] = ready;
-    m_scene_ready[index] = std::max(now, ready - std::min(ready, m_scene_hidden));
+    uint64_t exposed = ready > now + m_scene_hidden ? ready - now - m_scene_hidden : 0;
+    if (m_l1d && op.kind == OpKind::box_test && m_loop[index] != TraversalLoop::stream)
+        // A CPU core's short loops run ahead of a node's read to the next ones'
+        // (OpCostConfig::node_read_exposed_share); its arrival still gates the right child's.
+        exposed = uint64_t(std::llround(p.cost.node_read_exposed_share * double(exposed)));
+    m_scene_ready[index] = now + exposed;
 }
 
 void CoreModel::request_child_scene(uint32_t producer, uint32_t consumer, uint64_t now) {

@@ -625,6 +625,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.hit_read_exposed_share > 0
                       ? ", hit_read_exposed_share: " + fmt(o.hit_read_exposed_share, 3)
                       : std::string())
+              << (o.node_read_exposed_share < 1
+                      ? ", node_read_exposed_share: " + fmt(o.node_read_exposed_share, 3)
+                      : std::string())
               << (o.thin_lens_per_lane_cycles > 0
                       ? ", thin_lens_per_lane_cycles: " + fmt(o.thin_lens_per_lane_cycles, 2)
                       : std::string())

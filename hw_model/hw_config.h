@@ -491,6 +491,18 @@ struct OpCostConfig {
     // cache model that prices the frames. 0: not measured (the reads cost what the
     // cache-resident microbenchmark saw).
     double hit_read_exposed_share = 0.0;
+    // The box test's: the share of its node read's latency beyond an L1D hit that a CPU core's
+    // one-ray and few-ray loops leave exposed. Those loops run one ray (or a few) down the
+    // tree with every branch predicted, so an out-of-order core issues the next nodes' reads
+    // before the current one has arrived (memory-level parallelism; Eyerman, Eeckhout,
+    // Karkhanis & Smith, "A mechanistic performance model for superscalar out-of-order
+    // processors", TOCS 2009), where the model otherwise serialises each read after its
+    // parent's. Fitted by sfx calibrate (fit_node_read_exposed_share, sweeps/host_calibration.h)
+    // on the branch microbenchmark's tile batches (20,000 random triangles) from DRAM against
+    // the same batches from the caches, per loop, through the model's own timing of them; the
+    // real scenes' batches and frames are held out. 1: not measured (the whole latency, as
+    // before 2026-12-02 and on a unit that waits for its node).
+    double node_read_exposed_share = 1.0;
     // The camera's: what a thin-lens camera's ray adds to a pinhole's (a concentric disk
     // sample, the focus point and a normalize; kernels/camera.h), fitted on the camera's
     // microbenchmarks with a lens beside its pinhole ones; paid by every lane of a camera op on
@@ -570,6 +582,10 @@ struct OpCostConfig {
                 "share of each lane's hit-primitive read latency beyond an L2 hit that is not "
                 "overlapped (0: not measured)",
                 0.0, 100.0);
+        v.param("node_read_exposed_share", node_read_exposed_share, "",
+                "the box test's: share of a node read's latency beyond an L1D hit that a CPU "
+                "core's one-ray and few-ray loops leave exposed (1: not measured)",
+                0.0, 1.0);
         v.param("thin_lens_per_lane_cycles", thin_lens_per_lane_cycles, "cycles",
                 "the camera's: cost a thin-lens camera adds per ray over a pinhole (0: not "
                 "measured)",

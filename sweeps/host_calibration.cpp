@@ -174,6 +174,73 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     return out;
 }
 
+NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
+                                        const std::vector<PredictorCheck>& samples,
+                                        const std::vector<PredictorSample>& baseline) {
+    if (samples.empty()) throw std::invalid_argument("no branch microbenchmark samples to fit");
+    const auto short_loops = [](const std::array<double, 3>& loops) {
+        return loops[size_t(TraversalLoop::one_ray)] + loops[size_t(TraversalLoop::few_ray)];
+    };
+    const auto modeled = [&](double share) {
+        HwConfig config = host;
+        for (OpCostConfig& cost : config.op_costs)
+            if (op_kind_named(cost.op) == OpKind::box_test) cost.node_read_exposed_share = share;
+        std::vector<double> out;
+        for (const PredictorCheck& s : samples) {
+            const BatchMemoryCycles m = model_batch_memory(config, s);
+            out.push_back(short_loops(m.cold_loop) - short_loops(m.warm_loop));
+        }
+        return out;
+    };
+    NodeReadFit fit;
+    for (const PredictorCheck& check : samples) {
+        const PredictorSample& s = check.measured;
+        double extra = short_loops(s.evicted_loop_cycles) - short_loops(s.primed_loop_cycles);
+        for (const PredictorSample& b : baseline)
+            if (b.bounce == s.bounce)
+                extra -= short_loops(b.evicted_loop_cycles) - short_loops(b.primed_loop_cycles);
+        fit.measured.push_back(extra);
+    }
+    // The model's extra is not proportional to the share (a shorter wait for a node can leave
+    // the core waiting on something else), but it grows with it: the squared error is minimised
+    // by a golden-section search over [0, 1].
+    const auto error_of = [&](const std::vector<double>& m) {
+        double sum = 0.0;
+        for (size_t i = 0; i < m.size(); ++i)
+            sum += (m[i] - fit.measured[i]) * (m[i] - fit.measured[i]);
+        return sum;
+    };
+    const auto squared_error = [&](double share) { return error_of(modeled(share)); };
+    const double golden = (std::sqrt(5.0) - 1.0) / 2.0;
+    double lo = 0.0, hi = 1.0;
+    double a = hi - golden * (hi - lo), b = lo + golden * (hi - lo);
+    double fa = squared_error(a), fb = squared_error(b);
+    while (hi - lo > 1e-3) {
+        if (fa <= fb) {
+            hi = b, b = a, fb = fa;
+            a = hi - golden * (hi - lo), fa = squared_error(a);
+        } else {
+            lo = a, a = b, fa = fb;
+            b = lo + golden * (hi - lo), fb = squared_error(b);
+        }
+    }
+    fit.modeled_whole = modeled(1.0);
+    // The search's ends are candidates too, and win a tie.
+    fit.share = (lo + hi) / 2;
+    fit.modeled = modeled(fit.share);
+    for (const double end : {0.0, 1.0}) {
+        std::vector<double> m = end == 1.0 ? fit.modeled_whole : modeled(end);
+        if (error_of(m) <= error_of(fit.modeled)) fit.share = end, fit.modeled = std::move(m);
+    }
+    std::vector<double> errors;
+    for (size_t i = 0; i < samples.size(); ++i)
+        errors.push_back(std::abs(fit.modeled[i] - fit.measured[i]) /
+                         std::max(std::abs(fit.measured[i]), 1.0));
+    std::sort(errors.begin(), errors.end());
+    fit.error = {errors[errors.size() / 2], errors.back()};
+    return fit;
+}
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source) {
@@ -245,8 +312,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     // triangles, what the displaced batches took beyond the cached ones, over the
     // mispredictions the model adds from primed to displaced on the same batches.
     const Scene branch_scene = branch_microbench_scene();
-    c.branch_samples =
-        check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence, false);
+    c.branch_samples = check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence);
     std::vector<double> extra_cycles, extra_mispredictions;
     for (const PredictorCheck& b : c.branch_samples) {
         extra_cycles.push_back(b.measured.displaced_cycles - b.measured.cached_cycles);
@@ -318,6 +384,18 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         if (kind != OpKind::count && op_info(kind).reads_hit_primitive)
             cost.hit_read_exposed_share = c.hit_read_fit.share;
     }
+    // The short loops' exposed share of a node read: the branch microbenchmark's batches from
+    // DRAM, less what evicting costs the synthetic scene's, through the model at these costs.
+    c.eviction_baseline = run_predictor_microbenchmarks(resolved, convergence);
+    for (const PredictorSample& b : c.eviction_baseline) {
+        c.converged_points += b.converged_batches;
+        c.points += b.batches;
+    }
+    c.node_read_fit =
+        fit_node_read_exposed_share(host_config, c.branch_samples, c.eviction_baseline);
+    for (OpCostConfig& cost : c.op_costs)
+        if (op_kind_named(cost.op) == OpKind::box_test)
+            cost.node_read_exposed_share = c.node_read_fit.share;
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
@@ -349,7 +427,12 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << " streams of 4096 hits on meshes of 416 KiB-52 MiB against a resident one, "
          << "through the cache model (relative error median "
          << std::lround(100 * c.hit_read_fit.error.first) << " %, worst "
-         << std::lround(100 * c.hit_read_fit.error.second) << " %); no frame";
+         << std::lround(100 * c.hit_read_fit.error.second) << " %); the box test's exposed "
+         << "share of a node read's latency in the one-ray and few-ray loops from the branch "
+         << "microbenchmark's batches from DRAM over primed in those loops, less the synthetic "
+         << "scene's, through the model (relative error median "
+         << std::lround(100 * c.node_read_fit.error.first) << " %, worst "
+         << std::lround(100 * c.node_read_fit.error.second) << " %); no frame";
     c.yaml = host_hw_yaml(c.host, c.op_costs, note.str());
     return c;
 }

@@ -53,6 +53,23 @@ struct BatchMemoryCycles {
 };
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
 
+// OpCostConfig::node_read_exposed_share, the box test's: per sample (a predictor check of the
+// branch microbenchmark, its evicted state timed), what reading the scene from DRAM added to
+// the short loops (one-ray and few-ray), measured (evicted - primed) less the same of the
+// synthetic scene's batches of the same rays, whose scene is a few lines (`baseline`: the
+// code, TLB and page tables the read evicts too), against the model's cold - warm in those
+// loops (model_batch_memory); the share in [0, 1] whose cold - warm has the least squared
+// error, with the model's extra at the whole latency and at that share, and its (median, worst)
+// error relative to the measured extra. Throws std::invalid_argument on no samples.
+struct NodeReadFit {
+    double share = 1.0;
+    std::pair<double, double> error{};
+    std::vector<double> measured, modeled_whole, modeled;  // per sample
+};
+NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
+                                        const std::vector<PredictorCheck>& samples,
+                                        const std::vector<PredictorSample>& baseline);
+
 struct HostCalibration {
     HostDescription host;
     std::vector<OpCostConfig> op_costs;
@@ -75,10 +92,15 @@ struct HostCalibration {
     // the core leaves exposed (OpCostConfig::hit_read_exposed_share).
     std::vector<SurfaceReadSample> surface_read_samples;
     HitReadFit hit_read_fit;
-    // The branch microbenchmark (check_predictor on branch_microbench_scene, evicted state not
-    // timed) and the model's mispredictions on its batches, on which
-    // HostDescription::branch_predictor's cost is fitted.
+    // The branch microbenchmark (check_predictor on branch_microbench_scene) and the model's
+    // mispredictions on its batches, on which HostDescription::branch_predictor's cost is fitted.
     std::vector<PredictorCheck> branch_samples;
+    // The synthetic scene's predictor batches (run_predictor_microbenchmarks), what evicting
+    // costs beyond the scene, and the short loops' exposed share of a node read's latency
+    // fitted on the branch microbenchmark's evicted batches
+    // (OpCostConfig::node_read_exposed_share).
+    std::vector<PredictorSample> eviction_baseline;
+    NodeReadFit node_read_fit;
     // The speed probe before the microbenchmarks (HostDescription::speed_probe_cycles is the
     // one after them): a calibration whose probe moved between the two measured a machine
     // that changed under it.

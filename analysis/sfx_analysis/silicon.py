@@ -811,8 +811,10 @@ def write_page(df, page, plot_name, header):
         "code, TLB and page tables the read evicts too, which a frame keeps), beside the "
         "model's timing of the same batches' traces from empty caches over right after "
         "themselves: how the model prices a scene read from DRAM (its measured latency, less "
-        "what the tracer's prefetch of a node's children hides), held out, fitted on "
-        "nothing.\n\n" + dram_text(df),
+        "what the tracer's prefetch of a node's children hides, and in the one-ray and "
+        "few-ray loops the share of it the core leaves exposed, `node_read_exposed_share`, "
+        "fitted on the branch microbenchmark's batches from DRAM, never on these scenes), "
+        "held out.\n\n" + dram_text(df),
         "## The traversal by loop\n\nThe native tracer runs a stream of one ray in its "
         "one-ray loop and, on a back end of 8 lanes or more, one of two to four rays in its "
         "few-ray loop, each down to the subtree's leaves (`kernels/trace.h`); the rest in the "

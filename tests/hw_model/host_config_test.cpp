@@ -626,6 +626,19 @@ TEST_CASE("The machine model times a host: measured costs, scene data beyond the
     for (OpCostConfig& c : one_lane.op_costs)
         if (c.op == "box_test") c.few_lane_cycles = 9;
     CHECK(time_boxes(one_lane, 2, 3).cycles == 83 + 9 + 9);
+
+    // A CPU core's short loops wait for the measured share of the 83 cycles
+    // (node_read_exposed_share), the stream loop for all of them.
+    for (OpCostConfig& c : one_lane.op_costs)
+        if (c.op == "box_test") c.node_read_exposed_share = 0.25;
+    const FrameTiming short_loop = time_boxes(one_lane, 1, 1);
+    CHECK(short_loop.cycles == 21 + 7);
+    CHECK(short_loop.traversal_loop_memory_cycles[size_t(TraversalLoop::one_ray)] == 21);
+    CHECK(time_boxes(one_lane, 1, 3).cycles == 21 + 9);
+    CHECK(time_boxes(one_lane, 1, 20).cycles == 83 + 18 + 8);
+    // The line is still on its way when a second pass reads it at cycle 28: that one waits a
+    // quarter of the rest, 14 cycles.
+    CHECK(time_boxes(one_lane, 2, 1).cycles == 21 + 7 + 14 + 7);
 }
 
 TEST_CASE("A host's ray buffers share its caches with the scene data", "[host][systemc]") {
@@ -749,6 +762,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.per_minority_lane_cycles = 7;
     box.one_ray_entry_cycles = 8;
     box.few_ray_entry_cycles = 9.5;
+    box.node_read_exposed_share = 0.375;
     HostDescription host = small_host();
     host.slot_arrays = 7;
     host.caches.push_back({3, "unified", 32768, 64, 16, true, "test"});
@@ -793,6 +807,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
     CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
     CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
+    CHECK(c.op_costs[0].node_read_exposed_share == Approx(0.375));
     CHECK(c.branch_predictor.kind == "tage");
     CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
     CHECK(yaml.find("fitted: test batches") != std::string::npos);
@@ -802,6 +817,15 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
                           "old.hw.yaml")
               .op_costs[0]
               .one_lane_cycles == 0.0);
+    // And before the short loops' node reads were: each waits for its node.
+    CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
+                          "old.hw.yaml")
+              .op_costs[0]
+              .node_read_exposed_share == 1.0);
+    CHECK_THROWS_AS(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, "
+                                    "node_read_exposed_share: 1.5}\n",
+                                    "bad.hw.yaml"),
+                    InputError);
     // The presets carry no op costs, so the store gains no columns from them.
     CHECK(HwConfig().op_costs.empty());
 

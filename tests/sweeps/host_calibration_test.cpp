@@ -336,15 +336,21 @@ TEST_CASE(
     CHECK(costs[0].per_op_cycles == 37);
 }
 
-TEST_CASE("The model times a microbenchmark's batches from DRAM and right after themselves",
-          "[host][systemc]") {
-    // One batch of 200 one-ray box tests on nodes a line apart: from empty caches every node
-    // comes from DRAM; right after itself, from the L1D.
+namespace {
+
+// A host whose box test costs 10 cycles an op, 5 on one lane (the rest free).
+HwConfig one_lane_box_host() {
     OpCostConfig box;
     box.op = "box_test";
     box.per_op_cycles = 10;
     box.one_lane_cycles = 5;
-    HwConfig host = host_hw_config(small_host(), costs_for_every_kind({box}));
+    return host_hw_config(small_host(), costs_for_every_kind({box}));
+}
+
+// Two batches of 200 one-ray box tests, camera rays: on nodes `step` apart (32-byte nodes, so
+// 2 is a line each), each the child of the one before (1: its left child, whose address the
+// core knows without its parent's data).
+PredictorCheck one_ray_batches(uint32_t step) {
     auto pass = std::make_shared<PassBuffer>();
     TilePass tile;
     tile.slot_count = 1;
@@ -354,7 +360,7 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     for (uint32_t i = 0; i < 200; ++i) {
         StreamOp op;
         op.kind = OpKind::box_test;
-        op.object = 2 * i;  // 32-byte nodes: a line each
+        op.object = step * i;
         op.length = 1;
         op.pass_count = 1;
         op.slots = &id;
@@ -366,6 +372,23 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     sample.batches = {pass, pass};
     sample.shape = triangle_shape(8);
     sample.shape.bvh_nodes = 400;
+    return sample;
+}
+
+HwConfig with_node_share(HwConfig host, double share) {
+    for (OpCostConfig& c : host.op_costs)
+        if (c.op == "box_test") c.node_read_exposed_share = share;
+    return host;
+}
+
+}  // namespace
+
+TEST_CASE("The model times a microbenchmark's batches from DRAM and right after themselves",
+          "[host][systemc]") {
+    // One batch of 200 one-ray box tests on nodes a line apart: from empty caches every node
+    // comes from DRAM; right after itself, from the L1D.
+    HwConfig host = one_lane_box_host();
+    const PredictorCheck sample = one_ray_batches(2);
     const BatchMemoryCycles m = model_batch_memory(host, sample);
     CHECK(m.warm == Approx(2 * 200 * 5).margin(4));
     CHECK(m.cold > m.warm + 2 * 200 * 20);  // 81 ns DRAM at 1 GHz, less what prefetch hides
@@ -381,6 +404,44 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(again.warm == m.warm);
     host.scene_memory.dram_latency_ns = 200;
     CHECK(model_batch_memory(host, sample).cold > m.cold);
+}
+
+TEST_CASE("The short loops' exposed share of a node read is fitted through the model",
+          "[host][systemc]") {
+    const HwConfig host = one_lane_box_host();
+    PredictorCheck sample = one_ray_batches(1);
+    constexpr size_t one_ray = size_t(TraversalLoop::one_ray);
+    // Measured: what the model gives at a share of 0.4, plus 200 cycles that evicting costs the
+    // synthetic scene's camera batches too; its bounces' eviction is another kind's.
+    const BatchMemoryCycles at = model_batch_memory(with_node_share(host, 0.4), sample);
+    const double extra = at.cold_loop[one_ray] - at.warm_loop[one_ray];
+    sample.measured.primed_loop_cycles[one_ray] = 5000;
+    sample.measured.evicted_loop_cycles[one_ray] = 5000 + extra + 200;
+    PredictorSample camera, bounces;
+    camera.primed_loop_cycles[one_ray] = 100;
+    camera.evicted_loop_cycles[one_ray] = 300;
+    bounces.bounce = true;
+    bounces.evicted_loop_cycles[one_ray] = 1e6;
+    const NodeReadFit fit = fit_node_read_exposed_share(host, {sample}, {camera, bounces});
+    CHECK(fit.share == Approx(0.4).margin(0.01));
+    CHECK(fit.measured[0] == Approx(extra));
+    CHECK(fit.modeled[0] == Approx(extra).epsilon(0.01));
+    CHECK(fit.modeled_whole[0] > 2 * extra);  // the whole latency waited
+    CHECK(fit.error.second < 0.01);
+    // Beyond the whole latency the share stays 1; at no extra, 0.
+    sample.measured.evicted_loop_cycles[one_ray] = 5000 + 3 * fit.modeled_whole[0];
+    CHECK(fit_node_read_exposed_share(host, {sample}, {}).share == 1.0);
+    sample.measured.evicted_loop_cycles[one_ray] = 5000;
+    CHECK(fit_node_read_exposed_share(host, {sample}, {}).share == 0.0);
+    // A chase of nodes whose addresses come from their parents' data: each waits for its
+    // parent's arrival, whatever the share.
+    const PredictorCheck chase = one_ray_batches(2);
+    const auto chase_extra = [&](double share) {
+        const BatchMemoryCycles m = model_batch_memory(with_node_share(host, share), chase);
+        return m.cold_loop[one_ray] - m.warm_loop[one_ray];
+    };
+    CHECK(chase_extra(0.0) > 0.9 * chase_extra(1.0));
+    CHECK_THROWS_AS(fit_node_read_exposed_share(host, {}, {}), std::invalid_argument);
 }
 
 TEST_CASE("The check's L3 chased now replaces a host file's shared last level only", "[host]") {
