@@ -3,6 +3,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <boost/math/tools/minima.hpp>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -202,31 +203,20 @@ NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
         fit.measured.push_back(extra);
     }
     // The model's extra is not proportional to the share (a shorter wait for a node can leave
-    // the core waiting on something else), but it grows with it: the squared error is minimised
-    // by a golden-section search over [0, 1].
+    // the core waiting on something else, as a node whose address is in its parent's data), but
+    // it does not fall as the share grows: Brent's search finds the least squared error.
     const auto error_of = [&](const std::vector<double>& m) {
         double sum = 0.0;
         for (size_t i = 0; i < m.size(); ++i)
             sum += (m[i] - fit.measured[i]) * (m[i] - fit.measured[i]);
         return sum;
     };
-    const auto squared_error = [&](double share) { return error_of(modeled(share)); };
-    const double golden = (std::sqrt(5.0) - 1.0) / 2.0;
-    double lo = 0.0, hi = 1.0;
-    double a = hi - golden * (hi - lo), b = lo + golden * (hi - lo);
-    double fa = squared_error(a), fb = squared_error(b);
-    while (hi - lo > 1e-3) {
-        if (fa <= fb) {
-            hi = b, b = a, fb = fa;
-            a = hi - golden * (hi - lo), fa = squared_error(a);
-        } else {
-            lo = a, a = b, fa = fb;
-            b = lo + golden * (hi - lo), fb = squared_error(b);
-        }
-    }
+    const double best = boost::math::tools::brent_find_minima(
+                            [&](double share) { return error_of(modeled(share)); }, 0.0, 1.0, 10)
+                            .first;
     fit.modeled_whole = modeled(1.0);
     // The search's ends are candidates too, and win a tie.
-    fit.share = (lo + hi) / 2;
+    fit.share = best;
     fit.modeled = modeled(fit.share);
     for (const double end : {0.0, 1.0}) {
         std::vector<double> m = end == 1.0 ? fit.modeled_whole : modeled(end);
@@ -333,6 +323,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                     << std::llround(extra_mispredictions[k]) << " mispredictions added";
     branch_note << " (the model's predictor, primed to displaced); no frame";
     c.host.branch_predictor_fit = branch_note.str();
+    // What evicting costs the synthetic scene's batches, whose scene is a few lines: the code,
+    // TLB and page tables a read of 256 MiB evicts besides the scene (fit_node_read_exposed_share).
+    c.eviction_baseline = run_predictor_microbenchmarks(resolved, convergence);
+    for (const PredictorSample& b : c.eviction_baseline) {
+        c.converged_points += b.converged_batches;
+        c.points += b.batches;
+    }
     // Ops of one lane run in the one-ray loop, and a wide back end's box tests of a few lanes in
     // the few-ray loop, not the filters above: their own fit, of what the samples' other ops
     // (their leaves' tests) and the model's mispredictions on them (priced above) leave when
@@ -386,11 +383,6 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     }
     // The short loops' exposed share of a node read: the branch microbenchmark's batches from
     // DRAM, less what evicting costs the synthetic scene's, through the model at these costs.
-    c.eviction_baseline = run_predictor_microbenchmarks(resolved, convergence);
-    for (const PredictorSample& b : c.eviction_baseline) {
-        c.converged_points += b.converged_batches;
-        c.points += b.batches;
-    }
     c.node_read_fit =
         fit_node_read_exposed_share(host_config, c.branch_samples, c.eviction_baseline);
     for (OpCostConfig& cost : c.op_costs)
