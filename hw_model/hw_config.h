@@ -422,24 +422,27 @@ struct BranchPredictorConfig {
 // the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
 // streams of mixed outcomes dealt at random, and of every lane passing and of none; on a
 // frame's outcomes in runs, about one a change of outcome, if fewer),
-// except an op of one lane when one_lane_cycles is set: the native tracer runs a one-ray
+// except an op of one lane when one_lane_cycles is given (not negative; a fitted 0 is a cost,
+// since session 52: on an AMD Zen 4 VM the traversal fit gave AVX-512's one-lane box test 0,
+// which priced it by the formula, 71 cycles, and the one-ray loop +44 to +121 %), for the
+// kinds the loop runs (OpCostTable keeps it for those only): the native tracer runs a one-ray
 // stream's whole subtree in its own loop (traverse_one: the ray's fields in registers, no
 // partition), so its box, triangle and sphere tests cost one_lane_cycles each (the box test's
 // fitted on one-ray traversals of the same synthetic scene, the leaf tests' timed on one lane
 // by the one-ray loop's leaf code: on a lane that fails, plus one_lane_pass_cycles if it
 // passes and one_lane_failed_candidate_cycles if it is a triangle test's failed candidate);
 // and a box test of 2 to k_few_ray_lanes lanes
-// when few_lane_cycles is set: on a back end of k_few_ray_min_width lanes or more the tracer runs
-// such a stream in its few-ray loop (traverse_few, kernels/trace.h), not the stream loop, so its
-// box tests cost few_lane_cycles each, fitted on few-ray traversals of that scene. The box
-// test's per_op is fitted on traversals of longer streams too (a stream-loop op waits for the
-// one before's output; the filter microbenchmarks' calls are independent, and a core overlaps
-// them), its other terms on the filter microbenchmarks. The box test that enters the one-ray or
-// the few-ray loop from the stream loop also costs one_ray_entry_cycles or few_ray_entry_cycles
-// (whatever a loop's start and end cost beyond its box tests), fitted on traversals whose
-// streams enter at the root and deep in the tree: from the root every subtree holds about as
-// many box tests, and a frame's short streams start deep.
-// Empty (every preset): ops are priced from instruction counts instead.
+// when few_lane_cycles is given (not negative) and the back end runs the few-ray loop: on a back
+// end of k_few_ray_min_width lanes or more the tracer runs such a stream in its few-ray loop
+// (traverse_few, kernels/trace.h), not the stream loop, so its box tests cost few_lane_cycles each,
+// fitted on few-ray traversals of that scene. The box test's per_op is fitted on traversals of
+// longer streams too (a stream-loop op waits for the one before's output; the filter
+// microbenchmarks' calls are independent, and a core overlaps them), its other terms on the filter
+// microbenchmarks. The box test that enters the one-ray or the few-ray loop from the stream loop
+// also costs one_ray_entry_cycles or few_ray_entry_cycles (whatever a loop's start and end cost
+// beyond its box tests), fitted on traversals whose streams enter at the root and deep in the tree:
+// from the root every subtree holds about as many box tests, and a frame's short streams start
+// deep. Empty (every preset): ops are priced from instruction counts instead.
 struct OpCostConfig {
     std::string op = "box_test";  // an op kind name (kernels/trace.h)
     double per_op_cycles = 0.0;
@@ -478,10 +481,10 @@ struct OpCostConfig {
     // 4096 slots) whose lane fails, whose lane passes, and (the triangle test's) whose lane is
     // a failed candidate, by turns behind its origin and beyond a closer hit; the extras as
     // their medians beyond the failing one's. No frame.
-    double one_lane_cycles = 0.0;
+    double one_lane_cycles = -1.0;                  // negative: not measured, the formula applies
     double one_lane_pass_cycles = 0.0;              // a leaf test's (0: not measured)
     double one_lane_failed_candidate_cycles = 0.0;  // the triangle test's (0: not measured)
-    double few_lane_cycles = 0.0;  // 0: not measured (or no few-ray loop), the formula applies
+    double few_lane_cycles = -1.0;                  // negative: not measured, the formula applies
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
     double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
     // An op that reads each lane's hit primitive (the emission filter): the share of those
@@ -555,9 +558,9 @@ struct OpCostConfig {
                 "candidate behind the origin or beyond a closer hit; 0: not measured)",
                 0.0, 1e9);
         v.param("one_lane_cycles", one_lane_cycles, "cycles",
-                "cost of a one-lane op in the one-ray traversal loop (0: not measured; the "
-                "formula above applies)",
-                0.0, 1e9);
+                "cost of a one-lane box, triangle or sphere test in the one-ray traversal loop "
+                "(negative: not measured; the formula above applies)",
+                -1.0, 1e9);
         v.param("one_lane_pass_cycles", one_lane_pass_cycles, "cycles",
                 "a leaf test's: what a one-lane op whose lane passes costs beyond one_lane_cycles "
                 "(0: not measured)",
@@ -567,9 +570,9 @@ struct OpCostConfig {
                 "beyond one_lane_cycles (0: not measured)",
                 0.0, 1e9);
         v.param("few_lane_cycles", few_lane_cycles, "cycles",
-                "cost of an op of 2 to 4 lanes in the few-ray traversal loop (0: not measured; "
-                "the formula above applies)",
-                0.0, 1e9);
+                "cost of a box test of 2 to 4 lanes in the few-ray traversal loop of a back end "
+                "of 8 lanes or more (negative: not measured; the formula above applies)",
+                -1.0, 1e9);
         v.param("one_ray_entry_cycles", one_ray_entry_cycles, "cycles",
                 "cost of entering the one-ray traversal loop from the stream loop, besides its "
                 "ops (the box test that enters it carries it; 0: not measured)",

@@ -211,6 +211,8 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         costs.few_lane[k] = x[k_op_kind_count + k];
         costs.stream_per_op[k] = x[2 * k_op_kind_count + k];
         costs.stream_measured[k] = active[2 * k_op_kind_count + k];
+        costs.one_lane_measured[k] = active[k];
+        costs.few_lane_measured[k] = active[k_op_kind_count + k];
     }
     for (size_t l = 0; l < 2; ++l) costs.entry[l] = x[k_entry_terms + l];
     return costs;

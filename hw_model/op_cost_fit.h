@@ -79,15 +79,17 @@ struct OneLaneSample {
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
-// one_lane_cycles, few_lane_cycles; 0 for the rest) and the per-op cost in a traversal of every
-// kind the samples' stream loops make (OpCostConfig::per_op_cycles): there each op waits for
-// the one before's output, where the filter microbenchmarks time independent calls, which a
-// core overlaps (an op's groups are independent in both, so their cost stays the filters').
+// one_lane_cycles, few_lane_cycles; not measured, negative, for the rest) and the per-op cost in a
+// traversal of every kind the samples' stream loops make (OpCostConfig::per_op_cycles): there each
+// op waits for the one before's output, where the filter microbenchmarks time independent calls,
+// which a core overlaps (an op's groups are independent in both, so their cost stays the filters').
 // Least squares on relative error of the cycles beyond the stream-priced groups and lanes,
 // non-negative as in fit_op_cost. Throws std::invalid_argument on no samples.
 struct ShortStreamCosts {
     std::array<double, k_op_kind_count> one_lane{}, few_lane{}, stream_per_op{};
     std::array<bool, k_op_kind_count> stream_measured{};  // the samples' stream loops made it
+    // The samples had such ops (a term at 0 is then a fitted 0, not a missing one).
+    std::array<bool, k_op_kind_count> one_lane_measured{}, few_lane_measured{};
     // What entering the one-ray and the few-ray loop costs besides their ops (OpCostConfig::
     // one_ray_entry_cycles, few_ray_entry_cycles).
     std::array<double, 2> entry{};

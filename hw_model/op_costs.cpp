@@ -201,6 +201,16 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
             if (op_kind_named(c.op) == OpKind(k)) {
                 p.measured = true;
                 p.cost = c;
+                // Short-loop costs only for what those loops run: a host file written before
+                // session 52 gives 0.00 for every op, and 0 is now a cost. The one-ray loop runs
+                // the box, triangle and sphere tests; the few-ray loop, on a back end wide
+                // enough, the box test (runs_in_few_ray_loop).
+                const OpKind kind = OpKind(k);
+                if (kind != OpKind::box_test && kind != OpKind::triangle_test &&
+                    kind != OpKind::sphere_test)
+                    p.cost.one_lane_cycles = -1.0;
+                if (!runs_in_few_ray_loop(kind, 2, config.simd.width))
+                    p.cost.few_lane_cycles = -1.0;
                 // A lens camera's rays cost more than a pinhole's (thin_lens_per_lane_cycles).
                 if (layout.features().thin_lens)
                     p.cost.per_lane_cycles += c.thin_lens_per_lane_cycles;
@@ -260,11 +270,11 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
         return programmable(d) ? double(compute_instructions) : double(d.initiation_interval);
     }
     // A one-ray stream runs its whole subtree in the tracer's own loop (traverse_one).
-    if (length == 1 && cost.one_lane_cycles > 0)
+    if (length == 1 && cost.one_lane_cycles >= 0)
         return cost.one_lane_cycles + cost.one_lane_pass_cycles * passed +
                cost.one_lane_failed_candidate_cycles * op_failed_candidates;
     // A stream of a few rays runs in the few-ray loop (traverse_few): one group, one cost.
-    if (length >= 2 && length <= k_few_ray_lanes && cost.few_lane_cycles > 0)
+    if (length >= 2 && length <= k_few_ray_lanes && cost.few_lane_cycles >= 0)
         return first ? cost.few_lane_cycles : 0.0;
     return (first ? cost.per_op_cycles : 0.0) + cost.per_group_cycles +
            cost.per_lane_cycles * lanes + cost.per_pass_cycles * passed +

@@ -61,7 +61,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
         // One-lane leaf tests at their directly timed cost, by outcome.
         for (size_t k = 0; k < k_op_kind_count; ++k)
-            if (cost_of[k] && one_lane_from_filters(OpKind(k)) && cost_of[k]->one_lane_cycles > 0) {
+            if (cost_of[k] && one_lane_from_filters(OpKind(k)) &&
+                cost_of[k]->one_lane_cycles >= 0) {
                 const OpCostConfig& cost = *cost_of[k];
                 sample.leaf_op_cycles +=
                     double(sample.ops[k]) * cost.one_lane_cycles +
@@ -76,7 +77,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
             const OpCostConfig* cost = cost_of[size_t(o.kind)];
             if (!cost) continue;
             OpCostConfig priced = *cost;
-            priced.one_lane_cycles = priced.few_lane_cycles = 0.0;
+            priced.one_lane_cycles = priced.few_lane_cycles = -1.0;
             if (per_op_from_traversals(o.kind)) {
                 priced.per_op_cycles = 0.0;
                 sample.stream_ops[size_t(o.kind)] += o.count;
@@ -111,9 +112,11 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
     for (OpCostConfig& o : costs) {
         const OpKind kind = op_kind_named(o.op);
         if (kind == OpKind::count) continue;
-        if (!one_lane_from_filters(kind) || o.one_lane_cycles == 0.0)
-            o.one_lane_cycles = fit.one_lane[size_t(kind)];
-        o.few_lane_cycles = fit.few_lane[size_t(kind)];
+        // A fitted 0 is a cost; a term no sample had is not measured (negative).
+        if (!one_lane_from_filters(kind) || o.one_lane_cycles < 0)
+            o.one_lane_cycles =
+                fit.one_lane_measured[size_t(kind)] ? fit.one_lane[size_t(kind)] : -1.0;
+        o.few_lane_cycles = fit.few_lane_measured[size_t(kind)] ? fit.few_lane[size_t(kind)] : -1.0;
         if (fit.stream_measured[size_t(kind)]) o.per_op_cycles = fit.stream_per_op[size_t(kind)];
         if (kind == OpKind::box_test) {
             o.one_ray_entry_cycles = fit.entry[0];

@@ -223,6 +223,35 @@ TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]
     CHECK(measured_op_cycles(one, 16, k_few_ray_lanes + 1, 1, 0.0) ==
           Approx(10 + 4 + 0.5 * (k_few_ray_lanes + 1) + 2));
     CHECK(measured_op_cycles(one, 16, 1, 1, 0.0) == Approx(7));
+    // A fitted 0 is a cost; only a negative one is not measured.
+    one.one_lane_cycles = 0;
+    one.few_lane_cycles = 0;
+    CHECK(measured_op_cycles(one, 16, 1, 1, 0.5) == 0.0);
+    CHECK(measured_op_cycles(one, 16, 3, 1, 0.0) == 0.0);
+    one.one_lane_cycles = one.few_lane_cycles = -1;
+    CHECK(measured_op_cycles(one, 16, 1, 1, 0.5) == Approx(10 + 4 + 0.5 + 2 + 4));
+    CHECK(OpCostConfig{}.one_lane_cycles < 0);
+    CHECK(OpCostConfig{}.few_lane_cycles < 0);
+
+    // In the model, short-loop costs are kept for the ops those loops run only: a host file
+    // written before session 52 gives every op 0.00 (then: not measured). A one-lane camera
+    // op stays the formula's; a box test of 3 lanes the few-ray cost on a wide back end only.
+    OpCostConfig old_camera = c, old_box = c;
+    old_camera.op = "camera";
+    old_box.op = "box_test";
+    old_camera.one_lane_cycles = old_camera.few_lane_cycles = 0;
+    old_box.one_lane_cycles = old_box.few_lane_cycles = 0;
+    HwConfig old_host = host_with({old_camera, old_box});
+    const DatapathConfig datapath;
+    for (const uint32_t width : {1u, 8u}) {
+        old_host.simd.width = width;
+        const OpCostTable table(RayRecordLayout(FeatureSet{}), old_host);
+        CHECK(table[OpKind::camera].issue_cycles(datapath, 1, 0, 1, 1, true, 0.0) ==
+              Approx(10 + 4 + 0.5 + 2));
+        CHECK(table[OpKind::box_test].issue_cycles(datapath, 1, 0, 1, 1, true, 0.0) == 0.0);
+        CHECK(table[OpKind::box_test].issue_cycles(datapath, 3, 0, 3, 1, true, 0.0) ==
+              (width == 1 ? Approx(10 + 4 + 1.5 + 2) : Approx(0.0)));
+    }
 }
 
 TEST_CASE("A thin-lens camera's rays cost what its microbenchmarks add to the pinhole's",
@@ -455,8 +484,12 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     CHECK(fit.stream_per_op[size_t(OpKind::box_test)] == Approx(140).epsilon(1e-6));
     CHECK(fit.stream_measured[size_t(OpKind::box_test)]);
     CHECK_FALSE(fit.stream_measured[size_t(OpKind::triangle_test)]);  // none in the samples
-    CHECK(fit.one_lane[size_t(OpKind::camera)] == 0.0);  // never made: no cost
+    CHECK(fit.one_lane[size_t(OpKind::camera)] == 0.0);  // never made: no cost, not measured
+    CHECK_FALSE(fit.one_lane_measured[size_t(OpKind::camera)]);
     CHECK(fit.few_lane[size_t(OpKind::triangle_test)] == 0.0);
+    CHECK_FALSE(fit.few_lane_measured[size_t(OpKind::triangle_test)]);
+    CHECK(fit.one_lane_measured[size_t(OpKind::box_test)]);
+    CHECK(fit.few_lane_measured[size_t(OpKind::box_test)]);
     CHECK(short_stream_fit_error(fit, samples).second < 1e-9);
     // A wrong cost shows in the error: 10 % off on the boxes, 20 % on the few-ray loop's or the
     // stream loop's.
@@ -816,7 +849,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
                           "old.hw.yaml")
               .op_costs[0]
-              .one_lane_cycles == 0.0);
+              .one_lane_cycles < 0);
     // And before the short loops' node reads were: each waits for its node.
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
                           "old.hw.yaml")
