@@ -246,7 +246,7 @@ struct CacheLevelConfig {
 // A read from DRAM within a span of memory: what it costs grows with the span. Measured for a
 // host (measure_dram_first_pass_ns, host_description.h: the first pass of a random chase over
 // the span right after 256 MiB read elsewhere): 91 ns over 2 MiB, 169 ns over 16 MiB and 327 ns
-// over 256 MiB on this project's AMD VM (docs/silicon-check-amd-avx512-host-scalar.hw.yaml,
+// over 256 MiB on this project's AMD VM (docs/silicon-check-amd-1ah-02h-avx512-host-scalar.hw.yaml,
 // 2026-11-28). What it grows with is the pages used since the read's page was last used, not
 // the distance: on that VM (2026-11-28, first-pass chases after 256 MiB read elsewhere) reads
 // alternating between two 1 MiB blocks 200 MiB apart cost 92 ns, as over one 2 MiB block
@@ -514,7 +514,8 @@ struct OpCostConfig {
     // with each ray set up in the camera's own loop (session 44), 72-76 with the set-up in a
     // loop of its own as the tracer runs it (session 45; run 27's scalar calibration, 130, was
     // an outlier); held out, atrium's camera stage there ran 78 cycles a ray above the pinhole
-    // scenes' (stage clock, run 24 of docs/silicon-check-amd-avx512.md): now within about 5 %.
+    // scenes' (stage clock, run 24 of docs/silicon-check-amd-1ah-02h-avx512.md): now within
+    // about 5 %.
     double thin_lens_per_lane_cycles = 0.0;
     // The direct-light filter's: what a passing lane's light sample on a sphere adds to one on a
     // triangle (a uniform point on the sphere and its error bound, kernels/lights.h; a failing
@@ -522,12 +523,13 @@ struct OpCostConfig {
     // filter's microbenchmarks with a sphere light beside its quad ones; paid by every passing
     // lane of its ops in proportion to the share of a scene's light samples that land on
     // spheres (FeatureSet::sphere_light_share: furnace's all, cornell's none). 0: not measured.
-    // Fitted on an AMD Zen 5 VM (2026-12-01, run 27 of docs/silicon-check-amd-avx512.md): 95.8
-    // / 95.8 / 104.8 cycles a passing lane (scalar / AVX2 / AVX-512). Held out, furnace's frames
-    // (AVX2, 128x128, tile 32, the same session's quick checks): its shading stage -16 %
-    // without it, -9 % with it (the emission filter's change in that run lowers the prediction
-    // too, so this cost's own part is larger); the direct-light op alone reads +13 %, but its
-    // prediction holds its shadow rays' set-up, which the frame's stage clock books apart.
+    // Fitted on an AMD Zen 5 VM (2026-12-01, run 27 of
+    // docs/silicon-check-amd-1ah-02h-avx512.md): 95.8 / 95.8 / 104.8 cycles a passing lane (scalar
+    // / AVX2 / AVX-512). Held out, furnace's frames (AVX2, 128x128, tile 32, the same session's
+    // quick checks): its shading stage -16 % without it, -9 % with it (the emission filter's change
+    // in that run lowers the prediction too, so this cost's own part is larger); the direct-light
+    // op alone reads +13 %, but its prediction holds its shadow rays' set-up, which the frame's
+    // stage clock books apart.
     double sphere_light_per_pass_cycles = 0.0;
 
     template <class V>
