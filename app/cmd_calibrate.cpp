@@ -618,6 +618,10 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.l3_fill_per_us_render"] = m.l3_render.foreign_fill_per_us;
             row["measured.l3_kib_rounds_min"] = m.l3_rounds_kib_max > 0 ? m.l3_rounds_kib_min : 0;
             row["measured.l3_kib_rounds_max"] = m.l3_rounds_kib_max;
+            if (!m.frame_sample_l3_kib.empty()) {
+                row["measured.frame_sample_l3_kib"] = m.frame_sample_l3_kib;
+                row["measured.frame_sample_l3_fill_per_us"] = m.frame_sample_l3_fill_per_us;
+            }
             row["predicted.memory_now"] = o->memory_now;
             row["predicted.frame_cycles_described"] = m.predicted_frame_described;
             if (variants[i].cold) {
@@ -638,6 +642,9 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.interrupted_renders"] = m.interrupted;
             row["measured.clock_moved_renders"] = m.clock_moved;
             row["measured.contended_renders"] = m.contended;
+            row["measured.render_cycles"] = m.render_cycles;
+            row["measured.render_shared_share"] = m.render_shared_share;
+            row["measured.monitor_share"] = m.monitor_share;
             row["measured.frame_tsc"] = m.measured_frame_tsc;
             for (int sg = 0; sg < 3; ++sg) {
                 row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =

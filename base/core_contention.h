@@ -56,6 +56,8 @@ class CoreContention {
                                 uint32_t most);
 
     double best() const { return m_best; }
+    // The rate below which a probe finds the core shared (0 once the gate is open: nothing is).
+    double shared_below() const { return open() ? 0.0 : (1.0 - m_tolerance) * m_best; }
     uint32_t waits() const { return m_waits; }          // wait() calls that found it shared
     uint32_t set_aside() const { return m_set_aside; }  // samples set aside
     bool open() const { return m_waited_ms >= m_total_wait_ms; }  // the total wait is spent
@@ -76,5 +78,34 @@ class CoreContention {
 
 // The process's one gate (microbenchmarks and renders of sfx calibrate share its best rate).
 CoreContention& core_contention();
+
+// Probes the core while a measured region runs, not only after it. On this project's AMD Zen 4
+// VM (2026-12-03) the sibling's load came in bursts of 1-10 ms besides the spells, several in
+// 100 ms at times (independent_adds_per_tick sampled back to back for 3 s): a render of 10-50 ms
+// overlapped them often and the one probe after it seldom saw one, so a large scene's renders
+// lay 0-60 % above their fastest and 8-13 of its 18 workloads a back end did not converge. A
+// timer on the monotonic clock interrupts the thread every `period_us` (the signal goes to the
+// thread), and the handler times the independent adds once (about 1 us, 0.1 % of a period of 1
+// ms, subtracted where it runs in a measured region); a probe below `shared_below` adds a tick
+// found the core shared. One monitor runs at a time (the handler's tallies are the process's).
+// Where the timer cannot be made (timer_create fails), the monitor probes nothing (probes 0).
+class ContentionMonitor {
+  public:
+    struct Tally {
+        uint32_t probes = 0;       // handler runs over the region
+        uint32_t shared = 0;       // of which found the core shared
+        double probe_ticks = 0.0;  // TSC ticks the handler spent: the monitor's own cost
+    };
+    ContentionMonitor(double shared_below, double period_us = 1000.0);
+    ~ContentionMonitor();
+    ContentionMonitor(const ContentionMonitor&) = delete;
+    ContentionMonitor& operator=(const ContentionMonitor&) = delete;
+    Tally stop();  // stops the timer (idempotent) and returns the tally
+
+  private:
+    void* m_timer = nullptr;  // timer_t
+    bool m_running = false;
+    Tally m_tally;
+};
 
 }  // namespace sfx

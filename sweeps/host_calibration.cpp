@@ -625,8 +625,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
     // (clock_moved) is set aside: it could pass for the fastest (or not) by the clock alone.
     // It spends the budget as a render does.
     auto frame_rule = [&](size_t v) { return after_discarded(convergence, out[v].clock_moved); };
+    // A render the core was found shared over (below) is set aside and taken again, at most the
+    // budget's number of times; then the workload stops, judged on the renders it kept.
     auto needs_more = [&](size_t v) {
-        return needs_more_samples(out[v].frame_samples, frame_rule(v)) ||
+        return (out[v].contended < convergence.budget &&
+                needs_more_samples(out[v].frame_samples, frame_rule(v))) ||
                (variants[v].cold && needs_more_samples(out[v].cold_samples, convergence));
     };
     for (uint32_t round = 1;; ++round) {
@@ -668,10 +671,26 @@ std::vector<SiliconMeasurement> predict_and_measure(
             clocked_totals[v].push_back(clocked.cycles);
             core_contention().wait();
             const std::vector<CpuTimes> load_before = read_cpu_times();
-            const auto [reading, ticks] = timed_render(scene, bvh, settings[v], false,
-                                                       source_of(v), tsc_mhz, r, m.interrupted);
+            ContentionMonitor monitor(core_contention().shared_below());
+            auto [reading, ticks] = timed_render(scene, bvh, settings[v], false, source_of(v),
+                                                 tsc_mhz, r, m.interrupted);
+            const ContentionMonitor::Tally probed = monitor.stop();
             const std::vector<CpuTimes> load_after = read_cpu_times();
-            const bool shared = core_contention().contended();
+            // The monitor's probes ran in the render's thread: their ticks at the render's clock
+            // come off its cycles (the signals' delivery, a few hundred cycles each, stays in).
+            const double monitor_cycles = probed.probe_ticks *
+                                          (reading.clock_mhz_before + reading.clock_mhz_after) /
+                                          (2.0 * tsc_mhz);
+            reading.cycles = std::max(0.0, reading.cycles - monitor_cycles);
+            m.render_cycles.push_back(reading.cycles);
+            m.render_shared_share.push_back(probed.probes ? double(probed.shared) / probed.probes
+                                                          : 0.0);
+            // Shared: over more than a tenth of the monitor's probes (a burst of a millisecond
+            // or two in a render of 50 ms is within what the fastest renders' agreement
+            // tolerates), or just after it, as the gate finds it (a render of a millisecond or
+            // two may see no probe).
+            const bool shared =
+                probed.shared > 0.1 * probed.probes || core_contention().contended();
             for (size_t c = 0; c < load_before.size() && c < load_after.size(); ++c)
                 if (int(c) != own_cpu) {
                     others_busy[v] += load_after[c].busy - load_before[c].busy;
@@ -681,14 +700,17 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 ++m.clock_moved;
                 continue;
             }
-            // One after which another hardware thread shared the core (base/core_contention.h;
-            // the core is waited for before each render) is set aside too and taken again, at
-            // most the budget's number of times.
-            if (shared && m.contended < convergence.budget) {
+            // One over which another hardware thread shared the core (base/core_contention.h:
+            // the core is waited for before each render, probed during it and after it) is set
+            // aside too; until 2026-12-03 only the probe after it counted, and once the budget's
+            // number were set aside, shared renders were kept (a workload of temple converged
+            // on renders 80-90 % of whose probes found the core shared).
+            if (shared) {
                 ++m.contended;
                 continue;
             }
             m.frame_samples.push_back(reading.cycles);
+            m.monitor_share += monitor_cycles / std::max(1.0, reading.cycles + monitor_cycles);
             sample_round[v].push_back(round - 1);
             readings[v].push_back(reading);
             tsc_samples[v].push_back(ticks);
@@ -717,6 +739,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
         m.convergence = judge_convergence(m.frame_samples, frame_rule(v));
         m.measured_frame = m.convergence.fastest;
         if (m.frame_samples.empty()) continue;  // every render set aside: nothing measured
+        m.monitor_share /= double(m.frame_samples.size());
         if (variants[v].cold) {
             m.cold_convergence = judge_convergence(m.cold_samples, convergence);
             m.measured_cold_frame = m.cold_convergence.fastest;
@@ -726,6 +749,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
             m.frame_samples.begin());
         if (memory_now) {
             m.l3_render = round_l3[sample_round[v][fastest]];
+            for (uint32_t round_index : sample_round[v]) {
+                m.frame_sample_l3_kib.push_back(round_l3[round_index].kib);
+                m.frame_sample_l3_fill_per_us.push_back(round_l3[round_index].foreign_fill_per_us);
+            }
             for (const SeenLevel& seen : round_l3) {
                 m.l3_rounds_kib_min = std::min(m.l3_rounds_kib_min, seen.kib);
                 m.l3_rounds_kib_max = std::max(m.l3_rounds_kib_max, seen.kib);

@@ -178,6 +178,10 @@ struct SiliconMeasurement {
     double neighbours_busy = -1.0;
     double measured_frame_tsc = 0.0;         // the raw TSC ticks' median, for comparison
     std::vector<double> frame_samples;       // every unclocked render's cycles
+    // With memory_now, the L3 chased in each frame sample's round (kib, others' fills per us):
+    // whether a render's time follows the L3 its neighbours left it.
+    std::vector<uint32_t> frame_sample_l3_kib;
+    std::vector<double> frame_sample_l3_fill_per_us;
     std::array<double, 3> measured_stage{};  // split of per-stage fewest ticks x measured_frame
     double stage_clock_overhead = 0.0;       // clocked render's cycles / unclocked median - 1
     uint32_t interrupted = 0;  // renders whose TSC ticks exceeded their CPU time by > 3 %
@@ -187,6 +191,11 @@ struct SiliconMeasurement {
     // Renders after which the core was found shared with another hardware thread, set aside
     // and taken again, at most the budget of them (base/core_contention.h).
     uint32_t contended = 0;
+    // Every unclocked render, kept or set aside: its cycles and the share of the contention
+    // monitor's probes during it that found the core shared (ContentionMonitor); and the
+    // monitor's own time over the kept renders, as a share of them (subtracted from their cycles).
+    std::vector<double> render_cycles, render_shared_share;
+    double monitor_share = 0.0;
     // The machine's speed during the renders against calibration: the speed probe re-run just
     // before the first render and just after the last, over its cycles at calibration, less 1
     // (NaN: the host file has none). The same for every workload of a back end; a probe beyond

@@ -621,11 +621,24 @@ def measurement_text(df):
     if "measured.contended_renders" in df:
         shared = df["measured.contended_renders"]
         renders = shared + df["measured.renders"] + df.get("measured.clock_moved_renders", 0)
-        lines.append(f"- renders set aside because another hardware thread shared the core after "
-                     f"them (base/core_contention.h: its rate of independent adds below the "
+        monitored = "measured.render_shared_share" in df
+        how = ("over more than a tenth of the probes every millisecond during them, or just "
+               "after them" if monitored else "after them")
+        lines.append(f"- renders set aside because another hardware thread shared the core {how} "
+                     f"(base/core_contention.h: its rate of independent adds below the "
                      f"best seen; the core waited for before each render): {int(shared.sum())} "
                      f"of {int(renders.sum())}, in {int((shared > 0).sum())} of {len(df)} "
                      f"workloads")
+        if monitored:
+            share = pd.Series([s for row in df["measured.render_shared_share"].dropna()
+                               for s in row], dtype=float)
+            if len(share):
+                lines.append(f"- the core found shared during the renders (the monitor's "
+                             f"probes): in none of their probes in {100 * (share == 0).mean():.0f} "
+                             f"% of the renders, in more than half in "
+                             f"{100 * (share > 0.5).mean():.0f} %; the probes took "
+                             f"{100 * df['measured.monitor_share'].mean():.2f} % of a kept render "
+                             f"(taken off its cycles)")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")

@@ -1,7 +1,10 @@
 // The core-contention gate on synthetic rates (an unshared core's, a shared one's in spells,
-// a lasting drop) with a clock that only counts the waits; and the rate probe on this core.
+// a lasting drop) with a clock that only counts the waits; the rate probe on this core; and the
+// monitor that probes it during a region, on its real timer.
 
 #include "base/core_contention.h"
+
+#include <time.h>
 
 #include <catch2/catch.hpp>
 #include <deque>
@@ -113,4 +116,37 @@ TEST_CASE("This core's rate of independent adds is a few a TSC tick", "[contenti
     const double rate = independent_adds_per_tick();
     CHECK(rate > 0.2);   // at least: one add a cycle at a core clock of a fifth of the TSC's
     CHECK(rate < 40.0);  // at most: eight adds a cycle at five times the TSC's
+}
+
+namespace {
+
+// Spins until the thread has run `ms` of CPU time (the monitor's timer counts that time).
+void spin_cpu_ms(double ms) {
+    timespec start, now;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+    volatile uint64_t x = 0;
+    do {
+        for (int i = 0; i < 10000; ++i) x = x + 1;
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    } while (double(now.tv_sec - start.tv_sec) * 1e3 + double(now.tv_nsec - start.tv_nsec) / 1e6 <
+             ms);
+}
+
+}  // namespace
+
+TEST_CASE("The contention monitor probes the core while a region runs", "[contention]") {
+    // Every probe below an infinite rate finds the core shared; none below 0.
+    ContentionMonitor always(1e300, 500.0);
+    spin_cpu_ms(20.0);
+    const ContentionMonitor::Tally shared = always.stop();
+    CHECK(shared.probes >= 10);  // about 40 at one a 500 us
+    CHECK(shared.shared == shared.probes);
+    CHECK(shared.probe_ticks > 0.0);
+    spin_cpu_ms(5.0);
+    CHECK(always.stop().probes == shared.probes);  // stopped: no more probes
+    ContentionMonitor never(0.0, 500.0);
+    spin_cpu_ms(20.0);
+    const ContentionMonitor::Tally alone = never.stop();
+    CHECK(alone.probes >= 10);
+    CHECK(alone.shared == 0);
 }
