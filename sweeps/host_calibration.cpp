@@ -626,10 +626,13 @@ std::vector<SiliconMeasurement> predict_and_measure(
     // It spends the budget as a render does.
     auto frame_rule = [&](size_t v) { return after_discarded(convergence, out[v].clock_moved); };
     // A render the core was found shared over (below) is set aside and taken again, at most the
-    // budget's number of times; then the workload stops, judged on the renders it kept.
+    // budget's number of times; then the workload stops, judged on the renders it kept (its
+    // cold renders too, which follow kept ones only: without the stop a workload whose every
+    // render was shared would render for ever to complete them).
     auto needs_more = [&](size_t v) {
-        return (out[v].contended < convergence.budget &&
-                needs_more_samples(out[v].frame_samples, frame_rule(v))) ||
+        if (out[v].contended >= convergence.budget || out[v].clock_moved >= convergence.budget)
+            return false;
+        return needs_more_samples(out[v].frame_samples, frame_rule(v)) ||
                (variants[v].cold && needs_more_samples(out[v].cold_samples, convergence));
     };
     for (uint32_t round = 1;; ++round) {
