@@ -60,8 +60,9 @@ def load_rows(path):
     # Spread of the measurement itself: (max - min) / median of the unclocked renders.
     df["noise"] = df["measured.frame_samples"].apply(
         lambda v: (max(v) - min(v)) / sorted(v)[len(v) // 2] if v else float("nan"))
-    df["measured.lo"] = df["measured.frame_samples"].apply(min)
-    df["measured.hi"] = df["measured.frame_samples"].apply(max)
+    # A workload whose every render was set aside (the core shared over each) has none.
+    df["measured.lo"] = df["measured.frame_samples"].apply(lambda v: min(v) if v else float("nan"))
+    df["measured.hi"] = df["measured.frame_samples"].apply(lambda v: max(v) if v else float("nan"))
     if "measured.spread" in df:
         # The range the convergence rule vouches for: the fastest to the k-th fastest render
         # (an unconverged workload's spread may be null: infinite, never judged anyway).

@@ -202,6 +202,33 @@ def test_nothing_converged(tmp_path, capsys):
     assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
 
 
+def test_renders_set_aside_as_shared(tmp_path, capsys):
+    # A workload whose every render was set aside (the core shared over each) keeps none: it is
+    # shown, not scored, and the page still writes; the monitor's probes are summarised.
+    rows = [row("a", 16, 100, 100), row("a", 32, 130, 120)]
+    for r in rows:
+        r["measured.converged"] = True
+        r["measured.contended_renders"] = 2
+        r["measured.render_shared_share"] = [0.0, 0.0, 0.0, 0.6, 1.0]
+        r["measured.monitor_share"] = 0.001
+    rows[1]["measured.frame_samples"] = []
+    rows[1]["measured.frame_cycles"] = 0.0
+    rows[1]["measured.converged"] = False
+    rows[1]["measured.render_shared_share"] = [1.0, 1.0]
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    assert silicon.summary(df)["workloads"] == 2
+    assert len(silicon.scored(df)) == 1
+    text = silicon.measurement_text(df)
+    assert "over more than a tenth of the probes" in text
+    # 7 renders: 3 with no shared probe (43 %), 4 shared over more than half (57 %).
+    assert "in none of their probes in 43 % of the renders, in more than half in 57 %" in text
+    header = tmp_path / "h.md"
+    header.write_text("")
+    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
+
+
 def test_rankings_judge_the_converged_range(tmp_path):
     # Renders spread over a noisy run overlap from min to max, but the converged ranges (the
     # fastest to the third fastest: frame x (1 + spread)) do not: the pair is judged.

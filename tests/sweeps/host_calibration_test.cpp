@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 
+#include "base/core_contention.h"
 #include "hw_model/ray_buffer_model.h"
 #include "kernels/bvh.h"
 #include "sweeps/point_group.h"
@@ -191,6 +192,10 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     RenderSettings f = s;
     f.max_depth = furnace.max_depth;
     std::vector<std::string> rounds;
+    // The contention gate open (as after its total wait): no render is set aside as shared, so
+    // that the counts below hold on a busy machine (the gate and its monitor have tests of
+    // their own, tests/base/core_contention_test.cpp); the test runner's 30 s return after.
+    core_contention().set_total_wait_ms(0.0);
     const std::vector<SiliconMeasurement> cell = predict_and_measure(
         {{&scene, &bvh, s, &config}, {&furnace, &furnace_bvh, f, &config, true}}, rule, 1,
         [&](const std::string& what, size_t, size_t) { rounds.push_back(what); });
@@ -208,6 +213,17 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(cell[0].predicted_cold_frame == 0.0);
     CHECK(cell[1].predicted_frame > 0);
     CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
+    // Every unclocked render is recorded, kept or set aside, with the share of the monitor's
+    // probes that found the core shared: none, with the gate open.
+    for (const SiliconMeasurement& w : cell) {
+        CHECK(w.contended == 0);
+        CHECK(w.render_cycles.size() == w.frame_samples.size() + w.clock_moved);
+        CHECK(w.render_shared_share.size() == w.render_cycles.size());
+        for (double share : w.render_shared_share) CHECK(share == 0.0);
+        CHECK(w.monitor_share >= 0.0);
+        CHECK(w.monitor_share < 0.05);
+        CHECK(w.frame_sample_l3_kib.empty());  // chased each round only with memory_now
+    }
     CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
     CHECK(std::count(rounds.begin(), rounds.end(), "round 2: 2 open") == 1);
     const SiliconMeasurement& m = cell.front();
@@ -265,6 +281,11 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     // run's, which used the file.
     const std::vector<SiliconMeasurement> again = predict_and_measure(
         {{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}}, rule, 1, {}, true);
+    core_contention().set_total_wait_ms(30000.0);
+    for (const SiliconMeasurement& w : again) {
+        REQUIRE(w.frame_sample_l3_kib.size() == w.frame_samples.size());
+        CHECK(w.frame_sample_l3_fill_per_us.size() == w.frame_samples.size());
+    }
     for (size_t v = 0; v < 2; ++v) {
         CHECK(cell[v].predicted_frame_described == cell[v].predicted_frame);
         CHECK(again[v].predicted_frame_described == cell[v].predicted_frame);
