@@ -188,8 +188,9 @@ struct SiliconMeasurement {
     // Unclocked renders set aside because the estimate's clock moved over them by more than
     // the convergence tolerance (clock_moved, base/cycle_source.h); not among frame_samples.
     uint32_t clock_moved = 0;
-    // Renders after which the core was found shared with another hardware thread, set aside
-    // and taken again, at most the budget of them (base/core_contention.h).
+    // Renders over which (ContentionMonitor) or after which the core was found shared with
+    // another hardware thread, set aside and taken again; at the budget's number the workload
+    // stops (base/core_contention.h).
     uint32_t contended = 0;
     // Every unclocked render, kept or set aside: its cycles and the share of the contention
     // monitor's probes during it that found the core shared (ContentionMonitor); and the

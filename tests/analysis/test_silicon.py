@@ -21,6 +21,13 @@ def row(scene, tile, predicted, measured, res=(64, 64), isa="avx512"):
     return r
 
 
+def write_page(tmp_path, rows_path):
+    """`python -m sfx_analysis silicon` on the rows with an empty header: its exit code."""
+    header = tmp_path / "h.md"
+    header.write_text("")
+    return main(["silicon", str(rows_path), "-o", str(tmp_path / "x.md"), "--header", str(header)])
+
+
 @pytest.fixture
 def rows_file(tmp_path):
     rows = [row("a", 16, 110, 100), row("a", 32, 90, 100.5), row("a", 64, 150, 120),
@@ -87,9 +94,7 @@ def test_page_and_plot(rows_file, tmp_path, capsys):
 def test_bad_rows(tmp_path):
     p = tmp_path / "rows.json"
     p.write_text("[]")
-    header = tmp_path / "h.md"
-    header.write_text("")
-    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 2
+    assert write_page(tmp_path, p) == 2
 
 
 def test_report_section(rows_file, tmp_path):
@@ -197,9 +202,7 @@ def test_nothing_converged(tmp_path, capsys):
     text = silicon.all_summaries_text(df)
     assert "of which 0 converged (0 %" in text
     assert "target at least 90 % of workloads converge: MISSED" in text
-    header = tmp_path / "h.md"
-    header.write_text("")
-    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
+    assert write_page(tmp_path, p) == 0
 
 
 def test_renders_set_aside_as_shared(tmp_path, capsys):
@@ -224,9 +227,7 @@ def test_renders_set_aside_as_shared(tmp_path, capsys):
     assert "over more than a tenth of the probes" in text
     # 7 renders: 3 with no shared probe (43 %), 4 shared over more than half (57 %).
     assert "in none of their probes in 43 % of the renders, in more than half in 57 %" in text
-    header = tmp_path / "h.md"
-    header.write_text("")
-    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header)]) == 0
+    assert write_page(tmp_path, p) == 0
 
 
 def test_rankings_judge_the_converged_range(tmp_path):
