@@ -645,6 +645,8 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.render_cycles"] = m.render_cycles;
             row["measured.render_shared_share"] = m.render_shared_share;
             row["measured.monitor_share"] = m.monitor_share;
+            row["measured.frame_cycles_parts"] = m.measured_frame_parts;
+            row["measured.frame_parts"] = m.frame_parts;
             row["measured.frame_tsc"] = m.measured_frame_tsc;
             for (int sg = 0; sg < 3; ++sg) {
                 row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =

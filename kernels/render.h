@@ -21,6 +21,9 @@ struct RenderSettings : TraceFrame {
     // The stream tracer reads the time-stamp counter at stage boundaries (RenderStats::
     // stage_tsc); off by default (it costs a few cycles per leaf visited); never changes a bit.
     bool stage_clock = false;
+    // The stream tracer reads the time-stamp counter at the end of each generation of a pass
+    // and of the pass (RenderStats::part_tsc); a few reads a pass; never changes a bit.
+    bool part_clock = false;
 };
 
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
@@ -68,6 +71,11 @@ struct RenderStats {
     // set-up (load_rays), which they price in the ops that made the rays.
     uint64_t shading_op_tsc[k_op_kind_count] = {};
     uint64_t ray_setup_tsc = 0;
+    // With RenderSettings::part_clock (stream tracer): each part's TSC ticks, a part being a
+    // generation of a pass (the first with its camera rays) or a pass's end (its sums), in the
+    // order they ran; with one thread that is the same order, and the same work, in every
+    // render of a frame (sfx calibrate --check takes each part's fastest over its renders).
+    std::vector<uint64_t> part_tsc;
 
     uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
     RenderStats& operator+=(const RenderStats& o);

@@ -483,6 +483,7 @@ std::pair<CycleReading, double> timed_render(const Scene& scene, const Bvh& bvh,
                                              CycleSource& source, double tsc_mhz,
                                              RenderResult& result, uint32_t& interrupted) {
     settings.stage_clock = clock;
+    settings.part_clock = !clock;
     source.start();
     const uint64_t start = read_tsc();
     result = render_stream(scene, bvh, settings);
@@ -584,6 +585,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
     for (auto& kinds : shading_op_min) kinds.fill(1e300);
     std::vector<double> ray_setup_min(n, 1e300);
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
+    // Each part's fewest ticks over the unclocked renders, the rest's, and the renders' cycles a
+    // tick (SiliconMeasurement::measured_frame_parts).
+    std::vector<std::vector<uint64_t>> part_min(n);
+    std::vector<double> part_rest_min(n, 1e300);
+    std::vector<std::vector<double>> cycles_per_tick(n);
     std::vector<std::vector<CycleReading>> readings(n);
     // With memory_now, the L3 chased at the start of each round, and each render's round.
     std::vector<SeenLevel> round_l3;
@@ -694,6 +700,18 @@ std::vector<SiliconMeasurement> predict_and_measure(
             // two may see no probe).
             const bool shared =
                 probed.shared > 0.1 * probed.probes || core_contention().contended();
+            const std::vector<uint64_t>& parts = r.stats.part_tsc;
+            if (part_min[v].empty()) part_min[v] = parts;
+            if (parts.size() == part_min[v].size()) {
+                uint64_t sum = 0;
+                for (size_t p = 0; p < parts.size(); ++p) {
+                    part_min[v][p] = std::min(part_min[v][p], parts[p]);
+                    sum += parts[p];
+                }
+                part_rest_min[v] = std::min(part_rest_min[v], std::max(0.0, ticks - double(sum)));
+            }
+            if (clock_moved(reading) <= convergence.tolerance && ticks > 0)
+                cycles_per_tick[v].push_back(reading.cycles / ticks);
             for (size_t c = 0; c < load_before.size() && c < load_after.size(); ++c)
                 if (int(c) != own_cpu) {
                     others_busy[v] += load_after[c].busy - load_before[c].busy;
@@ -741,6 +759,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
         m.probe_after = probe_after[lanes];
         m.convergence = judge_convergence(m.frame_samples, frame_rule(v));
         m.measured_frame = m.convergence.fastest;
+        if (!part_min[v].empty() && !cycles_per_tick[v].empty()) {
+            double ticks = part_rest_min[v];
+            for (uint64_t t : part_min[v]) ticks += double(t);
+            m.measured_frame_parts = ticks * median(cycles_per_tick[v]);
+            m.frame_parts = uint32_t(part_min[v].size());
+        }
         if (m.frame_samples.empty()) continue;  // every render set aside: nothing measured
         m.monitor_share /= double(m.frame_samples.size());
         if (variants[v].cold) {

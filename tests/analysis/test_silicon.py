@@ -230,6 +230,28 @@ def test_renders_set_aside_as_shared(tmp_path, capsys):
     assert write_page(tmp_path, p) == 0
 
 
+def test_the_frame_from_its_parts_is_reported_beside_the_fastest_render(tmp_path):
+    # Two converged workloads whose parts' sums lie 1 % and 3 % under their fastest renders,
+    # and one that did not converge, judged against its parts' sum only (not scored).
+    rows = [row("a", 16, 100, 100), row("a", 32, 103, 100), row("a", 64, 110, 0.0)]
+    for r, parts in zip(rows, (99.0, 97.0, 100.0)):
+        r["measured.converged"] = r["measured.frame_cycles"] > 0
+        r["measured.frame_cycles_parts"] = parts
+        r["measured.frame_parts"] = 12
+    rows[2]["measured.frame_samples"] = []
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    s = silicon.summary(silicon.load_rows(p))
+    assert s["converged"] == 2
+    assert s["parts_agree_median"] == pytest.approx(0.02)
+    assert s["parts_agree_worst"] == pytest.approx(0.03)
+    assert s["parts_workloads"] == 3
+    errors = [100 / 99 - 1, 103 / 97 - 1, 0.10]
+    assert s["parts_frame_mae"] == pytest.approx(sum(errors) / 3)
+    assert "the prediction against it on all 3: MAE" in silicon.summary_text(s)
+    assert write_page(tmp_path, p) == 0
+
+
 def test_rankings_judge_the_converged_range(tmp_path):
     # Renders spread over a noisy run overlap from min to max, but the converged ranges (the
     # fastest to the third fastest: frame x (1 + spread)) do not: the pair is judged.

@@ -35,6 +35,31 @@ TEST_CASE("The stage clock never changes a bit and counts every stage", "[stream
     }
 }
 
+TEST_CASE("The part clock never changes a bit and times each generation of each pass in order",
+          "[stream][host]") {
+    const Scene scene = load_scene("cornell");
+    const Bvh bvh(scene);
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.spp = 2;
+    s.tile = 8;
+    s.threads = 1;
+    s.max_depth = 3;
+    const RenderResult plain = render_stream(scene, bvh, s);
+    CHECK(plain.stats.part_tsc.empty());
+    s.part_clock = true;
+    const RenderResult timed = render_stream(scene, bvh, s);
+    REQUIRE(plain.image.pixels.size() == timed.image.pixels.size());
+    CHECK(std::memcmp(plain.image.pixels.data(), timed.image.pixels.data(),
+                      plain.image.pixels.size() * sizeof(Vec3)) == 0);
+    // 9 tiles x 2 passes, each of at most max_depth + 1 generations and its end; every render
+    // of the frame has the same parts.
+    CHECK(timed.stats.part_tsc.size() > 9 * 2 * 2);
+    CHECK(timed.stats.part_tsc.size() <= 9 * 2 * (3 + 2));
+    for (uint64_t ticks : timed.stats.part_tsc) CHECK(ticks > 0);
+    CHECK(render_stream(scene, bvh, s).stats.part_tsc.size() == timed.stats.part_tsc.size());
+}
+
 TEST_CASE("The stage clock splits the traversal by the loop that runs its short streams",
           "[stream][host]") {
     // Atrium's 64-ray streams narrow to one ray (the one-ray loop) on every back end, and to

@@ -223,6 +223,11 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(w.monitor_share >= 0.0);
         CHECK(w.monitor_share < 0.05);
         CHECK(w.frame_sample_l3_kib.empty());  // chased each round only with memory_now
+        // The sum of each part's fastest is at most the fastest render's (at the renders'
+        // median clock, which may differ from that render's by the tolerance).
+        CHECK(w.frame_parts >= 2);
+        CHECK(w.measured_frame_parts > 0.5 * w.measured_frame);
+        CHECK(w.measured_frame_parts < 1.1 * w.measured_frame);
     }
     CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
     CHECK(std::count(rounds.begin(), rounds.end(), "round 2: 2 open") == 1);
