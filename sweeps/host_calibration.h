@@ -234,8 +234,13 @@ struct SiliconMeasurement {
 // The speed probe: microbenchmark points of a traversal, an intersection and two shading
 // filters (box, triangle, emission, Lambertian indirect; streams of 512 and 1024 of 1024
 // slots), their fastest cycles summed. Measured at calibration (HwConfig::speed_probe_cycles)
-// and around a check's renders: their ratio says whether the machine runs as calibrated.
-double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence);
+// and around a check's renders: their ratio says whether the machine runs as calibrated. The
+// fastest of `probes` probes a second apart: a probe taken in a spell of the sibling hardware
+// thread (base/core_contention.h) converges there, and a spell slows a probe, never speeds it.
+// On the Zen 4 VM (2026-12-03) single probes before a check's renders read +36.5 / +28.0 /
+// +10.9 % (scalar / AVX2 / AVX-512) and after them +0.1 / -0.5 / -0.3 %, on host files
+// calibrated 15 minutes before; a run so flagged was calibrated and checked again.
+double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t probes = 3);
 // The probe's `cycles` now against `reference` (at calibration): +0.1 is 10 % slower; NaN
 // without a reference. Beyond k_speed_probe_tolerance either way the machine is not the one
 // measured then (scripts/silicon-check calibrates again).

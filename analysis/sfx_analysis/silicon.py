@@ -625,6 +625,7 @@ def measurement_text(df):
     if "measured.clock_mhz_before" in df and not df["measured.cycles_counted"].any():
         for isa in isas(df):
             g = df[df["isa"] == isa]
+            g = g[g["measured.frame_cycles"] > 0]  # a workload with no render kept has no clock
             clocks = pd.concat([g["measured.clock_mhz_before"], g["measured.clock_mhz_after"]])
             drift = (g["measured.clock_mhz_after"] / g["measured.clock_mhz_before"] - 1).abs()
             lines.append(f"- core clock around the fastest renders ({isa}): "

@@ -214,6 +214,9 @@ def test_renders_set_aside_as_shared(tmp_path, capsys):
         r["measured.contended_renders"] = 2
         r["measured.render_shared_share"] = [0.0, 0.0, 0.0, 0.6, 1.0]
         r["measured.monitor_share"] = 0.001
+        r["measured.cycles_counted"] = False
+        r["measured.clock_mhz_before"] = r["measured.clock_mhz_after"] = 3700.0
+    rows[1]["measured.clock_mhz_before"] = rows[1]["measured.clock_mhz_after"] = 0.0
     rows[1]["measured.frame_samples"] = []
     rows[1]["measured.frame_cycles"] = 0.0
     rows[1]["measured.converged"] = False
@@ -227,6 +230,8 @@ def test_renders_set_aside_as_shared(tmp_path, capsys):
     assert "over more than a tenth of the probes" in text
     # 7 renders: 3 with no shared probe (43 %), 4 shared over more than half (57 %).
     assert "in none of their probes in 43 % of the renders, in more than half in 57 %" in text
+    # The clock around the fastest renders is of the workload that kept one.
+    assert "core clock around the fastest renders (avx512): 3700-3700 MHz" in text
     assert write_page(tmp_path, p) == 0
 
 
