@@ -468,10 +468,11 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     const bool clock = settings.stage_clock;
     const uint64_t pass_start = clock ? __rdtsc() : 0;
     uint64_t traverse_tsc = 0;
-    // With the part clock, each generation's ticks and the pass end's (RenderStats::part_tsc).
+    // With the part clock, the frame is timed in parts (RenderStats::part_tsc): each generation
+    // of the pass, then its end.
     const bool parts = settings.part_clock;
     uint64_t part_mark = parts ? __rdtsc() : 0;
-    auto end_part_of_pass = [&] {
+    auto close_frame_part = [&] {
         if (!parts) return;
         const uint64_t now = __rdtsc();
         stats.part_tsc.push_back(now - part_mark);
@@ -676,7 +677,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         n = pushed;
         cur ^= 1;
         ++generation;
-        end_part_of_pass();
+        close_frame_part();
     }
 
     // Each path ends exactly once per pass; passes come in sample order, so each pixel sums
@@ -684,7 +685,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     for (uint32_t slot = 0; slot < count; ++slot)
         sums[slot] += sanitize_radiance(path[slot].radiance, stats);
     if (clock) stats.stage_tsc[2] += __rdtsc() - pass_start - traverse_tsc;
-    end_part_of_pass();
+    close_frame_part();
     info.generations = generation;
     if constexpr (Trace::k_enabled) sink->end_pass(info);
 }
