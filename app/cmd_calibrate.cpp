@@ -229,6 +229,7 @@ void add_calibrate_command(CLI::App& app) {
                         {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
                         {"sphere_light_per_pass", k.sphere_light_per_pass_cycles},
                         {"per_failed_candidate", k.per_failed_candidate_cycles},
+                        {"sphere_hit_per_lane", k.sphere_hit_per_lane_cycles},
                         {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                         {"fit_median_error", cal.fit_errors[i].first},
                         {"fit_worst_error", cal.fit_errors[i].second}};
@@ -244,7 +245,8 @@ void add_calibrate_command(CLI::App& app) {
                                             {"thin_lens", m.thin_lens},
                                             {"sphere_light", m.sphere_light},
                                             {"failing_candidates", m.failing_candidates},
-                                            {"failed_candidates", m.failed_candidates}});
+                                            {"failed_candidates", m.failed_candidates},
+                                            {"sphere_hits", m.sphere_hits}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (size_t i = 0; i < cal.one_ray_samples.size(); ++i) {
@@ -389,6 +391,12 @@ void add_calibrate_command(CLI::App& app) {
                         "%s: a candidate that fails its full test adds %.1f cycles to a "
                         "lane the float stage rejects\n",
                         k.op.c_str(), k.per_failed_candidate_cycles);
+            for (const OpCostConfig& k : cal.op_costs)
+                if (k.sphere_hit_per_lane_cycles != 0)
+                    std::printf(
+                        "%s: a lane whose hit is a sphere costs %+.1f cycles against one whose hit "
+                        "is a triangle (%.1f a lane)\n",
+                        k.op.c_str(), k.sphere_hit_per_lane_cycles, k.per_lane_cycles);
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.one_lane_pass_cycles > 0 || k.one_lane_failed_candidate_cycles > 0)
                     std::printf(

@@ -637,6 +637,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.per_failed_candidate_cycles > 0
                       ? ", per_failed_candidate_cycles: " + fmt(o.per_failed_candidate_cycles, 2)
                       : std::string())
+              << (o.sphere_hit_per_lane_cycles != 0
+                      ? ", sphere_hit_per_lane_cycles: " + fmt(o.sphere_hit_per_lane_cycles, 2)
+                      : std::string())
               << "}\n";
     }
     return y.str();

@@ -531,6 +531,17 @@ struct OpCostConfig {
     // op alone reads +13 %, but its prediction holds its shadow rays' set-up, which the frame's
     // stage clock books apart.
     double sphere_light_per_pass_cycles = 0.0;
+    // The emission filter's: what a lane whose hit is a sphere adds to one whose hit is a
+    // triangle (its per_lane_cycles; negative where it saves: a sphere's surface is a normalize
+    // and a re-projection, a triangle's three vertex reads behind its record, an interpolation
+    // and a cross product, kernels/intersect.h surface_at), fitted on the filter's
+    // microbenchmarks on sphere hits beside its triangle ones; paid by every lane of its ops in
+    // proportion to the share of the scene's surface area on spheres
+    // (FeatureSet::sphere_area_share). 0: not measured. Why: every host's page priced furnace's
+    // emission filter (all its hits on a sphere) 37-48 % over the stage clock's, cornell's within
+    // 8 % (docs/silicon-check-*.md, before 2026-12-03 the filter was timed on the synthetic
+    // scene's hits, triangles and a sphere mixed).
+    double sphere_hit_per_lane_cycles = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -599,6 +610,10 @@ struct OpCostConfig {
                 "the direct-light filter's: cost a light sample on a sphere adds per passing lane "
                 "over one on a triangle (0: not measured)",
                 0.0, 1e9);
+        v.param("sphere_hit_per_lane_cycles", sphere_hit_per_lane_cycles, "cycles",
+                "the emission filter's: cost a lane whose hit is a sphere adds over one on a "
+                "triangle, negative where it saves (0: not measured)",
+                -1e9, 1e9);
     }
 };
 

@@ -231,7 +231,7 @@ std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
 
 namespace {
 // The median over the samples with units (`units_of`) of their cycles beyond `base`'s price,
-// per unit; 0 when there are none, never negative.
+// per unit (negative where they cost less); 0 when there are none.
 template <class Units>
 double median_extra(const OpCostConfig& base, uint32_t width,
                     const std::vector<OpCostSample>& samples, Units units_of) {
@@ -241,20 +241,26 @@ double median_extra(const OpCostConfig& base, uint32_t width,
             extra.push_back((s.cycles - measured_op_cycles(base, width, s.lanes, s.passed,
                                                            s.beyond_l1, s.failed_candidates)) /
                             units);
-    return extra.empty() ? 0.0 : std::max(0.0, median(extra));
+    return extra.empty() ? 0.0 : median(extra);
 }
 }  // namespace
 
 double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
                                   const std::vector<OpCostSample>& variant_samples) {
-    return median_extra(base, width, variant_samples,
-                        [](const OpCostSample& s) { return s.passed; });
+    return std::max(0.0, median_extra(base, width, variant_samples,
+                                      [](const OpCostSample& s) { return s.passed; }));
 }
 
 double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
                                       const std::vector<OpCostSample>& variant_samples) {
+    return std::max(0.0, median_extra(base, width, variant_samples,
+                                      [](const OpCostSample& s) { return s.failed_candidates; }));
+}
+
+double fit_extra_per_lane(const OpCostConfig& base, uint32_t width,
+                          const std::vector<OpCostSample>& variant_samples) {
     return median_extra(base, width, variant_samples,
-                        [](const OpCostSample& s) { return s.failed_candidates; });
+                        [](const OpCostSample& s) { return s.lanes; });
 }
 
 void fit_one_lane_by_outcome(OpCostConfig& cost, const std::vector<OpCostSample>& one_lane) {

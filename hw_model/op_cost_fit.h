@@ -43,6 +43,11 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
 // quad's (sphere_light_per_pass_cycles: a failing lane costs the same on either).
 double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
                                   const std::vector<OpCostSample>& variant_samples);
+// Likewise per lane, and signed (negative where the variant's lanes cost less): the emission
+// filter's microbenchmarks on sphere hits over its fitted cost on triangle hits
+// (OpCostConfig::sphere_hit_per_lane_cycles).
+double fit_extra_per_lane(const OpCostConfig& base, uint32_t width,
+                          const std::vector<OpCostSample>& variant_samples);
 // Likewise per failed candidate: the triangle test's microbenchmark of failing candidates over
 // the op's fitted cost, whose failing lanes are lanes the float stage rejects
 // (OpCostConfig::per_failed_candidate_cycles).

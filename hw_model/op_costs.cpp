@@ -217,6 +217,9 @@ OpCostTable::OpCostTable(const RayRecordLayout& layout, const HwConfig& config)
                 // A passing lane's light sample on a sphere costs more than one on a triangle.
                 p.cost.per_pass_cycles +=
                     c.sphere_light_per_pass_cycles * layout.features().sphere_light_share;
+                // A lane whose hit is a sphere costs other than one on a triangle.
+                p.cost.per_lane_cycles +=
+                    c.sphere_hit_per_lane_cycles * layout.features().sphere_area_share;
             }
     }
 }

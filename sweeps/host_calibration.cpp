@@ -265,6 +265,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
     std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
     std::vector<OpCostSample> failing_candidates;    // the triangle test's
+    std::vector<OpCostSample> sphere_hits;           // the emission filter's on sphere hits
     for (const MicrobenchSample& s : c.samples) {
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
             one_lane[s.kind].push_back({1, s.passed, 0.0, s.cycles, s.failed_candidates});
@@ -279,6 +280,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         (s.thin_lens            ? lens_camera
          : s.sphere_light       ? sphere_light
          : s.failing_candidates ? failing_candidates
+         : s.sphere_hits        ? sphere_hits
                                 : by_kind[s.kind])
             .push_back(sample);
     }
@@ -300,6 +302,11 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             c.op_costs.back().per_failed_candidate_cycles = fit_extra_per_failed_candidate(
                 c.op_costs.back(), c.host.simd_width, failing_candidates);
             points += failing_candidates.size();
+        }
+        if (kind == OpKind::emission_filter) {
+            c.op_costs.back().sphere_hit_per_lane_cycles =
+                fit_extra_per_lane(c.op_costs.back(), c.host.simd_width, sphere_hits);
+            points += sphere_hits.size();
         }
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();

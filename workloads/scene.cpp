@@ -110,6 +110,13 @@ FeatureSet Scene::features() const {
         if (light.area > 0.f)
             f.sphere_light_share += sphere_area / light.area / float(lights.size());
     }
+    double sphere_area = 0.0, area = 0.0;
+    for (uint32_t p = 0; p < primitive_count(); ++p) {
+        const double a = primitive_area(p);
+        area += a;
+        if (is_sphere(p)) sphere_area += a;
+    }
+    if (area > 0.0) f.sphere_area_share = float(sphere_area / area);
     f.max_depth = max_depth;
     return f;
 }

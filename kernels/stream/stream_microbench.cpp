@@ -267,10 +267,15 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
     // no hit, where nearly every candidate (a lane its float stage does not reject) passes, and
     // on candidates that fail, point by point behind their origin (as on a secondary ray's own
     // surface) and beyond a closer hit, the two ways a frame's secondary rays fail
-    // (OpCostConfig::per_failed_candidate_cycles).
+    // (OpCostConfig::per_failed_candidate_cycles). The emission filter likewise: on hits on
+    // triangles and on hits on the sphere, whose surfaces cost differently (surface_at: a
+    // triangle's three vertices and an interpolation, a sphere's normalize), each stream of one
+    // kind (OpCostConfig::sphere_hit_per_lane_cycles; the mix of the two, which the filter was
+    // timed on before 2026-12-03, priced furnace's all-sphere filter 37-48 % over the host's).
     struct TimedKind {
         OpKind kind;
-        bool thin_lens = false, sphere_light = false, failing_candidates = false;
+        bool thin_lens = false, sphere_light = false, failing_candidates = false,
+             sphere_hits = false;
     };
     std::vector<TimedKind> timed_kinds;
     for (const OpKind kind : kinds) {
@@ -278,6 +283,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
         if (kind == OpKind::camera) timed_kinds.push_back({kind, true, false});
         if (kind == OpKind::lambertian_direct) timed_kinds.push_back({kind, false, true});
         if (kind == OpKind::triangle_test) timed_kinds.push_back({kind, false, false, true});
+        if (kind == OpKind::emission_filter)
+            timed_kinds.push_back({kind, false, false, false, true});
     }
     Scene sphere_light_scene = scene;
     {
@@ -628,12 +635,21 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             rays->erase(std::remove_if(rays->begin(), rays->end(), not_a_hit),
                                         rays->end());
                     }
+                    if (kind == OpKind::emission_filter) {  // hits of one primitive kind
+                        auto other_kind = [&](uint32_t ray) {
+                            return scene.is_sphere(b.saved_hit[ray].prim) != timed.sphere_hits;
+                        };
+                        for (auto* rays : {&passing, &failing})
+                            rays->erase(std::remove_if(rays->begin(), rays->end(), other_kind),
+                                        rays->end());
+                    }
                 }
                 for (uint32_t ray : passing) passes[ray] = 1;
                 // The rays a stream is dealt from: the whole buffer, or its hits.
                 std::vector<uint32_t> pool = passing;
                 pool.insert(pool.end(), failing.begin(), failing.end());
                 std::sort(pool.begin(), pool.end());
+                if (hits_only && pool.empty()) continue;  // no hit of the kind in this buffer
                 // The material sort has no outcome per lane to split its streams by.
                 const bool classified = !passing.empty() && !failing.empty() &&
                                         kind != OpKind::material_filter;
@@ -786,7 +802,8 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         const Convergence c = judge_convergence(cycles, options.convergence);
                         out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples,
                                        timed.thin_lens, timed.sphere_light,
-                                       timed.failing_candidates, failed_candidates});
+                                       timed.failing_candidates, failed_candidates,
+                                       timed.sphere_hits});
                     }
             }
             if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);

@@ -62,9 +62,12 @@ struct MicrobenchSample {
     // The triangle test's: lanes the float stage did not reject that failed the full test
     // (StreamOp::failed_candidates), counted by the tracer's own float stage on the timed streams.
     uint32_t failed_candidates = 0;
+    // The emission filter's: timed on hits on spheres; its plain samples on hits on triangles
+    // (OpCostConfig::sphere_hit_per_lane_cycles).
+    bool sphere_hits = false;
     // A variant's samples price only its extra over the plain op (fit_extra_per_passing_lane,
-    // fit_extra_per_failed_candidate).
-    bool variant() const { return thin_lens || sphere_light || failing_candidates; }
+    // fit_extra_per_failed_candidate, fit_extra_per_lane).
+    bool variant() const { return thin_lens || sphere_light || failing_candidates || sphere_hits; }
 };
 
 // The microbenchmarks' default rule: the fastest 3 within 3 %, 5 to 9 repetitions.

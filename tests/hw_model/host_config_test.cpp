@@ -392,6 +392,44 @@ TEST_CASE("A passing direct-light lane pays a sphere light's extra in the share 
     CHECK(load_scene("cornell").features().sphere_light_share == 0.f);
 }
 
+TEST_CASE("An emission lane pays a sphere hit's difference in the share of sphere area", "[host]") {
+    OpCostConfig emission = cost("emission_filter", 10, 20, 70, 0, 0);
+    emission.sphere_hit_per_lane_cycles = -24;
+    HwConfig host = host_with({emission, cost("depth_filter", 10, 0, 5, 0, 0)});
+    FeatureSet triangles, half, spheres;
+    half.sphere_area_share = 0.5f;
+    spheres.sphere_area_share = 1.f;
+    const OpCostTable on_triangles(RayRecordLayout(triangles), host),
+        on_half(RayRecordLayout(half), host), on_spheres(RayRecordLayout(spheres), host);
+    const DatapathConfig d;
+    auto issue = [&](const OpCostTable& t, OpKind k) {
+        return t[k].issue_cycles(d, 64, 0, 8, 0, false, 0.0);
+    };
+    CHECK(issue(on_half, OpKind::emission_filter) ==
+          Approx(issue(on_triangles, OpKind::emission_filter) - 8 * 12));
+    CHECK(issue(on_spheres, OpKind::emission_filter) ==
+          Approx(issue(on_triangles, OpKind::emission_filter) - 8 * 24));
+    CHECK(issue(on_spheres, OpKind::depth_filter) == issue(on_triangles, OpKind::depth_filter));
+    // The fit: the sphere hits' samples against the triangle hits' cost, per lane, signed.
+    std::vector<OpCostSample> on_sphere_hits;
+    for (uint32_t lanes : {16u, 64u, 256u})
+        on_sphere_hits.push_back(
+            {lanes, 0, 0.0, measured_op_cycles(emission, 8, lanes, 0, 0.0) - 24.0 * lanes});
+    CHECK(fit_extra_per_lane(emission, 8, on_sphere_hits) == Approx(-24));
+    CHECK(fit_extra_per_lane(emission, 8, {}) == 0.0);
+    // A host file keeps the sign.
+    const HwConfig parsed = parse_hw_config(host_hw_yaml(small_host(), {emission}, "e"), "e.yaml");
+    REQUIRE(parsed.op_costs.size() == 1);
+    CHECK(parsed.op_costs[0].sphere_hit_per_lane_cycles == Approx(-24));
+
+    // The share: exact where a scene has one kind of primitive, by area where it has both.
+    CHECK(load_scene("furnace").features().sphere_area_share == Approx(1.f));
+    CHECK(load_scene("conference").features().sphere_area_share == 0.f);
+    const float cornell = load_scene("cornell").features().sphere_area_share;
+    CHECK(cornell > 0.1f);
+    CHECK(cornell < 0.2f);
+}
+
 TEST_CASE("The fit recovers costs from exact samples and never goes negative", "[host]") {
     const OpCostConfig truth = cost("triangle_test", 30, 12, 0, 40, 3);
     std::vector<OpCostSample> samples;

@@ -131,15 +131,26 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
     // (a leaf test's one-lane stream only all passing and none passing: 2 + 3 + 3).
     // The camera's also on a thin lens, apart (thin_lens_per_lane_cycles), the direct-light
     // filter's on a sphere light (sphere_light_per_pass_cycles), and the triangle test's on
-    // candidates that fail (per_failed_candidate_cycles); no other kind's.
+    // candidates that fail (per_failed_candidate_cycles), and the emission filter's on sphere
+    // hits (sphere_hit_per_lane_cycles; its plain ones on triangle hits); no other kind's.
     std::map<OpKind, std::vector<const MicrobenchSample*>> by_kind;
-    std::vector<const MicrobenchSample*> lens, sphere_light, failing;
+    std::vector<const MicrobenchSample*> lens, sphere_light, failing, sphere_hits;
     for (const MicrobenchSample& m : samples)
         (m.thin_lens            ? lens
          : m.sphere_light       ? sphere_light
          : m.failing_candidates ? failing
+         : m.sphere_hits        ? sphere_hits
                                 : by_kind[m.kind])
             .push_back(&m);
+    // The synthetic scene's sphere is glass and its buffers' rays hit the light from above
+    // (no lane passes the emission filter), so both kinds' streams are mixed ones only.
+    REQUIRE(sphere_hits.size() == 3);
+    for (const MicrobenchSample* m : sphere_hits) {
+        CHECK(m->kind == OpKind::emission_filter);
+        CHECK(m->passed == 0);
+        CHECK(m->variant());
+    }
+    CHECK(by_kind[OpKind::emission_filter].size() == 3);
     // Streams of every lane failing, one lane long too (one_lane_failed_candidate_cycles): each
     // lane's ray turned round or given a closer hit still crosses the triangle (the tracer's
     // float stage counts it a candidate).
