@@ -395,8 +395,9 @@ void add_calibrate_command(CLI::App& app) {
                 if (k.sphere_hit_per_lane_cycles != 0)
                     std::printf(
                         "%s: a lane whose hit is a sphere costs %+.1f cycles against one whose hit "
-                        "is a triangle (%.1f a lane)\n",
-                        k.op.c_str(), k.sphere_hit_per_lane_cycles, k.per_lane_cycles);
+                        "is a triangle (%.1f a lane with its share of a full group)\n",
+                        k.op.c_str(), k.sphere_hit_per_lane_cycles,
+                        k.per_lane_cycles + k.per_group_cycles / std::max(1u, cal.host.simd_width));
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.one_lane_pass_cycles > 0 || k.one_lane_failed_candidate_cycles > 0)
                     std::printf(
