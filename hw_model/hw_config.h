@@ -540,7 +540,14 @@ struct OpCostConfig {
     // (FeatureSet::sphere_area_share). 0: not measured. Why: every host's page priced furnace's
     // emission filter (all its hits on a sphere) 37-48 % over the stage clock's, cornell's within
     // 8 % (docs/silicon-check-*.md, before 2026-12-03 the filter was timed on the synthetic
-    // scene's hits, triangles and a sphere mixed).
+    // scene's hits, triangles and a sphere mixed). Fitted on an AMD Zen 4 VM (2026-12-03, the
+    // synthetic scene's microbenchmarks only, docs/silicon-check-amd-19h-11h-avx512.md):
+    // -19.7 / -24.8 / -20.1 cycles a lane (scalar / AVX2 / AVX-512) against 71.6 / 75.9 / 71.7
+    // on a triangle hit. Held out, that page's frames: furnace's filter -2 to -4 % (+39 to +42 %
+    // before), cornell's -6 to -12 % (-1 to -8 % before: the mixed microbenchmark had carried the
+    // branch on the primitive's kind, mispredicted where a stream's kind changes, 0.10 times a
+    // lane on cornell, about 19 cycles each; unpriced, about 3 % of its filter, the rest of the
+    // miss unexplained).
     double sphere_hit_per_lane_cycles = 0.0;
 
     template <class V>
