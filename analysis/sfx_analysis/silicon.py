@@ -277,7 +277,18 @@ def width_summary(df):
 
 
 def pct(x):
-    return f"{100 * x:+.1f} %"
+    """'+4.2 %', or '-' where there is nothing to compare (a workload with no render kept)."""
+    return f"{100 * x:+.1f} %" if pd.notna(x) and abs(x) != float("inf") else "-"
+
+
+def mcyc(cycles):
+    """Mcycles with two decimals, or '-' for none (a workload with no render kept)."""
+    return f"{cycles / 1e6:.2f}" if pd.notna(cycles) and cycles > 0 else "-"
+
+
+def share_text(x):
+    """'12 %', or '-' for none (the noise of a workload with no render kept)."""
+    return f"{100 * x:.0f} %" if pd.notna(x) else "-"
 
 
 def converged_text(r):
@@ -292,10 +303,11 @@ def table_text(df):
     for _, r in df.iterrows():
         lines.append(
             f"| {r['isa']} | {r['scene']} | {r['res']} | {r['tile']} | "
-            f"{r['predicted.frame_cycles'] / 1e6:.2f} | "
-            f"{r['measured.frame_cycles'] / 1e6:.2f} | {pct(r['error.frame'])} | "
+            f"{mcyc(r['predicted.frame_cycles'])} | "
+            f"{mcyc(r['measured.frame_cycles'])} | {pct(r['error.frame'])} | "
             f"{pct(r['error.traversal'])} | {pct(r['error.intersection'])} | "
-            f"{pct(r['error.shading'])} | {100 * r['noise']:.0f} % | {converged_text(r)} |")
+            f"{pct(r['error.shading'])} | "
+            f"{share_text(r['noise'])} | {converged_text(r)} |")
     return "\n".join(lines)
 
 
@@ -887,10 +899,9 @@ def html_section(df, directory, plot_name="silicon-check.png"):
     rows = []
     for _, r in df.iterrows():
         cells = [r["isa"], r["scene"], r["res"], r["tile"],
-                 f"{r['predicted.frame_cycles'] / 1e6:.2f}",
-                 f"{r['measured.frame_cycles'] / 1e6:.2f}", pct(r["error.frame"]),
-                 pct(r["error.traversal"]), pct(r["error.intersection"]),
-                 pct(r["error.shading"]), f"{100 * r['noise']:.0f} %", converged_text(r)]
+                 mcyc(r["predicted.frame_cycles"]), mcyc(r["measured.frame_cycles"]),
+                 pct(r["error.frame"]), pct(r["error.traversal"]), pct(r["error.intersection"]),
+                 pct(r["error.shading"]), share_text(r["noise"]), converged_text(r)]
         rows.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in cells) + "</tr>")
     return "\n".join([
         "<h2>The timing model on silicon</h2>",

@@ -514,3 +514,20 @@ def test_branch_predictor(tmp_path):
     # Rows from before the predictor microbenchmarks: said so.
     p.write_text(json.dumps([row("a", 32, 1, 1)]))
     assert "no branch-predictor" in silicon.predictor_text(silicon.load_rows(p))
+
+
+def test_a_workload_with_no_render_kept_shows_dashes(tmp_path):
+    """Every render of a workload set aside: measured 0, no samples. Its row says so with
+    dashes, not '+inf %' and 'nan %', and it is scored nowhere."""
+    rows = [row("a", 16, 110, 100), row("a", 32, 90, 0)]
+    rows[1]["measured.frame_samples"] = []
+    for r in rows:
+        r["measured.converged"] = r["measured.frame_cycles"] > 0
+        r["measured.renders"] = 7 if r["measured.converged"] else 0
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    table = silicon.table_text(df)
+    assert "inf" not in table and "nan" not in table
+    assert "| avx512 | a | 64x64 | 32 | 0.00 | - | - | - | - | - | - | NO (0) |" in table
+    assert silicon.summary(df)["converged"] == 1
