@@ -42,9 +42,9 @@ struct RayPrecomp {
     // Every traced ray is set up here, and a frame's scattered rays point anywhere: the flush,
     // the axis and the swap are chosen by comparisons that feed arithmetic, not jumps, so a
     // ray's cost does not follow its direction (with jumps, set-up cost 29 TSC ticks a camera
-    // ray and 60 a bounced one in furnace's frames; 41 for both without; AMD Zen 4 VM,
-    // 2026-12-03). The same bits as max_axis, the ternaries and std::swap
-    // (kernels/geometry_robust_test.cpp).
+    // ray and 60 a scattered one in furnace's frames; without, 41 a ray on average; AMD Zen 4
+    // VM, 2026-12-03). The same bits as max_axis, the ternaries and std::swap
+    // (tests/kernels/geometry_robust_test.cpp).
     explicit RayPrecomp(const Ray& r) : org(r.org) {
         const auto flush = [](float d) {  // a denormal to the zero of its sign
             const uint32_t tiny = 0u - uint32_t(std::fabs(d) < FLT_MIN);
@@ -393,10 +393,10 @@ inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& n) {
 // Per lane, std::nextafter(x, +inf) where s > 0, std::nextafter(x, -inf) where s < 0, else
 // (s zero or NaN) x: the same bits, by bit operations on four lanes at once. Every scattered
 // ray's origin takes three of these (offset_ray_origin); by the comparisons and library calls
-// before, its cost followed the signs of the surface normals: furnace's sphere, whose normals
-// point anywhere, paid 38 % more a lane in lambertian_direct and 33 % more in
-// lambertian_indirect than by bit operations, cornell's walls nothing (AMD Zen 4 VM,
-// 2026-12-03), and no per-op cost or trace carries a normal's sign.
+// before, its cost followed the signs of the surface normals, which no per-op cost or trace
+// carries: by bit operations, lambertian_direct costs 38 % less a lane and lambertian_indirect
+// 33 % less on furnace's sphere, whose normals point anywhere, and 1 % more and 10 % less on
+// cornell's walls, along a few axes (AMD Zen 4 VM, 2026-12-03).
 SFX_LANES_INLINE __m128 next_floats_towards(__m128 x, __m128 s) {
     const __m128 zero_f = _mm_setzero_ps();
     const __m128i sign = _mm_set1_epi32(int(0x80000000u)), one = _mm_set1_epi32(1);
