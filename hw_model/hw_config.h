@@ -529,7 +529,12 @@ struct OpCostConfig {
     // quick checks): its shading stage -16 % without it, -9 % with it (the emission filter's change
     // in that run lowers the prediction too, so this cost's own part is larger); the direct-light
     // op alone reads +13 %, but its prediction holds its shadow rays' set-up, which the frame's
-    // stage clock books apart.
+    // stage clock books apart. Most of that difference was the jumps of offset_ray_origin on
+    // the sign of each component of a sphere's normal (kernels/intersect.h), which a quad's
+    // fixed normal predicts: refitted with the offset by bit operations, on the AMD Zen 4 VM
+    // (2026-12-03, docs/silicon-check-amd-19h-11h-avx512.md), 0 / 9.1 / 2.4 cycles (scalar /
+    // AVX2 / AVX-512; 80.1 / 82.8 / 81.2 there before), and furnace's shading stage reads
+    // +0.4 / +2.9 / +3.2 % of its sum over the page's workloads.
     double sphere_light_per_pass_cycles = 0.0;
     // The emission filter's: what a lane whose hit is a sphere adds to one whose hit is a
     // triangle (its per_lane_cycles; negative where it saves: a sphere's surface is a normalize
