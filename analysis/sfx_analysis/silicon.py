@@ -296,18 +296,20 @@ def converged_text(r):
     return f"{'yes' if r['measured.converged'] else 'NO'} ({r['measured.renders']})"
 
 
+def workload_cells(r):
+    """One workload's row of the per-workload table, the page's and the report's alike."""
+    return [r["isa"], r["scene"], r["res"], r["tile"], mcyc(r["predicted.frame_cycles"]),
+            mcyc(r["measured.frame_cycles"]), pct(r["error.frame"]), pct(r["error.traversal"]),
+            pct(r["error.intersection"]), pct(r["error.shading"]), share_text(r["noise"]),
+            converged_text(r)]
+
+
 def table_text(df):
     lines = ["| back end | scene | res | tile | predicted Mcyc | measured Mcyc | error | trav err | "
              "isect err | shade err | noise | converged (renders) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in df.iterrows():
-        lines.append(
-            f"| {r['isa']} | {r['scene']} | {r['res']} | {r['tile']} | "
-            f"{mcyc(r['predicted.frame_cycles'])} | "
-            f"{mcyc(r['measured.frame_cycles'])} | {pct(r['error.frame'])} | "
-            f"{pct(r['error.traversal'])} | {pct(r['error.intersection'])} | "
-            f"{pct(r['error.shading'])} | "
-            f"{share_text(r['noise'])} | {converged_text(r)} |")
+        lines.append("| " + " | ".join(str(c) for c in workload_cells(r)) + " |")
     return "\n".join(lines)
 
 
@@ -898,11 +900,8 @@ def html_section(df, directory, plot_name="silicon-check.png"):
             "isect err", "shade err", "noise", "converged (renders)"]
     rows = []
     for _, r in df.iterrows():
-        cells = [r["isa"], r["scene"], r["res"], r["tile"],
-                 mcyc(r["predicted.frame_cycles"]), mcyc(r["measured.frame_cycles"]),
-                 pct(r["error.frame"]), pct(r["error.traversal"]), pct(r["error.intersection"]),
-                 pct(r["error.shading"]), share_text(r["noise"]), converged_text(r)]
-        rows.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in cells) + "</tr>")
+        rows.append("<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in workload_cells(r)) +
+                    "</tr>")
     return "\n".join([
         "<h2>The timing model on silicon</h2>",
         "<p>The host CPU described as a hardware configuration of the machine model "
