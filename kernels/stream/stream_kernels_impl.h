@@ -155,7 +155,7 @@ SFX_LANES_INLINE uint32_t negative_lanes(const vfloat<Width> (&inv_dir)[3], int 
         // Indexed and without jumps (GCC's code for the ternaries and &&): the one-ray loop
         // votes at every inner node, whose split axis changes from node to node and whose
         // sign follows the ray's direction: jumps mispredict on a frame's bounced rays, not on
-        // the microbenchmarks' rays of fixed y and z signs (planes_by_sign, kernels/intersect.h).
+        // the microbenchmarks' rays of fixed y and z signs (slab_entry_exit, kernels/intersect.h).
         const float inv = inv_dir[axis];
         return uint32_t((inv < 0.f) & (inv != -INFINITY)) & lanes;
     } else {

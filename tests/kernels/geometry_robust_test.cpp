@@ -575,3 +575,71 @@ TEST_CASE("geometry: a ray's set-up picks the axes and flushes as the branches d
         check({a, -a, u(rng)});
     }
 }
+
+namespace {
+// What one ray's slab test was written as: slab_test's rule an axis at a time, with jumps.
+// `org` null: the box is relative to the ray's origin (BoxRelativeToOrigin).
+float slab_by_axes(const float* org, const float inv[3], float t_max, const Bounds3& b) {
+    float t0 = 0.f, t1 = t_max * k_slab_t_max_scale;
+    for (int a = 0; a < 3; ++a) {
+        const bool negative = std::signbit(inv[a]);
+        const float near_plane = negative ? b.hi[a] : b.lo[a];
+        const float far_plane = negative ? b.lo[a] : b.hi[a];
+        const float t_near = (org ? near_plane - org[a] : near_plane) * inv[a];
+        const float t_far = (org ? far_plane - org[a] : far_plane) * inv[a] * k_slab_far_scale;
+        if (t_near > t0) t0 = t_near;
+        if (t_far < t1) t1 = t_far;
+    }
+    return t0 <= t1 && t0 != INFINITY ? t0 : INFINITY;
+}
+}  // namespace
+
+TEST_CASE("geometry: one ray's slab test in SSE lanes is the per-axis rule's", "[geometry]") {
+    const auto check = [](const float(&org)[3], const float(&inv)[3], float t_max,
+                          const Bounds3& b) {
+        INFO("org " << org[0] << " " << org[1] << " " << org[2] << ", inv " << inv[0] << " "
+                    << inv[1] << " " << inv[2] << ", t_max " << t_max << ", box " << b.lo.x << " "
+                    << b.lo.y << " " << b.lo.z << " / " << b.hi.x << " " << b.hi.y << " "
+                    << b.hi.z);
+        float t0 = -1.f;
+        const bool pass = slab_test<1>(org, inv, t_max, b, t0);
+        const float expected = slab_by_axes(org, inv, t_max, b);
+        REQUIRE(pass == (expected != INFINITY));
+        if (pass) REQUIRE(same_float(t0, expected));
+        Bounds3 relative;  // as box_filter makes it for lanes that share their origin
+        for (int a = 0; a < 3; ++a) {
+            relative.lo[a] = b.lo[a] - org[a];
+            relative.hi[a] = b.hi[a] - org[a];
+        }
+        const bool relative_pass = slab_test<1>(BoxRelativeToOrigin(), inv, t_max, relative, t0);
+        const float relative_expected = slab_by_axes(nullptr, inv, t_max, relative);
+        REQUIRE(relative_pass == (relative_expected != INFINITY));
+        if (relative_pass) REQUIRE(same_float(t0, relative_expected));
+    };
+    const Bounds3 unit{{-1.f, -1.f, -1.f}, {1.f, 1.f, 1.f}};
+    const float origin[3] = {0.f, 0.f, 0.f}, outside[3] = {-1.f, 1.f, 3.f};
+    for (const float x : k_special_floats)
+        for (const float y : k_special_floats)
+            for (const float z : k_special_floats) {
+                const float inv[3] = {x, y, z};
+                check(origin, inv, INFINITY, unit);
+                check(outside, inv, 2.f, unit);
+            }
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(-2.f, 2.f);
+    const float t_maxes[] = {0.f, 1e-3f, 1.f, 3.f, INFINITY};
+    for (int i = 0; i < 1000000; ++i) {
+        float org[3], inv[3];
+        Bounds3 b;
+        for (int a = 0; a < 3; ++a) {
+            org[a] = u(rng);
+            const float p = u(rng), q = u(rng);
+            b.lo[a] = std::min(p, q);
+            b.hi[a] = i % 5 == 0 ? b.lo[a] : std::max(p, q);  // flat boxes
+            if (i % 7 == 0) org[a] = b.lo[a];                 // origins on a plane: 0 * inf
+            const float d = i % 3 == a ? (i % 2 ? 0.f : -0.f) : u(rng);  // axis-parallel rays
+            inv[a] = 1.f / d;
+        }
+        check(org, inv, t_maxes[i % 5] == 1.f ? std::fabs(u(rng)) * 4.f : t_maxes[i % 5], b);
+    }
+}
