@@ -163,9 +163,10 @@ SFX_LANES_INLINE float slab_entry_exit(const Origin& org, const float inv_dir[3]
         _mm_or_ps(_mm_and_ps(enters, t0), _mm_andnot_ps(enters, _mm_set_ss(INFINITY))));
 }
 
-// Slab test over [0, t_max] for Width rays against one box, written once for the reference
-// tracer (Width 1) and the stream filters (kernels/stream/stream_kernels_impl.h). A lane
-// passes iff its ray enters the box; t0 is the entry distance of passing lanes.
+// Slab test over [0, t_max] for Width rays against one box, one rule for the reference tracer
+// and the stream filters (kernels/stream/stream_kernels_impl.h); one ray (Width 1) takes its
+// three axes in SSE lanes (slab_entry_exit), the wide lanes an axis at a time. A lane passes
+// iff its ray enters the box; t0 is the entry distance of passing lanes.
 // The near and far planes are chosen by the sign of the direction (-0 counts as negative), so
 // no swap is needed. The only NaN source, 0 * inf, means the origin lies on a slab plane and the
 // ray runs inside that plane: the plane then bounds nothing (the box is closed, so it is kept),
