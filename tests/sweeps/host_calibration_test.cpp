@@ -179,7 +179,8 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     auto squared_relative_error = [&](const ShortStreamCosts& c) {
         double sum = 0.0;
         for (const OneLaneSample& x : short_streams) {
-            // Relative, as the fit weighs it (below 100 cycles, the clock's steps).
+            // Relative, as the fit weighs it (k_resolution in hw_model/op_cost_fit.cpp: below
+            // 100 cycles, the clock's steps).
             const double e = (short_stream_cycles(c, x) - x.cycles) / std::max(x.cycles, 100.0);
             sum += e * e;
         }
