@@ -181,6 +181,9 @@ struct StreamOp {
     // does about two thirds of a passing lane's work (OpCostConfig::
     // per_failed_candidate_cycles); 0 for every other kind.
     uint32_t failed_candidates = 0;
+    // The box test a traversal starts with (its entry node's): a CPU core's traversal pays its
+    // set-up there (OpCostConfig::traversal_start_cycles), once per traversal whatever its ops.
+    bool starts_traversal = false;
 };
 
 // One tile pass: one sample of every pixel of a tile, traced breadth-first to the end.
@@ -247,10 +250,11 @@ struct TraceFrame {
 
 // What a trace is of; written at the head of a trace file. Version 2 added the seed papers'
 // options (primary_entry, reorder, reorder_lod_ppm), version 3 RayGrid batching (batching,
-// batching_queue, batching_cell_prims), version 4 each op's failed candidates; an older file
-// reads with the later fields' defaults (an op's failed candidates 0).
+// batching_queue, batching_cell_prims), version 4 each op's failed candidates, version 5 whether
+// it starts a traversal; an older file reads with the later fields' defaults (an op's failed
+// candidates 0, no op starting a traversal).
 struct TraceHeader : TraceFrame {
-    static constexpr uint32_t k_version = 4;
+    static constexpr uint32_t k_version = 5;
     uint32_t version = k_version;
     uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
 };
@@ -388,6 +392,7 @@ class TraceRecorder : public TraceSink {
         OpStage stage;
         uint16_t generation;
         uint32_t object, length, pass_count, failed_candidates;
+        bool starts_traversal;
         size_t offset;
     };
     TilePass m_pass;

@@ -307,6 +307,12 @@ uint32_t partition(uint32_t* ids, uint32_t n, const uint8_t* mask, uint32_t* scr
     return front;
 }
 
+// Whether an op is the traversal's first: the box test of its entry node, which no other op of
+// the traversal tests (StreamOp::starts_traversal).
+SFX_LANES_INLINE bool starts_traversal(const TraversalJob& job, OpKind kind, uint32_t object) {
+    return kind == OpKind::box_test && object == job.entry;
+}
+
 // Reports one op of the traversal to job.sink at the detail asked for.
 template <TraceDetail Detail>
 SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage, uint32_t object,
@@ -314,8 +320,8 @@ SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage
                              uint32_t failed_candidates) {
     if constexpr (Detail != TraceDetail::none) {
         if constexpr (Detail != TraceDetail::lanes) ids = nullptr, mask = nullptr;
-        job.sink->op(
-            StreamOp{kind, stage, job.generation, object, n, passed, ids, mask, failed_candidates});
+        job.sink->op(StreamOp{kind, stage, job.generation, object, n, passed, ids, mask,
+                              failed_candidates, starts_traversal(job, kind, object)});
     }
 }
 
@@ -352,7 +358,7 @@ struct OpTally {
         if (first) {
             first = false;
             job.sink->op(StreamOp{kind, stage, job.generation, object, n, pass, nullptr, nullptr,
-                                  failed_candidates});
+                                  failed_candidates, starts_traversal(job, kind, object)});
             return;
         }
         const int k = kind == OpKind::box_test ? 0 : kind == OpKind::triangle_test ? 1 : 2;

@@ -372,11 +372,16 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CountingSink direct(widths);
     const RenderResult a = render_stream(s, bvh, r, &direct);
     // The failed candidates the tracer tallies for a counts-only sink (ops_of_length), and
-    // below the ones each op of the file carries.
+    // below the ones each op of the file carries; and the ops that start a traversal.
     struct FailedCandidates : TraceSink {
         bool counts = true;
-        uint64_t sum = 0;
-        void op(const StreamOp& o) override { sum += o.failed_candidates; }
+        uint64_t sum = 0, starts = 0, box_calls = 0, starts_not_box = 0;
+        void op(const StreamOp& o) override {
+            sum += o.failed_candidates;
+            starts += o.starts_traversal;
+            box_calls += o.kind == OpKind::box_test;
+            starts_not_box += o.starts_traversal && o.kind != OpKind::box_test;
+        }
         void ops_of_length(OpKind, OpStage, uint16_t, uint32_t, uint32_t, uint32_t,
                            uint32_t failed_candidates) override {
             sum += failed_candidates;
@@ -410,6 +415,14 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     from_file.counts = false;
     read_trace_file(p1, from_file);
     CHECK(from_file.sum == tallied.sum);
+    // A counts-only sink gets each traversal's first op alone (OpTally) and the rest of its box
+    // tests as tallies: its box-test calls count the traversals, and each starts one; the file
+    // flags as many of its box tests, and nothing else.
+    CHECK(tallied.box_calls > 0);
+    CHECK(tallied.starts == tallied.box_calls);
+    CHECK(from_file.starts == tallied.box_calls);
+    CHECK(from_file.box_calls > 3 * from_file.starts);
+    CHECK(from_file.starts_not_box == 0);
     CountingSink replayed(widths);
     const TraceHeader h = read_trace_file(p1, replayed);
     CHECK(h.scene_hash == scene_hash(s));
@@ -467,7 +480,7 @@ std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_co
 }
 }  // namespace
 
-TEST_CASE("Trace file version 4: the header carries the whole frame, the seed papers' options too",
+TEST_CASE("Trace file version 5: the header carries the whole frame, the seed papers' options too",
           "[stream]") {
     const Scene s = cluster_scene(true);
     const Bvh bvh(s);
@@ -486,7 +499,7 @@ TEST_CASE("Trace file version 4: the header carries the whole frame, the seed pa
     }
     CountingSink sink({8});
     const TraceHeader h = read_trace_file(path, sink);
-    CHECK(h.version == 4);
+    CHECK(h.version == 5);
     CHECK(h.width == r.width);
     CHECK(h.height == r.height);
     CHECK(h.spp == r.spp);
