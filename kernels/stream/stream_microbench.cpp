@@ -914,7 +914,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
     std::vector<uint32_t> order(k_slots);
     std::iota(order.begin(), order.end(), 0u);
     // Every stream its own ids with the kernels' padding: the traversal partitions them in place.
-    std::vector<uint32_t> stream_ids, other_ids;
+    std::vector<uint32_t> stream_ids, other_ids, stream_entry;
     std::vector<OneRaySample> out;
     struct Shape {
         uint32_t rays, streams;  // rays per stream, streams one after another
@@ -952,6 +952,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             std::shuffle(order.begin(), order.end(), rng);
             const uint32_t stride = rays + k_stream_padding;
             stream_ids.assign(size_t(streams) * stride, 0u);
+            stream_entry.assign(streams, 0u);
             // A bundle: one origin, targets within a cell of the floor, so that it stays one
             // stream for several levels (its rays restored after the batch).
             if (shape.bundle)
@@ -976,20 +977,26 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                     b.hit[ids[i]] = Hit{};
                 }
             };
-            auto traverse = [&](uint32_t* ids, TraceDetail detail, uint32_t entry_depth) {
+            // A traversal as the tracer starts one (its job's stream, the shared-origin check);
+            // the entry node found beforehand, as a frame's is by the search it traces as ops.
+            auto traverse = [&](uint32_t* ids, TraceDetail detail, uint32_t entry) {
                 job.n = rays;
                 job.ids = ids;
-                job.entry = entry_below(bvh, b.pre[ids[0]], b.ray[ids[0]].t_max, entry_depth);
+                job.entry = entry;
                 job.shared_origin = shared_origin(job.rays, ids, rays);  // as the tracer
                 kernels.traverse[int(detail)](job);
             };
             auto reset = [&] {
-                for (uint32_t s = 0; s < streams; ++s)
-                    load_stream(s * rays, stream_ids.data() + size_t(s) * stride);
+                for (uint32_t s = 0; s < streams; ++s) {
+                    uint32_t* ids = stream_ids.data() + size_t(s) * stride;
+                    load_stream(s * rays, ids);
+                    stream_entry[s] =
+                        entry_below(bvh, b.pre[ids[0]], b.ray[ids[0]].t_max, shape.entry_depth);
+                }
             };
             auto run = [&](TraceDetail detail) {
                 for (uint32_t s = 0; s < streams; ++s)
-                    traverse(stream_ids.data() + size_t(s) * stride, detail, shape.entry_depth);
+                    traverse(stream_ids.data() + size_t(s) * stride, detail, stream_entry[s]);
             };
             // Before each repetition, every other ray's traversal, in streams of as many rays, in
             // a new order: a branch predictor learns a batch of a few traversals that repeats
