@@ -622,6 +622,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
                       ? ", one_ray_entry_cycles: " + fmt(o.one_ray_entry_cycles, 2) +
                             ", few_ray_entry_cycles: " + fmt(o.few_ray_entry_cycles, 2)
                       : std::string())
+              << (o.traversal_start_cycles > 0
+                      ? ", traversal_start_cycles: " + fmt(o.traversal_start_cycles, 2)
+                      : std::string())
               << (o.hit_read_exposed_share > 0
                       ? ", hit_read_exposed_share: " + fmt(o.hit_read_exposed_share, 3)
                       : std::string())

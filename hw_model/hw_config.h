@@ -487,6 +487,14 @@ struct OpCostConfig {
     double few_lane_cycles = -1.0;                  // negative: not measured, the formula applies
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
     double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
+    // The box test's: what a traversal costs once besides its ops (the tracer's set-up of a
+    // traversal job and its shared-origin check, the loop's start and end), carried by the box
+    // test it starts with (StreamOp::starts_traversal). Fitted with the loop entries on the
+    // traversal microbenchmark's batches, each stream of which is one traversal: furnace's
+    // traversals are one box test and one leaf each, and the stream loop's per-op costs left
+    // about 105 cycles a traversal unpriced (an AMD Zen 4 VM at AVX2, 2026-12-04: 165
+    // traversals, 103.4 k cycles measured against 72.4 k priced). 0: not measured.
+    double traversal_start_cycles = 0.0;
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L2 hit (hit_read_latency_hidden, hw_model/cache_model.h) that
     // the core does not overlap with other work, fitted
@@ -605,6 +613,10 @@ struct OpCostConfig {
         v.param("few_ray_entry_cycles", few_ray_entry_cycles, "cycles",
                 "cost of entering the few-ray traversal loop from the stream loop, besides its "
                 "ops (the box test that enters it carries it; 0: not measured)",
+                0.0, 1e9);
+        v.param("traversal_start_cycles", traversal_start_cycles, "cycles",
+                "the box test's: cost of starting a traversal, besides its ops (the box test "
+                "it starts with carries it; 0: not measured)",
                 0.0, 1e9);
         v.param("hit_read_exposed_share", hit_read_exposed_share, "",
                 "share of each lane's hit-primitive read latency beyond an L2 hit that is not "

@@ -134,10 +134,11 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
     return x;
 }
 
-// A sample's one-lane counts, its few-lane counts, its stream-loop counts and its loop entries,
-// as a row of the fit.
+// A sample's one-lane counts, its few-lane counts, its stream-loop counts, its loop entries and
+// its traversals, as a row of the fit.
 constexpr size_t k_entry_terms = 3 * k_op_kind_count;
-constexpr size_t k_short_terms = k_entry_terms + 2;
+constexpr size_t k_traversal_term = k_entry_terms + 2;
+constexpr size_t k_short_terms = k_traversal_term + 1;
 std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
     std::array<double, k_short_terms> row{};
     for (size_t k = 0; k < k_op_kind_count; ++k) {
@@ -146,6 +147,7 @@ std::array<double, k_short_terms> short_stream_row(const OneLaneSample& s) {
         row[2 * k_op_kind_count + k] = double(s.stream_ops[k]);
     }
     for (size_t l = 0; l < 2; ++l) row[k_entry_terms + l] = double(s.entries[l]);
+    row[k_traversal_term] = double(s.traversals);
     return row;
 }
 
@@ -157,7 +159,7 @@ double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& s
         cycles += double(s.ops[k]) * costs.one_lane[k] + double(s.few_ops[k]) * costs.few_lane[k] +
                   double(s.stream_ops[k]) * costs.stream_per_op[k];
     for (size_t l = 0; l < 2; ++l) cycles += double(s.entries[l]) * costs.entry[l];
-    return cycles;
+    return cycles + double(s.traversals) * costs.traversal_start;
 }
 
 OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
@@ -215,6 +217,7 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         costs.few_lane_measured[k] = active[k_op_kind_count + k];
     }
     for (size_t l = 0; l < 2; ++l) costs.entry[l] = x[k_entry_terms + l];
+    costs.traversal_start = x[k_traversal_term];
     return costs;
 }
 

@@ -80,6 +80,7 @@ struct OneLaneSample {
     double stream_op_cycles = 0.0;
     std::array<uint64_t, k_op_kind_count> stream_ops{};
     std::array<uint64_t, 2> entries{};  // the one-ray and few-ray loops entered (TraversalLoop)
+    uint64_t traversals = 0;            // traversals started (StreamOp::starts_traversal)
     double leaf_op_cycles = 0.0;  // the leaf tests' part of stream_op_cycles (reported)
 };
 
@@ -98,6 +99,8 @@ struct ShortStreamCosts {
     // What entering the one-ray and the few-ray loop costs besides their ops (OpCostConfig::
     // one_ray_entry_cycles, few_ray_entry_cycles).
     std::array<double, 2> entry{};
+    // What starting a traversal costs besides its ops (OpCostConfig::traversal_start_cycles).
+    double traversal_start = 0.0;
 };
 ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
 // A sample's cycles as the fitted costs price it.

@@ -294,6 +294,10 @@ double OpProfile::loop_entry_cycles(TraversalLoop loop) const {
     return 0.0;
 }
 
+double OpProfile::traversal_start_cycles() const {
+    return measured ? cost.traversal_start_cycles : 0.0;
+}
+
 double OpProfile::result_cycles(const DatapathConfig& d, double issue) const {
     if (measured) return issue;
     if (cluster(d)) return double(schedule.length);

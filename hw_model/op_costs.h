@@ -136,6 +136,9 @@ struct OpProfile {
     // loop from the stream loop (TraversalLoop, kernels/trace.h): a measured box test's loop
     // entry cost; 0 for any other op or loop.
     double loop_entry_cycles(TraversalLoop loop) const;
+    // Cycles the op adds on its first group when it starts a traversal (StreamOp::
+    // starts_traversal): a measured box test's traversal_start_cycles; 0 otherwise.
+    double traversal_start_cycles() const;
     // Cycles from a group's first issue to its mask: the measured cost (its loads and chain are
     // inside it), the datapath's dependent chain or the cluster's schedule length.
     double result_cycles(const DatapathConfig& datapath, double issue) const;

@@ -61,6 +61,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     std::vector<OneLaneSample> out;
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
+        sample.traversals = s.streams;
         sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
         // One-lane leaf tests at their directly timed cost, by outcome.
         for (size_t k = 0; k < k_op_kind_count; ++k)
@@ -124,6 +125,7 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
         if (kind == OpKind::box_test) {
             o.one_ray_entry_cycles = fit.entry[0];
             o.few_ray_entry_cycles = fit.entry[1];
+            o.traversal_start_cycles = fit.traversal_start;
         }
     }
 }
@@ -419,8 +421,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "medians of their one-lane points that fail, pass and (the triangle test's) fail as "
          << "candidates (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
          << "+ lanes) few-lane box "
-         << "costs, the one-ray and few-ray loops' entry costs and the stream loop's per-op "
-         << "box cost, from " << c.one_ray_samples.size()
+         << "costs, the one-ray and few-ray loops' entry costs, a traversal's start and the "
+         << "stream loop's per-op box cost, from " << c.one_ray_samples.size()
          << " batches of traversals (8-32 streams of one ray and 4-32 of 2 to " << k_few_ray_lanes
          << " rays from the root, 8 and 32 entering 3 and 6 levels down, 1 and 4 of 8 to 128) "
          << "of the same scene, other rays' traversals between repetitions, less the model's "

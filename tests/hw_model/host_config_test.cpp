@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 #include <functional>
+#include <numeric>
 #include <random>
 
 #include "base/input_error.h"
@@ -494,9 +495,10 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
           "[host]") {
     auto sample = [](uint64_t boxes, uint64_t triangles, uint64_t spheres, uint64_t few_boxes,
                      uint64_t stream_boxes, double stream_cycles, uint64_t one_entries = 0,
-                     uint64_t few_entries = 0) {
+                     uint64_t few_entries = 0, uint64_t traversals = 0) {
         OneLaneSample s;
         s.entries = {one_entries, few_entries};
+        s.traversals = traversals;
         s.ops[size_t(OpKind::box_test)] = boxes;
         s.ops[size_t(OpKind::triangle_test)] = triangles;
         s.ops[size_t(OpKind::sphere_test)] = spheres;
@@ -504,7 +506,8 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
         s.stream_ops[size_t(OpKind::box_test)] = stream_boxes;
         s.stream_op_cycles = stream_cycles;
         s.cycles = 30.0 * boxes + 90.0 * triangles + 40.0 * spheres + 55.0 * few_boxes +
-                   140.0 * stream_boxes + stream_cycles + 25.0 * one_entries + 260.0 * few_entries;
+                   140.0 * stream_boxes + stream_cycles + 25.0 * one_entries + 260.0 * few_entries +
+                   70.0 * traversals;
         return s;
     };
     std::vector<OneLaneSample> samples;
@@ -566,6 +569,23 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     no_entry.entry[1] = 0;
     CHECK(short_stream_fit_error(no_entry, entered).second > 0.05);
     CHECK(fit.entry[0] == 0.0);  // samples without entries: none fitted
+    CHECK(fit.traversal_start == 0.0);
+
+    // A traversal's start: told from the ops and entries where traversals hold more or fewer of
+    // them (streams of one ray and of many, from the root and deep).
+    std::vector<OneLaneSample> started;
+    for (uint64_t b : {7u, 23u, 130u})
+        for (uint64_t w : {0u, 4u, 19u})
+            for (uint64_t e : {1u, 4u, 9u})
+                for (uint64_t n : {1u, 8u, 32u})
+                    started.push_back(sample(b, 0, 0, 0, w, 300.0, e, 0, n));
+    const ShortStreamCosts with_starts = fit_short_stream_cycles(started);
+    CHECK(with_starts.traversal_start == Approx(70).epsilon(1e-6));
+    CHECK(with_starts.entry[0] == Approx(25).epsilon(1e-6));
+    CHECK(short_stream_fit_error(with_starts, started).second < 1e-9);
+    ShortStreamCosts no_start = with_starts;
+    no_start.traversal_start = 0;
+    CHECK(short_stream_fit_error(no_start, started).second > 0.05);
 }
 
 TEST_CASE("The box test that enters a short loop from the stream loop carries its entry cost",
@@ -614,6 +634,43 @@ TEST_CASE("The box test that enters a short loop from the stream loop carries it
     CHECK(busy(with) == busy(without) + 100);  // one entry, not two
     CHECK(with.traversal_loop_cycles[size_t(TraversalLoop::one_ray)] ==
           without.traversal_loop_cycles[size_t(TraversalLoop::one_ray)] + 100);
+}
+
+TEST_CASE("The box test a traversal starts with carries the traversal's start cost", "[host]") {
+    OpProfile p;
+    p.measured = true;
+    p.cost.traversal_start_cycles = 70;
+    CHECK(p.traversal_start_cycles() == 70);
+    p.measured = false;  // instruction-priced: no start cost
+    CHECK(p.traversal_start_cycles() == 0);
+
+    // In the machine model: two traversals of a 16-lane stream, each a box test at its entry and
+    // one below it; each pays the start once, on its first op.
+    auto time_traversals = [](double start) {
+        OpCostConfig box = cost("box_test", 10, 4, 0, 0, 0);
+        box.traversal_start_cycles = start;
+        SystemcTiming timing({host_with({box})}, shape());
+        std::vector<uint32_t> ids(16);
+        std::iota(ids.begin(), ids.end(), 0u);
+        const std::vector<uint8_t> all(16, 1);
+        TilePass pass;
+        pass.slot_count = 64;
+        timing.begin_pass(pass);
+        for (bool starts : {true, false, true, false}) {
+            StreamOp op;
+            op.kind = OpKind::box_test;
+            op.stage = OpStage::traversal;
+            op.length = 16;
+            op.pass_count = 16;
+            op.slots = ids.data();
+            op.passed = all.data();
+            op.starts_traversal = starts;
+            timing.op(op);
+        }
+        timing.end_pass(pass);
+        return timing.timing(0).stages[0][size_t(OpStage::traversal)].busy_cycles;
+    };
+    CHECK(time_traversals(70) == time_traversals(0) + 2 * 70);
 }
 
 TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
@@ -833,6 +890,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.per_minority_lane_cycles = 7;
     box.one_ray_entry_cycles = 8;
     box.few_ray_entry_cycles = 9.5;
+    box.traversal_start_cycles = 41.25;
     box.node_read_exposed_share = 0.375;
     HostDescription host = small_host();
     host.slot_arrays = 7;
@@ -878,6 +936,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
     CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
     CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
+    CHECK(c.op_costs[0].traversal_start_cycles == Approx(41.25));
     CHECK(c.op_costs[0].node_read_exposed_share == Approx(0.375));
     CHECK(c.branch_predictor.kind == "tage");
     CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
