@@ -490,10 +490,14 @@ struct OpCostConfig {
     // The box test's: what a traversal costs once besides its ops (the tracer's set-up of a
     // traversal job and its shared-origin check, the loop's start and end), carried by the box
     // test it starts with (StreamOp::starts_traversal). Fitted with the loop entries on the
-    // traversal microbenchmark's batches, each stream of which is one traversal: furnace's
-    // traversals are one box test and one leaf each, and the stream loop's per-op costs left
-    // about 105 cycles a traversal unpriced (an AMD Zen 4 VM at AVX2, 2026-12-04: 165
-    // traversals, 103.4 k cycles measured against 72.4 k priced). 0: not measured.
+    // traversal microbenchmark's batches, each stream of which is one traversal. Why: furnace's
+    // traversals are one box test and one leaf each, and timed by parts they cost about 190
+    // cycles more than their ops are priced, about 105 of it the traversal's set-up and 70 the
+    // stage clock's own reads (an AMD Zen 4 VM at AVX2, session 57: 165 traversals, 103.4 k
+    // cycles measured against 72.4 k priced). The fit gave 0 on every back end of that VM
+    // (2026-12-04): a one-ray batch's traversals equal its one-ray loop entries and rise with
+    // its box tests, so only the stream-loop batches tell a traversal apart, and there it is a
+    // fraction of a percent. Default 0: not measured.
     double traversal_start_cycles = 0.0;
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L2 hit (hit_read_latency_hidden, hw_model/cache_model.h) that
