@@ -659,6 +659,10 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.monitor_share"] = m.monitor_share;
             row["measured.frame_cycles_parts"] = m.measured_frame_parts;
             row["measured.frame_parts"] = m.frame_parts;
+            row["measured.frame_parts_converged"] = m.parts_convergence.converged;
+            row["measured.frame_parts_samples"] = m.parts_convergence.samples;
+            if (std::isfinite(m.parts_convergence.spread))
+                row["measured.frame_parts_spread"] = m.parts_convergence.spread;
             row["measured.frame_tsc"] = m.measured_frame_tsc;
             for (int sg = 0; sg < 3; ++sg) {
                 row[std::string("predicted.") + k_stage_names[sg] + "_cycles"] =

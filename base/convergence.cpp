@@ -1,6 +1,7 @@
 #include "base/convergence.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -28,6 +29,26 @@ Convergence judge_convergence(const std::vector<double>& samples, const Converge
                                  : (kth_value > 0 ? std::numeric_limits<double>::infinity() : 0.0);
     const size_t enough = std::min(rule.min_samples, rule.budget);
     c.converged = samples.size() >= enough && c.spread <= rule.tolerance;
+    return c;
+}
+
+Convergence judge_parts_convergence(const std::vector<std::vector<double>>& parts,
+                                    const ConvergenceRule& rule) {
+    Convergence c;
+    c.spread = std::numeric_limits<double>::infinity();
+    if (parts.empty()) return c;
+    c.samples = std::numeric_limits<uint32_t>::max();
+    double kth_sum = 0.0;
+    for (const std::vector<double>& part : parts) {
+        const Convergence p = judge_convergence(part, rule);
+        c.samples = std::min(c.samples, p.samples);
+        c.fastest += p.fastest;
+        kth_sum += std::isfinite(p.spread) ? p.fastest * (1.0 + p.spread) : p.spread;
+    }
+    if (std::isfinite(kth_sum))
+        c.spread = c.fastest > 0 ? kth_sum / c.fastest - 1.0 : (kth_sum > 0 ? c.spread : 0.0);
+    const size_t enough = std::min(rule.min_samples, rule.budget);
+    c.converged = c.samples >= enough && c.spread <= rule.tolerance;
     return c;
 }
 

@@ -33,6 +33,13 @@ struct Convergence {
 // the whole budget, if smaller) and a spread within the tolerance.
 Convergence judge_convergence(const std::vector<double>& samples, const ConvergenceRule& rule);
 
+// A measurement read as the sum of parts that each repeat (a frame's generations, each timed
+// in every render over which the core was alone, sfx calibrate --check): its fastest the sum of
+// each part's fastest sample, its spread the sum of each part's k-th fastest over that, less 1,
+// its samples the fewest any part has. Converged as judge_convergence's sum would be: every part
+// has enough samples and the spread is within the tolerance. No parts: not converged.
+Convergence judge_parts_convergence(const std::vector<std::vector<double>>& parts,
+                                    const ConvergenceRule& rule);
 // The rule for samples beside which `discarded` more were taken and set aside (readings that
 // cannot be trusted): each spent the budget as a sample does.
 ConvergenceRule after_discarded(ConvergenceRule rule, uint32_t discarded);

@@ -101,14 +101,17 @@ namespace {
 std::atomic<double> g_shared_below{0.0};
 std::atomic<uint32_t> g_probes{0}, g_shared{0};
 std::atomic<uint64_t> g_probe_ticks{0};
+// Written by the handler on the monitored thread only, read after the timer stops.
+ContentionMonitor::Probe g_marks[ContentionMonitor::k_kept_probes];
 
 void probe_core(int) {
     const int saved_errno = errno;
     const uint64_t start = __rdtsc();
     const double rate = independent_adds_per_tick(1);
-    g_probes.fetch_add(1, std::memory_order_relaxed);
-    if (rate < g_shared_below.load(std::memory_order_relaxed))
-        g_shared.fetch_add(1, std::memory_order_relaxed);
+    const uint32_t index = g_probes.fetch_add(1, std::memory_order_relaxed);
+    const bool shared = rate < g_shared_below.load(std::memory_order_relaxed);
+    if (shared) g_shared.fetch_add(1, std::memory_order_relaxed);
+    if (index < ContentionMonitor::k_kept_probes) g_marks[index] = {start, shared};
     g_probe_ticks.fetch_add(__rdtsc() - start, std::memory_order_relaxed);
     errno = saved_errno;
 }
@@ -153,6 +156,8 @@ ContentionMonitor::Tally ContentionMonitor::stop() {
         m_tally.probes = g_probes;
         m_tally.shared = g_shared;
         m_tally.probe_ticks = double(g_probe_ticks.load());
+        std::atomic_signal_fence(std::memory_order_seq_cst);
+        m_tally.marks.assign(g_marks, g_marks + std::min(m_tally.probes, k_kept_probes));
     }
     return m_tally;
 }
@@ -163,6 +168,27 @@ ContentionMonitor::~ContentionMonitor() {
         timer_delete(*static_cast<timer_t*>(m_timer));
         delete static_cast<timer_t*>(m_timer);
     }
+}
+
+std::vector<bool> clean_spans(const std::vector<ContentionMonitor::Probe>& marks,
+                              const std::vector<std::pair<uint64_t, uint64_t>>& spans,
+                              uint64_t reach) {
+    std::vector<bool> clean(spans.size(), false);
+    auto before = [](const ContentionMonitor::Probe& m, uint64_t t) { return m.tsc < t; };
+    for (size_t i = 0; i < spans.size(); ++i) {
+        const auto [start, end] = spans[i];
+        // The first probe at or after the span's start, and the last before it.
+        auto first = std::lower_bound(marks.begin(), marks.end(), start, before);
+        const bool seen_before = first != marks.begin() && start - std::prev(first)->tsc <= reach;
+        if (seen_before && std::prev(first)->shared) continue;
+        auto after = first;
+        bool shared_inside = false;
+        for (; after != marks.end() && after->tsc < end; ++after) shared_inside |= after->shared;
+        const bool seen_after = after != marks.end() && after->tsc - end <= reach;
+        if (shared_inside || (seen_after && after->shared)) continue;
+        clean[i] = seen_before && seen_after;
+    }
+    return clean;
 }
 
 }  // namespace sfx

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace sfx {
@@ -91,11 +92,21 @@ CoreContention& core_contention();
 // Where the timer cannot be made (timer_create fails), the monitor probes nothing (probes 0).
 class ContentionMonitor {
   public:
+    // A probe: the TSC when it started and whether it found the core shared.
+    struct Probe {
+        uint64_t tsc = 0;
+        bool shared = false;
+    };
     struct Tally {
         uint32_t probes = 0;       // handler runs over the region
         uint32_t shared = 0;       // of which found the core shared
         double probe_ticks = 0.0;  // TSC ticks the handler spent: the monitor's own cost
+        // Each probe in order (the first k_kept_probes): where in a region the core was shared,
+        // so that a part of it between probes that found the core alone can be kept
+        // (clean_spans).
+        std::vector<Probe> marks;
     };
+    static constexpr uint32_t k_kept_probes = 1u << 16;
     ContentionMonitor(double shared_below, double period_us = 1000.0);
     ~ContentionMonitor();
     ContentionMonitor(const ContentionMonitor&) = delete;
@@ -107,5 +118,14 @@ class ContentionMonitor {
     bool m_running = false;
     Tally m_tally;
 };
+
+// Whether each span [start, end) of TSC ticks ran on a core alone by the probes around it
+// (`marks`, in TSC order): the nearest probe at or before it and the nearest after it, each
+// within `reach` ticks of the span, found the core alone, as did any probe inside it. A burst
+// of the sibling shorter than the probes' period can fall between two of them unseen, as it can
+// between a whole region's probes.
+std::vector<bool> clean_spans(const std::vector<ContentionMonitor::Probe>& marks,
+                              const std::vector<std::pair<uint64_t, uint64_t>>& spans,
+                              uint64_t reach);
 
 }  // namespace sfx

@@ -32,6 +32,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     for (uint32_t k = 0; k < k_op_kind_count; ++k) shading_op_tsc[k] += o.shading_op_tsc[k];
     ray_setup_tsc += o.ray_setup_tsc;
     part_tsc.insert(part_tsc.end(), o.part_tsc.begin(), o.part_tsc.end());
+    part_start_tsc.insert(part_start_tsc.end(), o.part_start_tsc.begin(), o.part_start_tsc.end());
     entry_searches += o.entry_searches;
     entry_depth_sum += o.entry_depth_sum;
     batch_queues += o.batch_queues;

@@ -76,6 +76,9 @@ struct RenderStats {
     // order they ran; with one thread that is the same order, and the same work, in every
     // render of a frame (sfx calibrate --check takes each part's fastest over its renders).
     std::vector<uint64_t> part_tsc;
+    // The TSC when each part started: where in the render it ran, for the contention monitor's
+    // probes around it (base/core_contention.h, clean_spans).
+    std::vector<uint64_t> part_start_tsc;
 
     uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
     RenderStats& operator+=(const RenderStats& o);

@@ -455,6 +455,9 @@ bool pin_to_current_cpu() {
 
 namespace {
 
+// How often the contention monitor probes a render (ContentionMonitor): every millisecond.
+constexpr double k_monitor_period_us = 1000.0;
+
 // The machine model's prediction of one workload, through the path sfx simulate takes.
 void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
              bool cold, SiliconMeasurement& m) {
@@ -602,10 +605,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
     for (auto& kinds : shading_op_min) kinds.fill(1e300);
     std::vector<double> ray_setup_min(n, 1e300);
     std::vector<std::vector<double>> clocked_totals(n), tsc_samples(n);
-    // Each part's fewest ticks over the unclocked renders, the rest's, and the renders' cycles a
-    // tick (SiliconMeasurement::measured_frame_parts).
-    std::vector<std::vector<uint64_t>> part_min(n);
-    std::vector<double> part_rest_min(n, 1e300);
+    // Each part's ticks in the unclocked renders whose clock held, where the monitor's probes
+    // around it found the core alone (clean_spans), the rest of each such render (its ticks
+    // outside the parts), and the renders' cycles a tick (SiliconMeasurement::
+    // measured_frame_parts).
+    std::vector<std::vector<std::vector<double>>> part_clean(n);
+    std::vector<std::vector<double>> part_rest(n);
     std::vector<std::vector<double>> cycles_per_tick(n);
     std::vector<std::vector<CycleReading>> readings(n);
     // With memory_now, the L3 chased at the start of each round, and each render's round.
@@ -695,12 +700,13 @@ std::vector<SiliconMeasurement> predict_and_measure(
                     std::min(shading_op_min[v][k], double(r.stats.shading_op_tsc[k]));
             ray_setup_min[v] = std::min(ray_setup_min[v], double(r.stats.ray_setup_tsc));
             clocked_totals[v].push_back(clocked.cycles);
-            core_contention().wait();
+            const bool alone_before = core_contention().wait();
+            const uint64_t waited_at = read_tsc();
             const std::vector<CpuTimes> load_before = read_cpu_times();
-            ContentionMonitor monitor(core_contention().shared_below());
+            ContentionMonitor monitor(core_contention().shared_below(), k_monitor_period_us);
             auto [reading, ticks] = timed_render(scene, bvh, settings[v], false, source_of(v),
                                                  tsc_mhz, r, m.interrupted);
-            const ContentionMonitor::Tally probed = monitor.stop();
+            ContentionMonitor::Tally probed = monitor.stop();
             const std::vector<CpuTimes> load_after = read_cpu_times();
             // The monitor's probes ran in the render's thread: their ticks at the render's clock
             // come off its cycles (the signals' delivery, a few hundred cycles each, stays in).
@@ -715,20 +721,33 @@ std::vector<SiliconMeasurement> predict_and_measure(
             // or two in a render of 50 ms is within what the fastest renders' agreement
             // tolerates), or just after it, as the gate finds it (a render of a millisecond or
             // two may see no probe).
-            const bool shared =
-                probed.shared > 0.1 * probed.probes || core_contention().contended();
+            const uint64_t checked_at = read_tsc();
+            const bool shared_after = core_contention().contended();
+            const bool shared = probed.shared > 0.1 * probed.probes || shared_after;
+            // The gate's checks just before and after the render are probes too: the first
+            // and last parts have one on their far side.
+            probed.marks.insert(probed.marks.begin(), {waited_at, !alone_before});
+            probed.marks.push_back({checked_at, shared_after});
             const std::vector<uint64_t>& parts = r.stats.part_tsc;
-            if (part_min[v].empty()) part_min[v] = parts;
-            if (parts.size() == part_min[v].size()) {
-                uint64_t sum = 0;
+            if (part_clean[v].empty()) part_clean[v].resize(parts.size());
+            if (parts.size() == part_clean[v].size() &&
+                clock_moved(reading) <= convergence.tolerance && ticks > 0) {
+                std::vector<std::pair<uint64_t, uint64_t>> spans;
+                double sum = 0.0;
                 for (size_t p = 0; p < parts.size(); ++p) {
-                    part_min[v][p] = std::min(part_min[v][p], parts[p]);
-                    sum += parts[p];
+                    spans.push_back(
+                        {r.stats.part_start_tsc[p], r.stats.part_start_tsc[p] + parts[p]});
+                    sum += double(parts[p]);
                 }
-                part_rest_min[v] = std::min(part_rest_min[v], std::max(0.0, ticks - double(sum)));
-            }
-            if (clock_moved(reading) <= convergence.tolerance && ticks > 0)
+                // A probe within one and a half periods of a part: the next one after it or
+                // the one before (a signal can come late by a little).
+                const std::vector<bool> clean =
+                    clean_spans(probed.marks, spans, uint64_t(1.5 * k_monitor_period_us * tsc_mhz));
+                for (size_t p = 0; p < parts.size(); ++p)
+                    if (clean[p]) part_clean[v][p].push_back(double(parts[p]));
+                part_rest[v].push_back(std::max(0.0, ticks - sum));
                 cycles_per_tick[v].push_back(reading.cycles / ticks);
+            }
             for (size_t c = 0; c < load_before.size() && c < load_after.size(); ++c)
                 if (int(c) != own_cpu) {
                     others_busy[v] += load_after[c].busy - load_before[c].busy;
@@ -776,11 +795,12 @@ std::vector<SiliconMeasurement> predict_and_measure(
         m.probe_after = probe_after[lanes];
         m.convergence = judge_convergence(m.frame_samples, frame_rule(v));
         m.measured_frame = m.convergence.fastest;
-        if (!part_min[v].empty() && !cycles_per_tick[v].empty()) {
-            double ticks = part_rest_min[v];
-            for (uint64_t t : part_min[v]) ticks += double(t);
-            m.measured_frame_parts = ticks * median(cycles_per_tick[v]);
-            m.frame_parts = uint32_t(part_min[v].size());
+        if (!part_clean[v].empty() && !cycles_per_tick[v].empty()) {
+            std::vector<std::vector<double>> parts = part_clean[v];
+            parts.push_back(part_rest[v]);
+            m.parts_convergence = judge_parts_convergence(parts, convergence);
+            m.measured_frame_parts = m.parts_convergence.fastest * median(cycles_per_tick[v]);
+            m.frame_parts = uint32_t(part_clean[v].size());
         }
         if (m.frame_samples.empty()) continue;  // every render set aside: nothing measured
         m.monitor_share /= double(m.frame_samples.size());

@@ -167,14 +167,17 @@ struct SiliconMeasurement {
     // `convergence` says the fastest of them agree.
     double measured_frame = 0.0;
     // The frame as the sum of its parts' fastest (RenderStats::part_tsc: a pass's generations,
-    // 2-20 a pass), each over every unclocked render, kept or set aside, plus the fastest rest
-    // of a render, in TSC ticks at the median cycles a tick of the renders whose clock held. A
-    // sibling thread's burst of 1-10 ms slows the parts it falls in, not the frame's others:
-    // a part of a few milliseconds is often run alone where a render of 50 ms seldom is. A
-    // second reading of the same renders, beside measured_frame (0: no render), not scored: it
-    // also takes each part's luckiest placement and cache state, and lay 3-5 % under the
-    // fastest render on cornell and furnace 64x64, which converged (AVX2, Zen 4, 2026-12-03).
+    // 2-20 a pass), each part over the unclocked renders whose clock held in which the monitor's
+    // probes around it found the core alone (clean_spans, base/core_contention.h), kept or set
+    // aside, plus the fastest rest of a render, in TSC ticks at the median cycles a tick of those
+    // renders; judged by judge_parts_convergence (0: no render). A sibling thread's burst of
+    // 1-10 ms slows the parts it falls in, not the frame's others: on a core shared a third of
+    // the time a render of 50 ms seldom runs alone, while each of its parts of a few
+    // milliseconds often does. It also takes each part's luckiest placement and cache state:
+    // read over every render, clean or not, it lay 3-5 % under the fastest render on cornell and
+    // furnace 64x64, which converged (AVX2, Zen 4, 2026-12-03).
     double measured_frame_parts = 0.0;
+    Convergence parts_convergence;
     uint32_t frame_parts = 0;  // parts a render
     Convergence convergence;
     std::string cycle_source;  // CycleSource::description() of the back end's source

@@ -233,16 +233,22 @@ def summary(df):
         out["frame_mae_described"] = described.abs().mean()
         out["frame_worst_described"] = described.abs().max()
     if "measured.frame_cycles_parts" in all_rows:
-        # The second reading of the same renders, each part's fastest summed: against the
-        # fastest render where that converged, and the prediction against it on every workload.
+        # The second reading of the same renders, each part's fastest where the core was alone
+        # over it, summed: against the fastest render where both converged, and the prediction
+        # against it wherever it converged (rows written before its verdict: wherever it was read).
         parts = all_rows[all_rows["measured.frame_cycles_parts"] > 0]
-        agree = df["measured.frame_cycles_parts"] / df["measured.frame_cycles"] - 1.0
+        if "measured.frame_parts_converged" in parts:
+            parts = parts[parts["measured.frame_parts_converged"].fillna(False).astype(bool)]
+        both = df[df.index.isin(parts.index)]
+        agree = both["measured.frame_cycles_parts"] / both["measured.frame_cycles"] - 1.0
         against = parts["predicted.frame_cycles"] / parts["measured.frame_cycles_parts"] - 1.0
-        out["parts_agree_median"] = agree.abs().median()
-        out["parts_agree_worst"] = agree.abs().max()
+        out["parts_agree_median"] = agree.abs().median() if len(agree) else float("nan")
+        out["parts_agree_worst"] = agree.abs().max() if len(agree) else float("nan")
+        out["parts_agree_signed"] = agree.median() if len(agree) else float("nan")
         out["parts_workloads"] = len(parts)
-        out["parts_frame_mae"] = against.abs().mean()
-        out["parts_frame_worst"] = against.abs().max()
+        out["parts_only"] = len(parts) - len(both)
+        out["parts_frame_mae"] = against.abs().mean() if len(against) else float("nan")
+        out["parts_frame_worst"] = against.abs().max() if len(against) else float("nan")
     out["ranking_right"] = int(measurable["right"].sum())
     out["ranking_cells"] = len(measurable)
     out["ranking_within_noise"] = len(rank) - len(measurable)
@@ -595,10 +601,13 @@ def summary_text(s, isa=None):
                      f"{100 * s['frame_worst_described']:.1f} %")
     if s.get("parts_workloads"):
         lines.append(f"  - the frame as the sum of its parts' fastest (a pass's generations, each "
-                     f"over every render, kept or set aside; not scored): within "
-                     f"{100 * s['parts_agree_median']:.1f} % of the fastest render (median; worst "
-                     f"{100 * s['parts_agree_worst']:.1f} %) on the converged workloads; the "
-                     f"prediction against it on all {s['parts_workloads']}: MAE "
+                     f"over the renders, kept or set aside, in which the monitor's probes around "
+                     f"it found the core alone; not scored): converged (the rule on the parts' "
+                     f"fastest and k-th fastest sums) on {s['parts_workloads']} workloads, "
+                     f"{s['parts_only']} of them workloads whose renders did not; "
+                     f"{100 * s['parts_agree_signed']:+.1f} % against the fastest render "
+                     f"(median; worst {100 * s['parts_agree_worst']:.1f} % apart) where both "
+                     f"converged; the prediction against it where it converged: MAE "
                      f"{100 * s['parts_frame_mae']:.1f} %, worst "
                      f"{100 * s['parts_frame_worst']:.1f} %")
     for st in STAGES:

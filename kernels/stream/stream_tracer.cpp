@@ -476,6 +476,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         if (!parts) return;
         const uint64_t now = __rdtsc();
         stats.part_tsc.push_back(now - part_mark);
+        stats.part_start_tsc.push_back(part_mark);
         part_mark = now;
     };
 

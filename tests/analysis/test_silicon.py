@@ -253,7 +253,20 @@ def test_the_frame_from_its_parts_is_reported_beside_the_fastest_render(tmp_path
     assert s["parts_workloads"] == 3
     errors = [100 / 99 - 1, 103 / 97 - 1, 0.10]
     assert s["parts_frame_mae"] == pytest.approx(sum(errors) / 3)
-    assert "the prediction against it on all 3: MAE" in silicon.summary_text(s)
+    assert s["parts_only"] == 1
+    assert "converged (the rule on the parts' fastest and k-th fastest sums) on 3 workloads, " \
+        "1 of them workloads whose renders did not; -2.0 % against" in silicon.summary_text(s)
+    assert write_page(tmp_path, p) == 0
+    # With the parts' verdict: only where they converged are they compared or judged.
+    rows[0]["measured.frame_parts_converged"] = False
+    rows[1]["measured.frame_parts_converged"] = True
+    rows[2]["measured.frame_parts_converged"] = True
+    p.write_text(json.dumps(rows))
+    s = silicon.summary(silicon.load_rows(p))
+    assert s["parts_workloads"] == 2
+    assert s["parts_only"] == 1
+    assert s["parts_agree_signed"] == pytest.approx(-0.03)
+    assert s["parts_frame_mae"] == pytest.approx((103 / 97 - 1 + 0.10) / 2)
     assert write_page(tmp_path, p) == 0
 
 

@@ -131,3 +131,31 @@ TEST_CASE("Convergence: samples set aside spend the budget", "[convergence]") {
     CHECK(judge_convergence({100, 100.5, 101, 101, 101}, after_discarded(r, 26)).converged);
     CHECK_FALSE(judge_convergence({100, 100.5, 101, 101, 101}, r).converged);
 }
+
+TEST_CASE("Convergence: a measurement in parts sums each part's fastest and k-th fastest",
+          "[convergence]") {
+    const ConvergenceRule r = rule(3, 0.03, 7, 31);
+    // Two parts, each clean: their fastest sum 100 + 50, their third fastest 101 + 52.
+    std::vector<std::vector<double>> parts = {{101, 100, 130, 101, 140, 150, 160},
+                                              {52, 50, 51, 90, 95, 99, 52}};
+    Convergence c = judge_parts_convergence(parts, r);
+    CHECK(c.fastest == Approx(150.0));
+    CHECK(c.spread == Approx(153.0 / 150.0 - 1.0));
+    CHECK(c.samples == 7);
+    CHECK(c.converged);
+    // A part slowed in most renders (bimodal) spreads the sum beyond the tolerance.
+    parts[1] = {50, 80, 80, 80, 80, 80, 80};
+    c = judge_parts_convergence(parts, r);
+    CHECK(c.fastest == Approx(150.0));
+    CHECK(c.spread == Approx(181.0 / 150.0 - 1.0));
+    CHECK_FALSE(c.converged);
+    // A part with too few samples keeps the whole from converging, however close its fastest.
+    parts[1] = {50, 50, 50};
+    c = judge_parts_convergence(parts, r);
+    CHECK(c.samples == 3);
+    CHECK(c.spread == Approx(151.0 / 150.0 - 1.0));
+    CHECK_FALSE(c.converged);
+    parts[1] = {50, 50};
+    CHECK(std::isinf(judge_parts_convergence(parts, r).spread));
+    CHECK_FALSE(judge_parts_convergence({}, r).converged);
+}

@@ -149,4 +149,34 @@ TEST_CASE("The contention monitor probes the core while a region runs", "[conten
     const ContentionMonitor::Tally alone = never.stop();
     CHECK(alone.probes >= 10);
     CHECK(alone.shared == 0);
+    // Each probe is kept in order, with its verdict.
+    REQUIRE(shared.marks.size() == shared.probes);
+    REQUIRE(alone.marks.size() == alone.probes);
+    for (size_t i = 0; i < alone.marks.size(); ++i) {
+        CHECK(shared.marks[i].shared);
+        CHECK_FALSE(alone.marks[i].shared);
+        if (i) CHECK(alone.marks[i].tsc > alone.marks[i - 1].tsc);
+    }
+}
+
+TEST_CASE("A span is clean only where the probes around it found the core alone", "[contention]") {
+    using Probe = ContentionMonitor::Probe;
+    // Probes every 100 ticks; the one at 300 found the core shared.
+    const std::vector<Probe> marks = {{0, false},  {100, false}, {200, false},
+                                      {300, true}, {400, false}, {500, false}};
+    const std::vector<std::pair<uint64_t, uint64_t>> spans = {
+        {110, 190},  // between two probes that found it alone
+        {210, 290},  // the probe after it found it shared
+        {310, 390},  // the probe before it did
+        {150, 450},  // a shared probe inside it
+        {410, 450},  // alone on both sides
+        {510, 590},  // no probe after it
+        {120, 180},  // alone on both sides, but the probes are farther than the reach below
+    };
+    const std::vector<bool> clean = clean_spans(marks, spans, 150);
+    CHECK(clean == std::vector<bool>{true, false, false, false, true, false, true});
+    // Within 15 ticks: only the first span has a probe that near on both sides.
+    const std::vector<bool> near = clean_spans(marks, spans, 15);
+    CHECK(near == std::vector<bool>{true, false, false, false, false, false, false});
+    CHECK(clean_spans({}, spans, 1000) == std::vector<bool>(spans.size(), false));
 }

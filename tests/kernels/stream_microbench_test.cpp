@@ -57,6 +57,11 @@ TEST_CASE("The part clock never changes a bit and times each generation of each 
     CHECK(timed.stats.part_tsc.size() > 9 * 2 * 2);
     CHECK(timed.stats.part_tsc.size() <= 9 * 2 * (3 + 2));
     for (uint64_t ticks : timed.stats.part_tsc) CHECK(ticks > 0);
+    // Each part's start, in order, none before the last one's end.
+    REQUIRE(timed.stats.part_start_tsc.size() == timed.stats.part_tsc.size());
+    for (size_t p = 1; p < timed.stats.part_tsc.size(); ++p)
+        CHECK(timed.stats.part_start_tsc[p] >=
+              timed.stats.part_start_tsc[p - 1] + timed.stats.part_tsc[p - 1]);
     CHECK(render_stream(scene, bvh, s).stats.part_tsc.size() == timed.stats.part_tsc.size());
 }
 

@@ -249,6 +249,10 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(w.frame_parts >= 2);
         CHECK(w.measured_frame_parts > 0.5 * w.measured_frame);
         CHECK(w.measured_frame_parts < 1.1 * w.measured_frame);
+        // With the gate open no probe finds the core shared: every part of every render whose
+        // clock held is clean.
+        CHECK(w.parts_convergence.samples == w.frame_samples.size());
+        CHECK(w.parts_convergence.fastest > 0.0);
     }
     CHECK(std::count(rounds.begin(), rounds.end(), "round 1: 2 open") == 1);
     CHECK(std::count(rounds.begin(), rounds.end(), "round 2: 2 open") == 1);
