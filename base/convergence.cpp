@@ -39,13 +39,22 @@ Convergence judge_parts_convergence(const std::vector<std::vector<double>>& part
     if (parts.empty()) return c;
     c.samples = std::numeric_limits<uint32_t>::max();
     double kth_sum = 0.0;
+    const size_t k = std::max<size_t>(rule.fastest, 1);
+    bool every_kth = true;  // every part has a k-th fastest sample
     for (const std::vector<double>& part : parts) {
-        const Convergence p = judge_convergence(part, rule);
-        c.samples = std::min(c.samples, p.samples);
-        c.fastest += p.fastest;
-        kth_sum += std::isfinite(p.spread) ? p.fastest * (1.0 + p.spread) : p.spread;
+        c.samples = std::min(c.samples, uint32_t(part.size()));
+        if (part.empty()) {
+            every_kth = false;
+            continue;
+        }
+        std::vector<double> sorted = part;
+        const size_t kth = std::min(k, sorted.size()) - 1;
+        std::nth_element(sorted.begin(), sorted.begin() + long(kth), sorted.end());
+        c.fastest += *std::min_element(sorted.begin(), sorted.begin() + long(kth) + 1);
+        kth_sum += sorted[kth];  // a part whose fastest is 0 still adds its k-th
+        every_kth = every_kth && part.size() >= k;
     }
-    if (std::isfinite(kth_sum))
+    if (every_kth)
         c.spread = c.fastest > 0 ? kth_sum / c.fastest - 1.0 : (kth_sum > 0 ? c.spread : 0.0);
     const size_t enough = std::min(rule.min_samples, rule.budget);
     c.converged = c.samples >= enough && c.spread <= rule.tolerance;

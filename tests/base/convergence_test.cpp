@@ -156,6 +156,16 @@ TEST_CASE("Convergence: a measurement in parts sums each part's fastest and k-th
     CHECK(c.spread == Approx(151.0 / 150.0 - 1.0));
     CHECK_FALSE(c.converged);
     parts[1] = {50, 50};
-    CHECK(std::isinf(judge_parts_convergence(parts, r).spread));
+    c = judge_parts_convergence(parts, r);
+    CHECK(std::isinf(c.spread));
+    CHECK(c.fastest == Approx(150.0));  // still the sum of every part's fastest
+    CHECK(c.samples == 2);
+    CHECK_FALSE(c.converged);
+    // A part whose fastest is 0 (a render's rest outside its parts, say) adds its k-th fastest.
+    parts[1] = {0, 0, 3, 4, 5, 6, 7};
+    c = judge_parts_convergence(parts, r);
+    CHECK(c.fastest == Approx(100.0));
+    CHECK(c.spread == Approx(104.0 / 100.0 - 1.0));
+    CHECK_FALSE(c.converged);
     CHECK_FALSE(judge_parts_convergence({}, r).converged);
 }
