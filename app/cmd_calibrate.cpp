@@ -227,6 +227,7 @@ void add_calibrate_command(CLI::App& app) {
                         {"one_ray_entry", k.one_ray_entry_cycles},
                         {"few_ray_entry", k.few_ray_entry_cycles},
                         {"traversal_start", k.traversal_start_cycles},
+                        {"shared_origin_per_lane", k.shared_origin_per_lane_cycles},
                         {"thin_lens_per_lane", k.thin_lens_per_lane_cycles},
                         {"sphere_light_per_pass", k.sphere_light_per_pass_cycles},
                         {"per_failed_candidate", k.per_failed_candidate_cycles},
@@ -427,8 +428,11 @@ void add_calibrate_command(CLI::App& app) {
                 if (k.op == "box_test")
                     std::printf(
                         "entering the one-ray loop %.1f cycles, the few-ray loop %.1f; "
-                        "starting a traversal %.1f\n",
-                        k.one_ray_entry_cycles, k.few_ray_entry_cycles, k.traversal_start_cycles);
+                        "starting a traversal %.1f; checking a shared origin %.2f a lane "
+                        "(timed by itself%s)\n",
+                        k.one_ray_entry_cycles, k.few_ray_entry_cycles, k.traversal_start_cycles,
+                        k.shared_origin_per_lane_cycles,
+                        cal.shared_origin.converged ? "" : ", NOT converged");
             for (size_t i = 0; i < cal.op_costs.size(); ++i)
                 if (cal.op_costs[i].per_op_cycles != cal.filter_costs[i].per_op_cycles)
                     std::printf("  %s per_op: %.1f in a traversal (above), %.1f in the filter "

@@ -407,7 +407,9 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
                               passed, t.first == 0, beyond_l1, op.failed_candidates)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
-        (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0);
+        (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
+        (t.first == 0 && op.starts_traversal && op.origin_shared ? p.shared_origin_cycles(op.length)
+                                                                 : 0.0);
     // The op's mispredicted branches, on its first group.
     const double mispredicted =
         t.first == 0 ? m_config.branch_predictor.mispredict_cycles * m_mispredicted[t.op] : 0.0;

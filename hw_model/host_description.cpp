@@ -625,6 +625,9 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.traversal_start_cycles > 0
                       ? ", traversal_start_cycles: " + fmt(o.traversal_start_cycles, 2)
                       : std::string())
+              << (o.shared_origin_per_lane_cycles > 0 ? ", shared_origin_per_lane_cycles: " +
+                                                            fmt(o.shared_origin_per_lane_cycles, 2)
+                                                      : std::string())
               << (o.hit_read_exposed_share > 0
                       ? ", hit_read_exposed_share: " + fmt(o.hit_read_exposed_share, 3)
                       : std::string())

@@ -499,6 +499,14 @@ struct OpCostConfig {
     // its box tests, so only the stream-loop batches tell a traversal apart, and there it is a
     // fraction of a percent. Default 0: not measured.
     double traversal_start_cycles = 0.0;
+    // The box test's: the tracer's check that a traversal's rays share one origin
+    // (shared_origin, kernels/stream/stream_kernels.h), per lane, where they do (StreamOp::
+    // origin_shared: a pinhole camera's rays) and it reads every lane's origin; where they do
+    // not it stops at the second, within traversal_start_cycles. Timed directly over a tile's
+    // records by its own microbenchmark (sfx calibrate --describe-host): 3.2 cycles a lane warm
+    // on an AMD Zen 4 VM (2026-12-04), where furnace's traversal at AVX2 and AVX-512, tiles of 32
+    // and 64, was 3.4-4.4 cycles a camera ray over its price without it. Default 0: not measured.
+    double shared_origin_per_lane_cycles = 0.0;
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L2 hit (hit_read_latency_hidden, hw_model/cache_model.h) that
     // the core does not overlap with other work, fitted
@@ -621,6 +629,11 @@ struct OpCostConfig {
         v.param("traversal_start_cycles", traversal_start_cycles, "cycles",
                 "the box test's: cost of starting a traversal, besides its ops (the box test "
                 "it starts with carries it; 0: not measured)",
+                0.0, 1e9);
+        v.param("shared_origin_per_lane_cycles", shared_origin_per_lane_cycles, "cycles",
+                "the box test's: cost per lane of checking that a traversal's rays share one "
+                "origin, where they do (the box test it starts with carries it; 0: not "
+                "measured)",
                 0.0, 1e9);
         v.param("hit_read_exposed_share", hit_read_exposed_share, "",
                 "share of each lane's hit-primitive read latency beyond an L2 hit that is not "

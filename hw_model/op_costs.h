@@ -139,6 +139,10 @@ struct OpProfile {
     // Cycles the op adds on its first group when it starts a traversal (StreamOp::
     // starts_traversal): a measured box test's traversal_start_cycles; 0 otherwise.
     double traversal_start_cycles() const;
+    // Cycles the op adds on its first group when it starts a traversal whose `lanes` rays share
+    // one origin (StreamOp::origin_shared): a measured box test's shared_origin_per_lane_cycles
+    // x the lanes after the first (each compared with it); 0 otherwise.
+    double shared_origin_cycles(uint32_t lanes) const;
     // Cycles from a group's first issue to its mask: the measured cost (its loads and chain are
     // inside it), the datapath's dependent chain or the cluster's schedule length.
     double result_cycles(const DatapathConfig& datapath, double issue) const;

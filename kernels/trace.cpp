@@ -178,7 +178,8 @@ CountingSink& CountingSink::operator+=(const CountingSink& o) {
 //           u32 reorder_lod_ppm u8 batching u32 batching_queue batching_cell_prims)
 //   pass:   u8 'P' u32 tile x0 y0 x1 y1 sample slot_count
 //   op:     u8 'O' u8 kind u8 stage u16 generation u32 object length pass_count
-//           failed_candidates (version 4 on) u8 starts_traversal (version 5 on) u32
+//           failed_candidates (version 4 on) u8 starts_traversal (version 5 on: 1 starts,
+//           version 6 on: 3 starts with its rays sharing one origin, StreamOp::origin_shared) u32
 //           slots[length] u8 passed_bits[ceil(length/8)] (bit i of byte i/8, LSB first)
 //   end:    u8 'E' u32 generations        (end of pass)
 //   frame:  u8 'F'                         (end of file)
@@ -233,7 +234,8 @@ void TraceFileWriter::op(const StreamOp& op) {
     put(m_bits, op.length);
     put(m_bits, op.pass_count);
     put(m_bits, op.failed_candidates);
-    m_bits.push_back(uint8_t(op.starts_traversal));
+    m_bits.push_back(uint8_t(op.starts_traversal) | uint8_t(op.origin_shared && op.starts_traversal)
+                                                        << 1);
     write(m_bits.data(), m_bits.size());
     write(op.slots, size_t(op.length) * 4);
     m_bits.assign((op.length + 7) / 8, 0);
@@ -360,8 +362,11 @@ TraceHeader read_trace_file(const std::string& path, TraceSink& sink) {
             if (h.version >= 4) op.failed_candidates = r.get<uint32_t>();
             if (h.version >= 5) {
                 const uint8_t starts = r.get<uint8_t>();
-                if (starts > 1) r.fail("a traversal-start flag that is neither 0 nor 1");
-                op.starts_traversal = starts == 1;
+                if (starts > (h.version >= 6 ? 3 : 1) || starts == 2)
+                    r.fail(h.version >= 6 ? "a traversal-start flag that is not 0, 1 or 3"
+                                          : "a traversal-start flag that is neither 0 nor 1");
+                op.starts_traversal = (starts & 1) != 0;
+                op.origin_shared = (starts & 2) != 0;
             }
             if (op.length > pass.slot_count) r.fail("an operation longer than its tile pass");
             if (op.failed_candidates > op.length - std::min(op.pass_count, op.length))
@@ -406,7 +411,7 @@ void TraceRecorder::begin_pass(const TilePass& p) {
 
 void TraceRecorder::op(const StreamOp& op) {
     m_ops.push_back({op.kind, op.stage, op.generation, op.object, op.length, op.pass_count,
-                     op.failed_candidates, op.starts_traversal, m_slots.size()});
+                     op.failed_candidates, op.starts_traversal, op.origin_shared, m_slots.size()});
     m_slots.insert(m_slots.end(), op.slots, op.slots + op.length);
     m_passed.insert(m_passed.end(), op.passed, op.passed + op.length);
 }
@@ -427,6 +432,7 @@ void TraceRecorder::replay(TraceSink& sink) const {
         op.pass_count = r.pass_count;
         op.failed_candidates = r.failed_candidates;
         op.starts_traversal = r.starts_traversal;
+        op.origin_shared = r.origin_shared;
         op.slots = m_slots.data() + r.offset;
         op.passed = m_passed.data() + r.offset;
         sink.op(op);

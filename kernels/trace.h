@@ -184,6 +184,11 @@ struct StreamOp {
     // The box test a traversal starts with (its entry node's): a CPU core's traversal pays its
     // set-up there (OpCostConfig::traversal_start_cycles), once per traversal whatever its ops.
     bool starts_traversal = false;
+    // Of an op that starts a traversal: its stream's rays all share one origin (a pinhole
+    // camera's), so that the native tracer's check of that (shared_origin) read every lane's
+    // origin (OpCostConfig::shared_origin_per_lane_cycles); otherwise it stopped at the first
+    // that differed, in practice the second.
+    bool origin_shared = false;
 };
 
 // One tile pass: one sample of every pixel of a tile, traced breadth-first to the end.
@@ -251,10 +256,11 @@ struct TraceFrame {
 // What a trace is of; written at the head of a trace file. Version 2 added the seed papers'
 // options (primary_entry, reorder, reorder_lod_ppm), version 3 RayGrid batching (batching,
 // batching_queue, batching_cell_prims), version 4 each op's failed candidates, version 5 whether
-// it starts a traversal; an older file reads with the later fields' defaults (an op's failed
-// candidates 0, no op starting a traversal).
+// it starts a traversal, version 6 whether that traversal's rays share one origin (the same
+// byte); an older file reads with the later fields' defaults (an op's failed candidates 0, no op
+// starting a traversal, no stream sharing an origin).
 struct TraceHeader : TraceFrame {
-    static constexpr uint32_t k_version = 5;
+    static constexpr uint32_t k_version = 6;
     uint32_t version = k_version;
     uint64_t scene_hash = 0;  // workloads/scene.h's scene_hash()
 };
@@ -392,7 +398,7 @@ class TraceRecorder : public TraceSink {
         OpStage stage;
         uint16_t generation;
         uint32_t object, length, pass_count, failed_candidates;
-        bool starts_traversal;
+        bool starts_traversal, origin_shared;
         size_t offset;
     };
     TilePass m_pass;

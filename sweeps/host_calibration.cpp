@@ -63,6 +63,10 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
         sample.traversals = s.streams;
         sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
+        // The check that a bundle's rays share one origin, at its directly timed cost.
+        if (const OpCostConfig* box = cost_of[size_t(OpKind::box_test)])
+            sample.stream_op_cycles +=
+                double(s.origin_shared_lanes) * box->shared_origin_per_lane_cycles;
         // One-lane leaf tests at their directly timed cost, by outcome.
         for (size_t k = 0; k < k_op_kind_count; ++k)
             if (cost_of[k] && one_lane_from_filters(OpKind(k)) &&
@@ -352,6 +356,14 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     // model adds its own to every traversal: fitted into the costs, a frame paid them twice
     // (atrium 64 x 64, AVX-512, tile 32, on an Intel Xeon VM, 2026-11-28: 20.9 M cycles
     // predicted, 17.0 measured, 4.4 M of them the predictor's).
+    // The tracer's check that a traversal's rays share one origin, per lane, timed by itself
+    // (priced in the traversals below, as a frame's camera rays pay it).
+    c.shared_origin = run_shared_origin_microbenchmark(resolved, convergence);
+    c.converged_points += c.shared_origin.converged;
+    ++c.points;
+    for (OpCostConfig& o : c.op_costs)
+        if (op_kind_named(o.op) == OpKind::box_test)
+            o.shared_origin_per_lane_cycles = c.shared_origin.per_lane_cycles;
     const std::vector<uint8_t> one_ray_leaves = bvh_leaves(Bvh(one_ray_microbench_scene()));
     c.one_ray_samples = run_one_ray_microbenchmarks(
         resolved, convergence, 1,

@@ -84,6 +84,7 @@ struct HostCalibration {
     // one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of a wide back
     // end's box test, and the box test's per_op_cycles in the stream loop).
     std::vector<OneRaySample> one_ray_samples;
+    SharedOriginSample shared_origin;  // OpCostConfig::shared_origin_per_lane_cycles
     std::pair<double, double> short_stream_fit_errors{};
     // The same samples as that fit sees them, and what it fitted (for the report's residuals).
     std::vector<OneLaneSample> short_stream_samples;

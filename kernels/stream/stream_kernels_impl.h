@@ -320,8 +320,9 @@ SFX_LANES_INLINE void report(const TraversalJob& job, OpKind kind, OpStage stage
                              uint32_t failed_candidates) {
     if constexpr (Detail != TraceDetail::none) {
         if constexpr (Detail != TraceDetail::lanes) ids = nullptr, mask = nullptr;
+        const bool starts = starts_traversal(job, kind, object);
         job.sink->op(StreamOp{kind, stage, job.generation, object, n, passed, ids, mask,
-                              failed_candidates, starts_traversal(job, kind, object)});
+                              failed_candidates, starts, starts && job.shared_origin});
     }
 }
 
@@ -357,8 +358,9 @@ struct OpTally {
                                      uint32_t failed_candidates) {
         if (first) {
             first = false;
+            const bool starts = starts_traversal(job, kind, object);
             job.sink->op(StreamOp{kind, stage, job.generation, object, n, pass, nullptr, nullptr,
-                                  failed_candidates, starts_traversal(job, kind, object)});
+                                  failed_candidates, starts, starts && job.shared_origin});
             return;
         }
         const int k = kind == OpKind::box_test ? 0 : kind == OpKind::triangle_test ? 1 : 2;

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 #include "base/convergence.h"
 #include "base/core_clock.h"
@@ -819,6 +820,8 @@ class OpLengthTally : public TraceSink {
     void op(const StreamOp& o) override {
         ops_of_length(o.kind, o.stage, o.generation, o.length, 1, o.pass_count,
                       o.failed_candidates);
+        if (o.starts_traversal && o.origin_shared && o.length > 1)
+            m_origin_shared_lanes += o.length - 1;  // each compared with the first
     }
     void ops_of_length(OpKind kind, OpStage, uint16_t, uint32_t length, uint32_t count,
                        uint32_t passed, uint32_t failed_candidates) override {
@@ -830,6 +833,7 @@ class OpLengthTally : public TraceSink {
     bool counts_only() const override { return true; }
     // Into a sample: one-lane ops, the few-ray loop's box tests (a wide back end's), the rest.
     void fill(OneRaySample& s, uint32_t width) const {
+        s.origin_shared_lanes += m_origin_shared_lanes;
         for (const auto& [key, t] : m_tally) {
             const auto [kind, length] = key;
             if (length == 1) {
@@ -845,6 +849,7 @@ class OpLengthTally : public TraceSink {
 
   private:
     std::map<std::pair<OpKind, uint32_t>, OpsOfLength> m_tally;  // its kind and lanes unset
+    uint64_t m_origin_shared_lanes = 0;
 };
 
 namespace {
@@ -1159,6 +1164,39 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
     std::vector<uint32_t> prims(sample.lanes);
     for (uint32_t& p : prims) p = pick(rng);
     return prims;
+}
+
+SharedOriginSample run_shared_origin_microbenchmark(Isa isa, const ConvergenceRule& convergence) {
+    namespace f = traversal_field;
+    constexpr uint32_t k_short = 1024, k_long = 4096;
+    const double overhead = tsc_overhead();
+    const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
+    // Traversal records (64 bytes a slot) whose origins all agree, as a pinhole camera's rays'.
+    std::vector<float> records(size_t(k_long) * f::record, 0.5f);
+    std::vector<uint32_t> ids(k_long + k_stream_padding);
+    std::iota(ids.begin(), ids.end(), 0u);
+    std::vector<double> times[2];
+    uint32_t set_aside = 0;
+    const float* found = nullptr;
+    while (needs_more_samples(times[0], convergence) || needs_more_samples(times[1], convergence)) {
+        for (int which = 0; which < 2; ++which) {
+            const uint32_t n = which ? k_long : k_short;
+            const uint64_t start = __rdtsc();
+            found = shared_origin(records.data(), ids.data(), n);
+            times[which].push_back(std::max(0.0, double(__rdtsc() - start) - overhead));
+        }
+        core_contention().set_aside_if_contended({&times[0], &times[1]}, set_aside,
+                                                 convergence.budget);
+    }
+    if (!found) throw std::logic_error("shared-origin microbenchmark: origins differ");
+    const Convergence a = judge_convergence(times[0], convergence);
+    const Convergence b = judge_convergence(times[1], convergence);
+    SharedOriginSample s;
+    s.per_lane_cycles =
+        std::max(0.0, (b.fastest - a.fastest) / double(k_long - k_short)) / ticks_per_cycle;
+    s.converged = a.converged && b.converged;
+    s.repetitions = uint32_t(times[1].size());
+    return s;
 }
 
 std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(Isa isa,

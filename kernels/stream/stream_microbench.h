@@ -148,6 +148,10 @@ struct OneRaySample {
     std::array<uint64_t, k_op_kind_count> one_lane_passed{}, one_lane_failed_candidates{};
     std::array<uint64_t, k_op_kind_count> few_ops{};
     std::vector<OpsOfLength> stream_ops;
+    // Lanes of the traversals whose rays share one origin (StreamOp::origin_shared: a bundle's)
+    // after each one's first, which the tracer's check of that compared with the first
+    // (OpCostConfig::shared_origin_per_lane_cycles).
+    uint64_t origin_shared_lanes = 0;
     double cycles = 0.0;  // core cycles, fastest repetition
     bool converged = false;
     uint32_t repetitions = 0;
@@ -207,6 +211,17 @@ struct SurfaceReadSample {
     uint32_t repetitions = 0;
     uint64_t seed = 0;  // of the hits' draw (surface_read_hits replays it)
 };
+// The tracer's check that a traversal's rays share one origin (shared_origin), timed over the
+// records of a tile's camera rays that all do (1024 and 4096 slots, in order, as a 32- and a
+// 64-pixel tile's): core cycles a lane, the slope between the two (a call's fixed cost is the
+// traversal's start), each the fastest repetition of the convergence rule.
+struct SharedOriginSample {
+    double per_lane_cycles = 0.0;
+    bool converged = false;
+    uint32_t repetitions = 0;
+};
+SharedOriginSample run_shared_origin_microbenchmark(
+    Isa isa, const ConvergenceRule& convergence = microbench_rule());
 // Meshes of 2^13, 2^17 and 2^20 triangles (416 KiB, 6.5 MiB, 52 MiB), streams of 4096 hits.
 std::vector<SurfaceReadSample> run_surface_read_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence, uint64_t seed = 5);

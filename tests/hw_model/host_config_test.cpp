@@ -644,11 +644,20 @@ TEST_CASE("The box test a traversal starts with carries the traversal's start co
     p.measured = false;  // instruction-priced: no start cost
     CHECK(p.traversal_start_cycles() == 0);
 
+    p.measured = true;
+    p.cost.shared_origin_per_lane_cycles = 3;
+    CHECK(p.shared_origin_cycles(16) == 45);  // the 15 lanes compared with the first
+    CHECK(p.shared_origin_cycles(1) == 0);
+    p.measured = false;
+    CHECK(p.shared_origin_cycles(16) == 0);
+
     // In the machine model: two traversals of a 16-lane stream, each a box test at its entry and
-    // one below it; each pays the start once, on its first op.
-    auto time_traversals = [](double start) {
+    // one below it; each pays the start once, on its first op, and the first traversal's rays
+    // share one origin: it pays the check of that per lane after the first.
+    auto time_traversals = [](double start, double shared_origin = 0.0) {
         OpCostConfig box = cost("box_test", 10, 4, 0, 0, 0);
         box.traversal_start_cycles = start;
+        box.shared_origin_per_lane_cycles = shared_origin;
         SystemcTiming timing({host_with({box})}, shape());
         std::vector<uint32_t> ids(16);
         std::iota(ids.begin(), ids.end(), 0u);
@@ -656,8 +665,10 @@ TEST_CASE("The box test a traversal starts with carries the traversal's start co
         TilePass pass;
         pass.slot_count = 64;
         timing.begin_pass(pass);
-        for (bool starts : {true, false, true, false}) {
+        for (int i = 0; i < 4; ++i) {
+            const bool starts = i % 2 == 0;
             StreamOp op;
+            op.origin_shared = i < 2;  // the first traversal's ops: only its start pays
             op.kind = OpKind::box_test;
             op.stage = OpStage::traversal;
             op.length = 16;
@@ -671,6 +682,7 @@ TEST_CASE("The box test a traversal starts with carries the traversal's start co
         return timing.timing(0).stages[0][size_t(OpStage::traversal)].busy_cycles;
     };
     CHECK(time_traversals(70) == time_traversals(0) + 2 * 70);
+    CHECK(time_traversals(70, 2) == time_traversals(70) + 15 * 2);
 }
 
 TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",

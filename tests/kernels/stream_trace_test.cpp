@@ -376,9 +376,13 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     struct FailedCandidates : TraceSink {
         bool counts = true;
         uint64_t sum = 0, starts = 0, box_calls = 0, starts_not_box = 0;
+        uint64_t shared = 0, shared_camera = 0, shared_not_start = 0;
         void op(const StreamOp& o) override {
             sum += o.failed_candidates;
             starts += o.starts_traversal;
+            shared += o.origin_shared;
+            shared_camera += o.origin_shared && o.generation == 0 && o.length > 1;
+            shared_not_start += o.origin_shared && !o.starts_traversal;
             box_calls += o.kind == OpKind::box_test;
             starts_not_box += o.starts_traversal && o.kind != OpKind::box_test;
         }
@@ -423,6 +427,13 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     CHECK(from_file.starts == tallied.box_calls);
     CHECK(from_file.box_calls > 3 * from_file.starts);
     CHECK(from_file.starts_not_box == 0);
+    // The camera's rays share its pinhole: their traversals are flagged, in the file as in the
+    // tracer's own tally, and only on ops that start a traversal; bounces' are not all.
+    CHECK(tallied.shared_camera > 0);
+    CHECK(from_file.shared == tallied.shared);
+    CHECK(from_file.shared_camera == tallied.shared_camera);
+    CHECK(from_file.shared < from_file.starts);
+    CHECK(from_file.shared_not_start == 0);
     CountingSink replayed(widths);
     const TraceHeader h = read_trace_file(p1, replayed);
     CHECK(h.scene_hash == scene_hash(s));
@@ -480,7 +491,7 @@ std::string crafted_trace(uint32_t slot_count, uint32_t length, uint32_t pass_co
 }
 }  // namespace
 
-TEST_CASE("Trace file version 5: the header carries the whole frame, the seed papers' options too",
+TEST_CASE("Trace file version 6: the header carries the whole frame, the seed papers' options too",
           "[stream]") {
     const Scene s = cluster_scene(true);
     const Bvh bvh(s);
@@ -499,7 +510,7 @@ TEST_CASE("Trace file version 5: the header carries the whole frame, the seed pa
     }
     CountingSink sink({8});
     const TraceHeader h = read_trace_file(path, sink);
-    CHECK(h.version == 5);
+    CHECK(h.version == 6);
     CHECK(h.width == r.width);
     CHECK(h.height == r.height);
     CHECK(h.spp == r.spp);

@@ -65,6 +65,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     // Short streams' box tests and entries, by the depth they enter at.
     std::map<uint32_t, std::pair<uint64_t, uint64_t>> ops_and_entries;
     uint64_t long_stream_entries = 0;
+    uint64_t origin_shared_lanes = 0;
     for (const OneRaySample& s : one_ray) {
         // A stream of 1 to k_few_ray_lanes rays enters its loop at once: one entry a stream.
         if (s.rays <= k_few_ray_lanes && (s.rays == 1 || wide)) {
@@ -98,7 +99,13 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
             if (s.rays <= k_few_ray_lanes) streamed_short[o.kind] += o.count;
         }
         if (s.rays == 1) CHECK(s.stream_ops.empty());
+        // A bundle's streams share one origin, each compared lane by lane after its first; a
+        // random draw's do not.
+        CHECK((s.origin_shared_lanes == 0 ||
+               s.origin_shared_lanes == uint64_t(s.streams) * (s.rays - 1)));
+        origin_shared_lanes += s.origin_shared_lanes;
     }
+    CHECK(origin_shared_lanes > 0);
     CHECK(one_ray_cycles > 0);
     CHECK(long_stream_entries > 0);  // longer streams narrow into the short loops
     // Streams that enter deep run fewer box tests each than streams from the root: what tells a
