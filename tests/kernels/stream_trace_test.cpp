@@ -454,6 +454,27 @@ TEST_CASE("Trace file: round trip, and the same bytes for 1 and 2 threads", "[st
     }
     CountingSink partial(widths);
     CHECK_THROWS(read_trace_file(p1, partial));
+    // A traversal-start byte of 2 (a shared origin without a start) is refused. The first op
+    // follows the header (magic, version, scene hash, the frame's fields) and the first pass
+    // record (u8 and seven u32); its flag byte follows u8 kind, stage, u16 generation and four
+    // u32.
+    size_t frame_bytes = 0;
+    TraceFrame frame = r;
+    frame.visit([&](auto& field) { frame_bytes += sizeof field; });
+    const size_t op_at = 8 + 4 + 8 + frame_bytes + 1 + 7 * 4,
+                 flag_at = op_at + 1 + 1 + 1 + 2 + 4 * 4;
+    REQUIRE(b1.size() > flag_at);
+    REQUIRE(b1[op_at] == 'O');
+    CHECK(b1[flag_at] == 0);  // the camera's op starts no traversal
+    std::string bad = b1;
+    bad[flag_at] = 2;
+    {
+        std::ofstream out(p1, std::ios::binary);
+        out << bad;
+    }
+    CountingSink refused(widths);
+    CHECK_THROWS_WITH(read_trace_file(p1, refused),
+                      Catch::Matchers::Contains("a traversal-start flag that is not 0, 1 or 3"));
     std::remove(p1.c_str());
 }
 
