@@ -488,12 +488,13 @@ struct OpCostConfig {
     double one_ray_entry_cycles = 0.0;  // the box test's: entering the one-ray loop (0: none)
     double few_ray_entry_cycles = 0.0;  // the box test's: entering the few-ray loop (0: none)
     // The box test's: what a traversal costs once besides its ops (the tracer's set-up of a
-    // traversal job and its shared-origin check, the loop's start and end), carried by the box
-    // test it starts with (StreamOp::starts_traversal). Fitted with the loop entries on the
-    // traversal microbenchmark's batches, each stream of which is one traversal. Why: furnace's
-    // traversals are one box test and one leaf each, and timed by parts they cost about 190
-    // cycles more than their ops are priced, about 105 of it the traversal's set-up and 70 the
-    // stage clock's own reads (an AMD Zen 4 VM at AVX2, session 57: 165 traversals, 103.4 k
+    // traversal job, its shared-origin check's first compare, the loop's start and end; where
+    // the rays do share an origin the check's other lanes are shared_origin_per_lane_cycles),
+    // carried by the box test it starts with (StreamOp::starts_traversal). Fitted with the loop
+    // entries on the traversal microbenchmark's batches, each stream of which is one traversal.
+    // Why: furnace's traversals are one box test and one leaf each, and timed by parts they cost
+    // about 190 cycles more than their ops are priced, about 105 of it the traversal's set-up and
+    // 70 the stage clock's own reads (an AMD Zen 4 VM at AVX2, session 57: 165 traversals, 103.4 k
     // cycles measured against 72.4 k priced). The fit gave 0 on every back end of that VM
     // (2026-12-04): a one-ray batch's traversals equal its one-ray loop entries and rise with
     // its box tests, so only the stream-loop batches tell a traversal apart, and there it is a
@@ -503,9 +504,10 @@ struct OpCostConfig {
     // (shared_origin, kernels/stream/stream_kernels.h), per lane, where they do (StreamOp::
     // origin_shared: a pinhole camera's rays) and it reads every lane's origin; where they do
     // not it stops at the second, within traversal_start_cycles. Timed directly over a tile's
-    // records by its own microbenchmark (sfx calibrate --describe-host): 3.2 cycles a lane warm
-    // on an AMD Zen 4 VM (2026-12-04), where furnace's traversal at AVX2 and AVX-512, tiles of 32
-    // and 64, was 3.4-4.4 cycles a camera ray over its price without it. Default 0: not measured.
+    // records by its own microbenchmark (sfx calibrate --describe-host): 3.00-3.02 cycles a lane
+    // on every back end of an AMD Zen 4 VM (2026-12-04), where furnace's traversal at AVX2 and
+    // AVX-512, tiles of 32 and 64, was 3.4-4.4 cycles a camera ray over its price without it.
+    // Default 0: not measured.
     double shared_origin_per_lane_cycles = 0.0;
     // An op that reads each lane's hit primitive (the emission filter): the share of those
     // reads' latency beyond an L2 hit (hit_read_latency_hidden, hw_model/cache_model.h) that
