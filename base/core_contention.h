@@ -86,8 +86,9 @@ CoreContention& core_contention();
 // overlapped them often and the one probe after it seldom saw one, so a large scene's renders
 // lay 0-60 % above their fastest and 8-13 of its 18 workloads a back end did not converge. A
 // timer on the monotonic clock interrupts the thread every `period_us` (the signal goes to the
-// thread), and the handler times the independent adds once (about 1 us, 0.1 % of a period of 1
-// ms, subtracted where it runs in a measured region); a probe below `shared_below` adds a tick
+// thread), and the handler times the independent adds twice and keeps the better (the first
+// run fetches the loop a large render evicted; about 2 us, 0.2 % of a period of 1 ms,
+// subtracted where it runs in a measured region); a probe below `shared_below` adds a tick
 // found the core shared. One monitor runs at a time (the handler's tallies are the process's).
 // Where the timer cannot be made (timer_create fails), the monitor probes nothing (probes 0).
 class ContentionMonitor {
