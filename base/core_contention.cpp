@@ -88,6 +88,16 @@ bool CoreContention::wait(double budget_ms) {
     return false;
 }
 
+bool CoreContention::wait_warm(const std::function<void()>& warm, int most) {
+    for (int attempt = 0; attempt < most; ++attempt) {
+        const uint32_t waits = m_waits;
+        const bool alone = wait();
+        if (m_waits == waits) return alone;  // no sleep: the caches are as the render before left
+        warm();
+    }
+    return !contended();
+}
+
 CoreContention& core_contention() {
     static CoreContention gate;
     return gate;

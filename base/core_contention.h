@@ -47,6 +47,11 @@ class CoreContention {
     // if it is not. A spell that outlasts the budget is the core's state now: the best seen
     // falls to the best rate of the wait, so that a lasting state is measured, not waited on.
     bool wait(double budget_ms = 2000.0);
+    // wait(), and where it slept, `warm` (what the sleep let others evict: on a VM whose L3 is
+    // shared, 10 ms asleep cost temple's 64 x 64 frame most of what the render before it left
+    // in the caches, 30 ms all of it) and the same again, at most `most` times; after the
+    // last, the core is checked without sleeping. Returns whether the core is not shared.
+    bool wait_warm(const std::function<void()>& warm, int most = 3);
 
     // After a timed sample: if the core is shared now and fewer than `most` samples of this
     // measurement were set aside (`set_aside`, which it counts), the last sample of each series

@@ -683,6 +683,13 @@ def measurement_text(df):
                              f"{100 * (share > 0.5).mean():.0f} %; the probes took "
                              f"{100 * df['measured.monitor_share'].mean():.2f} % of a kept render "
                              f"(taken off its cycles)")
+    if "measured.rewarmed_renders" in df:
+        waits, rewarmed = df["measured.gate_waits"], df["measured.rewarmed_renders"]
+        lines.append(f"- the gate's waits for the core before a measured render (each asleep 10 ms "
+                     f"or more, over which others' fills take what the render before left in a "
+                     f"shared L3): {int(waits.sum())}, each followed by a render of the workload "
+                     f"again to warm the caches ({int(rewarmed.sum())} renders; "
+                     f"CoreContention::wait_warm)")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")

@@ -202,3 +202,30 @@ TEST_CASE("The monitor's probes read the core's rate as the gate does", "[conten
     }
     CHECK(alone_seen);
 }
+
+TEST_CASE("Where the gate slept, the caches are warmed again before the core is checked",
+          "[contention]") {
+    Script s;
+    s.rates.assign(CoreContention::k_settle, 6.0);
+    for (double r : {4.0, 6.0, 4.0, 4.0, 6.0, 6.0}) s.rates.push_back(r);
+    CoreContention gate = s.gate();
+    int warmed = 0;
+    // Shared, alone after a wait: warm; shared, shared, alone after a wait: warm; alone.
+    CHECK(gate.wait_warm([&] { ++warmed; }));
+    CHECK(warmed == 2);
+    CHECK(gate.waits() == 2);
+    // Alone: no wait, nothing warmed.
+    s.rates = {6.0};
+    CHECK(gate.wait_warm([&] { ++warmed; }));
+    CHECK(warmed == 2);
+    // Shared at every check: `most` waits and warms, then one check without sleeping.
+    Script busy;
+    busy.rates.assign(CoreContention::k_settle, 6.0);
+    for (int i = 0; i < 4; ++i) busy.rates.insert(busy.rates.end(), {4.0, 6.0});
+    busy.rates.push_back(4.0);
+    CoreContention shared = busy.gate();
+    int rewarmed = 0;
+    CHECK_FALSE(shared.wait_warm([&] { ++rewarmed; }, 2));
+    CHECK(rewarmed == 2);
+    CHECK(shared.waits() == 2);
+}
