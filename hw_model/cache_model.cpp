@@ -101,6 +101,16 @@ bool SetAssociativeCache::access(uint64_t address, uint64_t now) {
     return false;
 }
 
+void SetAssociativeCache::fill(uint64_t address, uint64_t now) {
+    const uint64_t line = address >> m_line_shift;
+    const uint32_t set = uint32_t(line % m_sets);
+    if (m_foreign_per_set_cycle > 0) fill_foreign(set, now);
+    const uint64_t* tags = &m_tags[size_t(set) * m_ways];
+    for (uint32_t w = 0; w < m_ways; ++w)
+        if (tags[w] == line) return;
+    place(set, line);
+}
+
 double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes) {
     const std::vector<DramSpanLatency>& points = memory.dram_latency_by_span;
     if (points.empty() || span_bytes == 0) return memory.dram_latency_ns;
@@ -215,7 +225,7 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
     for (size_t i = 0; i < x.caches.size(); ++i)
         if (x.caches[i].kib != y.caches[i].kib ||
             x.caches[i].line_bytes != y.caches[i].line_bytes ||
-            x.caches[i].ways != y.caches[i].ways)
+            x.caches[i].ways != y.caches[i].ways || x.caches[i].pair_fill != y.caches[i].pair_fill)
             return false;
     return true;
 }
@@ -223,11 +233,16 @@ bool same_cache_lookups(const HwConfig& a, const HwConfig& b) {
 namespace {
 
 // The nearest of `levels` caches holding `address` (`levels`: none); each level missed fills
-// it (inclusive), as a read does.
+// it (inclusive), as a read does; a read from memory also fills the other line of its 128-byte
+// pair into a last level that pairs (CacheLevelConfig::pair_fill).
 template <class CacheOf>
 uint32_t first_holding(uint32_t levels, uint64_t address, uint64_t now, CacheOf cache_of) {
     uint32_t level = 0;
     while (level < levels && !cache_of(level).access(address, now)) ++level;
+    if (level == levels && levels > 0) {
+        SetAssociativeCache& last = cache_of(levels - 1);
+        if (last.config().pair_fill) last.fill(address ^ uint64_t(last.config().line_bytes), now);
+    }
     return level;
 }
 

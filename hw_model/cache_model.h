@@ -23,6 +23,9 @@ class SetAssociativeCache {
     // pseudo-LRU way). Others' fills into the set since its last lookup come first: each
     // takes the pseudo-LRU way, as a fill of this machine's would.
     bool access(uint64_t address, uint64_t now = 0);
+    // Places the line holding `address` if absent (a prefetch: not counted, not touched if
+    // present).
+    void fill(uint64_t address, uint64_t now = 0);
     void clear();
 
     const CacheLevelConfig& config() const { return m_config; }

@@ -303,6 +303,37 @@ double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs)
     return best / tsc_mhz * 1000.0;
 }
 
+PairFillReading measure_pair_fill(double tsc_mhz, uint64_t pair_bytes, int runs) {
+    const size_t pairs = std::max<uint64_t>(pair_bytes / 128, 8), stride = k_chase_stride;
+    // Two cycles through the pairs in random order: one over their even lines, one over their
+    // odd lines (each line's first word holds the index of the next's).
+    Chase chase(pairs * 2 * stride);
+    for (size_t half = 0; half < 2; ++half) {
+        std::vector<size_t> order(pairs);
+        std::iota(order.begin(), order.end(), size_t(0));
+        std::shuffle(order.begin(), order.end(), std::mt19937_64(777 + half));
+        for (size_t i = 0; i < pairs; ++i)
+            chase[(2 * order[i] + half) * stride] = (2 * order[(i + 1) % pairs] + half) * stride;
+    }
+    auto pass = [&](size_t start, size_t loads) {
+        size_t at = start;
+        const uint64_t c0 = __rdtsc();
+        for (size_t i = 0; i < loads; ++i) at = chase[at];
+        const uint64_t c1 = __rdtsc();
+        if (at == size_t(-1)) std::printf(" ");  // keeps the chase
+        return double(c1 - c0) / double(loads) / tsc_mhz * 1000.0;
+    };
+    PairFillReading r{1e30, 1e30};
+    for (int rep = 0; rep < runs; ++rep) {
+        evict_caches();
+        pass(0, 3 * pairs);  // the even lines
+        r.after_even_ns = std::min(r.after_even_ns, pass(stride, pairs));
+        evict_caches();
+        r.cold_ns = std::min(r.cold_ns, pass(stride, pairs));
+    }
+    return r;
+}
+
 namespace {
 
 // The last level's chases: from twice the level before it (mostly beyond that level) in steps
@@ -424,6 +455,7 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
         // Half the level: it fits there, and not in the level before (which is smaller).
         h.latency_ns.push_back(measure_load_latency_ns(uint64_t(c.kib) * 1024 / 2, h.tsc_mhz));
     }
+    h.pair_fill = measure_pair_fill(h.tsc_mhz);
     // DRAM: in huge pages, as the BVH's nodes and leaf primitives are.
     h.latency_ns.push_back(measure_load_latency_ns(k_beyond_last_level_bytes, h.tsc_mhz));
     // And by span, from a few MiB (a small scene's data) to 256 MiB.
@@ -466,6 +498,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
         c.scene_memory.caches.back().kib = seen.kib;
         c.scene_memory.caches.back().hit_latency_ns = seen.latency_ns;
         c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
+        c.scene_memory.caches.back().pair_fill = h.pair_fill.pairs();
     }
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
     for (const auto& [mib, ns] : h.dram_span_latencies)
@@ -529,7 +562,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
           << ", shared: " << (l.shared ? "true" : "false")
           << (l.foreign_fill_per_us > 0 ? ", foreign_fill_per_us: " + fmt(l.foreign_fill_per_us, 2)
                                         : std::string())
-          << "}  # ";
+          << (l.pair_fill ? ", pair_fill: true" : "") << "}  # ";
         if (!h.memory_source.empty()) {
             y << "as " << h.memory_source << " describes it\n";
             continue;
@@ -558,6 +591,11 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
                 y << " " << fmt(step, 0) << " ns " << fmt(ns, 1) << " ns"
                   << (step == h.last_level_idle_chases.back().first ? "" : ",");
         }
+        if (h.pair_fill.cold_ns > 0)
+            y << "; pair_fill (measure_pair_fill): the odd lines of 1 MiB read first after a chase "
+                 "of its even lines "
+              << fmt(h.pair_fill.after_even_ns, 1) << " ns a load, from DRAM "
+              << fmt(h.pair_fill.cold_ns, 1) << " ns";
         y << "\n";
     }
     y << "  dram_latency_ns: " << fmt(c.scene_memory.dram_latency_ns, 2) << "  # "

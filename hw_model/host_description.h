@@ -65,6 +65,12 @@ std::string vendor_short_name(const std::string& vendor);
 // "AuthenticAMD family 0x17 model 0x31 stepping 0 (AMD EPYC 7B12)".
 std::string describe(const Microarchitecture& m);
 
+// A reading of measure_pair_fill (below).
+struct PairFillReading {
+    double after_even_ns = 0.0, cold_ns = 0.0;
+    bool pairs() const { return after_even_ns > 0 && after_even_ns < 0.5 * cold_ns; }
+};
+
 struct HostDescription {
     Microarchitecture microarchitecture;
     uint32_t simd_width = 1;
@@ -86,6 +92,7 @@ struct HostDescription {
     // DRAM's latency by the span the reads fall in (MiB, ns), smallest first
     // (measure_dram_first_pass_ns): SceneMemoryConfig::dram_latency_by_span.
     std::vector<std::pair<double, double>> dram_span_latencies;
+    PairFillReading pair_fill;  // the last level's CacheLevelConfig::pair_fill (0: not measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     uint32_t slot_arrays = 1;        // the arrays it lies in beyond its traversal record
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
@@ -115,6 +122,14 @@ void evict_caches();
 // loads fall in: a scene of a few MiB reads DRAM faster than the 256 MiB chase of
 // dram_latency_ns (huge pages, as the BVH is allocated).
 double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs = 5);
+
+// Whether a read from DRAM brings the other line of its 128-byte pair into the caches (an
+// adjacent-line prefetch, CacheLevelConfig::pair_fill): after evict_caches, a random chase over
+// the even lines of `pair_bytes` (three laps), then the first pass over its odd lines, in ns a
+// load; against that first pass right after evict_caches alone (from DRAM). The fastest of
+// `runs` each. Pairs where the odd lines came at under half DRAM's latency.
+PairFillReading measure_pair_fill(double tsc_mhz, uint64_t pair_bytes = uint64_t(1) << 20,
+                                  int runs = 5);
 
 // Runs the last level's chases (HostDescription::last_level_chases and
 // last_level_idle_chases) from `h.caches` at `h.tsc_mhz`; none with fewer than two levels.

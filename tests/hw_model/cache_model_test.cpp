@@ -217,6 +217,9 @@ TEST_CASE("Shared cache lookups time every reader as its own caches would", "[hw
     other.scene_memory.caches[0].ways = 4;
     CHECK_FALSE(same_cache_lookups(a, other));
     other = a;
+    other.scene_memory.caches.back().pair_fill = true;  // fills lines a read never asked for
+    CHECK_FALSE(same_cache_lookups(a, other));
+    other = a;
     other.cores.count = 2;  // passes go to cores as their timing decides
     CHECK_FALSE(same_cache_lookups(a, other));
     other = a;
@@ -282,4 +285,28 @@ TEST_CASE("Other data read through the caches evicts scene lines and is not coun
     CHECK(model.dram_reads() == 2);
     model.touch_other(0, 0, 0, 400);  // nothing
     CHECK(model.read(0, 0, 4, 500) == 500 + 2);
+}
+
+TEST_CASE("A read from DRAM fills its 128-byte pair's other line into a last level that pairs",
+          "[hw_model][cache]") {
+    for (const bool pairs : {false, true}) {
+        SceneMemoryConfig config;  // l1, l2, l3 (the last) at 500 MHz: 1, 2 and 7 cycles
+        config.dram_latency_ns = 36.5;
+        config.dram_bandwidth_gbps = 32.0;
+        config.caches.back().pair_fill = pairs;
+        SceneMemoryModel memory(config, 500.0);
+        memory.read(0, 4096, 8, 0);  // from DRAM: line 64, whose pair's other line is 65
+        // The other line of the pair: in the last level only (not the first two), where it pairs.
+        CHECK(memory.read(0, 4096 + 64, 8, 100) == (pairs ? 100 + 7 : 100 + 19 + 1));
+        CHECK(memory.dram_reads() == (pairs ? 1 : 2));
+        CHECK(memory.hits(2) == (pairs ? 1 : 0));
+        // Line 66's pair (67) too; a line read again from the first level brings nothing new.
+        memory.read(0, 4096 + 128, 8, 200);
+        CHECK(memory.read(0, 4096 + 192, 8, 300) == (pairs ? 300 + 7 : 300 + 19 + 1));
+    }
+    SetAssociativeCache c({"l3", 1, 64, 2, 4});
+    c.fill(128);  // a prefetch: placed, not counted
+    CHECK(c.hits() == 0);
+    CHECK(c.misses() == 0);
+    CHECK(c.access(128));
 }

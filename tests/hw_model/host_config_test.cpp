@@ -911,6 +911,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
     host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
     host.dram_span_latencies = {{2, 78.5}, {16, 155.5}, {256, 294.2}};
+    host.pair_fill = {21.5, 148.0};  // the odd lines came from the L3: pairs
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
     host.branch_predictor_fit = "test batches";
@@ -936,6 +937,14 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.scene_memory.caches[2].hit_latency_ns == Approx(15.5));
     CHECK(c.scene_memory.caches[2].foreign_fill_per_us ==
           Approx(seen.foreign_fill_per_us).epsilon(0.01));
+    CHECK(c.scene_memory.caches[2].pair_fill);
+    CHECK_FALSE(c.scene_memory.caches[1].pair_fill);
+    CHECK(yaml.find("even lines 21.5 ns a load, from DRAM 148.0 ns") != std::string::npos);
+    HostDescription unpaired = host;
+    unpaired.pair_fill = {120.0, 148.0};  // the odd lines came from DRAM
+    CHECK_FALSE(parse_hw_config(host_hw_yaml(unpaired, {box}, ""), "host.hw.yaml")
+                    .scene_memory.caches[2]
+                    .pair_fill);
     CHECK(c.scene_memory.dram_latency_ns == Approx(81));
     REQUIRE(c.scene_memory.dram_latency_by_span.size() == 3);
     CHECK(c.scene_memory.dram_latency_by_span[1].span_mib == Approx(16));
