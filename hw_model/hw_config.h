@@ -231,7 +231,7 @@ struct CacheLevelConfig {
     // 128-byte pair into it too: a host's adjacent-line prefetch, which fills the level with
     // lines a scene's sparse reads may never use. Measured for a host (measure_pair_fill,
     // host_description.h): on the Zen 4 VM (2026-12-04) the odd lines of 1 MiB, read first
-    // after a chase of its even lines, took 14-29 ns a load against 147-160 ns from DRAM.
+    // after a chase of its even lines, took 13-22 ns a load against 147-150 ns from DRAM.
     bool pair_fill = false;
 
     template <class V>
