@@ -658,7 +658,6 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.interrupted_renders"] = m.interrupted;
             row["measured.clock_moved_renders"] = m.clock_moved;
             row["measured.contended_renders"] = m.contended;
-            row["measured.gate_waits"] = m.gate_waits;
             row["measured.rewarmed_renders"] = m.rewarmed;
             row["measured.render_cycles"] = m.render_cycles;
             row["measured.render_shared_share"] = m.render_shared_share;

@@ -131,7 +131,7 @@ void probe_core(int) {
     // the first of two back-to-back runs read 11 % or more below the second in a tenth of the
     // probes. Over temple's 64-pixel tiles (1.4 MB of rays), one run found 0.17-0.38 of the
     // probes shared and the better of two 0.07-0.19, in two of three alternated pairs of runs
-    // (the third: 0.2-0.4 both; AMD Zen 4 VM, 2026-12-04).
+    // (the third: 0.29-0.41 both; AMD Zen 4 VM, 2026-12-04).
     const double rate = independent_adds_per_tick(2);
     const uint32_t index = g_probes.fetch_add(1, std::memory_order_relaxed);
     const bool shared = rate < g_shared_below.load(std::memory_order_relaxed);

@@ -89,13 +89,12 @@ bool SetAssociativeCache::access(uint64_t address, uint64_t now) {
     const uint64_t line = address >> m_line_shift;
     const uint32_t set = uint32_t(line % m_sets);
     if (m_foreign_per_set_cycle > 0) fill_foreign(set, now);
-    uint64_t* tags = &m_tags[size_t(set) * m_ways];
-    for (uint32_t w = 0; w < m_ways; ++w)
-        if (tags[w] == line) {
-            ++m_hits;
-            touch(set, w);
-            return true;
-        }
+    const uint32_t way = way_holding(set, line);
+    if (way < m_ways) {
+        ++m_hits;
+        touch(set, way);
+        return true;
+    }
     ++m_misses;
     place(set, line);
     return false;
@@ -105,10 +104,14 @@ void SetAssociativeCache::fill(uint64_t address, uint64_t now) {
     const uint64_t line = address >> m_line_shift;
     const uint32_t set = uint32_t(line % m_sets);
     if (m_foreign_per_set_cycle > 0) fill_foreign(set, now);
+    if (way_holding(set, line) == m_ways) place(set, line);
+}
+
+uint32_t SetAssociativeCache::way_holding(uint32_t set, uint64_t line) const {
     const uint64_t* tags = &m_tags[size_t(set) * m_ways];
     for (uint32_t w = 0; w < m_ways; ++w)
-        if (tags[w] == line) return;
-    place(set, line);
+        if (tags[w] == line) return w;
+    return m_ways;
 }
 
 double dram_latency_ns_at(const SceneMemoryConfig& memory, uint64_t span_bytes) {

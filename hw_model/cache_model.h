@@ -33,6 +33,7 @@ class SetAssociativeCache {
     uint64_t misses() const { return m_misses; }
 
   private:
+    uint32_t way_holding(uint32_t set, uint64_t line) const;  // m_ways: none
     void touch(uint32_t set, uint32_t way);
     uint32_t victim(uint32_t set) const;
     void place(uint32_t set, uint64_t tag);

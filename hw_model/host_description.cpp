@@ -230,18 +230,33 @@ using Chase = std::vector<size_t, HugePageAllocator<size_t>>;
 
 constexpr size_t k_chase_stride = 64 / sizeof(size_t);  // words a line
 
+// Links `count` lines of `chase`, line `first` and every `step`-th after it, into a cycle in
+// random order from line `first`: each one's first word holds the index of the next one's.
+void link_cycle(Chase& chase, size_t count, size_t first, size_t step, uint64_t seed) {
+    std::vector<size_t> order(count);
+    for (size_t i = 0; i < count; ++i) order[i] = (first + i * step) * k_chase_stride;
+    std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(seed));
+    for (size_t i = 0; i < count; ++i) chase[order[i]] = order[(i + 1) % count];
+}
+
 // A cycle through the lines of `bytes` (at least 8) in random order: each line's first word
 // holds the index of the next line's. Allocated as the BVH is (base/huge_pages.h): huge pages
 // where the chase is 2 MiB or more, so the latency includes the page walks the traversal's
 // scene reads have, and no others.
 Chase random_chase(uint64_t bytes) {
-    const size_t lines = std::max<uint64_t>(bytes / 64, 8), stride = k_chase_stride;
-    std::vector<size_t> order(lines);
-    std::iota(order.begin(), order.end(), size_t(0));
-    std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(12345));
-    Chase chase(lines * stride);
-    for (size_t i = 0; i < lines; ++i) chase[order[i] * stride] = order[(i + 1) % lines] * stride;
+    const size_t lines = std::max<uint64_t>(bytes / 64, 8);
+    Chase chase(lines * k_chase_stride);
+    link_cycle(chase, lines, 0, 1, 12345);
     return chase;
+}
+
+// Nanoseconds a load over `loads` loads along `chase` from the word `at` (left where they end).
+double chase_pass_ns(const Chase& chase, size_t& at, size_t loads, double tsc_mhz) {
+    const uint64_t c0 = __rdtsc();
+    for (size_t i = 0; i < loads; ++i) at = chase[at];
+    const uint64_t c1 = __rdtsc();
+    if (at == size_t(-1)) std::printf(" ");  // keeps the chase
+    return double(c1 - c0) / double(loads) / tsc_mhz * 1000.0;
 }
 
 }  // namespace
@@ -294,42 +309,27 @@ double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs)
     double best = 1e30;
     for (int rep = 0; rep < runs; ++rep) {
         evict_caches();
-        const uint64_t c0 = __rdtsc();
-        for (size_t i = 0; i < loads; ++i) at = chase[at];
-        const uint64_t c1 = __rdtsc();
-        best = std::min(best, double(c1 - c0) / double(loads));
+        best = std::min(best, chase_pass_ns(chase, at, loads, tsc_mhz));
     }
-    if (at == size_t(-1)) std::printf(" ");  // keeps the chase
-    return best / tsc_mhz * 1000.0;
+    return best;
 }
 
 PairFillReading measure_pair_fill(double tsc_mhz, uint64_t pair_bytes, int runs) {
-    const size_t pairs = std::max<uint64_t>(pair_bytes / 128, 8), stride = k_chase_stride;
+    const size_t pairs = std::max<uint64_t>(pair_bytes / 128, 8);
     // Two cycles through the pairs in random order: one over their even lines, one over their
-    // odd lines (each line's first word holds the index of the next's).
-    Chase chase(pairs * 2 * stride);
-    for (size_t half = 0; half < 2; ++half) {
-        std::vector<size_t> order(pairs);
-        std::iota(order.begin(), order.end(), size_t(0));
-        std::shuffle(order.begin(), order.end(), std::mt19937_64(777 + half));
-        for (size_t i = 0; i < pairs; ++i)
-            chase[(2 * order[i] + half) * stride] = (2 * order[(i + 1) % pairs] + half) * stride;
-    }
-    auto pass = [&](size_t start, size_t loads) {
-        size_t at = start;
-        const uint64_t c0 = __rdtsc();
-        for (size_t i = 0; i < loads; ++i) at = chase[at];
-        const uint64_t c1 = __rdtsc();
-        if (at == size_t(-1)) std::printf(" ");  // keeps the chase
-        return double(c1 - c0) / double(loads) / tsc_mhz * 1000.0;
-    };
+    // odd lines.
+    Chase chase(pairs * 2 * k_chase_stride);
+    link_cycle(chase, pairs, 0, 2, 777);
+    link_cycle(chase, pairs, 1, 2, 778);
     PairFillReading r{1e30, 1e30};
     for (int rep = 0; rep < runs; ++rep) {
+        size_t even = 0, odd = k_chase_stride;
         evict_caches();
-        pass(0, 3 * pairs);  // the even lines
-        r.after_even_ns = std::min(r.after_even_ns, pass(stride, pairs));
+        chase_pass_ns(chase, even, 3 * pairs, tsc_mhz);
+        r.after_even_ns = std::min(r.after_even_ns, chase_pass_ns(chase, odd, pairs, tsc_mhz));
+        odd = k_chase_stride;
         evict_caches();
-        r.cold_ns = std::min(r.cold_ns, pass(stride, pairs));
+        r.cold_ns = std::min(r.cold_ns, chase_pass_ns(chase, odd, pairs, tsc_mhz));
     }
     return r;
 }

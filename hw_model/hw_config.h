@@ -232,6 +232,8 @@ struct CacheLevelConfig {
     // lines a scene's sparse reads may never use. Measured for a host (measure_pair_fill,
     // host_description.h): on the Zen 4 VM (2026-12-04) the odd lines of 1 MiB, read first
     // after a chase of its even lines, took 13-22 ns a load against 147-150 ns from DRAM.
+    // Default false: the presets' caches (Bikker's model, SceneMemoryConfig) fetch only what
+    // is read.
     bool pair_fill = false;
 
     template <class V>

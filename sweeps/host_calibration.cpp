@@ -714,12 +714,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
             clocked_totals[v].push_back(clocked.cycles);
             // Where the gate slept, the render before no longer warms this one: others' fills
             // over 10-30 ms asleep took what it left in a shared L3 (base/core_contention.h).
-            const uint32_t waits_before = core_contention().waits();
             const bool alone_before = core_contention().wait_warm([&] {
                 warm(v);
                 ++m.rewarmed;
             });
-            m.gate_waits += core_contention().waits() - waits_before;
             const uint64_t waited_at = read_tsc();
             const std::vector<CpuTimes> load_before = read_cpu_times();
             ContentionMonitor monitor(core_contention().shared_below(), k_monitor_period_us);

@@ -206,9 +206,9 @@ struct SiliconMeasurement {
     // another hardware thread, set aside and taken again; at the budget's number the workload
     // stops (base/core_contention.h).
     uint32_t contended = 0;
-    // Before measured renders, the gate's waits for the core (each asleep 10 ms or more), and
-    // the renders taken again after one to warm the caches (CoreContention::wait_warm).
-    uint32_t gate_waits = 0, rewarmed = 0;
+    // Renders taken again before a measured one to warm the caches, one after each of the
+    // gate's waits for the core, asleep 10 ms or more (CoreContention::wait_warm).
+    uint32_t rewarmed = 0;
     // Every unclocked render, kept or set aside: its cycles and the share of the contention
     // monitor's probes during it that found the core shared (ContentionMonitor); and the
     // monitor's own time over the kept renders, as a share of them (subtracted from their cycles).

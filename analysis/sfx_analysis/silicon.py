@@ -684,12 +684,11 @@ def measurement_text(df):
                              f"{100 * df['measured.monitor_share'].mean():.2f} % of a kept render "
                              f"(taken off its cycles)")
     if "measured.rewarmed_renders" in df:
-        waits, rewarmed = df["measured.gate_waits"], df["measured.rewarmed_renders"]
+        rewarmed = int(df["measured.rewarmed_renders"].sum())
         lines.append(f"- the gate's waits for the core before a measured render (each asleep 10 ms "
                      f"or more, over which others' fills take what the render before left in a "
-                     f"shared L3): {int(waits.sum())}, each followed by a render of the workload "
-                     f"again to warm the caches ({int(rewarmed.sum())} renders; "
-                     f"CoreContention::wait_warm)")
+                     f"shared L3): {rewarmed}, each followed by a render of the workload again to "
+                     f"warm the caches (CoreContention::wait_warm)")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")
