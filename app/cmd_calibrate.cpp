@@ -618,7 +618,7 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.speed_probe_before"] = m.probe_before;
             row["measured.speed_probe_after"] = m.probe_after;
             // The L3: the host file's, and this core's just before the first render, after the
-            // last and (memory_now) in the round of the fastest render, which the model
+            // last, (memory_now) in the round of the fastest render, the run's, which the model
             // predicted with, and the least and most of the rounds' (kib 0: not chased).
             const HwConfig& described = *variants[i].host;
             if (!described.scene_memory.caches.empty()) {
@@ -632,6 +632,8 @@ void add_calibrate_command(CLI::App& app) {
             row["measured.l3_fill_per_us_after"] = m.l3_after.foreign_fill_per_us;
             row["measured.l3_kib_render"] = m.l3_render.kib;
             row["measured.l3_fill_per_us_render"] = m.l3_render.foreign_fill_per_us;
+            row["measured.l3_kib_run"] = m.l3_run.kib;
+            row["measured.l3_fill_per_us_run"] = m.l3_run.foreign_fill_per_us;
             row["measured.l3_kib_rounds_min"] = m.l3_rounds_kib_max > 0 ? m.l3_rounds_kib_min : 0;
             row["measured.l3_kib_rounds_max"] = m.l3_rounds_kib_max;
             if (!m.frame_sample_l3_kib.empty()) {
@@ -640,6 +642,7 @@ void add_calibrate_command(CLI::App& app) {
             }
             row["predicted.memory_now"] = o->memory_now;
             row["predicted.frame_cycles_described"] = m.predicted_frame_described;
+            row["predicted.frame_cycles_round"] = m.predicted_frame_round;
             if (variants[i].cold) {
                 row["predicted.cold_frame_cycles"] = m.predicted_cold_frame;
                 row["measured.cold_frame_cycles"] = m.measured_cold_frame;

@@ -553,6 +553,20 @@ SeenLevel chase_last_level_now(double tsc_mhz) {
     return last_level_seen(h);
 }
 
+SeenLevel median_level(const std::vector<SeenLevel>& levels) {
+    std::vector<double> kib, fills;
+    for (const SeenLevel& seen : levels)
+        if (seen.kib > 0) {
+            kib.push_back(seen.kib);
+            fills.push_back(seen.foreign_fill_per_us);
+        }
+    SeenLevel run;
+    if (kib.empty()) return run;
+    run.kib = uint32_t(std::llround(median(kib)));
+    run.foreign_fill_per_us = median(fills);
+    return run;
+}
+
 HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen) {
     HwConfig c = host;
     if (seen.kib == 0 || c.scene_memory.caches.empty() || !c.scene_memory.caches.back().shared)
@@ -577,18 +591,23 @@ std::vector<SiliconMeasurement> predict_and_measure(
         out[v].l3_before = l3_before;
     }
     // The predictions, with the host file's L3 before the renders; with memory_now, after
-    // them, each with the L3 chased in the round of its fastest render.
+    // them, with the run's L3 (SiliconMeasurement::l3_run), and for comparison the file's and
+    // the one chased in the round of each workload's fastest render.
+    auto frame_with = [&](size_t v, const HwConfig& host) {
+        SiliconMeasurement other;
+        predict(*variants[v].scene, *variants[v].bvh, settings[v], host, false, other);
+        return other.predicted_frame;
+    };
     auto predict_all = [&](const std::function<HwConfig(size_t)>& host_of) {
         for (size_t v = 0; v < n; ++v) {
             if (progress) progress("predicting", v, n);
-            const HwConfig& described = *variants[v].host;
             predict(*variants[v].scene, *variants[v].bvh, settings[v], host_of(v), variants[v].cold,
                     out[v]);
             out[v].predicted_frame_described = out[v].predicted_frame;
             if (memory_now) {
-                SiliconMeasurement file;
-                predict(*variants[v].scene, *variants[v].bvh, settings[v], described, false, file);
-                out[v].predicted_frame_described = file.predicted_frame;
+                out[v].predicted_frame_described = frame_with(v, *variants[v].host);
+                out[v].predicted_frame_round =
+                    frame_with(v, with_last_level(*variants[v].host, out[v].l3_render));
             }
         }
     };
@@ -864,8 +883,14 @@ std::vector<SiliconMeasurement> predict_and_measure(
                 m.measured_frame -
             1.0;
     }
-    if (memory_now)
-        predict_all([&](size_t v) { return with_last_level(*variants[v].host, out[v].l3_render); });
+    if (memory_now) {
+        std::vector<SeenLevel> met;  // each kept render's round's
+        for (size_t v = 0; v < n; ++v)
+            for (uint32_t round_index : sample_round[v]) met.push_back(round_l3[round_index]);
+        const SeenLevel run = median_level(met);
+        for (SiliconMeasurement& m : out) m.l3_run = run;
+        predict_all([&](size_t v) { return with_last_level(*variants[v].host, run); });
+    }
     return out;
 }
 

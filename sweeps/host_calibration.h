@@ -223,13 +223,19 @@ struct SiliconMeasurement {
     // the first render and just after the last (kib 0: not chased). On a shared machine it
     // moves within a minute (22.3 to 4.5 MiB in four descriptions on this project's AMD VM,
     // 2026-11-28); a large move between the two flags a run whose memory was not the one
-    // the renders began with. With `memory_now` it is also chased at the start of every round,
-    // and the model predicts with `l3_render`, the one chased in the round of the fastest
-    // render (the one measured), in place of the host file's L3; `predicted_frame_described`
-    // is the frame with the file's, for comparison.
-    SeenLevel l3_before, l3_after, l3_render;
+    // the renders began with. With `memory_now` it is also chased at the start of every round
+    // (`l3_render`: the round of this workload's fastest render), and the model predicts every
+    // workload with `l3_run`, the median over all workloads' kept renders of their rounds'
+    // chases (median_level), in place of the host file's L3. One L3 for all: a chase takes
+    // 2.3 s and reads 2x apart within seconds (6.2 to 11.7 MiB, this project's Zen 4 VM,
+    // 2026-12-04), and a render's time barely follows its round's reading (Spearman -0.22 over
+    // 621 renders): with each workload's own round, the model's tiles of one frame differed
+    // by their readings (scalar temple 64x64: 31.5 / 36.2 / 29.0 Mcycles at 13.3 / 10.4 /
+    // 18.9 MiB) more than by their tiles. The frames with the file's L3 and with the round's
+    // are kept for comparison.
+    SeenLevel l3_before, l3_after, l3_render, l3_run;
     uint32_t l3_rounds_kib_min = ~0u, l3_rounds_kib_max = 0;  // over the rounds' chases
-    double predicted_frame_described = 0.0;
+    double predicted_frame_described = 0.0, predicted_frame_round = 0.0;
     // From cold caches (SiliconVariant::cold): the renders after reading 256 MiB of other data,
     // which leaves none of the scene in this core's caches, under the same rule; the
     // prediction from empty caches. 0 and no samples where not asked for.
@@ -277,10 +283,10 @@ struct SiliconVariant {
 // workload, so that it starts from the caches predict() assumes. A workload asked for `cold` also
 // renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
 // vary placement. `progress(what, done, total)` as it goes. With `memory_now`, the L3 is
-// chased at the start of every round, and each workload is predicted after the renders with
-// the one chased in the round of its fastest render as its host's last cache level
-// (SiliconMeasurement::l3_render), not the file's: the check then predicts the memory the
-// render it measured met.
+// chased at the start of every round, and every workload is predicted after the renders with
+// the median of the chases the kept renders met as its host's last cache level
+// (SiliconMeasurement::l3_run), not the file's: the check then predicts the memory its
+// renders met.
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence,
     uint64_t seed = 1, const std::function<void(const std::string&, size_t, size_t)>& progress = {},
@@ -289,6 +295,10 @@ std::vector<SiliconMeasurement> predict_and_measure(
 // The L3 this core keeps now: the last level's chases (chase_last_level) on this machine's
 // caches, read by last_level_seen (kib 0 where the CPU reports fewer than two levels).
 SeenLevel chase_last_level_now(double tsc_mhz);
+
+// The median level of `levels` (size and others' fills, each its own median, over those
+// chased; kib 0 where none was).
+SeenLevel median_level(const std::vector<SeenLevel>& levels);
 
 // `host` with its last scene-memory level's size and others' fills as `seen` says (unchanged
 // where `seen` was not chased or the host has no shared last level).

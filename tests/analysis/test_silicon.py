@@ -334,7 +334,23 @@ def test_l3_chased_around_the_renders(tmp_path):
     assert "before the first render 16.0 MiB" in line and "after the last render 4.0 MiB" in line
     assert "each round 3.0 to 20.0 MiB" in line
     assert "MOVED" in line and "round of its fastest render (--memory-now)" in line
+    # Rows that predicted every workload with the run's L3 (12 MiB), the rounds' beside it
+    # (10 % and 30 % under): the line names the run's, the summary gives the rounds' apart.
+    for r, round_ in zip(rows, (90, 70)):
+        r.update({"measured.l3_kib_run": 12288, "measured.l3_fill_per_us_run": 9.0,
+                  "predicted.frame_cycles_round": round_})
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    s = silicon.summary(df)
+    assert s["frame_mae_round"] == pytest.approx(0.20)
+    assert s["frame_worst_round"] == pytest.approx(0.30)
+    text = silicon.summary_text(s)
+    assert "host file's L3 instead of the run's" in text
+    assert "round of each workload's fastest render instead (same renders): MAE 20.0 %" in text
+    line = [x for x in silicon.measurement_text(df).splitlines() if "L3 this core" in x][0]
+    assert "every workload with the run's, 12.0 MiB (others' fills 9.00" in line
     for r in rows:
+        del r["measured.l3_kib_run"], r["predicted.frame_cycles_round"]
         r["measured.l3_kib_after"] = 18000
         r["measured.l3_kib_rounds_max"] = 0  # not chased each round
         r["predicted.memory_now"] = False

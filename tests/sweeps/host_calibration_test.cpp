@@ -313,8 +313,8 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(probe > 0);
     HwConfig probed = config;
     probed.speed_probe_cycles = 1000 * probe;
-    // This run also predicts with the L3 chased in the round of each workload's fastest render
-    // (memory_now), and keeps the host file's prediction beside it: the same as the first
+    // This run also predicts with the run's L3, the median of the rounds' chases its renders
+    // met (memory_now), and keeps the host file's prediction beside it: the same as the first
     // run's, which used the file.
     const std::vector<SiliconMeasurement> again = predict_and_measure(
         {{&scene, &bvh, s, &probed}, {&furnace, &furnace_bvh, f, &probed}}, rule, 1, {}, true);
@@ -334,15 +334,21 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         CHECK(again[0].l3_after.kib > 0);
         for (size_t v = 0; v < 2; ++v) {
             const SiliconMeasurement& w = again[v];
-            CHECK(w.prediction.config.scene_memory.caches.back().kib == w.l3_render.kib);
+            // One L3 for every workload: the run's, within the rounds' readings.
+            CHECK(w.l3_run.kib == again[0].l3_run.kib);
+            CHECK(w.prediction.config.scene_memory.caches.back().kib == w.l3_run.kib);
             CHECK(w.prediction.config.scene_memory.caches.back().foreign_fill_per_us ==
-                  w.l3_render.foreign_fill_per_us);
+                  w.l3_run.foreign_fill_per_us);
             CHECK(w.l3_rounds_kib_min > 0);
             CHECK(w.l3_rounds_kib_min <= w.l3_render.kib);
             CHECK(w.l3_render.kib <= w.l3_rounds_kib_max);
+            CHECK(w.l3_rounds_kib_min <= w.l3_run.kib);
+            CHECK(w.l3_run.kib <= w.l3_rounds_kib_max);
+            CHECK(w.predicted_frame_round > 0);
         }
     }
     CHECK(cell[0].l3_render.kib == 0);  // chased each round only with memory_now
+    CHECK(cell[0].l3_run.kib == 0);
     CHECK(cell[0].l3_rounds_kib_max == 0);
     CHECK(again[0].probe_before == again[1].probe_before);
     CHECK(again[0].probe_after == again[1].probe_after);
@@ -531,4 +537,22 @@ TEST_CASE("The check's L3 chased now replaces a host file's shared last level on
     CHECK(with_last_level(host, SeenLevel{}).scene_memory.caches.back().kib == 32768);
     host.scene_memory.caches.back().shared = false;
     CHECK(with_last_level(host, seen).scene_memory.caches.back().kib == 32768);
+}
+
+TEST_CASE("The run's L3 is the median of the chases, size and others' fills apart", "[host]") {
+    auto level = [](uint32_t kib, double fills) {
+        SeenLevel seen;
+        seen.kib = kib;
+        seen.foreign_fill_per_us = fills;
+        return seen;
+    };
+    // Size and fills each their own median (not one chase's pair); a round not chased is
+    // left out.
+    const SeenLevel run = median_level({level(6000, 30.0), level(19000, 8.0), SeenLevel{},
+                                        level(11000, 4.0), level(12000, 20.0), level(7000, 12.0)});
+    CHECK(run.kib == 11000);
+    CHECK(run.foreign_fill_per_us == Approx(12.0));
+    CHECK(median_level({level(9000, 2.0)}).kib == 9000);
+    CHECK(median_level({}).kib == 0);
+    CHECK(median_level({SeenLevel{}}).kib == 0);
 }
