@@ -35,6 +35,13 @@ namespace sfx {
 
 namespace {
 
+// A misprediction's cost in one loop as fitted ("-": not fitted, the pooled cost).
+std::string loop_cost_text(double cycles) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", cycles);
+    return cycles >= 0 ? text : "-";
+}
+
 std::vector<std::string> split(const std::string& s) {
     std::vector<std::string> out;
     size_t start = 0;
@@ -309,6 +316,9 @@ void add_calibrate_command(CLI::App& app) {
                 }
                 j["branch_predictor"] = cal.host.branch_predictor.kind;
                 j["mispredict_cycles"] = cal.host.branch_predictor.mispredict_cycles;
+                j["loop_mispredict_cycles"] = {cal.host.branch_predictor.one_ray_mispredict_cycles,
+                                               cal.host.branch_predictor.few_ray_mispredict_cycles,
+                                               cal.host.branch_predictor.stream_mispredict_cycles};
                 for (const PredictorCheck& b : cal.branch_samples)
                     j["branch_samples"].push_back(
                         {{"bounce", b.measured.bounce},
@@ -439,10 +449,14 @@ void add_calibrate_command(CLI::App& app) {
                                 "microbenchmarks' independent calls (their fit error)\n",
                                 cal.op_costs[i].op.c_str(), cal.op_costs[i].per_op_cycles,
                                 cal.filter_costs[i].per_op_cycles);
+            const BranchPredictorConfig& bp = cal.host.branch_predictor;
             std::printf(
-                "branch mispredictions (the model's predictor): %.1f cycles each, from "
+                "branch mispredictions (the model's predictor): %.1f cycles each; a box "
+                "test's by loop %s / %s / %s (one-ray / few-ray / stream; -: the pooled), from "
                 "the branch microbenchmark:\n",
-                cal.host.branch_predictor.mispredict_cycles);
+                bp.mispredict_cycles, loop_cost_text(bp.one_ray_mispredict_cycles).c_str(),
+                loop_cost_text(bp.few_ray_mispredict_cycles).c_str(),
+                loop_cost_text(bp.stream_mispredict_cycles).c_str());
             for (const PredictorCheck& b : cal.branch_samples)
                 std::printf(
                     "  %-7s cycles primed %.0f, cached %.0f, displaced %.0f (%u of %u "
@@ -726,10 +740,21 @@ void add_calibrate_command(CLI::App& app) {
                             b.kind == "none" ? 0.0 : b.mispredict_cycles;
                         row[model + "primed_mispredictions"] = c.modelled.primed;
                         row[model + "displaced_mispredictions"] = c.modelled.displaced;
-                        row[model + "extra_cycles"] =
-                            b.kind == "none" ? 0.0
-                                             : b.mispredict_cycles * (double(c.modelled.displaced) -
-                                                                      double(c.modelled.primed));
+                        // Priced as the model prices them: a box test's by its loop, the rest
+                        // (the leaf tests') at the pooled cost.
+                        double extra = 0.0, box_added = 0.0;
+                        for (size_t l = 0; l < 3; ++l) {
+                            const double added = double(c.modelled.displaced_by_loop[l]) -
+                                                 double(c.modelled.primed_by_loop[l]);
+                            extra += added * b.mispredict_cycles_in(l);
+                            box_added += added;
+                            row[model + "loop_mispredict_cycles." + loops[l]] =
+                                b.kind == "none" ? 0.0 : b.mispredict_cycles_in(l);
+                        }
+                        extra +=
+                            (double(c.modelled.displaced) - double(c.modelled.primed) - box_added) *
+                            b.mispredict_cycles;
+                        row[model + "extra_cycles"] = b.kind == "none" ? 0.0 : extra;
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
                         row[model + "cold_cycles"] = memory.cold;
                         row[model + "warm_cycles"] = memory.warm;

@@ -294,7 +294,8 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
 }
 
 uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& batch, uint32_t width,
-                                  const std::vector<uint8_t>& node_leaf) {
+                                  const std::vector<uint8_t>& node_leaf,
+                                  std::array<uint64_t, 3>* box_by_loop) {
     TagePredictor predictor;
     std::vector<uint32_t> scratch;
     const std::vector<TraversalLoop> others_loops = traversal_loops(others, width);
@@ -302,8 +303,16 @@ uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& ba
     // time a batch is timed; the second is the run before the timed one.
     for (int run = 0; run < 2; ++run)
         mispredictions_replaying(others, others_loops, width, node_leaf, predictor, scratch);
-    return mispredictions_replaying(batch, traversal_loops(batch, width), width, node_leaf,
-                                    predictor, scratch);
+    const std::vector<TraversalLoop> loops = traversal_loops(batch, width);
+    const uint64_t missed =
+        mispredictions_replaying(batch, loops, width, node_leaf, predictor, scratch);
+    if (box_by_loop) {
+        *box_by_loop = {};
+        for (size_t i = 0; i < scratch.size(); ++i)
+            if (batch.at(i).kind == OpKind::box_test)
+                (*box_by_loop)[size_t(loops[i])] += scratch[i];
+    }
+    return missed;
 }
 
 double fit_mispredict_cycles(const std::vector<double>& extra_cycles,

@@ -92,9 +92,11 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
 
 // The model's side of a short-stream microbenchmark sample (run_one_ray_microbenchmarks,
 // kernels/stream/stream_microbench.h): a fresh predictor over the other rays' traversals
-// (twice, the first warming it), then over the batch's; the batch's mispredictions.
+// (twice, the first warming it), then over the batch's; the batch's mispredictions (with
+// `box_by_loop`, its box tests' by the loop that runs them, as PredictorStates has them).
 uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& batch, uint32_t width,
-                                  const std::vector<uint8_t>& node_leaf);
+                                  const std::vector<uint8_t>& node_leaf,
+                                  std::array<uint64_t, 3>* box_by_loop = nullptr);
 
 // BranchPredictorConfig::mispredict_cycles from the branch microbenchmark: what the displaced
 // batches took beyond the cached ones (the predictor's part, measured) over the mispredictions

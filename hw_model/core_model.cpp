@@ -412,7 +412,12 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
                                                                  : 0.0);
     // The op's mispredicted branches, on its first group.
     const double mispredicted =
-        t.first == 0 ? m_config.branch_predictor.mispredict_cycles * m_mispredicted[t.op] : 0.0;
+        t.first == 0
+            ? m_mispredicted[t.op] *
+                  (op.kind == OpKind::box_test
+                       ? m_config.branch_predictor.mispredict_cycles_in(size_t(m_loop[t.op]))
+                       : m_config.branch_predictor.mispredict_cycles)
+            : 0.0;
     const uint64_t branch_cycles = uint64_t(std::llround(mispredicted));
     m_timing.branch_cycles += branch_cycles;
     const uint64_t busy = uint64_t(std::max(0.0, std::floor(exact + mispredicted)));

@@ -630,6 +630,17 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
           << "              # branches: the core's own predictor is not published\n"
           << "  mispredict_cycles: " << fmt(h.branch_predictor.mispredict_cycles, 1)
           << "  # fitted: " << h.branch_predictor_fit << "\n";
+    if (h.branch_predictor.kind != "none") {
+        const BranchPredictorConfig& b = h.branch_predictor;
+        const std::pair<const char*, double> by_loop[] = {{"one_ray", b.one_ray_mispredict_cycles},
+                                                          {"few_ray", b.few_ray_mispredict_cycles},
+                                                          {"stream", b.stream_mispredict_cycles}};
+        for (const auto& [loop, cycles] : by_loop)
+            if (cycles >= 0)
+                y << "  " << loop << "_mispredict_cycles: " << fmt(cycles, 1)
+                  << "  # fitted: the same microbenchmark, a box test's in that loop (the stage "
+                     "clock's split)\n";
+    }
     if (h.speed_probe_cycles > 0)
         y << "speed_probe_cycles: " << fmt(h.speed_probe_cycles, 0)
           << "  # measured: the speed probe's microbenchmark points at calibration (fastest of "

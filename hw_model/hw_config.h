@@ -404,6 +404,22 @@ struct BranchPredictorConfig {
     // frames: the pipeline's refill, the overlap a miss loses in a traversal, and the branches
     // the replay leaves out.
     double mispredict_cycles = 0.0;
+    // The same by the native tracer's loop that runs the mispredicted box test (one-ray,
+    // few-ray, stream: TraversalLoop, kernels/trace.h), each fitted on the same microbenchmark's
+    // batches split by the stage clock, where the model mispredicts in that loop; negative: not
+    // fitted (the model mispredicts too little there), the pooled mispredict_cycles. On the Zen 4
+    // VM (2026-12-04) the scenes' predictor batches, measured, cost 1.4-1.9x the pooled price a
+    // modelled misprediction in the scalar one-ray loop and 0.2-0.5x in its stream loop: a one-ray
+    // traversal's miss waits on its dependent node reads, a stream's overlaps other lanes' work.
+    double one_ray_mispredict_cycles = -1.0, few_ray_mispredict_cycles = -1.0,
+           stream_mispredict_cycles = -1.0;
+    // What one misprediction of a box test costs in loop `loop` (size_t(TraversalLoop)); a
+    // leaf test's, which the stage clock splits into no loop, costs mispredict_cycles.
+    double mispredict_cycles_in(size_t loop) const {
+        const double by_loop[] = {one_ray_mispredict_cycles, few_ray_mispredict_cycles,
+                                  stream_mispredict_cycles};
+        return loop < 3 && by_loop[loop] >= 0 ? by_loop[loop] : mispredict_cycles;
+    }
 
     template <class V>
     void visit(V& v) {
@@ -414,6 +430,18 @@ struct BranchPredictorConfig {
                 "cost of one misprediction of the model's predictor (fitted on a "
                 "microbenchmark)",
                 0.0, 1e6);
+        v.param("one_ray_mispredict_cycles", one_ray_mispredict_cycles, "cycles",
+                "cost of one misprediction in the one-ray loop (fitted on the microbenchmark; "
+                "negative: mispredict_cycles)",
+                -1.0, 1e6);
+        v.param("few_ray_mispredict_cycles", few_ray_mispredict_cycles, "cycles",
+                "cost of one misprediction in the few-ray loop (fitted on the microbenchmark; "
+                "negative: mispredict_cycles)",
+                -1.0, 1e6);
+        v.param("stream_mispredict_cycles", stream_mispredict_cycles, "cycles",
+                "cost of one misprediction in the stream loop (fitted on the microbenchmark; "
+                "negative: mispredict_cycles)",
+                -1.0, 1e6);
     }
 };
 

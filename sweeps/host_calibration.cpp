@@ -53,7 +53,7 @@ bool one_lane_from_filters(OpKind kind) {
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
                                                     uint32_t width, uint32_t l1d_kib,
-                                                    double mispredict_cycles) {
+                                                    const BranchPredictorConfig& predictor) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
         if (const OpKind kind = op_kind_named(o.op); kind != OpKind::count)
@@ -62,7 +62,14 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
         sample.traversals = s.streams;
-        sample.stream_op_cycles = s.modelled_mispredictions * mispredict_cycles;
+        double box_mispredictions = 0.0;
+        for (size_t l = 0; l < 3; ++l) {
+            sample.stream_op_cycles +=
+                s.modelled_box_loop_mispredictions[l] * predictor.mispredict_cycles_in(l);
+            box_mispredictions += s.modelled_box_loop_mispredictions[l];
+        }
+        sample.stream_op_cycles += std::max(0.0, s.modelled_mispredictions - box_mispredictions) *
+                                   predictor.mispredict_cycles;
         // The check that a bundle's rays share one origin, at its directly timed cost.
         if (const OpCostConfig* box = cost_of[size_t(OpKind::box_test)])
             sample.stream_op_cycles +=
@@ -107,13 +114,18 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     return out;
 }
 
-double replay_short_stream_predictor(const TraversalRecorder& others,
-                                     const TraversalRecorder& batch, uint32_t width,
-                                     const std::vector<uint8_t>& node_leaf) {
+ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,
+                                                     const TraversalRecorder& batch, uint32_t width,
+                                                     const std::vector<uint8_t>& node_leaf) {
     PassBuffer others_trace, batch_trace;
     others(others_trace);
     batch(batch_trace);
-    return double(simulate_displaced_batch(others_trace, batch_trace, width, node_leaf));
+    std::array<uint64_t, 3> by_loop{};
+    ModelledMispredictions m;
+    m.total =
+        double(simulate_displaced_batch(others_trace, batch_trace, width, node_leaf, &by_loop));
+    for (size_t l = 0; l < 3; ++l) m.box_by_loop[l] = double(by_loop[l]);
+    return m;
 }
 
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs) {
@@ -132,6 +144,23 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
             o.traversal_start_cycles = fit.traversal_start;
         }
     }
+}
+
+std::array<double, 3> fit_loop_mispredict_cycles(const std::vector<PredictorCheck>& samples) {
+    std::array<double, 3> cycles{}, mispredictions{};
+    double all = 0.0;
+    for (const PredictorCheck& b : samples)
+        for (size_t l = 0; l < 3; ++l) {
+            cycles[l] += b.measured.displaced_loop_cycles[l] - b.measured.cached_loop_cycles[l];
+            mispredictions[l] +=
+                double(b.modelled.displaced_by_loop[l]) - double(b.modelled.primed_by_loop[l]);
+        }
+    for (double m : mispredictions) all += std::max(0.0, m);
+    std::array<double, 3> cost{-1.0, -1.0, -1.0};
+    for (size_t l = 0; l < 3; ++l)
+        if (all > 0 && mispredictions[l] >= k_loop_mispredict_min_share * all)
+            cost[l] = fit_mispredict_cycles({cycles[l]}, {mispredictions[l]});
+    return cost;
 }
 
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
@@ -332,6 +361,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.host.branch_predictor.kind = "tage";
     c.host.branch_predictor.mispredict_cycles =
         fit_mispredict_cycles(extra_cycles, extra_mispredictions);
+    const std::array<double, 3> by_loop = fit_loop_mispredict_cycles(c.branch_samples);
+    c.host.branch_predictor.one_ray_mispredict_cycles = by_loop[0];
+    c.host.branch_predictor.few_ray_mispredict_cycles = by_loop[1];
+    c.host.branch_predictor.stream_mispredict_cycles = by_loop[2];
     std::ostringstream branch_note;
     branch_note << "the branch microbenchmark (kernels/stream/stream_microbench.h: 20,000 random "
                 << "triangles, a 64 x 64 frame's 16 x 16 tile batches, camera rays and bounces):";
@@ -372,9 +405,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         });
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());
-    c.short_stream_samples =
-        short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, l1d,
-                                 c.host.branch_predictor.mispredict_cycles);
+    c.short_stream_samples = short_stream_fit_samples(
+        c.one_ray_samples, c.op_costs, c.host.simd_width, l1d, c.host.branch_predictor);
     c.short_stream_costs = fit_short_stream_cycles(c.short_stream_samples);
     c.short_stream_fit_errors =
         short_stream_fit_error(c.short_stream_costs, c.short_stream_samples);

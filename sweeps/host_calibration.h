@@ -42,6 +42,14 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
                                             const ConvergenceRule& convergence,
                                             bool time_evicted = true);
 
+// BranchPredictorConfig's costs by loop (one-ray, few-ray, stream) from the branch
+// microbenchmark's samples: per loop, what the displaced batches took beyond the cached ones in
+// that loop (the stage clock's split) over the box tests' mispredictions the model adds there
+// from primed to displaced, pooled over the samples; -1 (the pooled cost) for a loop holding
+// under k_loop_mispredict_min_share of the box tests' added mispredictions.
+std::array<double, 3> fit_loop_mispredict_cycles(const std::vector<PredictorCheck>& samples);
+constexpr double k_loop_mispredict_min_share = 0.1;
+
 // The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
 // priced: the states compared share the predictor's), each batch from empty caches (cold: the
 // microbenchmark's evicted state) and right after itself (warm: primed), summed: how the model
@@ -117,19 +125,20 @@ struct HostCalibration {
 // sample's other ops (its leaves' tests, and its stream-loop box tests' lanes) priced by
 // `costs`, the stream formula of a back end of `width` lanes, over the sample's buffer (its
 // slots, the native slot size) beside an L1D of `l1d_kib`; and the model's mispredictions on
-// its batch (OneRaySample::modelled_mispredictions) at `mispredict_cycles` each, which the
-// model adds to every traversal it times, so that the fitted costs do not hold them twice.
+// its batch (OneRaySample::modelled_mispredictions) as `predictor` prices them (a box test's
+// by its loop), which the model adds to every traversal it times, so that the fitted costs do
+// not hold them twice.
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
                                                     uint32_t width, uint32_t l1d_kib,
-                                                    double mispredict_cycles = 0.0);
+                                                    const BranchPredictorConfig& predictor = {});
 
 // run_one_ray_microbenchmarks' PredictorReplay: the sample's traces recorded and run through
 // the model's predictor as the microbenchmark times them (simulate_displaced_batch, for a back
 // end of `width` lanes in the scene whose tree has leaves `node_leaf`).
-double replay_short_stream_predictor(const TraversalRecorder& others,
-                                     const TraversalRecorder& batch, uint32_t width,
-                                     const std::vector<uint8_t>& node_leaf);
+ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,
+                                                     const TraversalRecorder& batch, uint32_t width,
+                                                     const std::vector<uint8_t>& node_leaf);
 // The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
 // cost where the traversals measured it (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);

@@ -515,7 +515,8 @@ def predictor_loops_text(df):
                     cached = r[f"{m}cached_loop_cycles.{key}"]
                     if cached < 0.01 * max(cached_all, 1):  # a loop the batches barely run
                         continue
-                    price = r.get(p + "mispredict_cycles", float("nan"))
+                    price = r.get(f"{p}loop_mispredict_cycles.{key}",
+                                  r.get(p + "mispredict_cycles", float("nan")))
                     if pd.isna(price):  # rows without it: the price the extra cycles imply
                         added_all = (r[p + "displaced_mispredictions"]
                                      - r[p + "primed_mispredictions"])
@@ -880,7 +881,8 @@ def write_page(df, page, plot_name, header):
         "learns well; a scene whose traversals it learns less well costs more than they say, "
         "whatever its caches hold. The model runs its own predictor (L-TAGE's TAGE, "
         "`hw_model/branch_predictor.h`) over the traversal's branches, which it derives from "
-        "the trace, and prices each misprediction at the host file's `mispredict_cycles`, "
+        "the trace, and prices each misprediction at the host file's `mispredict_cycles` (a box "
+        "test's in the loop that runs it, `one_ray_` / `few_ray_` / `stream_mispredict_cycles`), "
         "fitted on a scene of random triangles (the branch microbenchmark), never on these "
         "scenes: its column is its prediction for the same batches (what its mispredictions "
         "from primed to displaced cost, over the cached cycles), held out.\n\n"

@@ -1050,7 +1050,10 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                         sink.end_pass(pass);
                     };
                 };
-                sample.modelled_mispredictions = predictor_replay(recorder(true), recorder(false));
+                const ModelledMispredictions modelled =
+                    predictor_replay(recorder(true), recorder(false));
+                sample.modelled_mispredictions = modelled.total;
+                sample.modelled_box_loop_mispredictions = modelled.box_by_loop;
             }
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));

@@ -156,8 +156,10 @@ struct OneRaySample {
     bool converged = false;
     uint32_t repetitions = 0;
     // The mispredictions the model's branch predictor makes on the batch's traversals, run as
-    // the timed repetitions run them (`predictor_replay` below; 0 without one).
+    // the timed repetitions run them (`predictor_replay` below; 0 without one), and of those
+    // the box tests' by the loop that runs them (TraversalLoop: one-ray, few-ray, stream).
     double modelled_mispredictions = 0.0;
+    std::array<double, 3> modelled_box_loop_mispredictions{};
     // Where a repetition's time went, by the stage clock a frame's traversal is split with
     // (TraversalJob::leaf_tsc, ShortLoopClock): the shares of the leaves and of the one-ray and
     // few-ray loops less their leaves (the median of 5 repetitions, each displaced as the timed
@@ -168,11 +170,16 @@ struct OneRaySample {
 // Traces a run of traversals into `sink` (TraceDetail::lanes, one TilePass of the sample's
 // 4096 slots).
 using TraversalRecorder = std::function<void(TraceSink& sink)>;
+// The model's mispredictions on a batch: all, and the box tests' by loop (OneRaySample).
+struct ModelledMispredictions {
+    double total = 0.0;
+    std::array<double, 3> box_by_loop{};
+};
 // Given one sample's two recorders, the other rays' traversals that precede each timed
 // repetition (one such run) and the batch's traversals, returns the mispredictions the model's
 // branch predictor makes on the batch after the others (OneRaySample::modelled_mispredictions).
-using PredictorReplay =
-    std::function<double(const TraversalRecorder& others, const TraversalRecorder& batch)>;
+using PredictorReplay = std::function<ModelledMispredictions(const TraversalRecorder& others,
+                                                             const TraversalRecorder& batch)>;
 // Batches of 8 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
 // 32 streams of 2, 3 and 4 rays; the same streams entering 3 and 6 levels down (8 and 32 of
 // them); and of 1 and 4 streams of 8 to 128 rays, whose first ops run in the stream loop

@@ -728,6 +728,17 @@ TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
     // Every op is a one-ray stream's: the one-ray loop's prediction holds them all.
     CHECK(tage.traversal_loop_branch_cycles[size_t(TraversalLoop::one_ray)] == tage.branch_cycles);
     CHECK(none.traversal_loop_branch_cycles[size_t(TraversalLoop::one_ray)] == 0);
+    // A box test's misprediction at its loop's cost where one is fitted; another loop's
+    // (negative: not fitted) leaves the pooled cost.
+    host.branch_predictor.one_ray_mispredict_cycles = 80;
+    host.branch_predictor.stream_mispredict_cycles = 5;
+    const FrameTiming by_loop = time_random(host);
+    CHECK(by_loop.branch_mispredictions == tage.branch_mispredictions);
+    CHECK(by_loop.branch_cycles == 80 * by_loop.branch_mispredictions);
+    host.branch_predictor.one_ray_mispredict_cycles = -1;
+    CHECK(time_random(host).branch_cycles == tage.branch_cycles);
+    host.branch_predictor.one_ray_mispredict_cycles = 0;  // a fitted 0 is a cost
+    CHECK(time_random(host).branch_cycles == 0);
     CHECK(HwConfig().branch_predictor.kind == "none");  // the paper's machine: no branches
 }
 
@@ -914,6 +925,8 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.pair_fill = {21.5, 148.0};  // the odd lines came from the L3: pairs
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
+    host.branch_predictor.one_ray_mispredict_cycles = 72.5;
+    host.branch_predictor.stream_mispredict_cycles = 0;
     host.branch_predictor_fit = "test batches";
     const std::string yaml = host_hw_yaml(host, {box}, "test samples");
     const SeenLevel seen = last_level_seen(host);
@@ -961,6 +974,10 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].node_read_exposed_share == Approx(0.375));
     CHECK(c.branch_predictor.kind == "tage");
     CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
+    CHECK(c.branch_predictor.one_ray_mispredict_cycles == Approx(72.5));
+    CHECK(c.branch_predictor.few_ray_mispredict_cycles == -1);  // not fitted: not written
+    CHECK(c.branch_predictor.stream_mispredict_cycles == 0);
+    CHECK(yaml.find("few_ray_mispredict_cycles") == std::string::npos);
     CHECK(yaml.find("fitted: test batches") != std::string::npos);
     CHECK(host_hw_yaml(small_host(), {box}, "").find("branch_predictor") == std::string::npos);
     // A host file written before one-lane costs were measured: the formula for every op.

@@ -48,13 +48,17 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         isa, microbench_rule(3), 1,
         [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
             primed_mispredictions +=
-                replay_short_stream_predictor(batch, batch, isa_width(isa), leaves);
+                replay_short_stream_predictor(batch, batch, isa_width(isa), leaves).total;
             return replay_short_stream_predictor(others, batch, isa_width(isa), leaves);
         });
     double displaced_mispredictions = 0.0;
     for (const OneRaySample& s : one_ray) {
         CHECK(s.modelled_mispredictions >= 0.0);
         displaced_mispredictions += s.modelled_mispredictions;
+        // The box tests' by loop are a part of them; a narrow back end has no few-ray loop.
+        const auto& by_loop = s.modelled_box_loop_mispredictions;
+        CHECK(by_loop[0] + by_loop[1] + by_loop[2] <= s.modelled_mispredictions);
+        if (isa_width(isa) < k_few_ray_min_width) CHECK(by_loop[1] == 0.0);
     }
     INFO("mispredictions on the batches: primed " << primed_mispredictions << ", displaced "
                                                   << displaced_mispredictions);
@@ -133,11 +137,25 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     const std::vector<OneLaneSample> short_streams =
         short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib);
     // The model's mispredictions priced before the fit, at the cost given.
+    BranchPredictorConfig pooled;
+    pooled.mispredict_cycles = 50.0;
     const std::vector<OneLaneSample> net =
-        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, 50.0);
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, pooled);
     for (size_t i = 0; i < one_ray.size(); ++i)
         CHECK(net[i].stream_op_cycles == Approx(short_streams[i].stream_op_cycles +
                                                 50.0 * one_ray[i].modelled_mispredictions));
+    // A box test's in the one-ray loop at its own cost, the rest at the pooled one.
+    BranchPredictorConfig by_loop = pooled;
+    by_loop.one_ray_mispredict_cycles = 80.0;
+    const std::vector<OneLaneSample> loop_priced =
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, by_loop);
+    bool one_ray_mispredicted = false;
+    for (size_t i = 0; i < one_ray.size(); ++i) {
+        const double one = one_ray[i].modelled_box_loop_mispredictions[0];
+        one_ray_mispredicted = one_ray_mispredicted || one > 0;
+        CHECK(loop_priced[i].stream_op_cycles == Approx(net[i].stream_op_cycles + 30.0 * one));
+    }
+    CHECK(one_ray_mispredicted);
     for (size_t i = 0; i < one_ray.size(); ++i) {
         CHECK((short_streams[i].stream_op_cycles > 0) == !one_ray[i].stream_ops.empty());
         // The stream loop's box tests counted for the fit of their per-op cost, the leaves' not.
@@ -555,4 +573,27 @@ TEST_CASE("The run's L3 is the median of the chases, size and others' fills apar
     CHECK(median_level({level(9000, 2.0)}).kib == 9000);
     CHECK(median_level({}).kib == 0);
     CHECK(median_level({SeenLevel{}}).kib == 0);
+}
+
+TEST_CASE("A misprediction's cost is fitted per loop where the model mispredicts there", "[host]") {
+    // Two samples: the one-ray loop's displaced batches took 3000 + 1000 cycles more than the
+    // cached, over 40 + 10 box mispredictions the model added there (80 each); the stream
+    // loop's 500 over 50 (10 each); the few-ray loop's 30 over 2, under a tenth of the 102
+    // added: not fitted (-1, the pooled cost).
+    PredictorCheck a, b;
+    a.measured.displaced_loop_cycles = {13000, 1030, 20500};
+    a.measured.cached_loop_cycles = {10000, 1000, 20000};
+    a.modelled.displaced_by_loop = {45, 3, 60};
+    a.modelled.primed_by_loop = {5, 1, 10};
+    b.measured.displaced_loop_cycles = {2000, 0, 0};
+    b.measured.cached_loop_cycles = {1000, 0, 0};
+    b.modelled.displaced_by_loop = {10, 0, 0};
+    const std::array<double, 3> cost = fit_loop_mispredict_cycles({a, b});
+    CHECK(cost[0] == Approx(80.0));
+    CHECK(cost[1] == -1.0);
+    CHECK(cost[2] == Approx(10.0));
+    // A loop whose displaced batches ran faster than the cached: a cost of 0, not negative.
+    a.measured.displaced_loop_cycles[2] = 19000;
+    CHECK(fit_loop_mispredict_cycles({a, b})[2] == 0.0);
+    CHECK(fit_loop_mispredict_cycles({}) == std::array<double, 3>{-1.0, -1.0, -1.0});
 }
