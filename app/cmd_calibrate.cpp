@@ -210,6 +210,8 @@ void add_calibrate_command(CLI::App& app) {
                 j["speed_probe_cycles"] = cal.host.speed_probe_cycles;
                 j["speed_probe_drift"] =
                     speed_probe_drift(cal.host.speed_probe_cycles, cal.speed_probe_start_cycles);
+                j["sweep_probe_points_cycles"] = cal.sweep_probe_points_cycles;
+                j["calibration_drift"] = calibration_drift(cal);
                 j["microarchitecture"] = describe(cal.host.microarchitecture);
                 j["convergence_rule"] = describe(bench_rule);
                 j["converged_points"] = cal.converged_points;
@@ -378,11 +380,16 @@ void add_calibrate_command(CLI::App& app) {
                     "they came\n");
             const double drift =
                 speed_probe_drift(cal.host.speed_probe_cycles, cal.speed_probe_start_cycles);
+            const double moved = calibration_drift(cal);
             std::printf(
                 "speed probe: %.0f cycles before the microbenchmarks, %.0f after (drift %+.1f "
-                "%%)%s\n",
+                "%%); its points in the microbenchmarks' sweeps %.0f (%+.1f %% from the probe "
+                "after)%s\n",
                 cal.speed_probe_start_cycles, cal.host.speed_probe_cycles, 100.0 * drift,
-                std::abs(drift) > k_speed_probe_tolerance
+                cal.sweep_probe_points_cycles,
+                100.0 *
+                    speed_probe_drift(cal.sweep_probe_points_cycles, cal.host.speed_probe_cycles),
+                std::abs(moved) > k_speed_probe_tolerance
                     ? ": the machine moved during calibration, calibrate again"
                     : "");
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind", "per_op",

@@ -290,6 +290,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     options.convergence = convergence;
     c.samples = run_stream_microbenchmarks(options, progress);
     c.microbench_visits = options.visits;
+    c.sweep_probe_points_cycles = speed_probe_points_cycles(c.samples);
     c.rates = run_gather_compress_microbenchmarks(resolved, convergence.budget);
     for (const MicrobenchSample& s : c.samples) c.converged_points += s.converged;
     c.points = uint32_t(c.samples.size());
@@ -554,7 +555,10 @@ std::pair<CycleReading, double> timed_render(const Scene& scene, const Bvh& bvh,
 
 }  // namespace
 
-double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t probes) {
+namespace {
+
+// The speed probe's microbenchmark points (speed_probe_cycles).
+MicrobenchOptions speed_probe_options(Isa isa, const ConvergenceRule& convergence) {
     MicrobenchOptions options;
     options.isa = isa;
     options.convergence = convergence;
@@ -562,6 +566,26 @@ double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t 
                      OpKind::lambertian_indirect};
     options.buffer_slots = {1024};
     options.lengths = {512, 1024};
+    return options;
+}
+
+}  // namespace
+
+double speed_probe_points_cycles(const std::vector<MicrobenchSample>& samples) {
+    const MicrobenchOptions probe = speed_probe_options(Isa::automatic, microbench_rule());
+    auto among = [](const auto& values, const auto& value) {
+        return std::find(values.begin(), values.end(), value) != values.end();
+    };
+    double cycles = 0.0;
+    for (const MicrobenchSample& s : samples)
+        if (among(probe.kinds, s.kind) && among(probe.buffer_slots, s.slots) &&
+            among(probe.lengths, s.lanes))
+            cycles += s.cycles;
+    return cycles;
+}
+
+double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t probes) {
+    const MicrobenchOptions options = speed_probe_options(isa, convergence);
     double fastest = std::numeric_limits<double>::infinity();
     for (uint32_t p = 0; p < std::max(1u, probes); ++p) {
         if (p) std::this_thread::sleep_for(std::chrono::seconds(1));
@@ -574,6 +598,17 @@ double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t 
 
 double speed_probe_drift(double cycles, double reference) {
     return reference > 0 ? cycles / reference - 1.0 : std::nan("");
+}
+
+double calibration_drift(const HostCalibration& c) {
+    const double probe = speed_probe_drift(c.host.speed_probe_cycles, c.speed_probe_start_cycles);
+    const double sweeps =
+        c.sweep_probe_points_cycles > 0
+            ? speed_probe_drift(c.sweep_probe_points_cycles, c.host.speed_probe_cycles)
+            : std::nan("");
+    if (std::isnan(probe)) return sweeps;
+    if (std::isnan(sweeps)) return probe;
+    return std::abs(sweeps) > std::abs(probe) ? sweeps : probe;
 }
 
 SeenLevel chase_last_level_now(double tsc_mhz) {

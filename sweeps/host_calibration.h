@@ -114,6 +114,12 @@ struct HostCalibration {
     // one after them): a calibration whose probe moved between the two measured a machine
     // that changed under it.
     double speed_probe_start_cycles = 0.0;
+    // The probe's points as the microbenchmarks' sweeps timed them (speed_probe_points_cycles):
+    // a slow spell over the sweeps, between the two probes, shows as their drift from the probe
+    // after them (calibration_drift). On the Zen 4 VM (2026-12-04) one calibration's sweeps ran
+    // 25-40 % slow (the triangle test 39.0 cycles a lane against 27.4-27.5 in the refits around
+    // it) while its probes, before and after, read as the others'.
+    double sweep_probe_points_cycles = 0.0;
     // Microbenchmark points (filters and one-ray batches) whose repetitions converged, of all.
     uint32_t converged_points = 0, points = 0;
     // Sweeps over the filter microbenchmarks' points (MicrobenchOptions::visits).
@@ -268,6 +274,13 @@ double speed_probe_cycles(Isa isa, const ConvergenceRule& convergence, uint32_t 
 // measured then (scripts/silicon-check calibrates again).
 double speed_probe_drift(double cycles, double reference);
 constexpr double k_speed_probe_tolerance = 0.10;
+// The fastest cycles of the speed probe's points among `samples` (a calibration's sweeps, which
+// time every kind at those buffers and lengths too), summed as the probe sums its own.
+double speed_probe_points_cycles(const std::vector<MicrobenchSample>& samples);
+// How far a calibration's machine moved: the larger in size of the probe's drift from before
+// the microbenchmarks to after, and of the sweeps' timing of the probe's points from the probe
+// after (NaN where neither was measured). Beyond k_speed_probe_tolerance, calibrate again.
+double calibration_drift(const HostCalibration& c);
 
 // One workload of a silicon check: its scene, render settings and the host configuration (whose
 // SIMD width is the back end's, settings.isa) that predicts it.

@@ -597,3 +597,40 @@ TEST_CASE("A misprediction's cost is fitted per loop where the model mispredicts
     CHECK(fit_loop_mispredict_cycles({a, b})[2] == 0.0);
     CHECK(fit_loop_mispredict_cycles({}) == std::array<double, 3>{-1.0, -1.0, -1.0});
 }
+
+TEST_CASE("A calibration whose sweeps ran slower than its probes moved", "[host]") {
+    auto sample = [](OpKind kind, uint32_t slots, uint32_t lanes, double cycles) {
+        MicrobenchSample s;
+        s.kind = kind;
+        s.slots = slots;
+        s.lanes = lanes;
+        s.cycles = cycles;
+        return s;
+    };
+    // The probe's points (box, triangle, emission, Lambertian indirect; 512 and 1024 lanes of
+    // 1024 slots), every outcome variant of them; not another kind, buffer or length.
+    const std::vector<MicrobenchSample> sweeps = {
+        sample(OpKind::box_test, 1024, 512, 100),
+        sample(OpKind::box_test, 1024, 1024, 200),
+        sample(OpKind::triangle_test, 1024, 1024, 300),
+        sample(OpKind::triangle_test, 1024, 1024, 50),  // another outcome's
+        sample(OpKind::lambertian_indirect, 1024, 512, 400),
+        sample(OpKind::box_test, 4096, 1024, 1e6),
+        sample(OpKind::box_test, 1024, 200, 1e6),
+        sample(OpKind::shadow_filter, 1024, 1024, 1e6)};
+    CHECK(speed_probe_points_cycles(sweeps) == Approx(1050));
+    HostCalibration c;
+    c.speed_probe_start_cycles = 1000;
+    c.host.speed_probe_cycles = 1010;
+    c.sweep_probe_points_cycles = 1300;  // the probes held; the sweeps between them did not
+    CHECK(calibration_drift(c) == Approx(1300.0 / 1010 - 1));
+    c.sweep_probe_points_cycles = 990;
+    CHECK(calibration_drift(c) == Approx(-0.0198).margin(1e-3));
+    c.host.speed_probe_cycles = 880;  // the probe moved more than the sweeps from it
+    c.sweep_probe_points_cycles = 900;
+    CHECK(calibration_drift(c) == Approx(-0.12));
+    c.sweep_probe_points_cycles = 0;  // not swept: the probes alone
+    CHECK(calibration_drift(c) == Approx(-0.12));
+    c.speed_probe_start_cycles = 0;
+    CHECK(std::isnan(calibration_drift(c)));
+}
