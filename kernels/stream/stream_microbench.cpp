@@ -1004,18 +1004,26 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                     traverse(stream_ids.data() + size_t(s) * stride, detail, stream_entry[s]);
             };
             // Before each repetition, every other ray's traversal, in streams of as many rays, in
-            // a new order: a branch predictor learns a batch of a few traversals that repeats
-            // (a one-ray box test in cornell costs 14-16 cycles in a batch of 32-256 repeated
-            // traversals and 29-31 in one of 8192-32768, on an AMD Zen 5 VM, 2026-11-27), and a
-            // frame's traversals do not repeat.
+            // a new order (a frame's traversals do not repeat), then the batch's own, untimed:
+            // the timed run is primed, as the model's predictor replays it. Displaced, the model
+            // mispredicted 0.26-0.57 times a one-ray box test where the core's timing barely
+            // moved (33.3 / 52.9 cycles a box test entering at the root / 6 levels down against
+            // 30.8 / 51.3 primed, scalar, Zen 4 VM, 2026-12-04: 3-11 cycles a modelled
+            // misprediction, against 51 on the branch microbenchmark), and the fit that nets the
+            // model's mispredictions out priced the one-lane box test at 0 (scalar) and the
+            // stream loop's box per-op at 0 (AVX2, AVX-512). Primed, both mispredict little, and
+            // the costs fitted hold the work; a frame's mispredictions are the model's, priced
+            // at the branch microbenchmark's cost.
             const uint32_t batch_rays = rays * streams;
-            auto displace_predictor = [&](TraceDetail detail) {
+            auto displace_then_prime = [&](TraceDetail detail) {
                 std::shuffle(order.begin() + batch_rays, order.end(), rng);
                 other_ids.assign(stride, 0u);
                 for (uint32_t first = batch_rays; first + rays <= k_slots; first += rays) {
                     load_stream(first, other_ids.data());
                     traverse(other_ids.data(), detail, 0);
                 }
+                reset();
+                run(detail);
             };
             OneRaySample sample;
             sample.rays = rays;
@@ -1041,7 +1049,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                         sink.begin_pass(pass);
                         job.sink = &sink;
                         if (others) {
-                            displace_predictor(TraceDetail::lanes);
+                            displace_then_prime(TraceDetail::lanes);
                         } else {
                             reset();
                             run(TraceDetail::lanes);
@@ -1059,7 +1067,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
             uint32_t set_aside = 0;
             while (needs_more_samples(times, convergence)) {
-                displace_predictor(TraceDetail::none);
+                displace_then_prime(TraceDetail::none);
                 reset();
                 const uint64_t start = __rdtsc();
                 run(TraceDetail::none);
@@ -1073,7 +1081,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             const std::array<double, 3> shares = clocked_loop_shares(
                 job,
                 [&] {
-                    displace_predictor(TraceDetail::none);
+                    displace_then_prime(TraceDetail::none);
                     reset();
                 },
                 [&] { run(TraceDetail::none); });

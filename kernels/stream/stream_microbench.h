@@ -175,17 +175,19 @@ struct ModelledMispredictions {
     double total = 0.0;
     std::array<double, 3> box_by_loop{};
 };
-// Given one sample's two recorders, the other rays' traversals that precede each timed
-// repetition (one such run) and the batch's traversals, returns the mispredictions the model's
-// branch predictor makes on the batch after the others (OneRaySample::modelled_mispredictions).
+// Given one sample's two recorders, what precedes each timed repetition (the other rays'
+// traversals, then the batch's own) and the batch's traversals, returns the mispredictions the
+// model's branch predictor makes on the batch after them (OneRaySample::modelled_mispredictions).
 using PredictorReplay = std::function<ModelledMispredictions(const TraversalRecorder& others,
                                                              const TraversalRecorder& batch)>;
 // Batches of 8 to 32 one-ray streams; on a back end of k_few_ray_min_width lanes or more, of 4 to
 // 32 streams of 2, 3 and 4 rays; the same streams entering 3 and 6 levels down (8 and 32 of
 // them); and of 1 and 4 streams of 8 to 128 rays, whose first ops run in the stream loop
 // (several batches of each shape), drawn from 4096 rays; before
-// each repetition of a batch the other rays are traversed in a new order, so that a branch
-// predictor meets the batch as a frame's traversals, which never repeat.
+// each repetition of a batch the other rays are traversed in a new order, then the batch once
+// untimed: the timed repetition is primed, where the model's predictor and the core's both
+// mispredict little (the costs fitted on it hold the work; a frame's mispredictions are priced
+// apart).
 std::vector<OneRaySample> run_one_ray_microbenchmarks(
     Isa isa, const ConvergenceRule& convergence = microbench_rule(), uint64_t seed = 1,
     const PredictorReplay& predictor_replay = {});
