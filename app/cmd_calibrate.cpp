@@ -749,19 +749,18 @@ void add_calibrate_command(CLI::App& app) {
                         row[model + "displaced_mispredictions"] = c.modelled.displaced;
                         // Priced as the model prices them: a box test's by its loop, the rest
                         // (the leaf tests') at the pooled cost.
-                        double extra = 0.0, box_added = 0.0;
+                        std::array<double, 3> box_added{};
                         for (size_t l = 0; l < 3; ++l) {
-                            const double added = double(c.modelled.displaced_by_loop[l]) -
-                                                 double(c.modelled.primed_by_loop[l]);
-                            extra += added * b.mispredict_cycles_in(l);
-                            box_added += added;
+                            box_added[l] = double(c.modelled.displaced_by_loop[l]) -
+                                           double(c.modelled.primed_by_loop[l]);
                             row[model + "loop_mispredict_cycles." + loops[l]] =
                                 b.kind == "none" ? 0.0 : b.mispredict_cycles_in(l);
                         }
-                        extra +=
-                            (double(c.modelled.displaced) - double(c.modelled.primed) - box_added) *
-                            b.mispredict_cycles;
-                        row[model + "extra_cycles"] = b.kind == "none" ? 0.0 : extra;
+                        row[model + "extra_cycles"] =
+                            b.kind == "none"
+                                ? 0.0
+                                : b.price(double(c.modelled.displaced) - double(c.modelled.primed),
+                                          box_added);
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
                         row[model + "cold_cycles"] = memory.cold;
                         row[model + "warm_cycles"] = memory.warm;

@@ -227,6 +227,17 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
 
 namespace {
 
+// Of the mispredictions op by op in `scratch` (mispredictions_replaying's), the box tests' by
+// the loop that runs them.
+std::array<uint64_t, 3> box_mispredictions_by_loop(const PassBuffer& pass,
+                                                   const std::vector<TraversalLoop>& loops,
+                                                   const std::vector<uint32_t>& scratch) {
+    std::array<uint64_t, 3> by_loop{};
+    for (size_t i = 0; i < scratch.size(); ++i)
+        if (pass.at(i).kind == OpKind::box_test) by_loop[size_t(loops[i])] += scratch[i];
+    return by_loop;
+}
+
 // `pass`'s traversal branches through `predictor`: the mispredictions they add.
 uint64_t mispredictions_replaying(const PassBuffer& pass, const std::vector<TraversalLoop>& loops,
                                   uint32_t width, const std::vector<uint8_t>& node_leaf,
@@ -255,10 +266,7 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
                            std::array<uint64_t, 3>& fewest_by_loop) {
         if (m >= fewest) return;
         fewest = m;
-        fewest_by_loop = {};
-        for (size_t i = 0; i < scratch.size(); ++i)
-            if (batches[b]->at(i).kind == OpKind::box_test)
-                fewest_by_loop[size_t(loops[b][i])] += scratch[i];
+        fewest_by_loop = box_mispredictions_by_loop(*batches[b], loops[b], scratch);
     };
     PredictorStates states;
     const uint64_t start = predictor.branches();
@@ -306,12 +314,7 @@ uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& ba
     const std::vector<TraversalLoop> loops = traversal_loops(batch, width);
     const uint64_t missed =
         mispredictions_replaying(batch, loops, width, node_leaf, predictor, scratch);
-    if (box_by_loop) {
-        *box_by_loop = {};
-        for (size_t i = 0; i < scratch.size(); ++i)
-            if (batch.at(i).kind == OpKind::box_test)
-                (*box_by_loop)[size_t(loops[i])] += scratch[i];
-    }
+    if (box_by_loop) *box_by_loop = box_mispredictions_by_loop(batch, loops, scratch);
     return missed;
 }
 

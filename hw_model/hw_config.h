@@ -5,6 +5,7 @@
 // YAML parsing (strict), YAML dumping, flattened dotted names (result columns, sweep axes) and
 // setting a parameter by its dotted path.
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -419,6 +420,16 @@ struct BranchPredictorConfig {
         const double by_loop[] = {one_ray_mispredict_cycles, few_ray_mispredict_cycles,
                                   stream_mispredict_cycles};
         return loop < 3 && by_loop[loop] >= 0 ? by_loop[loop] : mispredict_cycles;
+    }
+    // What `total` mispredictions cost, of which `box_by_loop` are box tests' in each loop
+    // (the rest, leaf tests', pooled; counts may be differences between two states).
+    double price(double total, const std::array<double, 3>& box_by_loop) const {
+        double cycles = 0.0, box = 0.0;
+        for (size_t l = 0; l < 3; ++l) {
+            cycles += box_by_loop[l] * mispredict_cycles_in(l);
+            box += box_by_loop[l];
+        }
+        return cycles + (total - box) * mispredict_cycles;
     }
 
     template <class V>

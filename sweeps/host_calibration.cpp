@@ -62,14 +62,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
     for (const OneRaySample& s : samples) {
         OneLaneSample sample{s.ops, s.cycles, s.few_ops, 0.0, {}, s.entries};
         sample.traversals = s.streams;
-        double box_mispredictions = 0.0;
-        for (size_t l = 0; l < 3; ++l) {
-            sample.stream_op_cycles +=
-                s.modelled_box_loop_mispredictions[l] * predictor.mispredict_cycles_in(l);
-            box_mispredictions += s.modelled_box_loop_mispredictions[l];
-        }
-        sample.stream_op_cycles += std::max(0.0, s.modelled_mispredictions - box_mispredictions) *
-                                   predictor.mispredict_cycles;
+        sample.stream_op_cycles =
+            predictor.price(s.modelled_mispredictions, s.modelled_box_loop_mispredictions);
         // The check that a bundle's rays share one origin, at its directly timed cost.
         if (const OpCostConfig* box = cost_of[size_t(OpKind::box_test)])
             sample.stream_op_cycles +=
