@@ -441,6 +441,22 @@ void add_calibrate_command(CLI::App& app) {
                 mispredictions,
                 batch_cycles > 0 ? 100 * mispredictions * mispredict / batch_cycles : 0.0,
                 mispredict);
+            // Where the fit puts the batches' cycles, against the stage clock's split of them.
+            const ShortStreamSplit split =
+                short_stream_split(cal.short_stream_costs, cal.short_stream_samples,
+                                   cal.one_ray_samples, cal.host.branch_predictor);
+            std::printf(
+                "  by the stage clock (the fastest cycles split by 5 clocked repetitions' "
+                "shares), measured / priced Mcycles:");
+            const std::pair<const char*, const ShortStreamPart*> parts[] = {
+                {"one-ray loop", &split.one_ray},
+                {"few-ray loop", &split.few_ray},
+                {"leaf tests", &split.leaves},
+                {"the rest", &split.rest}};
+            for (size_t i = 0; i < std::size(parts); ++i)
+                std::printf("%s %s %.3f / %.3f", i ? ";" : "", parts[i].first,
+                            parts[i].second->measured / 1e6, parts[i].second->priced / 1e6);
+            std::printf("\n");
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.op == "box_test")
                     std::printf(

@@ -147,7 +147,7 @@ namespace {
 enum class Branch : uint32_t {
     stream_one_ray,   // traverse: len == 1
     stream_few_ray,   // traverse: len <= k_few_ray_lanes (wide back ends)
-    stream_group,     // box_filter's group loop: another group
+    stream_group,     // box_filter's group loop: a second group
     stream_none,      // traverse: k == 0
     stream_leaf,      // traverse: node.is_leaf()
     few_one_ray,      // traverse_few: n == 1
@@ -217,8 +217,15 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
             if (k > 0) branch(Branch::few_leaf, leaf);
         } else {
             branch(Branch::stream_prefetch, node_is_leaf);
+            // The group loop as one branch an op, whether it runs a second group: its branch a
+            // group put one entry in the global history per group, as many as a stream's lanes
+            // over the width (a 500-lane op: 63 at 8 lanes, 32 at 16, 500 at 1), and the model's
+            // mispredictions in the short loops, the same code on every wide back end, then
+            // followed the width where the core's cost did not (the branch microbenchmark's
+            // few-ray loop on the AMD Zen 4 VM, 2026-12-04: 7093 mispredictions added at 8
+            // lanes, 6232 at 16, the core's 621 and 611 thousand cycles; one an op: 5754, 5780).
             const uint32_t groups = (len + width - 1) / width;
-            for (uint32_t g = 1; g <= groups; ++g) branch(Branch::stream_group, g < groups);
+            branch(Branch::stream_group, groups > 1);
             branch(Branch::stream_none, k == 0);
             if (k > 0) branch(Branch::stream_leaf, leaf);
         }

@@ -67,9 +67,10 @@ std::vector<TraversalLoop> traversal_loops(const PassBuffer& pass, uint32_t widt
 // tracer's program order), through `predictor`: per box test the loop's test of its stream
 // length (stream loop: one ray? few?), whether any lane passed (the one-ray loop: the ray), and
 // whether a node is a leaf (the prefetch of what it needs next, before the test; and after a
-// pass); the stream loop's group loop; the one-ray loop's stack; per leaf test whether a lane
-// took the hit and whether another primitive follows. `node_leaf[node]`: the tree's leaves
-// (the trace names the nodes tested, not their kind). `mispredicted[i]` gets op i's count.
+// pass); the stream loop's group loop (one branch an op: a second group?); the one-ray loop's
+// stack; per leaf test whether a lane took the hit and whether another primitive follows.
+// `node_leaf[node]`: the tree's leaves (the trace names the nodes tested, not their kind).
+// `mispredicted[i]` gets op i's count.
 void replay_traversal_branches(const PassBuffer& pass, const std::vector<TraversalLoop>& loops,
                                uint32_t width, const std::vector<uint8_t>& node_leaf,
                                TagePredictor& predictor, std::vector<uint32_t>& mispredicted);

@@ -11,6 +11,7 @@
 #include <memory>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "base/convergence.h"
@@ -106,6 +107,38 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         out.push_back(sample);
     }
     return out;
+}
+
+ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
+                                    const std::vector<OneLaneSample>& fitted,
+                                    const std::vector<OneRaySample>& samples,
+                                    const BranchPredictorConfig& predictor) {
+    if (fitted.size() != samples.size())
+        throw std::invalid_argument("short_stream_split: the fit's samples are not the batches'");
+    constexpr size_t box = size_t(OpKind::box_test);
+    ShortStreamSplit split;
+    for (size_t i = 0; i < samples.size(); ++i) {
+        const OneRaySample& s = samples[i];
+        const OneLaneSample& f = fitted[i];
+        const double one_ray =
+            double(f.ops[box]) * costs.one_lane[box] + double(f.entries[0]) * costs.entry[0] +
+            s.modelled_box_loop_mispredictions[0] * predictor.mispredict_cycles_in(0);
+        const double few_ray =
+            double(f.few_ops[box]) * costs.few_lane[box] + double(f.entries[1]) * costs.entry[1] +
+            s.modelled_box_loop_mispredictions[1] * predictor.mispredict_cycles_in(1);
+        split.one_ray.priced += one_ray;
+        split.few_ray.priced += few_ray;
+        split.leaves.priced += f.leaf_op_cycles;
+        split.rest.priced += short_stream_cycles(costs, f) - one_ray - few_ray - f.leaf_op_cycles;
+        const double one_ray_measured = s.short_loop_share[0] * s.cycles,
+                     few_ray_measured = s.short_loop_share[1] * s.cycles,
+                     leaves_measured = s.leaf_share * s.cycles;
+        split.one_ray.measured += one_ray_measured;
+        split.few_ray.measured += few_ray_measured;
+        split.leaves.measured += leaves_measured;
+        split.rest.measured += s.cycles - one_ray_measured - few_ray_measured - leaves_measured;
+    }
+    return split;
 }
 
 ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,

@@ -139,6 +139,24 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                     uint32_t width, uint32_t l1d_kib,
                                                     const BranchPredictorConfig& predictor = {});
 
+// The traversal samples' cycles by part, as the stage clock splits them (OneRaySample::
+// short_loop_share, leaf_share: the one-ray and few-ray loops less their leaves, the leaf tests,
+// the rest) and as the fitted costs price them: `costs` on the fit's samples (`fitted`, from
+// short_stream_fit_samples on the same `samples`), the box tests' mispredictions in each loop
+// at `predictor`'s price there. Reported beside the fit, which fits the batches' whole cycles:
+// the clock's reads in a short loop's interval (rdtsc is not ordered with the work around it)
+// make the split a check of where the fit puts the cost, not a target.
+struct ShortStreamPart {
+    double measured = 0.0, priced = 0.0;
+};
+struct ShortStreamSplit {
+    ShortStreamPart one_ray, few_ray, leaves, rest;
+};
+ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
+                                    const std::vector<OneLaneSample>& fitted,
+                                    const std::vector<OneRaySample>& samples,
+                                    const BranchPredictorConfig& predictor);
+
 // run_one_ray_microbenchmarks' PredictorReplay: the sample's traces recorded and run through
 // the model's predictor as the microbenchmark times them (simulate_displaced_batch, for a back
 // end of `width` lanes in the scene whose tree has leaves `node_leaf`).

@@ -79,19 +79,23 @@ TEST_CASE("A pass's traversal branches follow the tracer's loops", "[branch]") {
     TagePredictor p;
     std::vector<uint32_t> missed;
     replay_traversal_branches(pass, loops, 8, {0, 1}, p, missed);
-    // Each box test in the stream loop: one ray? few? leaf (prefetch)? two groups, none
-    // passed? leaf? Seven each. The triangle test: took the hit? another primitive? Two.
-    CHECK(p.branches() == 7 + 7 + 2);
+    // Each box test in the stream loop: one ray? few? leaf (prefetch)? a second group? none
+    // passed? leaf? Six each. The triangle test: took the hit? another primitive? Two.
+    CHECK(p.branches() == 6 + 6 + 2);
     REQUIRE(missed.size() == 3);
     CHECK(missed[0] + missed[1] + missed[2] == p.mispredictions());
     // Without the tree's leaves a passing node is a leaf where leaf tests follow it.
     TagePredictor q;
     replay_traversal_branches(pass, loops, 8, {}, q, missed);
     CHECK(q.branches() == p.branches());
-    // A narrow back end has no few-ray loop: no such test.
+    // A narrow back end has no few-ray loop: no such test. The group loop is one branch an
+    // op at any width (the short loops' predictions must not follow the stream loop's width).
     TagePredictor r;
     replay_traversal_branches(pass, traversal_loops(pass, 4), 4, {0, 1}, r, missed);
-    CHECK(r.branches() == 2 * (7 - 1 + 2) + 2);  // four groups of four a test
+    CHECK(r.branches() == 2 * (6 - 1) + 2);
+    TagePredictor wide;
+    replay_traversal_branches(pass, traversal_loops(pass, 16), 16, {0, 1}, wide, missed);
+    CHECK(wide.branches() == p.branches());
 }
 
 TEST_CASE("A batch mispredicts less after itself than after others", "[branch]") {

@@ -635,3 +635,44 @@ TEST_CASE("A calibration whose sweeps ran slower than its probes moved", "[host]
     c.speed_probe_start_cycles = 0;
     CHECK(std::isnan(calibration_drift(c)));
 }
+
+TEST_CASE("The short-stream batches split by the stage clock beside the fit's price", "[host]") {
+    constexpr size_t box = size_t(OpKind::box_test);
+    OneRaySample raw;
+    raw.cycles = 1000.0;
+    raw.short_loop_share = {0.3, 0.2};
+    raw.leaf_share = 0.1;
+    raw.modelled_box_loop_mispredictions = {2.0, 1.0, 4.0};
+    OneLaneSample fitted;
+    fitted.ops[box] = 10;
+    fitted.few_ops[box] = 5;
+    fitted.stream_ops[box] = 3;
+    fitted.entries = {1, 1};
+    fitted.leaf_op_cycles = 150.0;
+    fitted.stream_op_cycles = 150.0 + 2 * 50.0 + 1 * 40.0 + 4 * 30.0 + 60.0;
+    ShortStreamCosts costs;
+    costs.one_lane[box] = 20.0;
+    costs.few_lane[box] = 30.0;
+    costs.stream_per_op[box] = 11.0;
+    costs.entry = {7.0, 9.0};
+    BranchPredictorConfig predictor;
+    predictor.mispredict_cycles = 25.0;
+    predictor.one_ray_mispredict_cycles = 50.0;
+    predictor.few_ray_mispredict_cycles = 40.0;
+    predictor.stream_mispredict_cycles = 30.0;
+    const ShortStreamSplit split = short_stream_split(costs, {fitted}, {raw}, predictor);
+    CHECK(split.one_ray.measured == Approx(300.0));
+    CHECK(split.few_ray.measured == Approx(200.0));
+    CHECK(split.leaves.measured == Approx(100.0));
+    CHECK(split.rest.measured == Approx(400.0));
+    // Each loop's ops, its entry and its box tests' mispredictions at that loop's price.
+    CHECK(split.one_ray.priced == Approx(10 * 20.0 + 7.0 + 2 * 50.0));
+    CHECK(split.few_ray.priced == Approx(5 * 30.0 + 9.0 + 1 * 40.0));
+    CHECK(split.leaves.priced == Approx(150.0));
+    // The rest: the stream loop's per-op cost, its mispredictions and the other priced ops.
+    CHECK(split.rest.priced == Approx(3 * 11.0 + 4 * 30.0 + 60.0));
+    CHECK(split.one_ray.priced + split.few_ray.priced + split.leaves.priced + split.rest.priced ==
+          Approx(short_stream_cycles(costs, fitted)));
+    CHECK_THROWS_AS(short_stream_split(costs, {fitted, fitted}, {raw}, predictor),
+                    std::invalid_argument);
+}
