@@ -81,6 +81,7 @@ void add_calibrate_command(CLI::App& app) {
         bool describe = false;
         std::string output = "host.hw.yaml";
         std::string memory_from;
+        std::string few_ray_from;
         std::string check;
         std::string isa = "auto";
         uint32_t repeats = 41;
@@ -107,6 +108,11 @@ void add_calibrate_command(CLI::App& app) {
                   "--describe-host: take the scene memory (caches, their latencies, the L3 this "
                   "core keeps, DRAM) from this host file of the same machine instead of "
                   "measuring it, so that every back end's file describes one memory");
+    c->add_option("--few-ray-from", o->few_ray_from,
+                  "--describe-host, a back end of 8 lanes or more: take the few-ray loop's "
+                  "costs (its box test's, its entry's, its mispredictions') from this host file "
+                  "of another such back end of the same machine instead of fitting them: the "
+                  "loop runs the same four-lane code at every such width");
     c->add_option("--check", o->check,
                   "HOST.hw.yaml[,MORE.hw.yaml]: predict and measure the native tracer's cycles "
                   "per workload, each file on the back end of its SIMD width");
@@ -180,12 +186,33 @@ void add_calibrate_command(CLI::App& app) {
         const int cpu = sched_getcpu();  // the rows say where they were measured
         if (!o->memory_from.empty() && !o->describe)
             throw InputError("command line", 0, "--memory-from", "only with --describe-host");
+        if (!o->few_ray_from.empty() && !o->describe)
+            throw InputError("command line", 0, "--few-ray-from", "only with --describe-host");
+        if (!o->few_ray_from.empty() && isa_width(resolve_isa(isa)) < k_few_ray_min_width)
+            throw InputError("command line", 0, "--few-ray-from",
+                             "the " + std::string(isa_name(resolve_isa(isa))) +
+                                 " back end has no few-ray loop (" +
+                                 std::to_string(k_few_ray_min_width) + " lanes or more)");
         if (o->memory_now && o->check.empty())
             throw InputError("command line", 0, "--memory-now", "only with --check");
         if (o->describe) {
             std::unique_ptr<HwConfig> memory_from;
             if (!o->memory_from.empty())
                 memory_from = std::make_unique<HwConfig>(load_hw_config(o->memory_from));
+            std::unique_ptr<HwConfig> few_ray_from;
+            if (!o->few_ray_from.empty()) {
+                few_ray_from = std::make_unique<HwConfig>(load_hw_config(o->few_ray_from));
+                bool has_few_ray = few_ray_from->branch_predictor.kind != "none";
+                bool box_few_lane = false;
+                for (const OpCostConfig& cost : few_ray_from->op_costs)
+                    box_few_lane |= cost.op == "box_test" && cost.few_lane_cycles >= 0;
+                if (!has_few_ray || !box_few_lane)
+                    throw InputError(o->few_ray_from, 0, "--few-ray-from",
+                                     "no few-ray loop costs (the box test's few_lane_cycles and "
+                                     "a fitted branch_predictor: a back end of " +
+                                         std::to_string(k_few_ray_min_width) +
+                                         " lanes or more writes them)");
+            }
             OutputFiles outputs;
             const std::string temp = outputs.add(o->output, "--output");
             Progress progress("calibrate", 15, "op kinds");
@@ -195,7 +222,7 @@ void add_calibrate_command(CLI::App& app) {
                     progress.set_total(total);
                     progress.set_done(done);
                 },
-                memory_from.get(), o->memory_from);
+                memory_from.get(), o->memory_from, few_ray_from.get(), o->few_ray_from);
             progress.finish();
             std::ofstream(temp) << cal.yaml;
             parse_hw_config(cal.yaml, o->output);  // what was written reads back

@@ -638,8 +638,12 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
         for (const auto& [loop, cycles] : by_loop)
             if (cycles >= 0)
                 y << "  " << loop << "_mispredict_cycles: " << fmt(cycles, 1)
-                  << "  # fitted: the same microbenchmark, a box test's in that loop (the stage "
-                     "clock's split)\n";
+                  << (std::string(loop) == "few_ray" && !h.few_ray_source.empty()
+                          ? "  # as " + h.few_ray_source +
+                                " gives it (the few-ray loop is the same code at 8 and 16 "
+                                "lanes)\n"
+                          : std::string("  # fitted: the same microbenchmark, a box test's in "
+                                        "that loop (the stage clock's split)\n"));
     }
     if (h.speed_probe_cycles > 0)
         y << "speed_probe_cycles: " << fmt(h.speed_probe_cycles, 0)

@@ -110,6 +110,13 @@ struct HostDescription {
     // mispredictions (sweeps/host_calibration.h), with how it was fitted; kind none: not fitted.
     BranchPredictorConfig branch_predictor;
     std::string branch_predictor_fit;
+    // The few-ray loop's costs (its misprediction cost here, the box test's few_lane_cycles and
+    // few_ray_entry_cycles in the op costs) as another back end's host file of this machine
+    // gives them (`sfx calibrate --describe-host --few-ray-from FILE`): the loop runs the same
+    // four-lane code at every width of k_few_ray_min_width lanes or more, and fitted on each
+    // back end apart they differed by the fits' noise where the core's loop did not. Empty:
+    // fitted here.
+    std::string few_ray_source;
 };
 
 // Reads other data beyond the L3 a core keeps (k_beyond_last_level_bytes, a line at a time):

@@ -192,8 +192,11 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     return from_coefficients(op, fit_nonnegative(rows, cycles, active));
 }
 
-ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples) {
+ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples,
+                                         const GivenFewRayCosts* given) {
     if (samples.empty()) throw std::invalid_argument("no short-stream traversal samples");
+    constexpr size_t few_box = k_op_kind_count + size_t(OpKind::box_test);
+    constexpr size_t few_entry = k_entry_terms + 1;
     std::array<bool, k_short_terms> active{};
     std::vector<std::array<double, k_short_terms>> rows;
     std::vector<double> loops, whole;
@@ -203,10 +206,20 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         rows.push_back(row);
         // What the one-ray and few-ray loops' ops took (the rest is priced by the formula),
         // its error relative to the whole sample's cycles, as short_stream_fit_error judges it.
-        loops.push_back(s.cycles - s.stream_op_cycles);
+        loops.push_back(
+            s.cycles - s.stream_op_cycles -
+            (given ? row[few_box] * given->few_lane_cycles + row[few_entry] * given->entry_cycles
+                   : 0.0));
         whole.push_back(s.cycles);
     }
-    const std::array<double, k_short_terms> x = fit_nonnegative(rows, loops, active, &whole);
+    const bool few_measured = active[few_box];
+    if (given) active[few_box] = active[few_entry] = false;
+    std::array<double, k_short_terms> x = fit_nonnegative(rows, loops, active, &whole);
+    if (given) {
+        x[few_box] = given->few_lane_cycles;
+        x[few_entry] = given->entry_cycles;
+        active[few_box] = few_measured;
+    }
     ShortStreamCosts costs;
     for (size_t k = 0; k < k_op_kind_count; ++k) {
         costs.one_lane[k] = x[k];

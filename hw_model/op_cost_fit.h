@@ -102,7 +102,13 @@ struct ShortStreamCosts {
     // What starting a traversal costs besides its ops (OpCostConfig::traversal_start_cycles).
     double traversal_start = 0.0;
 };
-ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples);
+// The few-ray loop's box cost and entry cost given, not fitted (GivenFewRayCosts): they are
+// priced out of the samples and returned as given.
+struct GivenFewRayCosts {
+    double few_lane_cycles = 0.0, entry_cycles = 0.0;
+};
+ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& samples,
+                                         const GivenFewRayCosts* given = nullptr);
 // A sample's cycles as the fitted costs price it.
 double short_stream_cycles(const ShortStreamCosts& costs, const OneLaneSample& sample);
 

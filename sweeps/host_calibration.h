@@ -174,7 +174,9 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {},
                                const HwConfig* memory_from = nullptr,
-                               const std::string& memory_source = "");
+                               const std::string& memory_source = "",
+                               const HwConfig* few_ray_from = nullptr,
+                               const std::string& few_ray_source = "");
 
 // Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
 bool pin_to_current_cpu();

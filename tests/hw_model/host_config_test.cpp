@@ -568,6 +568,20 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     ShortStreamCosts no_entry = with_entries;
     no_entry.entry[1] = 0;
     CHECK(short_stream_fit_error(no_entry, entered).second > 0.05);
+    // The few-ray loop's costs given (another back end's): priced out, the rest fitted, the
+    // given ones returned as given, right or wrong.
+    const GivenFewRayCosts right{55.0, 260.0}, wrong{70.0, 200.0};
+    const ShortStreamCosts given = fit_short_stream_cycles(entered, &right);
+    CHECK(given.few_lane[size_t(OpKind::box_test)] == 55.0);
+    CHECK(given.entry[1] == 260.0);
+    CHECK(given.few_lane_measured[size_t(OpKind::box_test)]);
+    CHECK(given.one_lane[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
+    CHECK(given.entry[0] == Approx(25).epsilon(1e-6));
+    CHECK(short_stream_fit_error(given, entered).second < 1e-9);
+    const ShortStreamCosts given_wrong = fit_short_stream_cycles(entered, &wrong);
+    CHECK(given_wrong.few_lane[size_t(OpKind::box_test)] == 70.0);
+    CHECK(given_wrong.entry[1] == 200.0);
+    CHECK(short_stream_fit_error(given_wrong, entered).second > 0.01);
     CHECK(fit.entry[0] == 0.0);  // samples without entries: none fitted
     CHECK(fit.traversal_start == 0.0);
 
@@ -979,6 +993,15 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.branch_predictor.stream_mispredict_cycles == 0);
     CHECK(yaml.find("few_ray_mispredict_cycles") == std::string::npos);
     CHECK(yaml.find("fitted: test batches") != std::string::npos);
+    // The few-ray loop's costs taken from another back end's file: the file says whose.
+    HostDescription taken = host;
+    taken.branch_predictor.few_ray_mispredict_cycles = 88.5;
+    taken.few_ray_source = "host-avx2.hw.yaml";
+    const std::string taken_yaml = host_hw_yaml(taken, {box}, "");
+    CHECK(parse_hw_config(taken_yaml, "host.hw.yaml").branch_predictor.few_ray_mispredict_cycles ==
+          Approx(88.5));
+    CHECK(taken_yaml.find("few_ray_mispredict_cycles: 88.5  # as host-avx2.hw.yaml gives it") !=
+          std::string::npos);
     CHECK(host_hw_yaml(small_host(), {box}, "").find("branch_predictor") == std::string::npos);
     // A host file written before one-lane costs were measured: the formula for every op.
     CHECK(parse_hw_config("version: 1\nop_costs:\n  - {op: box_test, per_op_cycles: 3}\n",
