@@ -188,30 +188,20 @@ void add_calibrate_command(CLI::App& app) {
             throw InputError("command line", 0, "--memory-from", "only with --describe-host");
         if (!o->few_ray_from.empty() && !o->describe)
             throw InputError("command line", 0, "--few-ray-from", "only with --describe-host");
-        if (!o->few_ray_from.empty() && isa_width(resolve_isa(isa)) < k_few_ray_min_width)
-            throw InputError("command line", 0, "--few-ray-from",
-                             "the " + std::string(isa_name(resolve_isa(isa))) +
-                                 " back end has no few-ray loop (" +
-                                 std::to_string(k_few_ray_min_width) + " lanes or more)");
         if (o->memory_now && o->check.empty())
             throw InputError("command line", 0, "--memory-now", "only with --check");
         if (o->describe) {
             std::unique_ptr<HwConfig> memory_from;
             if (!o->memory_from.empty())
                 memory_from = std::make_unique<HwConfig>(load_hw_config(o->memory_from));
-            std::unique_ptr<HwConfig> few_ray_from;
+            std::unique_ptr<FewRayFrom> few_ray_from;
             if (!o->few_ray_from.empty()) {
-                few_ray_from = std::make_unique<HwConfig>(load_hw_config(o->few_ray_from));
-                bool has_few_ray = few_ray_from->branch_predictor.kind != "none";
-                bool box_few_lane = false;
-                for (const OpCostConfig& cost : few_ray_from->op_costs)
-                    box_few_lane |= cost.op == "box_test" && cost.few_lane_cycles >= 0;
-                if (!has_few_ray || !box_few_lane)
-                    throw InputError(o->few_ray_from, 0, "--few-ray-from",
-                                     "no few-ray loop costs (the box test's few_lane_cycles and "
-                                     "a fitted branch_predictor: a back end of " +
-                                         std::to_string(k_few_ray_min_width) +
-                                         " lanes or more writes them)");
+                try {
+                    few_ray_from = std::make_unique<FewRayFrom>(
+                        few_ray_costs_from(load_hw_config(o->few_ray_from), o->few_ray_from, isa));
+                } catch (const std::invalid_argument& e) {
+                    throw InputError(o->few_ray_from, 0, "--few-ray-from", e.what());
+                }
             }
             OutputFiles outputs;
             const std::string temp = outputs.add(o->output, "--output");
@@ -222,7 +212,7 @@ void add_calibrate_command(CLI::App& app) {
                     progress.set_total(total);
                     progress.set_done(done);
                 },
-                memory_from.get(), o->memory_from, few_ray_from.get(), o->few_ray_from);
+                memory_from.get(), o->memory_from, few_ray_from.get());
             progress.finish();
             std::ofstream(temp) << cal.yaml;
             parse_hw_config(cal.yaml, o->output);  // what was written reads back

@@ -224,8 +224,7 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
             // followed the width where the core's cost did not (the branch microbenchmark's
             // few-ray loop on the AMD Zen 4 VM, 2026-12-04: 7093 mispredictions added at 8
             // lanes, 6232 at 16, the core's 621 and 611 thousand cycles; one an op: 5754, 5780).
-            const uint32_t groups = (len + width - 1) / width;
-            branch(Branch::stream_group, groups > 1);
+            branch(Branch::stream_group, len > width);
             branch(Branch::stream_none, k == 0);
             if (k > 0) branch(Branch::stream_leaf, leaf);
         }

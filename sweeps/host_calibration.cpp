@@ -299,26 +299,29 @@ NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
     return fit;
 }
 
+FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, Isa isa) {
+    const Isa resolved = resolve_isa(isa);
+    if (isa_width(resolved) < k_few_ray_min_width)
+        throw std::invalid_argument("the " + std::string(isa_name(resolved)) +
+                                    " back end has no few-ray loop (" +
+                                    std::to_string(k_few_ray_min_width) + " lanes or more)");
+    for (const OpCostConfig& o : file.op_costs)
+        if (op_kind_named(o.op) == OpKind::box_test && o.few_lane_cycles >= 0 &&
+            file.branch_predictor.kind != "none")
+            return {{o.few_lane_cycles, o.few_ray_entry_cycles},
+                    file.branch_predictor.mispredict_cycles_in(1),
+                    source};
+    throw std::invalid_argument(
+        "no few-ray loop costs (the box test's few_lane_cycles and a fitted branch_predictor: a "
+        "back end of " +
+        std::to_string(k_few_ray_min_width) + " lanes or more writes them)");
+}
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source,
-                               const HwConfig* few_ray_from, const std::string& few_ray_source) {
+                               const FewRayFrom* few_ray_from) {
     HostCalibration c;
-    // The few-ray loop's costs as another back end's file gives them (HostDescription::
-    // few_ray_source): its box test's, and its misprediction cost.
-    GivenFewRayCosts few_ray_given;
-    if (few_ray_from) {
-        const OpCostConfig* box = nullptr;
-        for (const OpCostConfig& o : few_ray_from->op_costs)
-            if (op_kind_named(o.op) == OpKind::box_test) box = &o;
-        if (!box || box->few_lane_cycles < 0 || few_ray_from->branch_predictor.kind == "none")
-            throw std::invalid_argument(few_ray_source + ": no few-ray loop costs (a back end of " +
-                                        std::to_string(k_few_ray_min_width) +
-                                        " lanes or more fits them)");
-        if (isa_width(resolve_isa(isa)) < k_few_ray_min_width)
-            throw std::invalid_argument("this back end has no few-ray loop");
-        few_ray_given = {box->few_lane_cycles, box->few_ray_entry_cycles};
-    }
     const Isa resolved = resolve_isa(isa);
     c.host = describe_host(isa_width(resolved), describe_isa(resolved), memory_from == nullptr);
     if (memory_from) {
@@ -408,8 +411,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     const std::array<double, 3> by_loop = fit_loop_mispredict_cycles(c.branch_samples);
     c.host.branch_predictor.one_ray_mispredict_cycles = by_loop[0];
     c.host.branch_predictor.few_ray_mispredict_cycles =
-        few_ray_from ? few_ray_from->branch_predictor.mispredict_cycles_in(1) : by_loop[1];
-    c.host.few_ray_source = few_ray_source;
+        few_ray_from ? few_ray_from->mispredict_cycles : by_loop[1];
+    if (few_ray_from) c.host.few_ray_source = few_ray_from->source;
     c.host.branch_predictor.stream_mispredict_cycles = by_loop[2];
     std::ostringstream branch_note;
     branch_note << "the branch microbenchmark (kernels/stream/stream_microbench.h: 20,000 random "
@@ -453,8 +456,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.points += uint32_t(c.one_ray_samples.size());
     c.short_stream_samples = short_stream_fit_samples(
         c.one_ray_samples, c.op_costs, c.host.simd_width, l1d, c.host.branch_predictor);
-    c.short_stream_costs =
-        fit_short_stream_cycles(c.short_stream_samples, few_ray_from ? &few_ray_given : nullptr);
+    c.short_stream_costs = fit_short_stream_cycles(c.short_stream_samples,
+                                                   few_ray_from ? &few_ray_from->costs : nullptr);
     c.short_stream_fit_errors =
         short_stream_fit_error(c.short_stream_costs, c.short_stream_samples);
     c.filter_costs = c.op_costs;
@@ -515,7 +518,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "costs, the one-ray and few-ray loops' entry costs, a traversal's start and the "
          << "stream loop's per-op box cost, from " << c.one_ray_samples.size()
          << " batches of traversals"
-         << (few_ray_from ? " (the few-ray loop's box and entry costs as " + few_ray_source +
+         << (few_ray_from ? " (the few-ray loop's box and entry costs as " + few_ray_from->source +
                                 " gives them: the same code at 8 and 16 lanes)"
                           : std::string())
          << " (8-32 streams of one ray and 4-32 of 2 to " << k_few_ray_lanes

@@ -171,12 +171,23 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 // fits. `isa`: the back end measured (auto: the widest). `progress(done, total)` per op kind.
 // `memory_from` (a host file of this machine, read as `memory_source` names it), where given:
 // its scene memory instead of measuring one (HostDescription::memory).
+// The few-ray loop's costs as another wide back end's host file of the machine gives them
+// (`sfx calibrate --describe-host --few-ray-from FILE`, HostDescription::few_ray_source): its
+// box test's few-lane and entry costs and the loop's misprediction cost.
+struct FewRayFrom {
+    GivenFewRayCosts costs;
+    double mispredict_cycles = 0.0;
+    std::string source;  // the file
+};
+// Those of `file` (read from `source`) for a back end of `isa`. Throws std::invalid_argument
+// where that back end has no few-ray loop or the file has no such costs.
+FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, Isa isa);
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {},
                                const HwConfig* memory_from = nullptr,
                                const std::string& memory_source = "",
-                               const HwConfig* few_ray_from = nullptr,
-                               const std::string& few_ray_source = "");
+                               const FewRayFrom* few_ray_from = nullptr);
 
 // Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
 bool pin_to_current_cpu();
