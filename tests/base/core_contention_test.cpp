@@ -152,8 +152,10 @@ TEST_CASE("The contention monitor probes the core while a region runs", "[conten
     // Each probe is kept in order, with its verdict.
     REQUIRE(shared.marks.size() == shared.probes);
     REQUIRE(alone.marks.size() == alone.probes);
+    // Each tally over its own probes: the two counts differ (indexing one by the other's read
+    // past its end, a CI failure on 2026-12-05).
+    for (const ContentionMonitor::Probe& p : shared.marks) CHECK(p.shared);
     for (size_t i = 0; i < alone.marks.size(); ++i) {
-        CHECK(shared.marks[i].shared);
         CHECK_FALSE(alone.marks[i].shared);
         if (i) CHECK(alone.marks[i].tsc > alone.marks[i - 1].tsc);
     }
