@@ -100,8 +100,8 @@ void SamplingFlags::add_to(CLI::App* c) {
     c->add_option("--warmup-passes", warmup_passes, "sampled fidelity: passes replayed into the caches first")
         ->capture_default_str();
     c->add_option("--warm-frames", warm_frames,
-                  "full fidelity: renders of the same workload into the scene caches before the "
-                  "timed frame (0: it starts from empty caches)")
+                  "full fidelity: renders of the workload's other frames (seeds after --seed) into "
+                  "the scene caches before the timed frame (0: it starts from empty caches)")
         ->capture_default_str();
     c->add_option("--strata", strata, "sampled fidelity: strata of tiles")->capture_default_str();
     c->add_option("--calibration", calibration,

@@ -26,6 +26,18 @@ struct RenderSettings : TraceFrame {
     bool part_clock = false;
 };
 
+// The workload's k-th other frame (k >= 1): the same scene, image, tiles and settings, other
+// random numbers (seed + k), as a progressive renderer's next frames. A CPU core's branch
+// predictor learns a frame's random outcomes from a render of that very frame: on an AMD Zen 4
+// VM (AVX2, 64 x 64, 2026-12-05), furnace's Lambertian lobe choice took 133 K TSC ticks right
+// after a render of its own frame and 252 K after one of another seed (cornell's 99-125 and
+// 164; its frame 2.5 % faster), and more of it the longer the tile's streams. So a frame timed
+// warm follows other frames (sampling's warm frames, the silicon check's renders).
+inline RenderSettings other_frame(RenderSettings settings, uint64_t k) {
+    settings.seed += k;
+    return settings;
+}
+
 // One float RGB value per pixel. Each pixel is the mean of its samples, summed in sample
 // order, so neither thread count nor tile order changes a bit.
 struct Image {

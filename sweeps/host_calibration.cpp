@@ -553,6 +553,15 @@ bool pin_to_current_cpu() {
 
 namespace {
 
+// Which of a workload's other frames (other_frame in kernels/render.h) the check renders where
+// it does not time the workload's own: none of its timed renders follows a render of the same
+// frame, whose random outcomes the core's branch predictor would have learned (the model prices
+// them fresh). Its measured render follows the warm frame and the stage-clocked one (whose
+// stage shares stand for the measured frame's: another seed moves them by its noise only), as
+// the model's warm frame (sampling's, other_frame 1) precedes its timed one; its cold render,
+// after the measured one, is a frame of its own, predicted as such.
+constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3;
+
 // How often the contention monitor probes a render (ContentionMonitor): every millisecond.
 constexpr double k_monitor_period_us = 1000.0;
 
@@ -579,9 +588,10 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
         if (stage_of(OpKind(k)) == OpStage::shading)
             m.predicted_shading_op[k] = double(t.op_cycles[k]);
     m.predicted_frame = double(t.cycles);
-    if (cold)  // from empty caches, as the renders after evict_caches start
+    if (cold)  // from empty caches, as the renders after evict_caches start (their frame)
         m.predicted_cold_frame =
-            double(run_point_group(scene, bvh, settings, {host}, Fidelity::full, SamplingOptions{})
+            double(run_point_group(scene, bvh, other_frame(settings, k_cold_frame), {host},
+                                   Fidelity::full, SamplingOptions{})
                        .predictions.front()
                        .timing.cycles);
 }
@@ -774,8 +784,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
     size_t warm_variant = n;
     auto warm = [&](size_t v) {
         uint32_t ignored = 0;
-        timed_render(*variants[v].scene, *variants[v].bvh, settings[v], false, source_of(v),
-                     tsc_mhz, r, ignored);
+        timed_render(*variants[v].scene, *variants[v].bvh, other_frame(settings[v], k_warm_frame),
+                     false, source_of(v), tsc_mhz, r, ignored);
         warm_variant = v;
     };
     for (size_t v = 0; v < n; ++v) warm(v);
@@ -833,12 +843,13 @@ std::vector<SiliconMeasurement> predict_and_measure(
             if (warm_variant != v) warm(v);
             std::vector<char> shift(64 * size_t(rng() % 1024));
             // The stage-clocked render comes before the measured one, so that two renders of
-            // the workload precede it: one left temple's 64 x 64 frame in 16-pixel tiles 11-13 %
-            // slower (45.2 against 39.5-39.9 Mcycles, scalar) whenever another scene's
-            // workloads ran before it, a state the caches' replacement had not left yet
-            // (the model's caches reach it in one frame, --warm-frames 1).
+            // the workload (other frames of it) precede it: one left temple's 64 x 64 frame in
+            // 16-pixel tiles 11-13 % slower (45.2 against 39.5-39.9 Mcycles, scalar) whenever
+            // another scene's workloads ran before it, a state the caches' replacement had not left
+            // yet (the model's caches reach it in one frame, --warm-frames 1).
             const CycleReading clocked =
-                timed_render(scene, bvh, settings[v], true, source_of(v), tsc_mhz, r, m.interrupted)
+                timed_render(scene, bvh, other_frame(settings[v], k_clocked_frame), true,
+                             source_of(v), tsc_mhz, r, m.interrupted)
                     .first;
             for (int s = 0; s < 3; ++s)
                 stage_min[v][size_t(s)] =
@@ -933,8 +944,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
             m.huge_page_kib_max = std::max(m.huge_page_kib_max, huge);
             if (variants[v].cold) {
                 evict_caches();
-                m.cold_samples.push_back(timed_render(scene, bvh, settings[v], false, source_of(v),
-                                                      tsc_mhz, r, m.interrupted)
+                m.cold_samples.push_back(timed_render(scene, bvh,
+                                                      other_frame(settings[v], k_cold_frame), false,
+                                                      source_of(v), tsc_mhz, r, m.interrupted)
                                              .first.cycles);
                 warm_variant = n;  // one render since the eviction: not yet the warm state
             }

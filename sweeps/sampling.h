@@ -19,9 +19,10 @@ struct SamplingOptions {
     double confidence = 0.997;   // two-sided level of the interval
     uint32_t strata = 8;
     uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
-    // Full fidelity: frames of the same workload rendered into the scene caches (no time, no
-    // counts) before the timed one; 0: the timed frame starts from empty caches. 1 predicts a
-    // frame that follows a render of its workload, as the silicon check's measured renders do.
+    // Full fidelity: other frames of the same workload (other_frame in kernels/render.h:
+    // other seeds) rendered into the scene caches (no time, no counts) before the timed one; 0:
+    // the timed frame starts from empty caches. 1 predicts a frame that follows a render of its
+    // workload, as the silicon check's measured renders do.
     // As sampled fidelity's warm-up passes, they pass through the first core's private levels
     // and the shared ones (Accelerator::warm): another core's private levels start empty.
     uint32_t warm_frames = 0;
