@@ -651,6 +651,7 @@ void add_calibrate_command(CLI::App& app) {
             row["height"] = h;
             row["tile"] = st.tile;
             row["spp"] = o->spp;
+            row["seed"] = m.seed;
             row["isa"] = isa_name(st.isa);
             row["simd_width"] = isa_width(st.isa);
             row["pinned"] = pinned;

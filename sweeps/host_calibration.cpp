@@ -558,9 +558,15 @@ namespace {
 // frame, whose random outcomes the core's branch predictor would have learned (the model prices
 // them fresh). Its measured render follows the warm frame and the stage-clocked one (whose
 // stage shares stand for the measured frame's: another seed moves them by its noise only), as
-// the model's warm frame (sampling's, other_frame 1) precedes its timed one; its cold render,
-// after the measured one, is a frame of its own, predicted as such.
-constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3;
+// the model's warm frames (sampling's: other_frame 2, then 1) precede its timed one; its cold
+// render, after the measured one, is a frame of its own, predicted as such. Each workload's frames
+// are its own (its seed k_frames_per_workload times its index past the variant's): the workloads
+// before it, of the same scene at other tiles and back ends, leave the caches their frames'
+// lines, not its own (with one seed for all, atrium's and conference's AVX2 frames measured
+// 0-2 % slower after other frames of their own than after their own, where the model, its caches
+// warmed by the two other frames alone, put them 3-6 % dearer).
+constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3,
+                   k_frames_per_workload = 4;
 
 // How often the contention monitor probes a render (ContentionMonitor): every millisecond.
 constexpr double k_monitor_period_us = 1000.0;
@@ -569,11 +575,13 @@ constexpr double k_monitor_period_us = 1000.0;
 void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const HwConfig& host,
              bool cold, SiliconMeasurement& m) {
     settings.stage_clock = false;
-    // Every measured render follows two renders of its own workload (predict_and_measure),
-    // so the prediction starts from the caches a render of this workload leaves, not from
-    // empty ones (the model's caches settle in one frame).
+    // Every measured render follows two renders of its own workload, its other frames 2 and 1
+    // (predict_and_measure), so the prediction starts from the caches those leave, not from
+    // empty ones: two frames of other seeds touch more of a large scene than one (with one, the
+    // model put atrium's and conference's AVX2 frames 3-8 % dearer than the same frame's warm
+    // left them, where the host's moved 0-2 %).
     SamplingOptions warm;
-    warm.warm_frames = 1;
+    warm.warm_frames = uint32_t(k_warm_frame);
     const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full, warm);
     m.prediction = r.predictions.front();
     const FrameTiming& t = m.prediction.timing;
@@ -718,6 +726,8 @@ std::vector<SiliconMeasurement> predict_and_measure(
     for (size_t v = 0; v < n; ++v) {
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
+        settings[v].seed += k_frames_per_workload * v;
+        out[v].seed = settings[v].seed;
         out[v].l3_before = l3_before;
     }
     // The predictions, with the host file's L3 before the renders; with memory_now, after
@@ -846,7 +856,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
             // the workload (other frames of it) precede it: one left temple's 64 x 64 frame in
             // 16-pixel tiles 11-13 % slower (45.2 against 39.5-39.9 Mcycles, scalar) whenever
             // another scene's workloads ran before it, a state the caches' replacement had not left
-            // yet (the model's caches reach it in one frame, --warm-frames 1).
+            // yet (the model's warm frames: predict()).
             const CycleReading clocked =
                 timed_render(scene, bvh, other_frame(settings[v], k_clocked_frame), true,
                              source_of(v), tsc_mhz, r, m.interrupted)

@@ -193,6 +193,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
 bool pin_to_current_cpu();
 
 struct SiliconMeasurement {
+    uint64_t seed = 0;  // the measured frame's (predict_and_measure gives each workload its own)
     Prediction prediction;                     // the machine model's, whole
     std::array<double, 3> predicted_stage{};   // traversal, intersection, shading (cycles)
     std::array<double, 3> predicted_memory{};  // of which scene-data misses

@@ -529,7 +529,8 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     }
     PointGroupResult result;
     // Warm frames: the workload's other frames (other_frame: another seed each, as a
-    // progressive renderer's frames before this one) into the caches only; the timed frame's
+    // progressive renderer's frames before this one; the last is other_frame 1) into the caches
+    // only; the timed frame's
     // counters exclude their lookups. Where others fill a cache level (foreign_fill_per_us), lines
     // are lost by age: the warm frames are then timed too, so that each line is as old when the
     // timed frame starts as the render before left it (untimed, every line would be fresh).
@@ -541,7 +542,8 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
         });
         systemc->set_warming(!by_age);
         for (uint32_t f = 0; f < sampling.warm_frames; ++f)
-            render_stream(scene, bvh, other_frame(settings, f + 1), systemc.get());
+            render_stream(scene, bvh, other_frame(settings, sampling.warm_frames - f),
+                          systemc.get());
         systemc->set_warming(false);
         for (size_t c = 0; c < configs.size(); ++c) warmed[c] = systemc->timing(c);
     }

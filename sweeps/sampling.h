@@ -21,8 +21,9 @@ struct SamplingOptions {
     uint32_t warmup_passes = 1;  // passes replayed into the scene caches before each sampled one
     // Full fidelity: other frames of the same workload (other_frame in kernels/render.h:
     // other seeds) rendered into the scene caches (no time, no counts) before the timed one; 0:
-    // the timed frame starts from empty caches. 1 predicts a frame that follows a render of its
-    // workload, as the silicon check's measured renders do.
+    // the timed frame starts from empty caches (the last warm frame is other_frame 1, the one
+    // before it 2, ...). 2 predicts a frame that follows two renders of its workload, as the
+    // silicon check's measured renders do.
     // As sampled fidelity's warm-up passes, they pass through the first core's private levels
     // and the shared ones (Accelerator::warm): another core's private levels start empty.
     uint32_t warm_frames = 0;

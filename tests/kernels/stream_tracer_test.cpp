@@ -120,6 +120,22 @@ TEST_CASE("The stream image changes with the seed (the comparison can fail)", "[
     CHECK_FALSE(same_bits(a.image, render_stream(s, bvh, r).image));
 }
 
+TEST_CASE("A workload's other frame is the same workload with other random numbers", "[stream]") {
+    const Scene s = box_scene(Variant::lights);
+    const Bvh bvh(s);
+    RenderSettings r = small(s, 16, 16, 1);
+    r.tile = 8;
+    r.stage_clock = true;
+    const RenderSettings other = other_frame(r, 2);
+    CHECK(other.seed == r.seed + 2);
+    CHECK((other.width == r.width && other.height == r.height && other.spp == r.spp &&
+           other.max_depth == r.max_depth && other.tile == r.tile && other.isa == r.isa &&
+           other.threads == r.threads && other.stage_clock && !other.part_clock));
+    const RenderResult a = render_stream(s, bvh, r);
+    CHECK(same_bits(a.image, render_stream(s, bvh, other_frame(r, 0)).image));
+    CHECK_FALSE(same_bits(a.image, render_stream(s, bvh, other).image));
+}
+
 TEST_CASE("Stream per-ray hit records equal the reference traversal's", "[stream]") {
     for (Variant v : {Variant::lights, Variant::environment_only}) {
         const Scene s = box_scene(v);

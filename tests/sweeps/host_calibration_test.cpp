@@ -260,6 +260,19 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(cell[0].predicted_cold_frame == 0.0);
     CHECK(cell[1].predicted_frame > 0);
     CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
+    // Each workload renders frames of its own (seeds four apart), and its prediction is sfx
+    // simulate's of that frame after two other frames of it (--seed S --warm-frames 2).
+    CHECK(cell[0].seed == s.seed);
+    CHECK(cell[1].seed == f.seed + 4);
+    RenderSettings own = f;
+    own.threads = 1;
+    own.seed = cell[1].seed;
+    SamplingOptions two_warm;
+    two_warm.warm_frames = 2;
+    CHECK(cell[1].predicted_frame ==
+          double(run_point_group(furnace, furnace_bvh, own, {config}, Fidelity::full, two_warm)
+                     .predictions.front()
+                     .timing.cycles));
     // Every unclocked render is recorded, kept or set aside, with the share of the monitor's
     // probes that found the core shared: none, with the gate open.
     for (const SiliconMeasurement& w : cell) {
