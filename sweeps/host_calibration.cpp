@@ -560,11 +560,11 @@ namespace {
 // stage shares stand for the measured frame's: another seed moves them by its noise only), as
 // the model's warm frames (sampling's: other_frame 2, then 1) precede its timed one; its cold
 // render, after the measured one, is a frame of its own, predicted as such. Each workload's frames
-// are its own (its seed k_frames_per_workload times its index past the variant's): the workloads
-// before it, of the same scene at other tiles and back ends, leave the caches their frames'
-// lines, not its own (with one seed for all, atrium's and conference's AVX2 frames measured
-// 0-2 % slower after other frames of their own than after their own, where the model, its caches
-// warmed by the two other frames alone, put them 3-6 % dearer).
+// are its own (its seed k_frames_per_workload times its index past the variant's): with one seed
+// for all, the workloads rendered before it (the same scene at other tiles and back ends) left
+// the caches lines of its own frame, which the model's warm frames do not hold (atrium's and
+// conference's AVX2 frames measured 0-6 % slower after two other frames than after their own,
+// 2026-12-05, where the model warmed by those two put them 1-9 % dearer).
 constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3,
                    k_frames_per_workload = 4;
 
@@ -577,9 +577,9 @@ void predict(const Scene& scene, const Bvh& bvh, RenderSettings settings, const 
     settings.stage_clock = false;
     // Every measured render follows two renders of its own workload, its other frames 2 and 1
     // (predict_and_measure), so the prediction starts from the caches those leave, not from
-    // empty ones: two frames of other seeds touch more of a large scene than one (with one, the
-    // model put atrium's and conference's AVX2 frames 3-8 % dearer than the same frame's warm
-    // left them, where the host's moved 0-2 %).
+    // empty ones: two frames of other seeds touch more of a large scene than one (warmed by one,
+    // the model put atrium's and conference's AVX2 frames 1-12 % dearer than warmed by their
+    // own frame, by two 1-9 %).
     SamplingOptions warm;
     warm.warm_frames = uint32_t(k_warm_frame);
     const PointGroupResult r = run_point_group(scene, bvh, settings, {host}, Fidelity::full, warm);

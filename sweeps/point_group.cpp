@@ -530,10 +530,10 @@ PointGroupResult run_point_group(const Scene& scene, const Bvh& bvh, const Rende
     PointGroupResult result;
     // Warm frames: the workload's other frames (other_frame: another seed each, as a
     // progressive renderer's frames before this one; the last is other_frame 1) into the caches
-    // only; the timed frame's
-    // counters exclude their lookups. Where others fill a cache level (foreign_fill_per_us), lines
-    // are lost by age: the warm frames are then timed too, so that each line is as old when the
-    // timed frame starts as the render before left it (untimed, every line would be fresh).
+    // only; the timed frame's counters exclude their lookups. Where others fill a cache level
+    // (foreign_fill_per_us), lines are lost by age: the warm frames are then timed too, so that
+    // each line is as old when the timed frame starts as the render before left it (untimed,
+    // every line would be fresh).
     std::vector<FrameTiming> warmed(configs.size());
     if (systemc && sampling.warm_frames > 0) {
         const bool by_age = std::any_of(configs.begin(), configs.end(), [](const HwConfig& c) {
