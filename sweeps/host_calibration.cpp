@@ -553,21 +553,6 @@ bool pin_to_current_cpu() {
 
 namespace {
 
-// Which of a workload's other frames (other_frame in kernels/render.h) the check renders where
-// it does not time the workload's own: none of its timed renders follows a render of the same
-// frame, whose random outcomes the core's branch predictor would have learned (the model prices
-// them fresh). Its measured render follows the warm frame and the stage-clocked one (whose
-// stage shares stand for the measured frame's: another seed moves them by its noise only), as
-// the model's warm frames (sampling's: other_frame 2, then 1) precede its timed one; its cold
-// render, after the measured one, is a frame of its own, predicted as such. Each workload's frames
-// are its own (its seed k_frames_per_workload times its index past the variant's): with one seed
-// for all, the workloads rendered before it (the same scene at other tiles and back ends) left
-// the caches lines of its own frame, which the model's warm frames do not hold (atrium's and
-// conference's AVX2 frames measured 0-6 % slower after two other frames than after their own,
-// 2026-12-05, where the model warmed by those two put them 1-9 % dearer).
-constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3,
-                   k_frames_per_workload = 4;
-
 // How often the contention monitor probes a render (ContentionMonitor): every millisecond.
 constexpr double k_monitor_period_us = 1000.0;
 

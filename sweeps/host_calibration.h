@@ -326,6 +326,21 @@ struct SiliconVariant {
     bool cold = false;
 };
 
+// Which of a workload's other frames (other_frame in kernels/render.h) the check renders where
+// it does not time the workload's own: none of its timed renders follows a render of the same
+// frame, whose random outcomes the core's branch predictor would have learned (the model prices
+// them fresh). Its measured render follows the warm frame and the stage-clocked one (whose
+// stage shares stand for the measured frame's: another seed moves them by its noise only), as
+// the model's warm frames (sampling's: other_frame 2, then 1) precede its timed one; its cold
+// render, after the measured one, is a frame of its own, predicted as such. Each workload's frames
+// are its own (its seed k_frames_per_workload times its index past the variant's): with one seed
+// for all, the workloads rendered before it (the same scene at other tiles and back ends) left
+// the caches lines of its own frame, which the model's warm frames do not hold (atrium's and
+// conference's AVX2 frames measured 0-6 % slower after two other frames than after their own,
+// 2026-12-05, where the model warmed by those two put them 1-9 % dearer).
+constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3,
+                   k_frames_per_workload = 4;
+
 // The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
 // every host config must carry op_costs for every kind its scene uses. Each is predicted by the
 // machine model on the trace of its own render (before the renders; with `memory_now`, after
@@ -334,11 +349,11 @@ struct SiliconVariant {
 // converged or spent its budget (`convergence`): every workload's renders span the whole run,
 // so that the drift of a shared machine touches all of them alike, and a slow spell shows as
 // disagreement instead of a bias. Each measured render follows an unmeasured render of its own
-// workload, so that it starts from the caches predict() assumes. A workload asked for `cold` also
-// renders, each round, after evicting this core's caches. `seed` draws the heap offsets that
-// vary placement. `progress(what, done, total)` as it goes. With `memory_now`, the L3 is
-// chased at the start of every round, and every workload is predicted after the renders with
-// the median of the chases the kept renders met as its host's last cache level
+// workload (other frames, above), so that it starts from the caches predict() assumes. A workload
+// asked for `cold` also renders, each round, after evicting this core's caches. `seed` draws the
+// heap offsets that vary placement. `progress(what, done, total)` as it goes. With `memory_now`,
+// the L3 is chased at the start of every round, and every workload is predicted after the renders
+// with the median of the chases the kept renders met as its host's last cache level
 // (SiliconMeasurement::l3_run), not the file's: the check then predicts the memory its
 // renders met.
 std::vector<SiliconMeasurement> predict_and_measure(
