@@ -856,7 +856,11 @@ def write_page(df, page, plot_name, header):
         "caches is what the frame otherwise saves from the lines the render before left: on "
         "silicon, what those lines are worth after their ageing by the neighbours' fills; in "
         "the model, its misses to DRAM at its DRAM latency and exposure. (The eviction also "
-        "empties the TLBs and the ray buffers' lines, which the model does not price.)\n\n"
+        "empties the TLBs and the ray buffers' lines, which the model does not price.) "
+        "Since 2026-12-05 the cold render is another frame of the workload (another seed, "
+        "as each render before a timed one is: the core's branch predictor learns a frame it "
+        "has just rendered), measured and predicted alike, so the cost also holds the two "
+        "frames' difference in work.\n\n"
         + cold_text(df),
         "## Where the prediction goes wrong, by stage\n\nScene-data stalls are what the "
         "machine model exposes of each miss (the latency of the level that holds the line, less "
