@@ -698,8 +698,8 @@ def measurement_text(df):
         rewarmed = int(df["measured.rewarmed_renders"].sum())
         lines.append(f"- the gate's waits for the core before a measured render (each asleep 10 ms "
                      f"or more, over which others' fills take what the render before left in a "
-                     f"shared L3): {rewarmed}, each followed by a render of the workload again to "
-                     f"warm the caches (CoreContention::wait_warm)")
+                     f"shared L3): {rewarmed}, each followed by a render of the workload "
+                     f"(another frame) again to warm the caches (CoreContention::wait_warm)")
     if "host.microarchitecture" in df:
         for m in df["host.microarchitecture"].dropna().unique():
             lines.append(f"- microarchitecture: {m}")
