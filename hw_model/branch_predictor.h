@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "hw_model/pass_buffer.h"
@@ -27,8 +28,20 @@ class TagePredictor {
     TagePredictor();
     // Predicts the branch at `pc`, learns its outcome; returns whether it mispredicted.
     bool predict_and_update(uint32_t pc, bool taken);
+    // A counted loop of the stream loop run `trips` times: its test after each trip but the
+    // first, taken until the last, through a TAGE of its own whose history holds the stream
+    // loop's counted loops' tests alone (the box filter's group loop, for_each_group, whose
+    // first test is the replay's one branch an op in the global history, "a second group?";
+    // the copy of the failing ids, copy_ids: kernels/stream/stream_kernels_impl.h), so that the
+    // global history, and the short loops' predictions with it, does not follow the width.
+    // Trip counts that repeat (a microbenchmark's batch timed right after itself) have their
+    // exits learned; a frame's op lengths do not repeat, and each exit is mispredicted about
+    // once an op. Returns its mispredictions, which mispredictions() counts too.
+    uint32_t run_counted_loop(uint32_t pc, uint32_t trips);
     uint64_t branches() const { return m_branches; }
     uint64_t mispredictions() const { return m_mispredictions; }
+    // Of branches(), the counted loops' tests (run_counted_loop).
+    uint64_t counted_loop_branches() const { return m_counted_loop_branches; }
 
   private:
     static constexpr int k_tables = 12;
@@ -56,6 +69,8 @@ class TagePredictor {
     int m_use_alt_on_new = 0;  // 4-bit signed: trust the alternative over a fresh entry
     uint64_t m_branches = 0, m_mispredictions = 0;
     uint32_t m_seed = 0x2545f491;  // allocation's pseudo-random choice
+    std::unique_ptr<TagePredictor> m_counted_loops;  // run_counted_loop's, made on its first use
+    uint64_t m_counted_loop_branches = 0;
 };
 
 // The box tests of a pass by the native tracer's loop that runs them (TraversalLoop): the
@@ -67,7 +82,8 @@ std::vector<TraversalLoop> traversal_loops(const PassBuffer& pass, uint32_t widt
 // tracer's program order), through `predictor`: per box test the loop's test of its stream
 // length (stream loop: one ray? few?), whether any lane passed (the one-ray loop: the ray), and
 // whether a node is a leaf (the prefetch of what it needs next, before the test; and after a
-// pass); the stream loop's group loop (one branch an op: a second group?); the one-ray loop's
+// pass); the stream loop's group loop (one branch an op: a second group?; its further tests
+// and the loop copying the failing ids, run_counted_loop); the one-ray loop's
 // stack; per leaf test whether a lane took the hit and whether another primitive follows.
 // `node_leaf[node]`: the tree's leaves (the trace names the nodes tested, not their kind).
 // `mispredicted[i]` gets op i's count.

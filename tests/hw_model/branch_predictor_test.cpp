@@ -80,8 +80,12 @@ TEST_CASE("A pass's traversal branches follow the tracer's loops", "[branch]") {
     std::vector<uint32_t> missed;
     replay_traversal_branches(pass, loops, 8, {0, 1}, p, missed);
     // Each box test in the stream loop: one ray? few? leaf (prefetch)? a second group? none
-    // passed? leaf? Six each. The triangle test: took the hit? another primitive? Two.
-    CHECK(p.branches() == 6 + 6 + 2);
+    // passed? leaf? Six each in the global history. The triangle test: took the hit? another
+    // primitive? Two. In the counted loops' own history: the group loop's test after the
+    // second group of 16 lanes at 8, one an op; the copy of the second op's 15 failing ids,
+    // one trip of 8 and its exit test.
+    CHECK(p.branches() - p.counted_loop_branches() == 6 + 6 + 2);
+    CHECK(p.counted_loop_branches() == 2 + 1);
     REQUIRE(missed.size() == 3);
     CHECK(missed[0] + missed[1] + missed[2] == p.mispredictions());
     // Without the tree's leaves a passing node is a leaf where leaf tests follow it.
@@ -89,13 +93,40 @@ TEST_CASE("A pass's traversal branches follow the tracer's loops", "[branch]") {
     replay_traversal_branches(pass, loops, 8, {}, q, missed);
     CHECK(q.branches() == p.branches());
     // A narrow back end has no few-ray loop: no such test. The group loop is one branch an
-    // op at any width (the short loops' predictions must not follow the stream loop's width).
+    // op in the global history at any width (the short loops' predictions must not follow the
+    // stream loop's width); its further tests, 3 an op of 4 groups, in its own, beside the
+    // copy's, which runs 8 ids a trip at every width.
     TagePredictor r;
     replay_traversal_branches(pass, traversal_loops(pass, 4), 4, {0, 1}, r, missed);
-    CHECK(r.branches() == 2 * (6 - 1) + 2);
+    CHECK(r.branches() - r.counted_loop_branches() == 2 * (6 - 1) + 2);
+    CHECK(r.counted_loop_branches() == 2 * 3 + 1);
     TagePredictor wide;
     replay_traversal_branches(pass, traversal_loops(pass, 16), 16, {0, 1}, wide, missed);
-    CHECK(wide.branches() == p.branches());
+    CHECK(wide.branches() - wide.counted_loop_branches() ==
+          p.branches() - p.counted_loop_branches());
+    CHECK(wide.counted_loop_branches() == 1);
+}
+
+TEST_CASE("The group loop's exit is learned where its trip counts repeat, not where they vary",
+          "[branch]") {
+    // A frame's stream-loop ops have lengths that do not repeat: the loop's exit is mispredicted
+    // about once an op. A batch timed right after itself repeats them: learned.
+    std::mt19937 rng(3);
+    std::uniform_int_distribution<uint32_t> groups(3, 40);
+    std::vector<uint32_t> batch(24);
+    for (uint32_t& g : batch) g = groups(rng);
+    TagePredictor fresh;
+    uint32_t missed = 0;
+    for (int op = 0; op < 2000; ++op) missed += fresh.run_counted_loop(7, groups(rng));
+    CHECK(double(missed) / 2000 > 0.8);
+    TagePredictor primed;
+    for (int run = 0; run < 20; ++run)
+        for (const uint32_t g : batch) primed.run_counted_loop(7, g);
+    uint32_t again = 0;
+    for (const uint32_t g : batch) again += primed.run_counted_loop(7, g);
+    CHECK(double(again) / double(batch.size()) < 0.2);
+    // A stream of one group runs no further test.
+    CHECK(primed.run_counted_loop(7, 1) == 0);
 }
 
 TEST_CASE("A batch mispredicts less after itself than after others", "[branch]") {
