@@ -338,8 +338,9 @@ struct SiliconVariant {
 // the caches lines of its own frame, which the model's warm frames do not hold (atrium's and
 // conference's AVX2 frames measured 0-6 % slower after two other frames than after their own,
 // 2026-12-05, where the model warmed by those two put them 1-9 % dearer).
-constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3,
-                   k_frames_per_workload = 4;
+constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3;
+// Its own frame and its other frames 1 to k_cold_frame.
+constexpr uint64_t k_frames_per_workload = k_cold_frame + 1;
 
 // The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;
 // every host config must carry op_costs for every kind its scene uses. Each is predicted by the
