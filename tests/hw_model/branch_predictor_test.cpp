@@ -107,10 +107,10 @@ TEST_CASE("A pass's traversal branches follow the tracer's loops", "[branch]") {
     CHECK(wide.counted_loop_branches() == 1);
 }
 
-TEST_CASE("The group loop's exit is learned where its trip counts repeat, not where they vary",
+TEST_CASE("A counted loop's exit is learned where its trip counts repeat, not where they vary",
           "[branch]") {
-    // A frame's stream-loop ops have lengths that do not repeat: the loop's exit is mispredicted
-    // about once an op. A batch timed right after itself repeats them: learned.
+    // A frame's stream-loop ops have lengths that do not repeat: a counted loop's exit is
+    // mispredicted about once an op. A batch timed right after itself repeats them: learned.
     std::mt19937 rng(3);
     std::uniform_int_distribution<uint32_t> groups(3, 40);
     std::vector<uint32_t> batch(24);
