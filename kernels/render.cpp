@@ -31,6 +31,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     for (int i = 0; i < 2; ++i) short_loop_tsc[i] += o.short_loop_tsc[i];
     for (uint32_t k = 0; k < k_op_kind_count; ++k) shading_op_tsc[k] += o.shading_op_tsc[k];
     ray_setup_tsc += o.ray_setup_tsc;
+    shading_rest_tsc += o.shading_rest_tsc;
     part_tsc.insert(part_tsc.end(), o.part_tsc.begin(), o.part_tsc.end());
     part_start_tsc.insert(part_start_tsc.end(), o.part_start_tsc.begin(), o.part_start_tsc.end());
     entry_searches += o.entry_searches;

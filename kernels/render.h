@@ -79,10 +79,12 @@ struct RenderStats {
     uint64_t short_loop_tsc[2] = {0, 0};
     // Of stage_tsc[2] (stream tracer, stage clock): the ticks of each shading op kind as the
     // timing models price it (camera: the camera loop; emission_filter: with the hits'
-    // surfaces, compute_surfaces; material_filter: the sort by material), and of the ray
-    // set-up (load_rays), which they price in the ops that made the rays.
+    // surfaces, compute_surfaces; material_filter: the sort by material), of the ray set-up
+    // (load_rays), which they price in the ops that made the rays, and of the rest (the
+    // reordering, the sums into the image): laps of one clock, so that the three make the stage.
     uint64_t shading_op_tsc[k_op_kind_count] = {};
     uint64_t ray_setup_tsc = 0;
+    uint64_t shading_rest_tsc = 0;
     // With RenderSettings::part_clock (stream tracer): each part's TSC ticks, a part being a
     // generation of a pass (the first with its camera rays) or a pass's end (its sums), in the
     // order they ran; with one thread that is the same order, and the same work, in every

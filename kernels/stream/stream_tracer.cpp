@@ -468,6 +468,21 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     const bool clock = settings.stage_clock;
     const uint64_t pass_start = clock ? __rdtsc() : 0;
     uint64_t traverse_tsc = 0;
+    // With the stage clock, the pass is timed in laps (RenderStats::shading_op_tsc and the
+    // stages): each read of the TSC ends one part and starts the next, so that the parts tile
+    // the pass and each read's cost falls in the parts on either side of it. With a read at the
+    // start and one at the end of each part (until 2026-12-05), the two reads between
+    // consecutive parts ran back to back, about 20 TSC ticks a part in no part but the shading
+    // stage's rest, more of them the smaller the tile: on cornell 128 x 128 at AVX2 (Zen 5),
+    // that rest took 131 / 64 / 51 K ticks at tiles 16 / 32 / 64, and 205 / 84 / 57 K with a
+    // third read at each boundary; in laps 38-41 K at every tile (the sums into the image).
+    uint64_t lap_mark = pass_start;
+    auto lap = [&](uint64_t& ticks) {
+        if (!clock) return;
+        const uint64_t now = __rdtsc();
+        ticks += now - lap_mark;
+        lap_mark = now;
+    };
     // With the part clock, the frame is timed in parts (RenderStats::part_tsc): each generation
     // of the pass, then its end.
     const bool parts = settings.part_clock;
@@ -480,16 +495,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         part_mark = now;
     };
 
-    // With the stage clock, the ticks of a part of the shading stage (RenderStats::shading_op_tsc).
-    uint64_t part_start = 0;
-    auto start_part = [&] { part_start = clock ? __rdtsc() : 0; };
-    auto end_part = [&](uint64_t& ticks) {
-        if (clock) ticks += __rdtsc() - part_start;
-    };
-
     // Camera: the input buffer gets one primary ray per pixel of the tile.
     int cur = 0;
-    start_part();
     for (uint32_t slot = 0; slot < count; ++slot) {
         const uint32_t x = rect.x0 + slot % w, y = rect.y0 + slot / w;
         PathState& p = path[slot];
@@ -501,25 +508,28 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     }
     stats.camera_rays += count;
     trace.op(OpKind::camera, 0, k_no_object, ids, count, mask, count);
-    end_part(stats.shading_op_tsc[size_t(OpKind::camera)]);
+    lap(stats.shading_op_tsc[size_t(OpKind::camera)]);
 
     uint32_t n = count;
     uint16_t generation = 0;
     while (n > 0) {
         const Ray* rays = b.ray[cur].data();
         Ray* next = b.ray[cur ^ 1].data();
-        if (reorder) reorder_stream(ids, n, rays, generation, trace);
-        start_part();
+        if (reorder) {
+            reorder_stream(ids, n, rays, generation, trace);
+            lap(stats.shading_rest_tsc);
+        }
         const uint32_t traversal_rays = load_rays(b, rays, n);
-        end_part(stats.ray_setup_tsc);
+        lap(stats.ray_setup_tsc);
+        // The entry search (its frustum tests are traversal ops) is in the traversal's lap.
         uint32_t entry = 0;
         if (generation == 0 && settings.primary_entry == PrimaryEntry::aepsa)
             entry = primary_entry_point(traversal_rays, stats, trace);
         if (clock) {
             TraversalClock ticks;
-            const uint64_t start = __rdtsc();
+            uint64_t spent = 0;
             traverse_generation(traversal_rays, generation, entry, stats, trace, &ticks);
-            const uint64_t spent = __rdtsc() - start;
+            lap(spent);
             stats.stage_tsc[0] += spent - ticks.leaf;
             stats.stage_tsc[1] += ticks.leaf;
             for (int l = 0; l < 2; ++l) stats.short_loop_tsc[l] += ticks.short_loops.ticks[l];
@@ -533,15 +543,15 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                 observer->ray(path[id], rays[id], hit[id], any_hit[id] && hit[id].valid());
             }
 
-        // The shading filter stack (Fig. 4) over the generation's stream.
+        // The shading filter stack (Fig. 4) over the generation's stream; each filter's lap
+        // holds the bookkeeping since the lap before it.
         uint32_t pushed = 0;
         uint32_t* next_ids = b.next_ids.data();
         auto run_filter = [&](OpKind kind, uint32_t object, uint32_t* s, uint32_t len,
                               auto&& test) {
-            start_part();
             const uint32_t passed =
                 filter(kernels, trace, kind, generation, object, s, len, mask, scratch, test);
-            end_part(stats.shading_op_tsc[size_t(kind)]);
+            lap(stats.shading_op_tsc[size_t(kind)]);
             return passed;
         };
         uint32_t* s = ids;
@@ -564,10 +574,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
         len -= misses;
         // The hits' surfaces, for the emission filter and the stack below. Timing models
         // price this as part of the emission filter (OpKindInfo::reads_hit_primitive), as the
-        // microbenchmarks time it.
-        start_part();
+        // microbenchmarks time it: in the emission filter's lap.
         compute_surfaces(scene, rays, hit, s, len, b.surf.data());
-        end_part(stats.shading_op_tsc[size_t(OpKind::emission_filter)]);
         run_filter(OpKind::emission_filter, k_no_object, s, len, [&](uint32_t id) {
             const Material& m = scene.materials[surf[id].material];
             if (!m.emissive()) return false;
@@ -591,7 +599,6 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             next_ids[pushed++] = id;
             ++(shadow ? stats.shadow_rays : stats.extension_rays);
         };
-        start_part();
         // The material filters below leave the stream stably sorted by material, in
         // `present` order. Without a trace of lanes nothing needs their masks, so one counting
         // sort does it here and each filter's op carries only its counts.
@@ -607,7 +614,7 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
                 std::copy(scratch, scratch + len, s);
             }
         }
-        end_part(stats.shading_op_tsc[size_t(OpKind::material_filter)]);
+        lap(stats.shading_op_tsc[size_t(OpKind::material_filter)]);
         // One sub-stack per material (a shader instance: its constants are uniform over the
         // lanes), for the materials this generation hit; the last one is what is left.
         for (size_t j = 0; j < present.size(); ++j) {
@@ -685,7 +692,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     // its samples in the reference tracer's order.
     for (uint32_t slot = 0; slot < count; ++slot)
         sums[slot] += sanitize_radiance(path[slot].radiance, stats);
-    if (clock) stats.stage_tsc[2] += __rdtsc() - pass_start - traverse_tsc;
+    lap(stats.shading_rest_tsc);
+    if (clock) stats.stage_tsc[2] += lap_mark - pass_start - traverse_tsc;
     close_frame_part();
     info.generations = generation;
     if constexpr (Trace::k_enabled) sink->end_pass(info);

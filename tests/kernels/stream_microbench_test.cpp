@@ -33,6 +33,13 @@ TEST_CASE("The stage clock never changes a bit and counts every stage", "[stream
         CHECK(plain.stats.stage_tsc[i] == 0);
         CHECK(clocked.stats.stage_tsc[i] > 0);
     }
+    // The shading stage is laps of one clock: its op kinds, the ray set-up and its rest make it
+    // to the tick (two reads a part, a start and an end, left the ticks between parts in none).
+    uint64_t laps = clocked.stats.ray_setup_tsc + clocked.stats.shading_rest_tsc;
+    for (uint64_t ticks : clocked.stats.shading_op_tsc) laps += ticks;
+    CHECK(laps == clocked.stats.stage_tsc[2]);
+    CHECK(clocked.stats.shading_rest_tsc > 0);  // the sums into the image
+    CHECK(plain.stats.shading_rest_tsc == 0);
 }
 
 TEST_CASE("The part clock never changes a bit and times each generation of each pass in order",
