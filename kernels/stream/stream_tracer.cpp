@@ -474,8 +474,8 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
     // start and one at the end of each part (until 2026-12-05), the two reads between
     // consecutive parts ran back to back, about 20 TSC ticks a part in no part but the shading
     // stage's rest, more of them the smaller the tile: on cornell 128 x 128 at AVX2 (Zen 5),
-    // that rest took 131 / 64 / 51 K ticks at tiles 16 / 32 / 64, and 205 / 84 / 57 K with a
-    // third read at each boundary; in laps 38-41 K at every tile (the sums into the image).
+    // that rest took 131 / 64 / 51 K ticks at tiles 16 / 32 / 64, and 205 / 84 / 57 K with each
+    // read doubled; in laps 38-41 K at every tile (the sums into the image).
     uint64_t lap_mark = pass_start;
     auto lap = [&](uint64_t& ticks) {
         if (!clock) return;
