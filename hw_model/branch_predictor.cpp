@@ -248,7 +248,7 @@ void replay_traversal_branches(const PassBuffer& pass, const std::vector<Travers
             // where tile 32's was 51 / 14 K under (AVX2 / AVX-512); with them, on the same host
             // files, 14 / 25 K and 16 / -12 K.
             missed += predictor.run_counted_loop(address(Branch::stream_group_loop),
-                                                 (len + width - 1) / width);
+                                                 lane_groups(len, width));
             if (len - k >= 8)
                 missed += predictor.run_counted_loop(address(Branch::stream_copy_loop),
                                                      (len - k) / 8 + 1);

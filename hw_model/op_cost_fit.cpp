@@ -44,7 +44,7 @@ constexpr double k_resolution = 100.0;
 constexpr int k_terms = 7;
 std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
     return {1.0,
-            double((s.lanes + width - 1) / width),
+            double(lane_groups(s.lanes, width)),
             double(s.lanes),
             double(s.passed),
             double(minority_lanes(s.passed, s.lanes)),

@@ -84,7 +84,7 @@ void CountingSink::ops_of_length(OpKind kind, OpStage stage, uint16_t generation
     uint64_t* groups = s.groups.data();
     const uint32_t* widths = m_widths.data();
     for (size_t i = 0, n = m_widths.size(); i < n; ++i)
-        groups[i] += uint64_t(count) * ((length - 1) / widths[i] + 1);  // ceil(length / width)
+        groups[i] += uint64_t(count) * lane_groups(length, widths[i]);
     s.histogram[31u - uint32_t(__builtin_clz(length))] += count;        // length > 0: below 32
     const uint32_t slot = bounce_slot(generation);
     KindTally& k = m_kinds[slot][uint32_t(kind)];

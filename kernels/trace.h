@@ -151,6 +151,11 @@ inline bool runs_in_few_ray_loop(OpKind kind, uint32_t length, uint32_t width) {
            width >= k_few_ray_min_width;
 }
 
+// The lane groups an op of `length` lanes takes on a SIMD unit of `width` lanes.
+inline uint32_t lane_groups(uint32_t length, uint32_t width) {
+    return (length + width - 1) / width;
+}
+
 // The native tracer's loop that runs a box test: a stream of one ray runs its subtree in the
 // one-ray loop, one of 2 to k_few_ray_lanes rays (a wide back end) in the few-ray loop, and every
 // op below either is that loop's; `producer` is the loop of the op whose partition produced the
