@@ -258,23 +258,30 @@ void add_calibrate_command(CLI::App& app) {
                         {"sphere_light_per_pass", k.sphere_light_per_pass_cycles},
                         {"per_failed_candidate", k.per_failed_candidate_cycles},
                         {"sphere_hit_per_lane", k.sphere_hit_per_lane_cycles},
+                        {"cold_call", k.cold_call_cycles},
                         {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                         {"fit_median_error", cal.fit_errors[i].first},
                         {"fit_worst_error", cal.fit_errors[i].second}};
                 }
                 for (const MicrobenchSample& m : cal.samples)
-                    j["samples"].push_back({{"op", to_string(m.kind)},
-                                            {"slots", m.slots},
-                                            {"lanes", m.lanes},
-                                            {"passed", m.passed},
-                                            {"cycles", m.cycles},
-                                            {"converged", m.converged},
-                                            {"repetitions", m.repetitions},
-                                            {"thin_lens", m.thin_lens},
-                                            {"sphere_light", m.sphere_light},
-                                            {"failing_candidates", m.failing_candidates},
-                                            {"failed_candidates", m.failed_candidates},
-                                            {"sphere_hits", m.sphere_hits}});
+                    j["samples"].push_back(
+                        {{"op", to_string(m.kind)},
+                         {"slots", m.slots},
+                         {"lanes", m.lanes},
+                         {"passed", m.passed},
+                         {"cycles", m.cycles},
+                         {"converged", m.converged},
+                         {"repetitions", m.repetitions},
+                         {"thin_lens", m.thin_lens},
+                         {"sphere_light", m.sphere_light},
+                         {"failing_candidates", m.failing_candidates},
+                         {"failed_candidates", m.failed_candidates},
+                         {"sphere_hits", m.sphere_hits},
+                         {"cold_call_cycles", m.cold_call_timed ? nlohmann::json(m.cold_call_cycles)
+                                                                : nlohmann::json()}});
+                for (size_t i = 0; i < cal.cold_traversal_cycles.size(); ++i)
+                    j["cold_traversals"].push_back({{"lanes", cal.cold_traversal_lengths[i]},
+                                                    {"cycles", cal.cold_traversal_cycles[i]}});
                 j["one_lane_fit_median_error"] = cal.short_stream_fit_errors.first;
                 j["one_lane_fit_worst_error"] = cal.short_stream_fit_errors.second;
                 for (size_t i = 0; i < cal.one_ray_samples.size(); ++i) {
@@ -434,6 +441,14 @@ void add_calibrate_command(CLI::App& app) {
                         "is a triangle (%.1f a lane with its share of a full group)\n",
                         k.op.c_str(), k.sphere_hit_per_lane_cycles,
                         k.per_lane_cycles + k.per_group_cycles / std::max(1u, cal.host.simd_width));
+            for (const OpCostConfig& k : cal.op_costs)
+                if (k.cold_call_cycles > 0)
+                    std::printf(
+                        "%s: %s cold (as a frame's) costs %.1f cycles over one right "
+                        "after another\n",
+                        k.op.c_str(),
+                        op_kind_named(k.op) == OpKind::box_test ? "a traversal's start" : "a call",
+                        k.cold_call_cycles);
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.one_lane_pass_cycles > 0 || k.one_lane_failed_candidate_cycles > 0)
                     std::printf(

@@ -291,9 +291,14 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             // A one-lane op's pass is priced by the bucket's pass rate (rounded, one lane
             // would pass all or none of the bucket).
             const double passing = length == 1 ? pass_rate : double(std::lround(pass_rate * lanes));
-            const double busy = p.issue_cycles(
-                c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
-                passing, g == 0, beyond_l1 * opening_share, double(bucket.failed_candidates) / ops);
+            const double busy =
+                p.issue_cycles(c.datapath, length,
+                               uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
+                               passing, g == 0, beyond_l1 * opening_share,
+                               double(bucket.failed_candidates) / ops) +
+                // A shading filter's call cold (a traversal's start is not priced here, as
+                // its other start costs are not: the cycle-level model's).
+                (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

@@ -408,6 +408,12 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
                               passed, t.first == 0, beyond_l1, op.failed_candidates)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
+        // A call cold: a shading filter's (the material sort's once, on its first filter) and a
+        // traversal's start.
+        (t.first == 0 && (stage_of(op.kind) == OpStage::shading ? !m_placed_by_sort[t.op]
+                                                                : op.starts_traversal)
+             ? p.cold_call_cycles()
+             : 0.0) +
         (t.first == 0 && op.starts_traversal && op.origin_shared ? p.shared_origin_cycles(op.length)
                                                                  : 0.0);
     // The op's mispredicted branches, on its first group.

@@ -699,6 +699,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << (o.sphere_hit_per_lane_cycles != 0
                       ? ", sphere_hit_per_lane_cycles: " + fmt(o.sphere_hit_per_lane_cycles, 2)
                       : std::string())
+              << (o.cold_call_cycles > 0 ? ", cold_call_cycles: " + fmt(o.cold_call_cycles, 2)
+                                         : std::string())
               << "}\n";
     }
     return y.str();

@@ -626,6 +626,17 @@ struct OpCostConfig {
     // lane on cornell, about 19 cycles each; unpriced, about 3 % of its filter, the rest of the
     // miss unexplained).
     double sphere_hit_per_lane_cycles = 0.0;
+    // A shading op's: what a call costs cold, as a frame calls it (once per generation of a
+    // tile, the tile's traversal and the other filters between two calls), over the same call
+    // right after another (its microbenchmark points call it back to back), on the op's first
+    // group. Timed by its microbenchmark (MicrobenchOptions::cold_call_lengths): the mean over
+    // pairs of single calls, the first after a pass of a 16 x 16 tile, the median over the
+    // lengths. Why: on an AMD Zen 5 VM (2026-12-05, docs/silicon-check-amd-1ah-02h-avx512.md)
+    // cornell's and furnace's shading stage was priced about 80 cycles an op further under at
+    // tile 16 than at 32 on every back end (cornell 128 x 128 AVX2: 1314 K cycles under with
+    // 3275 ops, 1118 K with 921), and the tile ranking failed on such pairs; that host's
+    // filters took 40-140 cycles more cold than warm (AVX2). 0: not measured.
+    double cold_call_cycles = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -707,6 +718,11 @@ struct OpCostConfig {
                 "the emission filter's: cost a lane whose hit is a sphere adds over one on a "
                 "triangle, negative where it saves (0: not measured)",
                 -1e9, 1e9);
+        v.param("cold_call_cycles", cold_call_cycles, "cycles",
+                "a shading op's: what a call costs cold (other filters and a traversal since "
+                "its last) over a call right after another, on its first group (0: not "
+                "measured)",
+                0.0, 1e9);
     }
 };
 

@@ -273,6 +273,15 @@ double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
                                       [](const OpCostSample& s) { return s.failed_candidates; }));
 }
 
+double fit_cold_call_cycles(std::vector<double> differences) {
+    if (differences.empty()) return 0.0;
+    std::sort(differences.begin(), differences.end());
+    const size_t n = differences.size();
+    const double median =
+        n % 2 ? differences[n / 2] : 0.5 * (differences[n / 2 - 1] + differences[n / 2]);
+    return std::max(0.0, median);
+}
+
 double fit_extra_per_lane(const OpCostConfig& base, uint32_t width,
                           const std::vector<OpCostSample>& variant_samples) {
     return median_extra(base, width, variant_samples,

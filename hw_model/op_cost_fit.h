@@ -48,6 +48,10 @@ double fit_extra_per_passing_lane(const OpCostConfig& base, uint32_t width,
 // (OpCostConfig::sphere_hit_per_lane_cycles).
 double fit_extra_per_lane(const OpCostConfig& base, uint32_t width,
                           const std::vector<OpCostSample>& variant_samples);
+// A shading op's cold call over a warm one (OpCostConfig::cold_call_cycles) from its points'
+// differences, one a stream length: their median (a long call's difference is the noisiest),
+// 0 where that is negative or there are none.
+double fit_cold_call_cycles(std::vector<double> differences);
 // Likewise per failed candidate: the triangle test's microbenchmark of failing candidates over
 // the op's fitted cost, whose failing lanes are lanes the float stage rejects
 // (OpCostConfig::per_failed_candidate_cycles).

@@ -298,6 +298,10 @@ double OpProfile::traversal_start_cycles() const {
     return measured ? cost.traversal_start_cycles : 0.0;
 }
 
+double OpProfile::cold_call_cycles() const {
+    return measured ? cost.cold_call_cycles : 0.0;
+}
+
 double OpProfile::shared_origin_cycles(uint32_t lanes) const {
     // The check compares every lane after the first with the first.
     return measured && lanes > 1 ? cost.shared_origin_per_lane_cycles * double(lanes - 1) : 0.0;

@@ -139,6 +139,9 @@ struct OpProfile {
     // Cycles the op adds on its first group when it starts a traversal (StreamOp::
     // starts_traversal): a measured box test's traversal_start_cycles; 0 otherwise.
     double traversal_start_cycles() const;
+    // Cycles the op adds on its first group as a frame calls it, cold: a measured op's
+    // cold_call_cycles; 0 otherwise.
+    double cold_call_cycles() const;
     // Cycles the op adds on its first group when it starts a traversal whose `lanes` rays share
     // one origin (StreamOp::origin_shared): a measured box test's shared_origin_per_lane_cycles
     // x the lanes after the first (each compared with it); 0 otherwise.

@@ -348,7 +348,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
     std::vector<OpCostSample> failing_candidates;    // the triangle test's
     std::vector<OpCostSample> sphere_hits;           // the emission filter's on sphere hits
+    std::map<OpKind, std::vector<double>> cold_calls;  // a shading op's, one a length
     for (const MicrobenchSample& s : c.samples) {
+        if (s.cold_call_timed) cold_calls[s.kind].push_back(s.cold_call_cycles);
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
             one_lane[s.kind].push_back({1, s.passed, 0.0, s.cycles, s.failed_candidates});
             continue;
@@ -390,6 +392,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                 fit_extra_per_lane(c.op_costs.back(), c.host.simd_width, sphere_hits);
             points += sphere_hits.size();
         }
+        c.op_costs.back().cold_call_cycles = fit_cold_call_cycles(cold_calls[kind]);
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         points += samples.size() + one_lane[kind].size();
     }
@@ -446,6 +449,12 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     for (OpCostConfig& o : c.op_costs)
         if (op_kind_named(o.op) == OpKind::box_test)
             o.shared_origin_per_lane_cycles = c.shared_origin.per_lane_cycles;
+    // A traversal's start cold, as a frame's (its box test that starts it carries it).
+    c.cold_traversal_cycles =
+        run_cold_traversal_microbenchmarks(resolved, c.cold_traversal_lengths, 128);
+    for (OpCostConfig& o : c.op_costs)
+        if (op_kind_named(o.op) == OpKind::box_test)
+            o.cold_call_cycles = fit_cold_call_cycles(c.cold_traversal_cycles);
     const std::vector<uint8_t> one_ray_leaves = bvh_leaves(Bvh(one_ray_microbench_scene()));
     c.one_ray_samples = run_one_ray_microbenchmarks(
         resolved, convergence, 1,
@@ -511,7 +520,17 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << "until " << describe(convergence) << " in each of " << options.visits
          << " sweeps over the points, judged over all (" << c.converged_points << " of " << c.points
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
-         << "error; the triangle and sphere tests' one-lane costs by the lane's outcome, the "
+         << "error; a shading op's cold call (after a pass of a 16 x 16 tile) over a warm one, "
+         << "the mean over " << options.cold_call_pairs << " pairs of single calls at each of "
+         << "its mixed points of " << options.cold_call_slots << " slots and " <<
+        [&] {
+            std::string lengths;
+            for (const uint32_t n : options.cold_call_lengths)
+                lengths += (lengths.empty() ? "" : "/") + std::to_string(n);
+            return lengths;
+        }()
+         << " lanes, the median over the lengths; "
+         << "the triangle and sphere tests' one-lane costs by the lane's outcome, the "
          << "medians of their one-lane points that fail, pass and (the triangle test's) fail as "
          << "candidates (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width
          << "+ lanes) few-lane box "

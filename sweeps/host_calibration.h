@@ -93,6 +93,10 @@ struct HostCalibration {
     // end's box test, and the box test's per_op_cycles in the stream loop).
     std::vector<OneRaySample> one_ray_samples;
     SharedOriginSample shared_origin;  // OpCostConfig::shared_origin_per_lane_cycles
+    // A traversal's start cold over warm, per length of cold_traversal_lengths (the box test's
+    // OpCostConfig::cold_call_cycles: run_cold_traversal_microbenchmarks).
+    std::vector<uint32_t> cold_traversal_lengths = {16, 32, 64};
+    std::vector<double> cold_traversal_cycles;
     std::pair<double, double> short_stream_fit_errors{};
     // The same samples as that fit sees them, and what it fitted (for the report's residuals).
     std::vector<OneLaneSample> short_stream_samples;

@@ -19,6 +19,7 @@
 #include "kernels/path.h"
 #include "kernels/stream/stream_filter.h"
 #include "kernels/stream/stream_kernels.h"
+#include "kernels/stream/stream_tracer.h"
 #include "workloads/generators.h"
 
 namespace sfx {
@@ -215,6 +216,32 @@ void set_up_made(Buffers& b, const uint32_t* ids, uint32_t n, bool shadow) {
     }
 }
 
+// What a frame runs between two calls of one filter, for the cold calls: a pass of a 16 x 16
+// tile of the scene through the stream tracer (its traversal and every filter), each time
+// another sample.
+class BetweenCalls {
+  public:
+    BetweenCalls(const Scene& scene, const Bvh& bvh, Isa isa)
+        : m_tracer(scene, bvh, settings(isa)), m_sums(16 * 16) {}
+    void operator()() {
+        RenderStats stats;
+        m_tracer.trace_pass({0, 0, 16, 16}, 0, m_sample++, m_sums.data(), stats, nullptr);
+    }
+
+  private:
+    static RenderSettings settings(Isa isa) {
+        RenderSettings s;
+        s.width = s.height = s.tile = 16;
+        s.spp = 1;
+        s.threads = 1;
+        s.isa = isa;
+        return s;
+    }
+    StreamTracer m_tracer;
+    std::vector<Vec3> m_sums;
+    uint32_t m_sample = 0;
+};
+
 // TSC ticks of an empty timed region (subtracted from every measurement).
 double tsc_overhead() {
     std::vector<double> t;
@@ -227,6 +254,78 @@ double tsc_overhead() {
 }
 
 }  // namespace
+
+double cold_call_difference(const std::vector<double>& cold, const std::vector<double>& warm) {
+    // The TSC steps by tens of cycles on some hosts: one call's time is a multiple of the
+    // step, and only a mean over calls whose start falls anywhere in it resolves less. Pairs
+    // where either call took over four times its median were interrupted and are left out.
+    auto median = [](std::vector<double> v) {
+        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+        return v[v.size() / 2];
+    };
+    if (cold.empty() || cold.size() != warm.size()) return 0.0;
+    const double cold_limit = 4.0 * median(cold), warm_limit = 4.0 * median(warm);
+    double sum = 0.0;
+    uint32_t kept = 0;
+    for (size_t i = 0; i < cold.size(); ++i) {
+        if (cold[i] > cold_limit || warm[i] > warm_limit) continue;
+        sum += cold[i] - warm[i];
+        ++kept;
+    }
+    return kept ? sum / kept : 0.0;
+}
+
+std::vector<double> run_cold_traversal_microbenchmarks(Isa isa,
+                                                       const std::vector<uint32_t>& lengths,
+                                                       uint32_t pairs) {
+    const Scene scene = synthetic_scene();
+    const Bvh bvh(scene);
+    const StreamKernels& kernels = stream_kernels(resolve_isa(isa));
+    const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolve_isa(isa)));
+    BetweenCalls trace_tile(scene, bvh, isa);
+    std::mt19937 rng(13);
+    const uint32_t slots = 256;
+    Buffers b = make_buffers(scene, bvh, slots, rng);
+    TraversalJob job = traversal_job(bvh, b);
+    std::vector<uint32_t> order(slots);
+    std::iota(order.begin(), order.end(), 0u);
+    std::vector<double> out;
+    for (const uint32_t n : lengths) {
+        if (2 * n > slots) continue;
+        std::vector<double> cold, warm;
+        std::vector<uint32_t> streams[2];
+        for (uint32_t pair = 0; pair < pairs; ++pair) {
+            // Two streams of n rays each, in increasing order as the tracer's, other rays each
+            // pair; set up from no hit as the tracer loads them.
+            std::shuffle(order.begin(), order.end(), rng);
+            for (uint32_t j = 0; j < 2; ++j) {
+                streams[j].assign(order.begin() + j * n, order.begin() + (j + 1) * n);
+                std::sort(streams[j].begin(), streams[j].end());
+                streams[j].resize(n + k_stream_padding, 0u);
+                for (uint32_t i = 0; i < n; ++i) {
+                    const uint32_t id = streams[j][i];
+                    b.ray[id] = b.saved_ray[id];
+                    set_up_ray(b.ray[id], b.path[id].kind == RayKind::shadow, id, b.any_hit[id],
+                               b.hit[id], b.pre[id], b.trav);
+                }
+            }
+            trace_tile();
+            // The streams take turns being the cold call's (as the filters' pairs).
+            uint64_t tsc[3];
+            tsc[0] = __rdtsc();
+            for (uint32_t call = 0; call < 2; ++call) {
+                job.ids = streams[(pair + call) % 2].data();
+                job.n = n;
+                kernels.traverse[int(TraceDetail::none)](job);
+                tsc[call + 1] = __rdtsc();
+            }
+            cold.push_back(double(tsc[1] - tsc[0]));
+            warm.push_back(double(tsc[2] - tsc[1]));
+        }
+        out.push_back(cold_call_difference(cold, warm) / ticks_per_cycle);
+    }
+    return out;
+}
 
 bool frame_streams_hold_hits_only(OpKind kind) {
     return stage_of(kind) == OpStage::shading && kind != OpKind::camera &&
@@ -350,6 +449,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                        b.pre[i], b.trav);
         kernels.traverse[int(TraceDetail::none)](before_shading_job);
     };
+    BetweenCalls trace_tile(scene, bvh, options.isa);  // the cold calls' (cold_call_lengths)
     // The triangle test's floor triangle (primitive 0) at its leaf position.
     auto leaf_position = [&](uint32_t prim) {
         return uint32_t(std::find(bvh.prim_ids().begin(), bvh.prim_ids().end(), prim) -
@@ -780,6 +880,48 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                             core_contention().set_aside_if_contended({&times}, set_aside,
                                                                      options.convergence.budget);
                         }
+                        // Cold and warm single calls of a shading op (cold_call_lengths):
+                        // streams 0 and 1 of the last deal, which hold the same mix.
+                        double cold_call = 0.0;
+                        bool cold_timed = false;
+                        if (last_visit && stage_of(kind) == OpStage::shading && !timed.thin_lens &&
+                            !timed.sphere_light && !timed.sphere_hits && dealt == Deal::mixed &&
+                            slots == options.cold_call_slots && inner >= 2 &&
+                            options.cold_call_pairs > 0 &&
+                            std::count(options.cold_call_lengths.begin(),
+                                       options.cold_call_lengths.end(), n) > 0) {
+                            std::vector<double> cold, warm;
+                            std::vector<uint32_t> kept(size_t(2) * stride);
+                            std::copy(streams.begin(), streams.begin() + 2 * stride, kept.begin());
+                            for (uint32_t j = 0; j < 2; ++j)  // in increasing order again
+                                std::sort(kept.begin() + j * stride, kept.begin() + j * stride + n);
+                            for (uint32_t pair = 0; pair < options.cold_call_pairs; ++pair) {
+                                deal_rays(b, deal, true);
+                                std::copy(kept.begin(), kept.end(), streams.begin());
+                                trace_tile();
+                                float touch = 0.f;
+                                for (uint32_t id : order)
+                                    touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
+                                             b.surf[id].position.x + b.path[id].radiance.x +
+                                             b.hit[id].t;
+                                if (touch == 12345.f) b.mask[0] = 1;
+                                // The streams take turns being the cold call's, so that
+                                // what one costs over the other (its rays) cancels.
+                                uint64_t tsc[3];
+                                tsc[0] = __rdtsc();
+                                for (uint32_t call = 0; call < 2; ++call) {
+                                    const uint32_t j = (pair + call) % 2;
+                                    counts_now = material_counts.data() + size_t(j) * materials;
+                                    run_op(b, job, streams.data() + size_t(j) * stride, n,
+                                           box_node);
+                                    tsc[call + 1] = __rdtsc();
+                                }
+                                cold.push_back(double(tsc[1] - tsc[0]));
+                                warm.push_back(double(tsc[2] - tsc[1]));
+                            }
+                            cold_call = cold_call_difference(cold, warm) / ticks_per_cycle;
+                            cold_timed = true;
+                        }
                         if (visited.size() <= point) visited.resize(point + 1);
                         std::vector<double>& cycles = visited[point++];
                         for (const double t : times) cycles.push_back(t / ticks_per_cycle);
@@ -804,7 +946,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                         out.push_back({kind, slots, n, passed, c.fastest, c.converged, c.samples,
                                        timed.thin_lens, timed.sphere_light,
                                        timed.failing_candidates, failed_candidates,
-                                       timed.sphere_hits});
+                                       timed.sphere_hits, cold_call, cold_timed});
                     }
             }
             if (progress) progress(++done, uint32_t(timed_kinds.size()) * visits);

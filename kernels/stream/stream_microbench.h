@@ -65,6 +65,10 @@ struct MicrobenchSample {
     // The emission filter's: timed on hits on spheres; its plain samples on hits on triangles
     // (OpCostConfig::sphere_hit_per_lane_cycles).
     bool sphere_hits = false;
+    // A shading op's: what its call costs cold, as a frame's calls are, over the same call
+    // warm (MicrobenchOptions::cold_call_lengths); timed where cold_call_timed.
+    double cold_call_cycles = 0.0;
+    bool cold_call_timed = false;
     // A variant's samples price only its extra over the plain op (fit_extra_per_passing_lane,
     // fit_extra_per_failed_candidate, fit_extra_per_lane).
     bool variant() const { return thin_lens || sphere_light || failing_candidates || sphere_hits; }
@@ -96,6 +100,16 @@ struct MicrobenchOptions {
     uint32_t visits = 2;
     uint64_t seed = 1;
     std::vector<OpKind> kinds;  // empty: every kind the native tracer has
+    // A frame calls each shading filter once per generation of a tile, the tile's traversal
+    // and the other filters between two calls, where the points above call it `inner` times
+    // back to back (the TSC steps by tens of cycles). So a shading op's mixed points of these
+    // lengths on the buffer of cold_call_slots also time pairs of single calls: the first
+    // right after a pass of a 16 x 16 tile of the synthetic scene through the stream tracer
+    // (and a touch of the buffer: its rays are where the previous filter left them), the
+    // second right after it on other rays of the same mix (OpCostConfig::cold_call_cycles).
+    std::vector<uint32_t> cold_call_lengths = {8, 24, 96};
+    uint32_t cold_call_slots = 256;
+    uint32_t cold_call_pairs = 128;
 };
 
 // Whether a frame's streams of `kind` hold only hits that are not shadow rays: the tracer's
@@ -106,6 +120,20 @@ struct MicrobenchOptions {
 // (an Intel Xeon VM, 2026-11-29: lambertian_direct's 1411 failing rays of 4096, 1252 of them
 // misses; fitted so, its frames were priced 20-25 % under on atrium and temple).
 bool frame_streams_hold_hits_only(OpKind kind);
+
+// A traversal's start cold, as a frame's are (a tile's filters between two), over one right
+// after another: per length of `lengths`, the mean over `pairs` pairs of traversals of that
+// many rays of the synthetic scene from the root (StreamKernels::traverse, trace off), the
+// first right after a pass of a 16 x 16 tile, the second right after it on other rays
+// (cold_call_difference), in core cycles (OpCostConfig::cold_call_cycles of the box test).
+std::vector<double> run_cold_traversal_microbenchmarks(Isa isa,
+                                                       const std::vector<uint32_t>& lengths,
+                                                       uint32_t pairs);
+
+// A cold call's cost over a warm one from pairs of single calls (MicrobenchOptions::
+// cold_call_lengths), in the samples' unit: the mean difference over the pairs neither of
+// whose calls took over four times its median (an interrupt); 0 without pairs.
+double cold_call_difference(const std::vector<double>& cold, const std::vector<double>& warm);
 
 // Every op kind the native tracer has, at every (buffer, length <= buffer; a hits-only kind's
 // mixed streams no longer than its hits can fill). `progress(done, total)` is called after

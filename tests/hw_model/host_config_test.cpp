@@ -418,6 +418,11 @@ TEST_CASE("An emission lane pays a sphere hit's difference in the share of spher
             {lanes, 0, 0.0, measured_op_cycles(emission, 8, lanes, 0, 0.0) - 24.0 * lanes});
     CHECK(fit_extra_per_lane(emission, 8, on_sphere_hits) == Approx(-24));
     CHECK(fit_extra_per_lane(emission, 8, {}) == 0.0);
+    // A cold call's extra: the median over its lengths, never negative.
+    CHECK(fit_cold_call_cycles({60, -400, 80}) == Approx(60));
+    CHECK(fit_cold_call_cycles({60, 90}) == Approx(75));
+    CHECK(fit_cold_call_cycles({-10, -5, 3}) == 0.0);
+    CHECK(fit_cold_call_cycles({}) == 0.0);
     // A host file keeps the sign.
     const HwConfig parsed = parse_hw_config(host_hw_yaml(small_host(), {emission}, "e"), "e.yaml");
     REQUIRE(parsed.op_costs.size() == 1);
@@ -668,10 +673,11 @@ TEST_CASE("The box test a traversal starts with carries the traversal's start co
     // In the machine model: two traversals of a 16-lane stream, each a box test at its entry and
     // one below it; each pays the start once, on its first op, and the first traversal's rays
     // share one origin: it pays the check of that per lane after the first.
-    auto time_traversals = [](double start, double shared_origin = 0.0) {
+    auto time_traversals = [](double start, double shared_origin = 0.0, double cold = 0.0) {
         OpCostConfig box = cost("box_test", 10, 4, 0, 0, 0);
         box.traversal_start_cycles = start;
         box.shared_origin_per_lane_cycles = shared_origin;
+        box.cold_call_cycles = cold;
         SystemcTiming timing({host_with({box})}, shape());
         std::vector<uint32_t> ids(16);
         std::iota(ids.begin(), ids.end(), 0u);
@@ -697,6 +703,8 @@ TEST_CASE("The box test a traversal starts with carries the traversal's start co
     };
     CHECK(time_traversals(70) == time_traversals(0) + 2 * 70);
     CHECK(time_traversals(70, 2) == time_traversals(70) + 15 * 2);
+    // A traversal's start cold (the box test's cold call): once a traversal too.
+    CHECK(time_traversals(70, 0, 40) == time_traversals(70) + 2 * 40);
 }
 
 TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
@@ -928,6 +936,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.one_ray_entry_cycles = 8;
     box.few_ray_entry_cycles = 9.5;
     box.traversal_start_cycles = 41.25;
+    box.cold_call_cycles = 77.5;
     box.node_read_exposed_share = 0.375;
     HostDescription host = small_host();
     host.slot_arrays = 7;
@@ -985,6 +994,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].one_ray_entry_cycles == Approx(8));
     CHECK(c.op_costs[0].few_ray_entry_cycles == Approx(9.5));
     CHECK(c.op_costs[0].traversal_start_cycles == Approx(41.25));
+    CHECK(c.op_costs[0].cold_call_cycles == Approx(77.5));
     CHECK(c.op_costs[0].node_read_exposed_share == Approx(0.375));
     CHECK(c.branch_predictor.kind == "tage");
     CHECK(c.branch_predictor.mispredict_cycles == Approx(61.5));
@@ -1279,6 +1289,37 @@ TEST_CASE("A CPU core's material filters after a generation's first cost nothing
         // ... the second is placed by the sort and adds nothing.
         CHECK(timed(ops(true, true)) == timed(ops(true, false)));
     }
+}
+
+TEST_CASE(
+    "Both timing models charge a shading filter's call cold once, none to a material filter "
+    "the sort placed",
+    "[host][systemc]") {
+    auto host = [](double cold) {
+        std::vector<OpCostConfig> costs = {cost("material_filter", 10, 4, 1, 0, 0),
+                                           cost("lambertian_choice", 10, 4, 1, 0, 0),
+                                           cost("depth_filter", 10, 4, 1, 0, 0)};
+        for (OpCostConfig& c : costs) c.cold_call_cycles = cold;
+        return host_with(costs);
+    };
+    std::vector<uint32_t> ids(16);
+    for (uint32_t i = 0; i < 16; ++i) ids[i] = i;
+    const std::vector<uint8_t> all(16, 1), half = {1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+    // The depth filter, a stack's op and a material filter after it (placed by the sort), none
+    // of which reads the scene (a material filter after the depth filter waits for its
+    // material's record, which can hide what the ops before it took).
+    const std::vector<StreamOp> ops = {
+        {OpKind::depth_filter, OpStage::shading, 0, k_no_object, 16, 16, ids.data(), all.data()},
+        {OpKind::lambertian_choice, OpStage::shading, 0, k_no_object, 16, 8, ids.data(),
+         half.data()},
+        {OpKind::material_filter, OpStage::shading, 0, 1, 8, 4, ids.data() + 8, half.data()}};
+    CHECK(cycle_level_cycles(host(50), ops) == cycle_level_cycles(host(0), ops) + 2 * 50);
+    CHECK(closed_form_cycles(host(50), ops) == closed_form_cycles(host(0), ops) + 2 * 50);
+    OpProfile p;
+    p.cost.cold_call_cycles = 50;
+    CHECK(p.cold_call_cycles() == 0);  // instruction-priced: no cold call
+    p.measured = true;
+    CHECK(p.cold_call_cycles() == 50);
 }
 
 TEST_CASE("Both timing models price a triangle op's failed candidates", "[host][systemc]") {

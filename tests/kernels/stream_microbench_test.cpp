@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <set>
@@ -344,4 +345,55 @@ TEST_CASE("The shared-origin check is timed per lane over a tile's records", "[s
     CHECK(s.per_lane_cycles > 0.3);
     CHECK(s.per_lane_cycles < 60.0);
     CHECK(s.repetitions >= microbench_rule().min_samples);
+}
+
+TEST_CASE("A cold call's cost over a warm one resolves below the TSC's step", "[stream][host]") {
+    // A TSC that steps by 36 ticks: calls of 100 and 150 ticks, starting anywhere in a step,
+    // read as multiples of 36; over many pairs the mean difference is the true 50. One pair
+    // interrupted (a cold call 40 times its median) is left out.
+    std::vector<double> cold, warm;
+    for (int i = 0; i < 360; ++i) {
+        const double phase = double(i % 36);
+        auto read = [&](double start, double length) {
+            return std::floor((start + length) / 36.0) * 36.0 - std::floor(start / 36.0) * 36.0;
+        };
+        cold.push_back(read(phase, 150.0));
+        warm.push_back(read(phase + 150.0, 100.0));
+    }
+    CHECK(cold_call_difference(cold, warm) == Approx(50.0).margin(1.0));
+    cold[7] = 40 * 150.0;
+    CHECK(cold_call_difference(cold, warm) == Approx(50.0).margin(1.0));
+    CHECK(cold_call_difference({}, {}) == 0.0);
+}
+
+TEST_CASE("A shading op's mixed points of the cold lengths time its call cold and warm",
+          "[stream][host]") {
+    MicrobenchOptions o;
+    o.buffer_slots = {64, 256};
+    o.lengths = {8, 16, 24};
+    o.cold_call_lengths = {8, 24};
+    o.cold_call_pairs = 8;
+    o.kinds = {OpKind::box_test, OpKind::miss_filter};
+    o.convergence = microbench_rule(3);
+    o.visits = 1;
+    uint32_t timed = 0;
+    for (const MicrobenchSample& m : run_stream_microbenchmarks(o)) {
+        INFO(to_string(m.kind) << " " << m.slots << " slots, " << m.lanes << " lanes, " << m.passed
+                               << " passed");
+        // Only the miss filter's mixed points (passing some lanes and failing others) of the
+        // buffer of 256 slots at 8 and 24 lanes; a traversal's start has its own.
+        const bool mixed = m.passed > 0 && m.passed < m.lanes;
+        const bool expected = m.kind == OpKind::miss_filter && m.slots == 256 && mixed &&
+                              (m.lanes == 8 || m.lanes == 24);
+        CHECK(m.cold_call_timed == expected);
+        timed += m.cold_call_timed;
+        if (!m.cold_call_timed) CHECK(m.cold_call_cycles == 0.0);
+    }
+    CHECK(timed == 2);
+    // One value a length, of traversals from the root; a length two streams of which do not
+    // fit the buffer is left out.
+    const std::vector<double> traversal =
+        run_cold_traversal_microbenchmarks(Isa::automatic, {16, 32, 512}, 4);
+    CHECK(traversal.size() == 2);
+    for (const double d : traversal) CHECK(std::isfinite(d));
 }
