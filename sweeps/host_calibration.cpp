@@ -451,7 +451,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             o.shared_origin_per_lane_cycles = c.shared_origin.per_lane_cycles;
     // A traversal's start cold, as a frame's (its box test that starts it carries it).
     c.cold_traversal_cycles =
-        run_cold_traversal_microbenchmarks(resolved, c.cold_traversal_lengths, 128);
+        run_cold_traversal_microbenchmarks(resolved, c.cold_traversal_lengths, 512);
     for (OpCostConfig& o : c.op_costs)
         if (op_kind_named(o.op) == OpKind::box_test)
             o.cold_call_cycles = fit_cold_call_cycles(c.cold_traversal_cycles);

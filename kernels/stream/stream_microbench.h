@@ -109,7 +109,7 @@ struct MicrobenchOptions {
     // second right after it on other rays of the same mix (OpCostConfig::cold_call_cycles).
     std::vector<uint32_t> cold_call_lengths = {8, 24, 96};
     uint32_t cold_call_slots = 256;
-    uint32_t cold_call_pairs = 128;
+    uint32_t cold_call_pairs = 512;
 };
 
 // Whether a frame's streams of `kind` hold only hits that are not shadow rays: the tracer's
