@@ -626,16 +626,24 @@ struct OpCostConfig {
     // lane on cornell, about 19 cycles each; unpriced, about 3 % of its filter, the rest of the
     // miss unexplained).
     double sphere_hit_per_lane_cycles = 0.0;
-    // A shading op's: what a call costs cold, as a frame calls it (once per generation of a
-    // tile, the tile's traversal and the other filters between two calls), over the same call
-    // right after another (its microbenchmark points call it back to back), on the op's first
-    // group. Timed by its microbenchmark (MicrobenchOptions::cold_call_lengths): the mean over
-    // pairs of single calls, the first after a pass of a 16 x 16 tile, the median over the
-    // lengths. Why: on an AMD Zen 5 VM (2026-12-05, docs/silicon-check-amd-1ah-02h-avx512.md)
-    // cornell's and furnace's shading stage was priced about 80 cycles an op further under at
-    // tile 16 than at 32 on every back end (cornell 128 x 128 AVX2: 1314 K cycles under with
-    // 3275 ops, 1118 K with 921), and the tile ranking failed on such pairs; that host's
-    // filters took 40-140 cycles more cold than warm (AVX2). 0: not measured.
+    // What a call costs cold, as a frame makes it (a shading filter once per generation of a
+    // tile, the tile's traversal and the other filters between two calls; a traversal after a
+    // generation's filters), over the same call right after another (the microbenchmark points
+    // call an op back to back), on the op's first group: a shading op's every call (none to a
+    // material filter the sort placed) and the box test's where it starts a traversal (the
+    // cycle-level model only, as traversal_start_cycles). Timed, never fitted on frames: pairs
+    // of single calls, the first after a pass of a 16 x 16 tile, the mean difference, the
+    // median over a few lengths (MicrobenchOptions::cold_call_lengths,
+    // run_cold_traversal_microbenchmarks). Why: on an AMD Zen 5 VM (2026-12-05,
+    // docs/silicon-check-amd-1ah-02h-avx512.md) cornell's and furnace's shading was priced
+    // about 80 cycles an op further under at tile 16 than at 32 on every back end (cornell
+    // 128 x 128 AVX2: 1314 K cycles under with 3275 ops, 1118 K with 921) and furnace's
+    // traversal 27-29 % under at tile 16 against 10-13 % at 32 and 64, and the tile ranking
+    // failed on such pairs. That host's shading calls took 0-195 cycles more cold (the depth
+    // filter's least), a traversal's start 118 / 59 / 68 (scalar / AVX2 / AVX-512); priced so,
+    // furnace's traversal at tile 16 came to 10-18 % under, the shading MAE from 11.8 / 11.0 /
+    // 12.6 % to 11.5 / 10.4 / 9.8 %, and every cornell cell's tiles ranked right.
+    // 0: not measured.
     double cold_call_cycles = 0.0;
 
     template <class V>
