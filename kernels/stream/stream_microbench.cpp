@@ -205,6 +205,16 @@ void deal_rays(Buffers& b, const std::vector<uint32_t>& deal, bool hits) {
     }
 }
 
+// Reads every slot of `order` (each of its arrays a shading op reads), so that the caches hold
+// what a pass over the buffer leaves in them.
+void touch_slots(Buffers& b, const std::vector<uint32_t>& order) {
+    float touch = 0.f;
+    for (uint32_t id : order)
+        touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) + b.surf[id].position.x +
+                 b.path[id].radiance.x + b.hit[id].t;
+    if (touch == 12345.f) b.mask[0] = 1;  // keeps the reads
+}
+
 // The rays an op made, ids[0, n) (the passing lanes, first after its partition), set up for the
 // next generation's traversal in a loop of their own after the op, as the tracer's load_rays
 // does (stream_tracer.cpp): a frame never sets a ray up in the loop that made it.
@@ -844,12 +854,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 }
                                 std::sort(stream, stream + n);
                             }
-                            float touch = 0.f;
-                            for (uint32_t id : order)
-                                touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
-                                         b.surf[id].position.x + b.path[id].radiance.x +
-                                         b.hit[id].t;
-                            if (touch == 12345.f) b.mask[0] = 1;
+                            touch_slots(b, order);
 
                             material_counts.resize(size_t(inner) * materials);
                             if (kind == OpKind::material_filter)
@@ -899,12 +904,7 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 deal_rays(b, deal, true);
                                 std::copy(kept.begin(), kept.end(), streams.begin());
                                 trace_tile();
-                                float touch = 0.f;
-                                for (uint32_t id : order)
-                                    touch += b.ray[id].org.x + b.next[id].org.x + b.trav.t(id) +
-                                             b.surf[id].position.x + b.path[id].radiance.x +
-                                             b.hit[id].t;
-                                if (touch == 12345.f) b.mask[0] = 1;
+                                touch_slots(b, order);
                                 // The streams take turns being the cold call's, so that
                                 // what one costs over the other (its rays) cancels.
                                 uint64_t tsc[3];
