@@ -727,9 +727,9 @@ struct OpCostConfig {
                 "triangle, negative where it saves (0: not measured)",
                 -1e9, 1e9);
         v.param("cold_call_cycles", cold_call_cycles, "cycles",
-                "a shading op's: what a call costs cold (other filters and a traversal since "
-                "its last) over a call right after another, on its first group (0: not "
-                "measured)",
+                "what a call costs cold (other filters and a traversal since its last) over a "
+                "call right after another, on its first group: a shading op's every call, the "
+                "box test's where it starts a traversal (0: not measured)",
                 0.0, 1e9);
     }
 };

@@ -450,8 +450,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         if (op_kind_named(o.op) == OpKind::box_test)
             o.shared_origin_per_lane_cycles = c.shared_origin.per_lane_cycles;
     // A traversal's start cold, as a frame's (its box test that starts it carries it).
-    c.cold_traversal_cycles =
-        run_cold_traversal_microbenchmarks(resolved, c.cold_traversal_lengths, 512);
+    c.cold_traversal_cycles = run_cold_traversal_microbenchmarks(resolved, c.cold_traversal_lengths,
+                                                                 options.cold_call_pairs);
     for (OpCostConfig& o : c.op_costs)
         if (op_kind_named(o.op) == OpKind::box_test)
             o.cold_call_cycles = fit_cold_call_cycles(c.cold_traversal_cycles);
@@ -506,6 +506,11 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     for (OpCostConfig& cost : c.op_costs)
         if (op_kind_named(cost.op) == OpKind::box_test)
             cost.node_read_exposed_share = c.node_read_fit.share;
+    auto slash_joined = [](const std::vector<uint32_t>& values) {
+        std::string joined;
+        for (const uint32_t v : values) joined += (joined.empty() ? "" : "/") + std::to_string(v);
+        return joined;
+    };
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
@@ -522,14 +527,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << " points converged; kernels/stream/stream_microbench.h), least squares on relative "
          << "error; a shading op's cold call (after a pass of a 16 x 16 tile) over a warm one, "
          << "the mean over " << options.cold_call_pairs << " pairs of single calls at each of "
-         << "its mixed points of " << options.cold_call_slots << " slots and " <<
-        [&] {
-            std::string lengths;
-            for (const uint32_t n : options.cold_call_lengths)
-                lengths += (lengths.empty() ? "" : "/") + std::to_string(n);
-            return lengths;
-        }()
-         << " lanes, the median over the lengths; "
+         << "its mixed points of " << options.cold_call_slots << " slots and "
+         << slash_joined(options.cold_call_lengths)
+         << " lanes, the median over the lengths, and a traversal's start likewise on streams of "
+         << slash_joined(c.cold_traversal_lengths) << " rays; "
          << "the triangle and sphere tests' one-lane costs by the lane's outcome, the "
          << "medians of their one-lane points that fail, pass and (the triangle test's) fail as "
          << "candidates (the one-ray loop's leaf code); one-lane and (" << k_few_ray_min_width

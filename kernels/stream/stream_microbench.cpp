@@ -252,6 +252,22 @@ class BetweenCalls {
     uint32_t m_sample = 0;
 };
 
+// One pair of single calls for cold_call_difference, in TSC ticks: `call(j)` on stream j, the
+// streams taking turns pair by pair being the cold call's, so that what one costs over the
+// other (its rays) cancels.
+template <class Call>
+void time_cold_then_warm(uint32_t pair, Call&& call, std::vector<double>& cold,
+                         std::vector<double>& warm) {
+    uint64_t tsc[3];
+    tsc[0] = __rdtsc();
+    for (uint32_t turn = 0; turn < 2; ++turn) {
+        call((pair + turn) % 2);
+        tsc[turn + 1] = __rdtsc();
+    }
+    cold.push_back(double(tsc[1] - tsc[0]));
+    warm.push_back(double(tsc[2] - tsc[1]));
+}
+
 // TSC ticks of an empty timed region (subtracted from every measurement).
 double tsc_overhead() {
     std::vector<double> t;
@@ -269,10 +285,6 @@ double cold_call_difference(const std::vector<double>& cold, const std::vector<d
     // The TSC steps by tens of cycles on some hosts: one call's time is a multiple of the
     // step, and only a mean over calls whose start falls anywhere in it resolves less. Pairs
     // where either call took over four times its median were interrupted and are left out.
-    auto median = [](std::vector<double> v) {
-        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-        return v[v.size() / 2];
-    };
     if (cold.empty() || cold.size() != warm.size()) return 0.0;
     const double cold_limit = 4.0 * median(cold), warm_limit = 4.0 * median(warm);
     double sum = 0.0;
@@ -320,17 +332,14 @@ std::vector<double> run_cold_traversal_microbenchmarks(Isa isa,
                 }
             }
             trace_tile();
-            // The streams take turns being the cold call's (as the filters' pairs).
-            uint64_t tsc[3];
-            tsc[0] = __rdtsc();
-            for (uint32_t call = 0; call < 2; ++call) {
-                job.ids = streams[(pair + call) % 2].data();
-                job.n = n;
-                kernels.traverse[int(TraceDetail::none)](job);
-                tsc[call + 1] = __rdtsc();
-            }
-            cold.push_back(double(tsc[1] - tsc[0]));
-            warm.push_back(double(tsc[2] - tsc[1]));
+            time_cold_then_warm(
+                pair,
+                [&](uint32_t j) {
+                    job.ids = streams[j].data();
+                    job.n = n;
+                    kernels.traverse[int(TraceDetail::none)](job);
+                },
+                cold, warm);
         }
         out.push_back(cold_call_difference(cold, warm) / ticks_per_cycle);
     }
@@ -905,19 +914,14 @@ std::vector<MicrobenchSample> run_stream_microbenchmarks(
                                 std::copy(kept.begin(), kept.end(), streams.begin());
                                 trace_tile();
                                 touch_slots(b, order);
-                                // The streams take turns being the cold call's, so that
-                                // what one costs over the other (its rays) cancels.
-                                uint64_t tsc[3];
-                                tsc[0] = __rdtsc();
-                                for (uint32_t call = 0; call < 2; ++call) {
-                                    const uint32_t j = (pair + call) % 2;
-                                    counts_now = material_counts.data() + size_t(j) * materials;
-                                    run_op(b, job, streams.data() + size_t(j) * stride, n,
-                                           box_node);
-                                    tsc[call + 1] = __rdtsc();
-                                }
-                                cold.push_back(double(tsc[1] - tsc[0]));
-                                warm.push_back(double(tsc[2] - tsc[1]));
+                                time_cold_then_warm(
+                                    pair,
+                                    [&](uint32_t j) {
+                                        counts_now = material_counts.data() + size_t(j) * materials;
+                                        run_op(b, job, streams.data() + size_t(j) * stride, n,
+                                               box_node);
+                                    },
+                                    cold, warm);
                             }
                             cold_call = cold_call_difference(cold, warm) / ticks_per_cycle;
                             cold_timed = true;
