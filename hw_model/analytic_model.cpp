@@ -269,7 +269,13 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         // (lanes_opening_pages), here as expected of a stream of `length` random slots.
         const OpStage op_stage = stage_of(kind);
         const double beyond_l1 =
-            slots_beyond_l1(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()), op_stage);
+            slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()), op_stage);
+        // Beyond the L2 behind it too (the scene memory's second level).
+        const double beyond_l2 =
+            c.scene_memory.caches.size() > 1
+                ? slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()),
+                                     op_stage, c.scene_memory.caches[1].kib)
+                : 0.0;
         const double opening_share =
             beyond_l1 > 0
                 ? expected_lanes_opening_pages(
@@ -295,7 +301,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                 p.issue_cycles(c.datapath, length,
                                uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
                                passing, g == 0, beyond_l1 * opening_share,
-                               double(bucket.failed_candidates) / ops) +
+                               beyond_l2 * opening_share, double(bucket.failed_candidates) / ops) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
                 (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);

@@ -121,11 +121,12 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
         lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));
     const uint32_t page_bytes = lane_page_bytes_of(m_config.ray_buffer, m_record_bytes, op.stage);
     // A lane pays for its ray data beyond the L1D (beyond_l1_per_lane_cycles) where the caches
-    // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays (the
+    // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays, and
+    // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
     // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes; a slot's
     // arrays: lane_page_bytes); counted per group. The fit expects the same of its microbenchmarks
-    // (beyond_l1_share). A slot's traversal record: what a box or leaf test reads, and a made ray's
-    // set-up writes.
+    // (beyond_cache_share). A slot's traversal record: what a box or leaf test reads, and a made
+    // ray's set-up writes.
     const auto record_address = [](uint32_t slot) {
         return k_records + uint64_t(slot) * k_traversal_record_bytes;
     };
@@ -133,7 +134,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     m_group_beyond_offset[index] = m_group_beyond_lanes.size();
     uint64_t last = ~uint64_t(0);  // the line touched last
     for (uint32_t i = 0; i < op.length; ++i) {
-        if (i % n == 0) m_group_beyond_lanes.push_back(0);
+        if (i % n == 0) m_group_beyond_lanes.push_back({});
         const uint64_t address =
             record ? record_address(op.slots[i]) : k_slots + op.slots[i] * bytes;
         const uint64_t first_line = address / k_line, last_line = (address + bytes - 1) / k_line;
@@ -143,7 +144,10 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
                 ? m_scene_memory->touch_other(m_core, from * k_line,
                                               uint32_t((last_line - from + 1) * k_line), now)
                 : 0;
-        if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) ++m_group_beyond_lanes.back();
+        if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) {
+            ++m_group_beyond_lanes.back().l1;
+            m_group_beyond_lanes.back().l2 += level > 1;
+        }
         last = last_line;
     }
     // A ray an op makes is set up for the next traversal with the op (its cost holds the
@@ -393,19 +397,21 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
     uint32_t passed = 0;
     if (p.measured)
         for (uint32_t i = 0; i < t.lanes; ++i) passed += op.passed[t.first + i];
-    // The share of its lanes that pay for ray data beyond the L1D (touch_ray_lines).
-    const double beyond_l1 =
+    // The shares of its lanes that pay for ray data beyond the L1D and beyond the L2
+    // (touch_ray_lines).
+    const BeyondLanes beyond =
         m_group_beyond_offset[t.op] != k_none && t.lanes > 0
-            ? double(m_group_beyond_lanes[m_group_beyond_offset[t.op] + t.first / width()]) /
-                  double(t.lanes)
-            : 0.0;
+            ? m_group_beyond_lanes[m_group_beyond_offset[t.op] + t.first / width()]
+            : BeyondLanes{};
+    const double group_lanes = std::max(1u, t.lanes);
     // Fractional measured cycles: the unit carries the remainder to its next group.
     const double exact =
         m_unit_carry[unit] +
         (m_placed_by_sort[t.op]
              ? 0.0
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
-                              passed, t.first == 0, beyond_l1, op.failed_candidates)) +
+                              passed, t.first == 0, beyond.l1 / group_lanes,
+                              beyond.l2 / group_lanes, op.failed_candidates)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
         // A call cold: a shading filter's (the material sort's once, on its first filter) and a

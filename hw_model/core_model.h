@@ -135,9 +135,12 @@ class CoreModel {
     std::vector<uint64_t> m_group_lane_stall;
     // Per op whose ray lines a CPU core reads (touch_ray_lines): where its groups' entries start
     // in m_group_beyond_lanes (k_none otherwise); per such group, its lanes that pay for ray data
-    // beyond the L1D.
+    // beyond the L1D, and of them those beyond the L2 too.
+    struct BeyondLanes {
+        uint32_t l1 = 0, l2 = 0;
+    };
     std::vector<size_t> m_group_beyond_offset;
-    std::vector<uint32_t> m_group_beyond_lanes;
+    std::vector<BeyondLanes> m_group_beyond_lanes;
     static constexpr size_t k_none = ~size_t(0);
     // When the scene data a group waits for (its op's, its lanes') has arrived.
     uint64_t scene_ready(const GroupToken& t) const;

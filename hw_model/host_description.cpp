@@ -662,6 +662,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", per_fail_cycles: " << fmt(o.per_fail_cycles, 2)
               << ", per_minority_lane_cycles: " << fmt(o.per_minority_lane_cycles, 2)
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
+              << ", beyond_l2_per_lane_cycles: " << fmt(o.beyond_l2_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
               << (o.one_lane_pass_cycles > 0
                       ? ", one_lane_pass_cycles: " + fmt(o.one_lane_pass_cycles, 2)

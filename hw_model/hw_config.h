@@ -463,10 +463,12 @@ struct BranchPredictorConfig {
 // b of its lanes paying for ray data beyond the L1D (their line not in it, and their slot in
 // another 4 KiB page of the array the op reads than the lane before it's: the prefetchers
 // cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
-// hw_model/ray_buffer_model.h beyond_l1_share), and c failing lanes that ran its full test
-// (a triangle test's failed candidates, StreamOp::failed_candidates), costs
+// hw_model/ray_buffer_model.h beyond_cache_share), b2 of them beyond the L2 as well (the same
+// with the L2's size), and c failing lanes that ran its full test (a triangle test's failed
+// candidates, StreamOp::failed_candidates), costs
 //   per_op + per_group * g + per_lane * n + per_pass * p + per_fail * (n - p)
-//   + per_minority_lane * m + beyond_l1_per_lane * b + per_failed_candidate * c cycles
+//   + per_minority_lane * m + beyond_l1_per_lane * b + beyond_l2_per_lane * b2
+//   + per_failed_candidate * c cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
 // predictor's misses, m = mispredicted_lanes in hw_model/op_costs.h: on outcomes in no order
 // the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
@@ -502,6 +504,14 @@ struct OpCostConfig {
     double per_fail_cycles = 0.0;
     double per_minority_lane_cycles = 0.0;
     double beyond_l1_per_lane_cycles = 0.0;
+    // What such a lane adds where its line is beyond the L2 too: fitted with the rest on the
+    // microbenchmarks' 64 x 64 buffers (4096 slots, 1.35 MB: a quarter beyond a 1 MB L2; their
+    // 32 x 32 ones fit in it). One term for both levels priced a 32-pixel tile's lanes (in the
+    // L2) as dear as a 64-pixel tile's (partly in the L3): on an AMD Zen 5 VM (2026-12-05, AVX2,
+    // 200-1024 lanes) a passing direct-light lane cost 218-219 cycles over 256 and 1024 slots
+    // and 259-290 over 4096, the miss filter's 4.9-5.2 against 6.4-7.7, and the model ranked
+    // furnace's tile 64 ahead of 32 where the host ran it 1-4 % slower. 0: not measured.
+    double beyond_l2_per_lane_cycles = 0.0;
     // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
     // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
     // microbenchmark's failing lanes are (its rays start from no hit: nearly every candidate
@@ -668,6 +678,10 @@ struct OpCostConfig {
         v.param("beyond_l1_per_lane_cycles", beyond_l1_per_lane_cycles, "cycles",
                 "extra cost per lane when the ray buffer is wholly beyond the L1D (scaled by "
                 "the fraction beyond)",
+                0.0, 1e9);
+        v.param("beyond_l2_per_lane_cycles", beyond_l2_per_lane_cycles, "cycles",
+                "what a lane beyond the L1D adds where its ray data is beyond the L2 too (0: not "
+                "measured)",
                 0.0, 1e9);
         v.param("per_failed_candidate_cycles", per_failed_candidate_cycles, "cycles",
                 "the triangle test's: extra cost per failing lane that ran the full test (a "

@@ -88,9 +88,9 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, cons
     return partition_cost(config, width, length, stable_partition_moves(passed, length));
 }
 
-double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib) {
+double beyond_cache_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t cache_kib) {
     const double bytes = double(slots) * slot_bytes;
-    return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(l1d_kib) * 1024.0 / bytes);
+    return bytes <= 0 ? 0.0 : std::max(0.0, 1.0 - double(cache_kib) * 1024.0 / bytes);
 }
 
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
@@ -131,10 +131,10 @@ uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_array
     return std::max(1u, bytes / slot_arrays);
 }
 
-double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
-                       uint32_t l1d_kib) {
+double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                          uint32_t cache_kib) {
     if (lanes == 0) return 0.0;
-    return beyond_l1_fraction(slots, slot_bytes, l1d_kib) *
+    return beyond_cache_fraction(slots, slot_bytes, cache_kib) *
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
@@ -146,11 +146,11 @@ uint32_t lane_page_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes
     return lane_page_bytes(stage, slot_bytes_of(buffer, record_bytes), buffer.slot_arrays);
 }
 
-double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
-                       OpStage stage) {
+double slots_beyond_cache(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
+                          OpStage stage, uint32_t cache_kib) {
     if (buffer.storage != "l1d") return 0.0;
-    return beyond_l1_fraction(slots, lane_ray_bytes(stage, slot_bytes_of(buffer, record_bytes)),
-                              buffer.kib);
+    return beyond_cache_fraction(slots, lane_ray_bytes(stage, slot_bytes_of(buffer, record_bytes)),
+                                 cache_kib ? cache_kib : buffer.kib);
 }
 
 }  // namespace sfx

@@ -113,8 +113,9 @@ PartitionCost partition_cost(const PartitionConfig& config, uint32_t width, uint
 uint32_t stable_partition_moves(const uint8_t* passed, uint32_t length);
 
 // Ray buffers in a CPU core's L1D (storage l1d): the share of `slots` slots of `slot_bytes`
-// that an L1D of `l1d_kib` cannot hold; a random lane misses it with that probability.
-double beyond_l1_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t l1d_kib);
+// that a cache of `cache_kib` (the L1D, or the L2 behind it) cannot hold; a random lane misses
+// it with that probability.
+double beyond_cache_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t cache_kib);
 // The hardware prefetchers follow a stream of ascending loads within a 4 KiB page and stop
 // at its end ("Does not prefetch across 4K boundary": Intel's Optimization Reference Manual,
 // the streamer; AMD's guides say only that theirs fetch lines in ascending or descending
@@ -157,25 +158,27 @@ uint32_t lane_ray_bytes(OpStage stage, uint32_t slot_bytes);
 // streams paid a sparse lane's cost at every 15th lane: cornell's shading at tile 32 came out
 // 3-4 % over tile 16's where the host ran it no dearer, and its tile ranking upside down.
 uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_arrays);
-// A random stream's share of lanes that pay for ray data beyond the L1D, as the op costs' fit
+// A random stream's share of lanes that pay for ray data beyond the L1D (or, with the L2's
+// `cache_kib`, beyond the L2 as well), as the op costs' fit
 // prices its microbenchmarks: those opening a page of an array of `lane_bytes` a slot the op
-// reads (lane_page_bytes; expected), times beyond_l1_fraction of the whole slots (`slot_bytes`: the
-// microbenchmarks read every array of the buffer before they time, so the L1D holds a share of
+// reads (lane_page_bytes; expected), times beyond_cache_fraction of the whole slots (`slot_bytes`:
+// the microbenchmarks read every array of the buffer before they time, so the L1D holds a share of
 // each). The cycle level asks its caches instead (CoreModel::touch_ray_lines). On this
 // project's AMD host (2026-11-28) the dense streams of a frame paid nearly none of what its
-// sparse microbenchmark streams did: priced by beyond_l1_fraction alone, cornell's 64 x 64
+// sparse microbenchmark streams did: priced by beyond_cache_fraction alone, cornell's 64 x 64
 // frames came out 7-15 % over the measured.
-double beyond_l1_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
-                       uint32_t l1d_kib);
+double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                          uint32_t cache_kib);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);
 // lane_page_bytes of a configuration's buffer (slot_bytes_of, ray_buffer.slot_arrays).
 uint32_t lane_page_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes, OpStage stage);
 // The closed form's share of a pass's `slots` slots beyond an l1d buffer for an op of `stage`:
-// beyond_l1_fraction of the array it reads (lane_ray_bytes of slot_bytes_of), as if that array
-// alone filled the L1D; 0 for banked buffers.
-double slots_beyond_l1(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
-                       OpStage stage);
+// beyond_cache_fraction of the array it reads (lane_ray_bytes of slot_bytes_of), as if that array
+// alone filled the L1D (or, given `cache_kib`, that cache: the L2 behind it); 0 for banked
+// buffers.
+double slots_beyond_cache(const RayBufferConfig& buffer, uint32_t record_bytes, uint32_t slots,
+                          OpStage stage, uint32_t cache_kib = 0);
 
 }  // namespace sfx

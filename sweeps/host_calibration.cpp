@@ -51,9 +51,24 @@ bool one_lane_from_filters(OpKind kind) {
 
 }  // namespace
 
+LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slots,
+                                      const std::vector<HostCacheLevel>& caches) {
+    const uint32_t lane_bytes =
+        lane_page_bytes(stage_of(kind), stream_slot_bytes(), stream_slot_arrays());
+    auto beyond = [&](size_t level) {
+        return level < caches.size() ? beyond_cache_share(lanes, slots, stream_slot_bytes(),
+                                                          lane_bytes, caches[level].kib)
+                                     : 0.0;
+    };
+    return {caches.empty() ? beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, 32)
+                           : beyond(0),
+            beyond(1)};
+}
+
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
-                                                    uint32_t width, uint32_t l1d_kib,
+                                                    uint32_t width,
+                                                    const std::vector<HostCacheLevel>& caches,
                                                     const BranchPredictorConfig& predictor) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
@@ -92,16 +107,13 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                 priced.per_op_cycles = 0.0;
                 sample.stream_ops[size_t(o.kind)] += o.count;
             }
+            const LanesBeyondCaches beyond = lanes_beyond_caches(o.kind, o.lanes, s.slots, caches);
             (o.kind == OpKind::box_test ? sample.stream_op_cycles : sample.leaf_op_cycles) +=
                 double(o.count) *
-                measured_op_cycles(
-                    priced, width, o.lanes,
-                    uint32_t(std::lround(double(o.passed) / double(o.count))),
-                    beyond_l1_share(o.lanes, s.slots, stream_slot_bytes(),
-                                    lane_page_bytes(stage_of(o.kind), stream_slot_bytes(),
-                                                    stream_slot_arrays()),
-                                    l1d_kib),
-                    double(o.failed_candidates) / double(o.count));
+                measured_op_cycles(priced, width, o.lanes,
+                                   uint32_t(std::lround(double(o.passed) / double(o.count))),
+                                   beyond.l1, beyond.l2,
+                                   double(o.failed_candidates) / double(o.count));
         }
         sample.stream_op_cycles += sample.leaf_op_cycles;
         out.push_back(sample);
@@ -340,7 +352,6 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.rates = run_gather_compress_microbenchmarks(resolved, convergence.budget);
     for (const MicrobenchSample& s : c.samples) c.converged_points += s.converged;
     c.points = uint32_t(c.samples.size());
-    const uint32_t l1d = c.host.caches.empty() ? 32 : c.host.caches.front().kib;
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     std::map<OpKind, std::vector<OpCostSample>> one_lane;  // a leaf test's one-lane samples
@@ -355,12 +366,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             one_lane[s.kind].push_back({1, s.passed, 0.0, s.cycles, s.failed_candidates});
             continue;
         }
-        const OpCostSample sample{
-            s.lanes, s.passed,
-            beyond_l1_share(s.lanes, s.slots, slot_bytes,
-                            lane_page_bytes(stage_of(s.kind), slot_bytes, stream_slot_arrays()),
-                            l1d),
-            s.cycles, s.failed_candidates};
+        const LanesBeyondCaches beyond =
+            lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches);
+        const OpCostSample sample{s.lanes,  s.passed, beyond.l1, s.cycles, s.failed_candidates,
+                                  beyond.l2};
         (s.thin_lens            ? lens_camera
          : s.sphere_light       ? sphere_light
          : s.failing_candidates ? failing_candidates
@@ -464,7 +473,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());
     c.short_stream_samples = short_stream_fit_samples(
-        c.one_ray_samples, c.op_costs, c.host.simd_width, l1d, c.host.branch_predictor);
+        c.one_ray_samples, c.op_costs, c.host.simd_width, c.host.caches, c.host.branch_predictor);
     c.short_stream_costs = fit_short_stream_cycles(c.short_stream_samples,
                                                    few_ray_from ? &few_ray_from->costs : nullptr);
     c.short_stream_fit_errors =

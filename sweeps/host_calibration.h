@@ -134,14 +134,26 @@ struct HostCalibration {
 // The traversal samples as the one- and few-lane fit sees them (fit_short_stream_cycles): each
 // sample's other ops (its leaves' tests, and its stream-loop box tests' lanes) priced by
 // `costs`, the stream formula of a back end of `width` lanes, over the sample's buffer (its
-// slots, the native slot size) beside an L1D of `l1d_kib`; and the model's mispredictions on
+// slots, the native slot size) beside the host's `caches` (its L1D and L2: lanes_beyond_caches);
+// and the model's mispredictions on
 // its batch (OneRaySample::modelled_mispredictions) as `predictor` prices them (a box test's
 // by its loop), which the model adds to every traversal it times, so that the fitted costs do
 // not hold them twice.
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
-                                                    uint32_t width, uint32_t l1d_kib,
+                                                    uint32_t width,
+                                                    const std::vector<HostCacheLevel>& caches,
                                                     const BranchPredictorConfig& predictor = {});
+
+// The shares of a microbenchmark stream's `lanes` lanes of `kind` over `slots` slots of the native
+// tracer's buffers that pay for ray data beyond the L1D and beyond the L2 as well
+// (beyond_cache_share with the first and the second of the host's `caches`; none beyond the
+// L2 where it has one level).
+struct LanesBeyondCaches {
+    double l1 = 0.0, l2 = 0.0;
+};
+LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slots,
+                                      const std::vector<HostCacheLevel>& caches);
 
 // The traversal samples' cycles by part, as the stage clock splits them (OneRaySample::
 // short_loop_share, leaf_share: the one-ray and few-ray loops less their leaves, the leaf tests,

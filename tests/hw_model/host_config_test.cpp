@@ -205,9 +205,9 @@ TEST_CASE("A measured op costs the formula of its kind, group by group", "[host]
     CHECK(measured_op_cycles(mixed, 16, 40, 40, 0.0) == Approx(10 + 12 + 20 + 80));
     CHECK(measured_op_cycles(mixed, 16, 40, 0, 0.0) == Approx(10 + 12 + 20));
     CHECK(p.result_cycles(DatapathConfig{}, 12.5) == 12.5);
-    CHECK(beyond_l1_fraction(256, 64, 32) == 0.0);   // 16 KiB in 32 KiB
-    CHECK(beyond_l1_fraction(1024, 64, 32) == 0.5);  // 64 KiB
-    CHECK(beyond_l1_fraction(0, 64, 32) == 0.0);
+    CHECK(beyond_cache_fraction(256, 64, 32) == 0.0);   // 16 KiB in 32 KiB
+    CHECK(beyond_cache_fraction(1024, 64, 32) == 0.5);  // 64 KiB
+    CHECK(beyond_cache_fraction(0, 64, 32) == 0.0);
 
     // A one-lane op runs in the one-ray loop: its own measured cost, when there is one.
     OpCostConfig one = c;
@@ -301,16 +301,16 @@ TEST_CASE("A triangle test's failed candidates cost what their microbenchmark ad
     // The model: an op's failed candidates, shared by its groups by lanes.
     OpCostConfig priced = plain;
     priced.per_failed_candidate_cycles = 35;
-    CHECK(measured_op_cycles(priced, 8, 40, 10, 0.0, 12) ==
+    CHECK(measured_op_cycles(priced, 8, 40, 10, 0.0, 0.0, 12) ==
           Approx(measured_op_cycles(plain, 8, 40, 10, 0.0) + 35 * 12));
     OpProfile p;
     p.measured = true;
     p.cost = priced;
-    CHECK(p.issue_cycles(DatapathConfig{}, 40, 0, 8, 2, false, 0.0, 12) ==
+    CHECK(p.issue_cycles(DatapathConfig{}, 40, 0, 8, 2, false, 0.0, 0.0, 12) ==
           Approx(p.issue_cycles(DatapathConfig{}, 40, 0, 8, 2, false, 0.0) + 35 * 12 * 8 / 40.0));
     // A one-lane op keeps its own timed cost.
     priced.one_lane_cycles = 50;
-    CHECK(measured_op_cycles(priced, 8, 1, 0, 0.0, 1) == Approx(50));
+    CHECK(measured_op_cycles(priced, 8, 1, 0, 0.0, 0.0, 1) == Approx(50));
 }
 
 TEST_CASE("A one-lane leaf test costs what its lane's outcome cost on one lane", "[host]") {
@@ -340,17 +340,17 @@ TEST_CASE("A one-lane leaf test costs what its lane's outcome cost on one lane",
     // the closed form's bucket of one-lane ops at its mean pass rate and failed candidates.
     CHECK(measured_op_cycles(triangle, 8, 1, 0, 0.0) == Approx(64));
     CHECK(measured_op_cycles(triangle, 8, 1, 1, 0.0) == Approx(154));
-    CHECK(measured_op_cycles(triangle, 8, 1, 0, 0.0, 1) == Approx(135));
+    CHECK(measured_op_cycles(triangle, 8, 1, 0, 0.0, 0.0, 1) == Approx(135));
     OpProfile p;
     p.measured = true;
     p.cost = triangle;
-    CHECK(p.issue_cycles(DatapathConfig{}, 1, 0, 1, 0.25, true, 0.0, 0.5) ==
+    CHECK(p.issue_cycles(DatapathConfig{}, 1, 0, 1, 0.25, true, 0.0, 0.0, 0.5) ==
           Approx(64 + 0.25 * 90 + 0.5 * 71));
     // A host file of one price (written before the extras) prices every outcome alike.
     OpCostConfig old_file = cost("triangle_test", 20, 6, 3, 40, 2);
     old_file.one_lane_cycles = 123;
     CHECK(measured_op_cycles(old_file, 8, 1, 1, 0.0) == Approx(123));
-    CHECK(measured_op_cycles(old_file, 8, 1, 0, 0.0, 1) == Approx(123));
+    CHECK(measured_op_cycles(old_file, 8, 1, 0, 0.0, 0.0, 1) == Approx(123));
     const HwConfig parsed = parse_hw_config(host_hw_yaml(small_host(), {triangle}, "t"), "t.yaml");
     REQUIRE(parsed.op_costs.size() == 1);
     CHECK(parsed.op_costs[0].one_lane_pass_cycles == Approx(90));
@@ -450,9 +450,26 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK(fit.per_lane_cycles == Approx(0).margin(1e-6));
     CHECK(fit.per_pass_cycles == Approx(40).epsilon(1e-6));
     CHECK(fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
+    CHECK(fit.beyond_l2_per_lane_cycles == 0.0);  // no sample beyond the L2
     CHECK(fit.per_minority_lane_cycles == 0.0);  // no stream of many lanes all passed
     CHECK(fit.per_fail_cycles == 0.0);  // a passing lane costs more: the pass column holds it
     CHECK(fit_error(fit, 16, samples).second < 1e-9);
+
+    // Lanes beyond the L2 (a share of those beyond the L1D, on the biggest buffers) tell what
+    // the L2 adds from what the L1D does.
+    OpCostConfig two_levels = truth;
+    two_levels.beyond_l2_per_lane_cycles = 20;
+    std::vector<OpCostSample> levels;
+    for (uint32_t lanes : {1u, 7u, 16u, 33u, 100u, 512u, 4096u})
+        for (const auto& [l1, l2] : {std::pair{0.0, 0.0}, {0.5, 0.0}, {0.9, 0.25}})
+            for (uint32_t passed : {0u, lanes / 3})
+                levels.push_back({lanes, passed, l1,
+                                  measured_op_cycles(two_levels, 16, lanes, passed, l1, l2), 0,
+                                  l2});
+    const OpCostConfig level_fit = fit_op_cost("triangle_test", 16, levels);
+    CHECK(level_fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
+    CHECK(level_fit.beyond_l2_per_lane_cycles == Approx(20).epsilon(1e-6));
+    CHECK(fit_error(level_fit, 16, levels).second < 1e-9);
 
     // A lane that passes costs less than one that fails (the scalar box test): the passing
     // lanes' cost would be negative, so the failing lanes' column takes it.
@@ -875,6 +892,24 @@ TEST_CASE(
     CHECK(time_surfaces(arrays).cycles == time_surfaces(host).cycles);
 }
 
+TEST_CASE("A lane beyond the L2 as well pays for both levels where it opens a page",
+          "[host][systemc]") {
+    // The box tests above (1024 records, 64 KiB in 16 pages) at 8 cycles a paying lane beyond
+    // the L1D and 5 more beyond the L2.
+    auto passes = [](uint32_t l2_kib) {
+        OpCostConfig box = cost("box_test", 0, 4, 0, 0, 8);
+        box.beyond_l2_per_lane_cycles = 5;
+        HwConfig host = host_with({box});
+        host.scene_memory.caches[0].kib = 16;
+        host.scene_memory.caches[1].kib = l2_kib;
+        return time_boxes(host, 2, 1024, 1024).stages[0][size_t(OpStage::traversal)].busy_cycles;
+    };
+    // A 32 KiB L2 holds half the records: both passes pay for both levels.
+    CHECK(passes(32) == 2 * (256 + 16 * (8 + 5)));
+    // A 128 KiB L2 keeps them: the second pass pays for the L1D only.
+    CHECK(passes(128) == 2 * 256 + 16 * (8 + 5) + 16 * 8);
+}
+
 TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
           "[host][systemc]") {
     // A shading op over slots 0-1023, then a box test over them (their records: 16 pages of
@@ -930,6 +965,7 @@ TEST_CASE("A host needs a measured cost for every kind its workload runs", "[hos
 
 TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
+    box.beyond_l2_per_lane_cycles = 6.5;
     box.one_lane_cycles = 6;
     box.few_lane_cycles = 4.5;
     box.per_minority_lane_cycles = 7;
@@ -988,6 +1024,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(yaml.find("first pass of a random chase") != std::string::npos);
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
+    CHECK(c.op_costs[0].beyond_l2_per_lane_cycles == Approx(6.5));
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
     CHECK(c.op_costs[0].few_lane_cycles == Approx(4.5));
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
@@ -1211,17 +1248,17 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(expected_lanes_opening_pages(0, 64, 330) == 0.0);
     // The share that pays: none within the L1D; beyond it, nearly every lane of a sparse
     // stream and about one in twelve of a dense one (a shading op: slots of 330 bytes).
-    CHECK(beyond_l1_share(64, 64, 330, 330, 48) == 0.0);
-    const double f = beyond_l1_fraction(4096, 330, 48);
-    CHECK(beyond_l1_share(16, 4096, 330, 330, 48) == Approx(f).epsilon(0.03));
-    CHECK(beyond_l1_share(4096, 4096, 330, 330, 48) == Approx(f * 330 / 4096).epsilon(0.02));
+    CHECK(beyond_cache_share(64, 64, 330, 330, 48) == 0.0);
+    const double f = beyond_cache_fraction(4096, 330, 48);
+    CHECK(beyond_cache_share(16, 4096, 330, 330, 48) == Approx(f).epsilon(0.03));
+    CHECK(beyond_cache_share(4096, 4096, 330, 330, 48) == Approx(f * 330 / 4096).epsilon(0.02));
     // A box test reads the traversal records, 64 to a page: a dense stream opens one page in
     // 64 lanes, a sparse one of 16 lanes in 4096 slots (64 pages) still nearly every lane.
     CHECK(lane_ray_bytes(OpStage::traversal, 330) == 64);
     CHECK(lane_ray_bytes(OpStage::intersection, 330) == 64);
     CHECK(lane_ray_bytes(OpStage::shading, 330) == 330 - 64);  // the record is the traversal's
-    CHECK(beyond_l1_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
-    CHECK(beyond_l1_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
+    CHECK(beyond_cache_share(4096, 4096, 330, 64, 48) == Approx(f / 64).epsilon(0.01));
+    CHECK(beyond_cache_share(16, 4096, 330, 64, 48) == Approx(f * 14.3 / 16).epsilon(0.03));
     // A shading lane's 266 bytes in 7 arrays of 38: a dense stream opens a page of one about
     // once in 108 lanes, a seventh as often as a page of one array of 266 bytes; 16 random
     // lanes of 4096 slots (38 pages of 108) still open 13.2 pages (37.9 (1 - (1 - 108 /
@@ -1229,8 +1266,8 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(lane_page_bytes(OpStage::traversal, 330, 7) == 64);
     CHECK(lane_page_bytes(OpStage::shading, 330, 1) == 266);
     CHECK(lane_page_bytes(OpStage::shading, 330, 7) == 38);
-    CHECK(beyond_l1_share(4096, 4096, 330, 38, 48) == Approx(f * 38 / 4096).epsilon(0.02));
-    CHECK(beyond_l1_share(16, 4096, 330, 38, 48) == Approx(f * 13.2 / 16).epsilon(0.02));
+    CHECK(beyond_cache_share(4096, 4096, 330, 38, 48) == Approx(f * 38 / 4096).epsilon(0.02));
+    CHECK(beyond_cache_share(16, 4096, 330, 38, 48) == Approx(f * 13.2 / 16).epsilon(0.02));
 }
 
 TEST_CASE("A filter's branch misses the rarer outcome's lanes, or one a change of outcome in runs",

@@ -32,9 +32,9 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         if (!s.variant())  // a lens camera's or a sphere light's: extras this frame does not pay
             by_kind[s.kind].push_back(
                 {s.lanes, s.passed,
-                 beyond_l1_share(s.lanes, s.slots, stream_slot_bytes(),
-                                 lane_ray_bytes(stage_of(s.kind), stream_slot_bytes()),
-                                 host.caches.front().kib),
+                 beyond_cache_share(s.lanes, s.slots, stream_slot_bytes(),
+                                    lane_ray_bytes(stage_of(s.kind), stream_slot_bytes()),
+                                    host.caches.front().kib),
                  s.cycles});
     std::vector<OpCostConfig> costs;
     for (const auto& [kind, samples] : by_kind)
@@ -136,12 +136,12 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     // Longer streams start in the stream loop, on every back end.
     CHECK(streamed[OpKind::box_test] > 0);
     const std::vector<OneLaneSample> short_streams =
-        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib);
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches);
     // The model's mispredictions priced before the fit, at the cost given.
     BranchPredictorConfig pooled;
     pooled.mispredict_cycles = 50.0;
     const std::vector<OneLaneSample> net =
-        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, pooled);
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches, pooled);
     for (size_t i = 0; i < one_ray.size(); ++i)
         CHECK(net[i].stream_op_cycles == Approx(short_streams[i].stream_op_cycles +
                                                 50.0 * one_ray[i].modelled_mispredictions));
@@ -149,7 +149,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     BranchPredictorConfig by_loop = pooled;
     by_loop.one_ray_mispredict_cycles = 80.0;
     const std::vector<OneLaneSample> loop_priced =
-        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches.front().kib, by_loop);
+        short_stream_fit_samples(one_ray, costs, host.simd_width, host.caches, by_loop);
     bool one_ray_mispredicted = false;
     for (size_t i = 0; i < one_ray.size(); ++i) {
         const double one = one_ray[i].modelled_box_loop_mispredictions[0];
@@ -174,7 +174,7 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
             o.one_lane_failed_candidate_cycles = 10;
         }
     const std::vector<OneLaneSample> priced =
-        short_stream_fit_samples(one_ray, direct, host.simd_width, host.caches.front().kib);
+        short_stream_fit_samples(one_ray, direct, host.simd_width, host.caches);
     const size_t tri = size_t(OpKind::triangle_test);
     uint64_t one_lane_passed = 0;
     for (size_t i = 0; i < one_ray.size(); ++i) {
