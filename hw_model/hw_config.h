@@ -509,8 +509,14 @@ struct OpCostConfig {
     // 32 x 32 ones fit in it). One term for both levels priced a 32-pixel tile's lanes (in the
     // L2) as dear as a 64-pixel tile's (partly in the L3): on an AMD Zen 5 VM (2026-12-05, AVX2,
     // 200-1024 lanes) a passing direct-light lane cost 218-219 cycles over 256 and 1024 slots
-    // and 259-290 over 4096, the miss filter's 4.9-5.2 against 6.4-7.7, and the model ranked
-    // furnace's tile 64 ahead of 32 where the host ran it 1-4 % slower. 0: not measured.
+    // and 259-290 over 4096, the miss filter's 4.9-5.2 against 6.4-7.7. Fitted there (scalar /
+    // AVX2 / AVX-512): the camera 409 / 246 / 210 cycles, the direct light 163 / 156 / 116, the
+    // indirect bounce 466 / 311 / 462, the beyond-L1 terms falling to a few cycles (the camera's
+    // 70 to 6 at AVX2); its fit's median error 6.6 to 1.3 %, the indirect bounce's 4.6 to 2.6 %.
+    // Only a lane that opens a page pays (as beyond the L1D): priced on every lane whose line
+    // the cache model's L2 missed, a frame's tile of 64 pixels, swept in slot order through an
+    // LRU L2 smaller than it, missed nearly all (furnace 128 x 128: 78 K lanes of 327 K against 1
+    // K at tile 32), 2.1 M cycles more where the host ran 0.1-0.3 M more. 0: not measured.
     double beyond_l2_per_lane_cycles = 0.0;
     // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
     // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
