@@ -1,5 +1,6 @@
 #include "sweeps/host_calibration.h"
 
+#include <malloc.h>
 #include <sched.h>
 
 #include <algorithm>
@@ -728,9 +729,15 @@ HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen) {
     return c;
 }
 
+void keep_freed_memory_in_heap() {
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest (HEAP_MAX_SIZE / 2 on 64 bits)
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
 std::vector<SiliconMeasurement> predict_and_measure(
     const std::vector<SiliconVariant>& variants, const ConvergenceRule& convergence, uint64_t seed,
     const std::function<void(const std::string&, size_t, size_t)>& progress, bool memory_now) {
+    keep_freed_memory_in_heap();
     const size_t n = variants.size();
     std::vector<SiliconMeasurement> out(n);
     std::vector<RenderSettings> settings(n);
