@@ -62,6 +62,41 @@ struct RayBuffers {
     }
 };
 
+// The ray buffers tracers leave (release_kept_ray_buffers): a tracer takes a set from here and
+// gives it back, so that a render finds the buffers of the render before it, as the timing
+// model's warm frame does (predict() in sweeps/host_calibration.h). Made with each render's
+// tracers until 2026-12-05, they were value-initialised every render, a cost the model does not
+// price: on an AMD Zen 5 VM (AVX2, furnace 64 x 64) 55 K TSC ticks of a 1.6 M frame at tile 64,
+// 13 K at tile 32, and a 64-pixel tile's 1.35 MB of zeros swept the L2 before the frame began.
+class RayBufferPool {
+  public:
+    std::unique_ptr<RayBuffers> take() {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        if (m_free.empty()) return std::make_unique<RayBuffers>();
+        std::unique_ptr<RayBuffers> kept = std::move(m_free.back());
+        m_free.pop_back();
+        return kept;
+    }
+    void give(std::unique_ptr<RayBuffers> buffers) {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        m_free.push_back(std::move(buffers));
+    }
+
+    void clear() {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        m_free.clear();
+    }
+
+  private:
+    std::mutex m_mutex;
+    std::vector<std::unique_ptr<RayBuffers>> m_free;
+};
+
+RayBufferPool& ray_buffer_pool() {
+    static RayBufferPool pool;
+    return pool;
+}
+
 // Stable partition of ids[0, len) by mask (passing ids first, in order; failing ones after,
 // through `spill`) for the scalar traversals of the seed options (the RayGrid walk, the
 // reordering's proxy hierarchy). Returns the passing count; `negative` counts the passing
@@ -150,7 +185,9 @@ struct StreamTracer::Impl {
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
     std::vector<uint32_t> material_next;  // per material: where its next ray goes in the sort
-    RayBuffers b;
+    std::unique_ptr<RayBuffers> kept = ray_buffer_pool().take();
+    RayBuffers& b =
+        *kept;  // every slot a pass reads, it writes first: a set's last contents never show
     // Hit-point reordering (RenderSettings::reorder): the simplified hierarchy and its buffers.
     std::unique_ptr<HitPointReorder> reorder;
     struct ReorderBuffers {
@@ -189,6 +226,9 @@ struct StreamTracer::Impl {
             gb.open.resize(grid->cell_count());
         }
     }
+    ~Impl() { ray_buffer_pool().give(std::move(kept)); }
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
 
     // The cell walk of RayGrid for ids[0, n): each ray's next cell after (last_entry,
     // last_cell), the smallest (entry, cell) beyond it among the cut's boxes its slab test
@@ -717,6 +757,10 @@ void StreamTracer::trace_pass(const TileRect& rect, uint32_t tile_index, uint32_
         NoTrace trace;
         m_impl->run(rect, tile_index, sample, sums, stats, trace, sink, observer);
     }
+}
+
+void release_kept_ray_buffers() {
+    ray_buffer_pool().clear();
 }
 
 RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,

@@ -56,6 +56,12 @@ class StreamTracer {
 RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSettings& settings,
                            TraceSink* sink = nullptr);
 
+// A tracer's ray buffers outlive it: the next tracer takes them, sized and in the caches (a
+// render's are the render before's, as a machine's ray buffers stay from frame to frame). This
+// frees the ones kept, so that the next render allocates its own wherever the heap places them
+// then (the silicon check varies that placement from render to render).
+void release_kept_ray_buffers();
+
 // Closest hits of an arbitrary ray list traced as one stream (Fig. 3 traversal). Used by the
 // benchmark and the hit-record checks. hits[i] is what Bvh::intersect(rays[i]) returns.
 // `isa`: the back end of the filters (the hits and the trace are the same for every one).

@@ -136,6 +136,27 @@ TEST_CASE("A workload's other frame is the same workload with other random numbe
     CHECK_FALSE(same_bits(a.image, render_stream(s, bvh, other).image));
 }
 
+TEST_CASE("A render never sees what the ray buffers held in the render before", "[stream]") {
+    // The buffers are kept from render to render (RayBufferPool): a render on one thread takes
+    // the set the render before it left, here another scene's deeper paths in a bigger tile.
+    const Scene s = box_scene(Variant::lights);
+    const Bvh bvh(s);
+    RenderSettings r = small(s, 16, 16, 1);
+    r.threads = 1;
+    for (const Isa isa : supported_isas()) {
+        r.isa = isa;
+        const RenderResult first = render_stream(s, bvh, r);
+        const Scene other = box_scene(Variant::emissive_sphere);
+        RenderSettings deeper = small(other, 40, 40, 2);
+        deeper.max_depth = 8;
+        deeper.tile = 64;
+        deeper.threads = 1;
+        deeper.isa = isa;
+        render_stream(other, Bvh(other), deeper);
+        CHECK(same_bits(first.image, render_stream(s, bvh, r).image));
+    }
+}
+
 TEST_CASE("Stream per-ray hit records equal the reference traversal's", "[stream]") {
     for (Variant v : {Variant::lights, Variant::environment_only}) {
         const Scene s = box_scene(v);
