@@ -838,8 +838,9 @@ std::vector<SiliconMeasurement> predict_and_measure(
     // Placement varies from render to render (Stabilizer's idea, for the heap alone): a block
     // of 0-64 KiB in 64-byte steps, held over the render, moves where the tracer's buffers land
     // relative to pages, cache sets and each other. The buffers renders keep are released after
-    // it: the stage-clocked render allocates them (and pays for their zeroing), the measured one
-    // after it finds them made, as the model's warm frame does.
+    // it where a warming render comes next: it allocates them (and pays for their zeroing), the
+    // stage-clocked and the measured render after it find them made, as the model's warm frame
+    // does.
     std::mt19937_64 rng(seed);
     std::vector<uint64_t> others_busy(n, 0), others_total(n, 0);
     const int own_cpu = sched_getcpu();
@@ -873,9 +874,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
             if (!needs_more(v)) continue;
             const Scene& scene = *variants[v].scene;
             const Bvh& bvh = *variants[v].bvh;
-            if (warm_variant != v) warm(v);
             std::vector<char> shift(64 * size_t(rng() % 1024));
-            release_kept_ray_buffers();  // the clocked render's are allocated after the block
+            if (warm_variant != v) {
+                release_kept_ray_buffers();  // the warming render's are allocated after the block
+                warm(v);
+            }
             // The stage-clocked render comes before the measured one, so that two renders of
             // the workload (other frames of it) precede it: one left temple's 64 x 64 frame in
             // 16-pixel tiles 11-13 % slower (45.2 against 39.5-39.9 Mcycles, scalar) whenever
