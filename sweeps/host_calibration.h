@@ -358,17 +358,17 @@ constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3;
 // Its own frame and its other frames 1 to k_cold_frame.
 constexpr uint64_t k_frames_per_workload = k_cold_frame + 1;
 
-// The check has its ray buffers allocated anew for each measured render (release_kept_ray_buffers,
-// kernels/stream/stream_tracer.h: made by each render until 2026-12-05), and glibc serves a block
-// beyond its mmap threshold from a fresh mapping and returns a freed heap top beyond its trim
-// threshold to the kernel, both thresholds moving as the process frees: whether a render's buffers
-// come back as pages already faulted in follows the process's allocation history, an effect that
-// holds for a whole run. On an AMD Zen 5 VM (2026-12-05, AVX2) cornell 64x64 rendered alone in a
-// process faulted 244 pages a render at tile 64 and took 4.8-5.5 ms of CPU time a render, 1.1 ms
-// with both thresholds raised (tile 32: 1.7 and 1.1 ms; 128x128 at tile 64: 356 pages, 9.1-9.3 ms
-// against 4.6-4.7). This keeps freed memory in the heap for the rest of the process:
-// predict_and_measure calls it first, so that a frame's cycles hold no page zeroing (a renderer
-// keeps its buffers).
+// The check has its ray buffers allocated anew in each round, by the warming render before the
+// measured one (release_kept_ray_buffers, kernels/stream/stream_tracer.h; made by every render
+// until 2026-12-05), and glibc serves a block beyond its mmap threshold from a fresh mapping and
+// returns a freed heap top beyond its trim threshold to the kernel, both thresholds moving as the
+// process frees: whether a render's buffers come back as pages already faulted in follows the
+// process's allocation history, an effect that holds for a whole run. On an AMD Zen 5 VM
+// (2026-12-05, AVX2) cornell 64x64 rendered alone in a process faulted 244 pages a render at tile
+// 64 and took 4.8-5.5 ms of CPU time a render, 1.1 ms with both thresholds raised (tile 32: 1.7 and
+// 1.1 ms; 128x128 at tile 64: 356 pages, 9.1-9.3 ms against 4.6-4.7). This keeps freed memory in
+// the heap for the rest of the process: predict_and_measure calls it first, so that a frame's
+// cycles hold no page zeroing (a renderer keeps its buffers).
 void keep_freed_memory_in_heap();
 
 // The workloads of a check (scenes, resolutions, tiles, back ends), each forced to one thread;

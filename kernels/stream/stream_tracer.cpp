@@ -185,9 +185,9 @@ struct StreamTracer::Impl {
     std::vector<uint32_t> material_rays;  // per material: rays of the stream that hit it
     std::vector<uint32_t> present;        // materials hit in this generation, in id order
     std::vector<uint32_t> material_next;  // per material: where its next ray goes in the sort
+    // Every slot a pass reads, it writes first: a kept set's last contents never show.
     std::unique_ptr<RayBuffers> kept = ray_buffer_pool().take();
-    RayBuffers& b =
-        *kept;  // every slot a pass reads, it writes first: a set's last contents never show
+    RayBuffers& b = *kept;
     // Hit-point reordering (RenderSettings::reorder): the simplified hierarchy and its buffers.
     std::unique_ptr<HitPointReorder> reorder;
     struct ReorderBuffers {

@@ -59,7 +59,7 @@ RenderResult render_stream(const Scene& scene, const Bvh& bvh, const RenderSetti
 // A tracer's ray buffers outlive it: the next tracer takes them, sized and in the caches (a
 // render's are the render before's, as a machine's ray buffers stay from frame to frame). This
 // frees the ones kept, so that the next render allocates its own wherever the heap places them
-// then (the silicon check varies that placement from render to render).
+// then (the silicon check varies that placement from round to round).
 void release_kept_ray_buffers();
 
 // Closest hits of an arbitrary ray list traced as one stream (Fig. 3 traversal). Used by the
