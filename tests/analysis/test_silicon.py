@@ -52,9 +52,22 @@ def test_errors_and_targets(rows_file):
     assert s["targets"]["tile ranking right in every measurable cell"] is True
     assert s["targets"]["frame worst <= 20 %"] is False
     assert df["noise"].iloc[0] == pytest.approx(0.03)
-    # A pair measurably apart and predicted the other way round is wrong.
+    assert s["ranking_wrong_gaps"] == ""
+    # A pair measurably apart and predicted the other way round is wrong, and the page says by
+    # how much each was apart: tile 64 measured 120 / 100.5 of tile 32 (+19.4 %), predicted
+    # 80 / 90 (-11.1 %).
     df.loc[2, "predicted.frame_cycles"] = 80
-    assert list(silicon.ranking(df)["right"]) == [False, True]
+    rank = silicon.ranking(df)
+    assert list(rank["right"]) == [False, True]
+    assert rank["wrong"].iloc[0] == [
+        {"slower": 64, "faster": 16, "measured": pytest.approx(0.2),
+         "predicted": pytest.approx(80 / 110 - 1)},
+        {"slower": 64, "faster": 32, "measured": pytest.approx(120 / 100.5 - 1),
+         "predicted": pytest.approx(80 / 90 - 1)}]
+    assert "no (0 of 2 pairs; 64 over 16: measured +20.0 %, predicted -27.3 %; 64 over 32: " \
+           "measured +19.4 %, predicted -11.1 %)" in silicon.ranking_text(df)
+    assert silicon.summary(df)["ranking_wrong_gaps"] == \
+        "; the 2 pairs ordered wrong were measured 19.4-20.0 % apart"
 
 
 def test_width_ranking(tmp_path):
@@ -72,7 +85,8 @@ def test_width_ranking(tmp_path):
     assert list(w["scenes"]["cells"]) == [1, 1, 0]
     assert w["scenes_right"] == 2 and w["target"] is False
     assert list(silicon.width_ranking(df)["measured"].iloc[0]) == [8, 1]
-    assert "width ranking right in 2 of 3 scenes" in silicon.all_summaries_text(df)
+    assert ("width ranking right in 2 of 3 scenes; the pair ordered wrong was measured "
+            "100.0 % apart") in silicon.all_summaries_text(df)
     # One back end per row set: no width ranking.
     assert silicon.width_summary(df[df["isa"] == "avx2"]) is None
 
