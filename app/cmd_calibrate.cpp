@@ -309,6 +309,7 @@ void add_calibrate_command(CLI::App& app) {
                          {"entries", {s.entries[0], s.entries[1]}},
                          {"ops", ops},
                          {"few_ops", few_ops},
+                         {"few_ray_one_lane_box_ops", s.few_ray_one_lane_box_ops},
                          {"stream_ops", stream_ops},
                          {"cycles", s.cycles},
                          {"converged", s.converged},

@@ -1208,6 +1208,7 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
                     predictor_replay(recorder(true), recorder(false));
                 sample.modelled_mispredictions = modelled.total;
                 sample.modelled_box_loop_mispredictions = modelled.box_by_loop;
+                sample.few_ray_one_lane_box_ops = modelled.few_ray_one_lane_box_ops;
             }
             std::vector<double> times;
             const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));

@@ -188,6 +188,9 @@ struct OneRaySample {
     // the box tests' by the loop that runs them (TraversalLoop: one-ray, few-ray, stream).
     double modelled_mispredictions = 0.0;
     std::array<double, 3> modelled_box_loop_mispredictions{};
+    // Of the one-lane box tests (`ops`), those below a stream of 2 to k_few_ray_lanes rays: the
+    // few-ray loop runs their one-ray subtrees itself, and the stage clock counts them there.
+    uint64_t few_ray_one_lane_box_ops = 0;
     // Where a repetition's time went, by the stage clock a frame's traversal is split with
     // (TraversalJob::leaf_tsc, ShortLoopClock): the shares of the leaves and of the one-ray and
     // few-ray loops less their leaves (the median of 5 repetitions, each displaced as the timed
@@ -202,6 +205,7 @@ using TraversalRecorder = std::function<void(TraceSink& sink)>;
 struct ModelledMispredictions {
     double total = 0.0;
     std::array<double, 3> box_by_loop{};
+    uint64_t few_ray_one_lane_box_ops = 0;  // OneRaySample's, read off the same trace
 };
 // Given one sample's two recorders, what precedes each timed repetition (the other rays'
 // traversals, then the batch's own) and the batch's traversals, returns the mispredictions the

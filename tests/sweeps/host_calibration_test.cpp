@@ -85,6 +85,13 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
         }
         if (s.rays > k_few_ray_lanes) long_stream_entries += s.entries[0] + s.entries[1];
         CHECK((wide || s.entries[1] == 0));
+        // The one-lane box tests below few-ray streams: none without a few-ray loop; all of
+        // them where every stream is of 2 to k_few_ray_lanes rays; never more than there are.
+        const uint64_t one_lane_box = s.ops[size_t(OpKind::box_test)];
+        CHECK(s.few_ray_one_lane_box_ops <= one_lane_box);
+        if (!wide || s.rays == 1) CHECK(s.few_ray_one_lane_box_ops == 0);
+        if (wide && s.rays >= 2 && s.rays <= k_few_ray_lanes)
+            CHECK(s.few_ray_one_lane_box_ops == one_lane_box);
         // A batch of one ray that misses the root costs about what reading the TSC does, so
         // its cycles can be 0 (after the overhead); the batches together cannot.
         CHECK(s.cycles >= 0);
@@ -672,6 +679,7 @@ TEST_CASE("The short-stream batches split by the stage clock beside the fit's pr
     raw.short_loop_share = {0.3, 0.2};
     raw.leaf_share = 0.1;
     raw.modelled_box_loop_mispredictions = {2.0, 1.0, 4.0};
+    raw.few_ray_one_lane_box_ops = 4;  // of the 10 one-lane box tests, below few-ray streams
     OneLaneSample fitted;
     fitted.ops[box] = 10;
     fitted.few_ops[box] = 5;
@@ -694,9 +702,10 @@ TEST_CASE("The short-stream batches split by the stage clock beside the fit's pr
     CHECK(split.few_ray.measured == Approx(200.0));
     CHECK(split.leaves.measured == Approx(100.0));
     CHECK(split.rest.measured == Approx(400.0));
-    // Each loop's ops, its entry and its box tests' mispredictions at that loop's price.
-    CHECK(split.one_ray.priced == Approx(10 * 20.0 + 7.0 + 2 * 50.0));
-    CHECK(split.few_ray.priced == Approx(5 * 30.0 + 9.0 + 1 * 40.0));
+    // Each loop's ops, its entry and its box tests' mispredictions at that loop's price; the
+    // one-lane box tests below few-ray streams in the few-ray loop, at the one-lane cost.
+    CHECK(split.one_ray.priced == Approx(6 * 20.0 + 7.0 + 2 * 50.0));
+    CHECK(split.few_ray.priced == Approx(5 * 30.0 + 4 * 20.0 + 9.0 + 1 * 40.0));
     CHECK(split.leaves.priced == Approx(150.0));
     // The rest: the stream loop's per-op cost, its mispredictions and the other priced ops.
     CHECK(split.rest.priced == Approx(3 * 11.0 + 4 * 30.0 + 60.0));
