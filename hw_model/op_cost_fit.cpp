@@ -210,8 +210,14 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         rows.push_back(row);
         // What the one-ray and few-ray loops' ops took (the rest is priced by the formula),
         // its error relative to the whole sample's cycles, as short_stream_fit_error judges it.
+        // The leaf tests' cycles by the stage clock where it split them off: priced by the
+        // filter microbenchmarks instead (until 2026-12-05), they came out 13 % over the clock's
+        // leaf share of the batches (AVX2, an AMD Zen 5 VM), and the fit took that off the
+        // stream loop's per-op box cost (0-4 cycles, against 20-37 in the filters' independent
+        // calls; the stream loop priced 28 % under its clocked share).
         loops.push_back(
-            s.cycles - s.stream_op_cycles -
+            s.cycles - s.stream_op_cycles +
+            (s.leaf_cycles_clocked >= 0 ? s.leaf_op_cycles - s.leaf_cycles_clocked : 0.0) -
             (given ? row[few_box] * given->few_lane_cycles + row[few_entry] * given->entry_cycles
                    : 0.0));
         whole.push_back(s.cycles);

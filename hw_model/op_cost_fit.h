@@ -88,6 +88,9 @@ struct OneLaneSample {
     std::array<uint64_t, 2> entries{};  // the one-ray and few-ray loops entered (TraversalLoop)
     uint64_t traversals = 0;            // traversals started (StreamOp::starts_traversal)
     double leaf_op_cycles = 0.0;  // the leaf tests' part of stream_op_cycles (reported)
+    // The leaf tests' part of `cycles` by the stage clock (OneRaySample::leaf_share), which the
+    // fit takes instead of leaf_op_cycles; negative where none was clocked.
+    double leaf_cycles_clocked = -1.0;
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
@@ -95,8 +98,11 @@ struct OneLaneSample {
 // traversal of every kind the samples' stream loops make (OpCostConfig::per_op_cycles): there each
 // op waits for the one before's output, where the filter microbenchmarks time independent calls,
 // which a core overlaps (an op's groups are independent in both, so their cost stays the filters').
-// Least squares on relative error of the cycles beyond the stream-priced groups and lanes,
-// non-negative as in fit_op_cost. Throws std::invalid_argument on no samples.
+// Least squares on relative error of the cycles beyond the stream-priced groups and lanes and
+// beyond the leaf tests as the stage clock splits them off (leaf_cycles_clocked, where clocked:
+// the leaf tests' costs are the filter microbenchmarks', and what those miss in a traversal is
+// not the traversal's to absorb), non-negative as in fit_op_cost. Throws std::invalid_argument
+// on no samples.
 struct ShortStreamCosts {
     std::array<double, k_op_kind_count> one_lane{}, few_lane{}, stream_per_op{};
     std::array<bool, k_op_kind_count> stream_measured{};  // the samples' stream loops made it

@@ -572,6 +572,28 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     CHECK(fit_short_stream_cycles(unpriced).few_lane[size_t(OpKind::box_test)] > 60);
     CHECK_THROWS_AS(fit_short_stream_cycles({}), std::invalid_argument);
 
+    // Leaf tests that the filter microbenchmarks price 30 % over what the stage clock split off
+    // (each sample's leaves 200 cycles by the clock): clocked, the fit keeps every cost; priced
+    // only, it takes the difference off the others.
+    std::vector<OneLaneSample> clocked = samples, priced_only = samples;
+    for (size_t i = 0; i < samples.size(); ++i) {
+        for (OneLaneSample* s : {&clocked[i], &priced_only[i]}) {
+            s->cycles += 200.0;
+            s->leaf_op_cycles = 260.0;
+            s->stream_op_cycles += 260.0;
+        }
+        clocked[i].leaf_cycles_clocked = 200.0;
+    }
+    const ShortStreamCosts clocked_fit = fit_short_stream_cycles(clocked);
+    CHECK(clocked_fit.stream_per_op[size_t(OpKind::box_test)] == Approx(140).epsilon(1e-6));
+    CHECK(clocked_fit.few_lane[size_t(OpKind::box_test)] == Approx(55).epsilon(1e-6));
+    CHECK(clocked_fit.one_lane[size_t(OpKind::box_test)] == Approx(30).epsilon(1e-6));
+    const ShortStreamCosts priced_fit = fit_short_stream_cycles(priced_only);
+    const double off_by = std::abs(priced_fit.stream_per_op[size_t(OpKind::box_test)] - 140) / 140 +
+                          std::abs(priced_fit.few_lane[size_t(OpKind::box_test)] - 55) / 55 +
+                          std::abs(priced_fit.one_lane[size_t(OpKind::box_test)] - 30) / 30;
+    CHECK(off_by > 0.01);
+
     // Loop entries: told from the ops only where subtrees hold fewer or more ops per entry (as
     // streams that enter deep and at the root do).
     std::vector<OneLaneSample> entered;
