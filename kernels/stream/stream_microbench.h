@@ -194,7 +194,8 @@ struct OneRaySample {
     // Where a repetition's time went, by the stage clock a frame's traversal is split with
     // (TraversalJob::leaf_tsc, ShortLoopClock): the shares of the leaves and of the one-ray and
     // few-ray loops less their leaves (the median of 5 repetitions, each displaced as the timed
-    // ones are; the clock's reads are in them). Reported, not fitted.
+    // ones are; the clock's reads are in them). The short-stream fit takes the leaves off by
+    // their share (OneLaneSample::leaf_cycles_clocked); the loops' shares are reported.
     double leaf_share = 0.0;
     std::array<double, 2> short_loop_share{};
 };
