@@ -213,8 +213,9 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         // The leaf tests' cycles by the stage clock where it split them off: priced by the
         // filter microbenchmarks instead (until 2026-12-05), they came out 13 % over the clock's
         // leaf share of the batches (AVX2, an AMD Zen 5 VM), and the fit took that off the
-        // stream loop's per-op box cost (0-4 cycles, against 20-37 in the filters' independent
-        // calls; the stream loop priced 28 % under its clocked share).
+        // stream loop's per-op box cost (0-4 cycles at AVX2 and 7-10 at AVX-512, against 35-38
+        // and 20-25 in the filters' independent calls; the stream loop priced 28 % under its
+        // clocked share at AVX2).
         loops.push_back(
             s.cycles - s.stream_op_cycles +
             (s.leaf_cycles_clocked >= 0 ? s.leaf_op_cycles - s.leaf_cycles_clocked : 0.0) -

@@ -54,8 +54,8 @@ def test_errors_and_targets(rows_file):
     assert df["noise"].iloc[0] == pytest.approx(0.03)
     assert s["ranking_wrong_gaps"] == ""
     # A pair measurably apart and predicted the other way round is wrong, and the page says by
-    # how much each was apart: tile 64 measured 120 / 100.5 of tile 32 (+19.4 %), predicted
-    # 80 / 90 (-11.1 %).
+    # how much each was apart: tile 64 measured 120 against tiles 16's and 32's 100 and 100.5,
+    # predicted 80 against 110 and 90.
     df.loc[2, "predicted.frame_cycles"] = 80
     rank = silicon.ranking(df)
     assert list(rank["right"]) == [False, True]
