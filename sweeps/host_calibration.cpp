@@ -66,6 +66,14 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
             beyond(1)};
 }
 
+bool microbenchmarks_reach_beyond_l2(const std::vector<uint32_t>& buffer_slots,
+                                     const std::vector<HostCacheLevel>& caches) {
+    for (const uint32_t slots : buffer_slots)
+        if (lanes_beyond_caches(OpKind::lambertian_indirect, slots, slots, caches).l2 > 0)
+            return true;
+    return false;
+}
+
 std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySample>& samples,
                                                     const std::vector<OpCostConfig>& costs,
                                                     uint32_t width,
@@ -537,7 +545,14 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
-         << "64/256/1024/4096 slots of " << slot_bytes << " bytes (a shading op's and a leaf "
+         << "64/256/1024/4096 slots of " << slot_bytes << " bytes"
+         << (c.host.caches.size() < 2 ||
+                     microbenchmarks_reach_beyond_l2(options.buffer_slots, c.host.caches)
+                 ? ""
+                 : ", none of them beyond this host's L2 (" + std::to_string(c.host.caches[1].kib) +
+                       " KiB): beyond_l2_per_lane_cycles is 0, not measured, and a tile whose "
+                       "rays outgrow the L2 is priced as if it held them")
+         << " (a shading op's and a leaf "
          << "test's streams also with every lane passing and with none, for a passing lane's "
          << "and a minority lane's costs; the "
          << "filters a frame runs after the miss and shadow filters dealt only hits of rays "

@@ -743,3 +743,22 @@ TEST_CASE("The check's renders find their ray buffers' pages already faulted in"
     CHECK(faults() - before < 60);
 #endif
 }
+
+TEST_CASE("The host file says where no microbenchmark buffer reaches beyond the L2", "[host]") {
+    const auto caches_with_l2 = [](uint32_t l2_kib) {
+        HostCacheLevel l1, l2;
+        l1.kib = 48;
+        l2.level = 2;
+        l2.kib = l2_kib;
+        return std::vector<HostCacheLevel>{l1, l2};
+    };
+    const std::vector<uint32_t> buffers = MicrobenchOptions{}.buffer_slots;
+    // The largest buffer, 4096 slots of the native tracer's (1.3 MiB), is beyond a 1 MiB L2
+    // (a Zen 5 core's) and inside a 2 MiB one.
+    REQUIRE(double(buffers.back()) * stream_slot_bytes() > 1024.0 * 1024);
+    REQUIRE(double(buffers.back()) * stream_slot_bytes() < 2048.0 * 1024);
+    CHECK(microbenchmarks_reach_beyond_l2(buffers, caches_with_l2(1024)));
+    CHECK_FALSE(microbenchmarks_reach_beyond_l2(buffers, caches_with_l2(2048)));
+    CHECK_FALSE(microbenchmarks_reach_beyond_l2({64, 256}, caches_with_l2(1024)));
+    CHECK_FALSE(microbenchmarks_reach_beyond_l2(buffers, {caches_with_l2(1024)[0]}));
+}
