@@ -68,9 +68,9 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
 
 bool microbenchmarks_reach_beyond_l2(const std::vector<uint32_t>& buffer_slots,
                                      const std::vector<HostCacheLevel>& caches) {
+    if (caches.size() < 2) return false;
     for (const uint32_t slots : buffer_slots)
-        if (lanes_beyond_caches(OpKind::lambertian_indirect, slots, slots, caches).l2 > 0)
-            return true;
+        if (beyond_cache_fraction(slots, stream_slot_bytes(), caches[1].kib) > 0) return true;
     return false;
 }
 
@@ -545,14 +545,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::ostringstream note;
     note << points << " microbenchmark points of the native filters on synthetic streams ("
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
-         << "64/256/1024/4096 slots of " << slot_bytes << " bytes"
-         << (c.host.caches.size() < 2 ||
-                     microbenchmarks_reach_beyond_l2(options.buffer_slots, c.host.caches)
-                 ? ""
-                 : ", none of them beyond this host's L2 (" + std::to_string(c.host.caches[1].kib) +
-                       " KiB): beyond_l2_per_lane_cycles is 0, not measured, and a tile whose "
-                       "rays outgrow the L2 is priced as if it held them")
-         << " (a shading op's and a leaf "
+         << slash_joined(options.buffer_slots) << " slots of " << slot_bytes << " bytes";
+    if (c.host.caches.size() >= 2 &&
+        !microbenchmarks_reach_beyond_l2(options.buffer_slots, c.host.caches))
+        note << ", none of them beyond this host's L2 (" << c.host.caches[1].kib
+             << " KiB): beyond_l2_per_lane_cycles is 0, not measured, and a tile whose rays "
+                "outgrow the L2 is priced as if it held them";
+    note << " (a shading op's and a leaf "
          << "test's streams also with every lane passing and with none, for a passing lane's "
          << "and a minority lane's costs; the "
          << "filters a frame runs after the miss and shadow filters dealt only hits of rays "

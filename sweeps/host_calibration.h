@@ -156,7 +156,8 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
                                       const std::vector<HostCacheLevel>& caches);
 
 // Whether any of the microbenchmarks' ray buffers of `buffer_slots` slots lies partly beyond
-// the L2 of `caches` (lanes_beyond_caches' share beyond it above 0). Where none does,
+// the L2 of `caches` (beyond_cache_fraction, whose share lanes_beyond_caches prices; false
+// without an L2). Where none does,
 // beyond_l2_per_lane_cycles is left 0, not measured, and the host file says so: a 64 x 64
 // tile's 1.3 MiB lies beyond a 1 MiB L2 but inside a 2 MiB one (an Intel Xeon VM, 2026-12-06:
 // at 128x128 the model priced a 128-pixel tile's frame within 1 % of a 64-pixel one's, where
