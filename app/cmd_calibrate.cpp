@@ -110,9 +110,10 @@ void add_calibrate_command(CLI::App& app) {
                   "measuring it, so that every back end's file describes one memory");
     c->add_option("--few-ray-from", o->few_ray_from,
                   "--describe-host, a back end of 8 lanes or more: take the few-ray loop's "
-                  "costs (its box test's, its entry's, its mispredictions') from this host file "
-                  "of another such back end of the same machine instead of fitting them: the "
-                  "loop runs the same four-lane code at every such width");
+                  "costs (its box test's, its entry's, its mispredictions') and the one-ray and "
+                  "few-ray loops' exposed share of a node read from this host file of another "
+                  "such back end of the same machine instead of fitting them: those loops run "
+                  "the same code at every such width");
     c->add_option("--check", o->check,
                   "HOST.hw.yaml[,MORE.hw.yaml]: predict and measure the native tracer's cycles "
                   "per workload, each file on the back end of its SIMD width");
@@ -359,6 +360,8 @@ void add_calibrate_command(CLI::App& app) {
                          {"primed_mispredictions", b.modelled.primed},
                          {"displaced_mispredictions", b.modelled.displaced}});
                 j["node_read_exposed_share"] = cal.node_read_fit.share;
+                j["node_read_share_given"] = cal.node_read_fit.given;
+                j["node_read_own_share"] = cal.node_read_fit.own_share;
                 j["node_read_fit_median_error"] = cal.node_read_fit.error.first;
                 j["node_read_fit_worst_error"] = cal.node_read_fit.error.second;
                 for (size_t i = 0; i < cal.branch_samples.size(); ++i) {
@@ -528,10 +531,15 @@ void add_calibrate_command(CLI::App& app) {
                     (unsigned long long)b.modelled.displaced);
             std::printf(
                 "node reads of the one-ray and few-ray loops: exposed share %.3f of "
-                "the model's latency beyond an L1D hit, fit error median %.1f%%, worst "
-                "%.1f%%\n",
-                cal.node_read_fit.share, 100 * cal.node_read_fit.error.first,
+                "the model's latency beyond an L1D hit%s%s%s, fit error median %.1f%%, worst "
+                "%.1f%%",
+                cal.node_read_fit.share, cal.node_read_fit.given ? " (as " : "",
+                cal.node_read_fit.given ? o->few_ray_from.c_str() : "",
+                cal.node_read_fit.given ? " gives it)" : "", 100 * cal.node_read_fit.error.first,
                 100 * cal.node_read_fit.error.second);
+            if (cal.node_read_fit.given)
+                std::printf("; these batches alone fit %.3f", cal.node_read_fit.own_share);
+            std::printf("\n");
             for (size_t i = 0; i < cal.branch_samples.size(); ++i)
                 std::printf(
                     "  %-7s from DRAM, short loops: measured +%.0f cycles beyond the "

@@ -111,10 +111,11 @@ struct HostDescription {
     BranchPredictorConfig branch_predictor;
     std::string branch_predictor_fit;
     // The few-ray loop's costs (its misprediction cost here, the box test's few_lane_cycles and
-    // few_ray_entry_cycles in the op costs) as another back end's host file of this machine
-    // gives them (`sfx calibrate --describe-host --few-ray-from FILE`): the loop runs the same
-    // four-lane code at every width of k_few_ray_min_width lanes or more, and fitted on each
-    // back end apart they differed by the fits' noise where the core's loop did not. Empty:
+    // few_ray_entry_cycles in the op costs) and the one-ray and few-ray loops' exposed share of
+    // a node read (the box test's node_read_exposed_share) as another back end's host file of
+    // this machine gives them (`sfx calibrate --describe-host --few-ray-from FILE`): those loops
+    // run the same code at every width of k_few_ray_min_width lanes or more, and fitted on each
+    // back end apart they differed by the fits' noise where the core's loops did not. Empty:
     // fitted here.
     std::string few_ray_source;
 };

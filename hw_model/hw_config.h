@@ -590,8 +590,9 @@ struct OpCostConfig {
     // processors", TOCS 2009), where the model otherwise serialises each read after its
     // parent's. Fitted by sfx calibrate (fit_node_read_exposed_share, sweeps/host_calibration.h)
     // on the branch microbenchmark's tile batches (20,000 random triangles) from DRAM against
-    // the same batches from the caches, per loop, through the model's own timing of them; the
-    // real scenes' batches and frames are held out. 1: not measured (the whole latency, as
+    // the same batches from the caches, per loop, through the model's own timing of them (one
+    // wide back end's, taken by the other: the same loops' code); the real scenes' batches and
+    // frames are held out. 1: not measured (the whole latency, as
     // before 2026-12-02 and on a unit that waits for its node).
     double node_read_exposed_share = 1.0;
     // The camera's: what a thin-lens camera's ray adds to a pinhole's (a concentric disk

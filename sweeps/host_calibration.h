@@ -68,15 +68,20 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
 // code, TLB and page tables the read evicts too), against the model's cold - warm in those
 // loops (model_batch_memory); the share in [0, 1] whose cold - warm has the least squared
 // error, with the model's extra at the whole latency and at that share, and its (median, worst)
-// error relative to the measured extra. Throws std::invalid_argument on no samples.
+// error relative to the measured extra. `given_share`, where given (another wide back end's
+// file: FewRayFrom): that share is used, and judged, instead of the one found here, which is
+// kept beside it (own_share). Throws std::invalid_argument on no samples.
 struct NodeReadFit {
     double share = 1.0;
+    double own_share = 1.0;  // the share these samples alone fit
+    bool given = false;      // share came from another back end's file
     std::pair<double, double> error{};
     std::vector<double> measured, modeled_whole, modeled;  // per sample
 };
 NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
                                         const std::vector<PredictorCheck>& samples,
-                                        const std::vector<PredictorSample>& baseline);
+                                        const std::vector<PredictorSample>& baseline,
+                                        const double* given_share = nullptr);
 
 struct HostCalibration {
     HostDescription host;
@@ -199,10 +204,13 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 // its scene memory instead of measuring one (HostDescription::memory).
 // The few-ray loop's costs as another wide back end's host file of the machine gives them
 // (`sfx calibrate --describe-host --few-ray-from FILE`, HostDescription::few_ray_source): its
-// box test's few-lane and entry costs and the loop's misprediction cost.
+// box test's few-lane and entry costs and the loop's misprediction cost, and the short loops'
+// (one-ray and few-ray: the same code at every width of k_few_ray_min_width lanes or more)
+// exposed share of a node read (OpCostConfig::node_read_exposed_share).
 struct FewRayFrom {
     GivenFewRayCosts costs;
     double mispredict_cycles = 0.0;
+    double node_read_exposed_share = 1.0;
     std::string source;  // the file
 };
 // Those of `file` (read from `source`) for a back end of `isa`. Throws std::invalid_argument

@@ -13,6 +13,7 @@
 #include "base/core_contention.h"
 #include "hw_model/ray_buffer_model.h"
 #include "kernels/bvh.h"
+#include "kernels/simd/isa.h"
 #include "kernels/stream/stream_tracer.h"
 #include "sweeps/point_group.h"
 #include "tests/hw_model/test_hosts.h"
@@ -535,6 +536,32 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(model_batch_memory(host, sample).cold > m.cold);
 }
 
+TEST_CASE("A wide back end takes the short loops' costs from another wide back end's file",
+          "[host]") {
+    HwConfig file = one_lane_box_host();
+    for (OpCostConfig& c : file.op_costs)
+        if (c.op == "box_test") {
+            c.few_lane_cycles = 58.0;
+            c.few_ray_entry_cycles = 150.0;
+            c.node_read_exposed_share = 0.6;
+        }
+    // The scalar back end runs no few-ray loop.
+    CHECK_THROWS_AS(few_ray_costs_from(file, "a.hw.yaml", Isa::scalar), std::invalid_argument);
+    const Isa wide = best_isa();
+    if (isa_width(wide) < k_few_ray_min_width) return;  // no wide back end on this host
+    // No fitted predictor: no few-ray misprediction cost to give.
+    CHECK_THROWS_AS(few_ray_costs_from(file, "a.hw.yaml", wide), std::invalid_argument);
+    file.branch_predictor.kind = "tage";
+    file.branch_predictor.mispredict_cycles = 100.0;
+    file.branch_predictor.few_ray_mispredict_cycles = 75.0;
+    const FewRayFrom from = few_ray_costs_from(file, "a.hw.yaml", wide);
+    CHECK(from.costs.few_lane_cycles == 58.0);
+    CHECK(from.costs.entry_cycles == 150.0);
+    CHECK(from.mispredict_cycles == 75.0);
+    CHECK(from.node_read_exposed_share == 0.6);
+    CHECK(from.source == "a.hw.yaml");
+}
+
 TEST_CASE("The short loops' exposed share of a node read is fitted through the model",
           "[host][systemc]") {
     const HwConfig host = one_lane_box_host();
@@ -560,6 +587,17 @@ TEST_CASE("The short loops' exposed share of a node read is fitted through the m
     CHECK(fit.modeled[0] == Approx(extra).epsilon(0.01));
     CHECK(fit.modeled_whole[0] > 2 * extra);  // the whole latency waited
     CHECK(fit.error.second < 0.01);
+    CHECK_FALSE(fit.given);
+    CHECK(fit.own_share == fit.share);
+    // Given another wide back end's share: used and judged at it, this one's kept beside it.
+    const double given = 0.8;
+    const NodeReadFit taken =
+        fit_node_read_exposed_share(host, {sample}, {camera, bounces}, &given);
+    CHECK(taken.given);
+    CHECK(taken.share == 0.8);
+    CHECK(taken.own_share == Approx(0.4).margin(0.01));
+    CHECK(taken.modeled[0] > 1.5 * extra);
+    CHECK(taken.error.second > 0.5);
     // Beyond the whole latency the share stays 1; at no extra, 0.
     sample.measured.evicted_loop_cycles[one_ray] = 5000 + 3 * fit.modeled_whole[0];
     CHECK(fit_node_read_exposed_share(host, {sample}, {}).share == 1.0);
