@@ -264,6 +264,11 @@ void add_calibrate_command(CLI::App& app) {
                         {"filter_per_op", cal.filter_costs[i].per_op_cycles},
                         {"fit_median_error", cal.fit_errors[i].first},
                         {"fit_worst_error", cal.fit_errors[i].second}};
+                    for (size_t b = 0; b < cal.residual_buffer_slots.size(); ++b)
+                        if (!std::isnan(cal.residuals_by_buffer[i][b]))
+                            j["op_costs"][k.op]["residual_by_buffer"]
+                             [std::to_string(cal.residual_buffer_slots[b])] =
+                                 cal.residuals_by_buffer[i][b];
                 }
                 for (const MicrobenchSample& m : cal.samples)
                     j["samples"].push_back(
@@ -434,6 +439,15 @@ void add_calibrate_command(CLI::App& app) {
                     k.beyond_l1_per_lane_cycles, k.beyond_l2_per_lane_cycles,
                     100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
                     k.one_lane_cycles, k.few_lane_cycles);
+            }
+            std::printf("fit error by buffer (median of priced / measured - 1) at");
+            for (const uint32_t slots : cal.residual_buffer_slots) std::printf(" %u", slots);
+            std::printf(" slots\n");
+            for (size_t i = 0; i < cal.op_costs.size(); ++i) {
+                std::printf("  %-20s", cal.op_costs[i].op.c_str());
+                for (const double r : cal.residuals_by_buffer[i])
+                    std::isnan(r) ? std::printf("        -") : std::printf(" %+7.1f%%", 100 * r);
+                std::printf("\n");
             }
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.per_failed_candidate_cycles > 0)

@@ -360,6 +360,25 @@ FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, I
         std::to_string(k_few_ray_min_width) + " lanes or more writes them)");
 }
 
+std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t width,
+                                            const std::vector<OpCostSample>& samples,
+                                            const std::vector<uint32_t>& slots,
+                                            const std::vector<uint32_t>& buffers) {
+    std::vector<double> medians;
+    for (const uint32_t buffer : buffers) {
+        std::vector<double> errors;
+        for (size_t i = 0; i < samples.size(); ++i) {
+            if (slots[i] != buffer) continue;
+            const OpCostSample& s = samples[i];
+            const double priced = measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1,
+                                                     s.beyond_l2, s.failed_candidates);
+            errors.push_back(priced / std::max(s.cycles, 1.0) - 1.0);
+        }
+        medians.push_back(errors.empty() ? std::nan("") : median(errors));
+    }
+    return medians;
+}
+
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source,
@@ -383,8 +402,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.rates = run_gather_compress_microbenchmarks(resolved, convergence.budget);
     for (const MicrobenchSample& s : c.samples) c.converged_points += s.converged;
     c.points = uint32_t(c.samples.size());
+    c.residual_buffer_slots = options.buffer_slots;
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
+    std::map<OpKind, std::vector<uint32_t>> slots_of;      // by_kind's samples' buffers
     std::map<OpKind, std::vector<OpCostSample>> one_lane;  // a leaf test's one-lane samples
     std::vector<OpCostSample> lens_camera;           // the camera's on a thin lens
     std::vector<OpCostSample> sphere_light;          // the direct-light filter's on a sphere
@@ -407,6 +428,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          : s.sphere_hits        ? sphere_hits
                                 : by_kind[s.kind])
             .push_back(sample);
+        if (!s.thin_lens && !s.sphere_light && !s.failing_candidates && !s.sphere_hits)
+            slots_of[s.kind].push_back(s.slots);
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {
@@ -434,6 +457,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         }
         c.op_costs.back().cold_call_cycles = fit_cold_call_cycles(cold_calls[kind]);
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
+        c.residuals_by_buffer.push_back(fit_residuals_by_buffer(
+            c.op_costs.back(), c.host.simd_width, samples, slots_of[kind], options.buffer_slots));
         points += samples.size() + one_lane[kind].size();
     }
     // The cost of a misprediction of the model's branch predictor: on a scene of random

@@ -93,6 +93,12 @@ struct HostCalibration {
     // traversals' per-op box cost: set_short_stream_costs).
     std::vector<std::pair<double, double>> fit_errors;
     std::vector<OpCostConfig> filter_costs;
+    // Per fitted kind, the fit's median signed error (priced over measured, less 1) on its
+    // samples at each microbenchmark buffer (`residual_buffer_slots`, MicrobenchOptions::
+    // buffer_slots; NaN where it has none): a trend along the buffers is a cost of the buffer's
+    // size that the form (ray data beyond the L1D, beyond the L2) does not price.
+    std::vector<uint32_t> residual_buffer_slots;
+    std::vector<std::vector<double>> residuals_by_buffer;
     // Traversals, and the one- and few-lane costs' fit error on them (OpCostConfig::
     // one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of a wide back
     // end's box test, and the box test's per_op_cycles in the stream loop).
@@ -216,6 +222,13 @@ struct FewRayFrom {
 // Those of `file` (read from `source`) for a back end of `isa`. Throws std::invalid_argument
 // where that back end has no few-ray loop or the file has no such costs.
 FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, Isa isa);
+
+// An op kind's fitted `cost` on its `samples` (the i-th at a buffer of `slots[i]`): per buffer
+// of `buffers`, the median of priced / measured - 1 (NaN where none is at that buffer).
+std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t width,
+                                            const std::vector<OpCostSample>& samples,
+                                            const std::vector<uint32_t>& slots,
+                                            const std::vector<uint32_t>& buffers);
 
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {},

@@ -536,6 +536,25 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(model_batch_memory(host, sample).cold > m.cold);
 }
 
+TEST_CASE("The filter fit's error is reported by microbenchmark buffer", "[host]") {
+    OpCostConfig cost;
+    cost.op = "lambertian_indirect";
+    cost.per_lane_cycles = 10.0;
+    cost.per_group_cycles = 5.0;
+    const double priced = measured_op_cycles(cost, 8, 16, 0, 0.0);
+    REQUIRE(priced > 0.0);
+    auto at = [&](double measured) { return OpCostSample{16, 0, 0.0, measured}; };
+    // Priced exactly at 256 slots; at 4096 the measured cycles run 1.1, 1.25 and 2 times it.
+    const std::vector<OpCostSample> samples = {at(priced), at(1.1 * priced), at(1.25 * priced),
+                                               at(2.0 * priced)};
+    const std::vector<uint32_t> slots = {256, 4096, 4096, 4096};
+    const std::vector<double> r = fit_residuals_by_buffer(cost, 8, samples, slots, {64, 256, 4096});
+    REQUIRE(r.size() == 3);
+    CHECK(std::isnan(r[0]));  // no sample at 64 slots
+    CHECK(r[1] == Approx(0.0).margin(1e-12));
+    CHECK(r[2] == Approx(-0.2));  // the median of -0.09, -0.2 and -0.5
+}
+
 TEST_CASE("A wide back end takes the short loops' costs from another wide back end's file",
           "[host]") {
     HwConfig file = one_lane_box_host();
