@@ -31,10 +31,6 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
 
 namespace {
 
-// Cycles under which a microbenchmark sample is mostly the time-stamp counter's granularity
-// (it steps by tens of ticks on some machines) and counts as this many in relative errors.
-constexpr double k_resolution = 100.0;
-
 // Columns of the cost formula for one sample (per op, group, lane, passing lane, minority
 // lane, beyond L1, beyond L2, failing lane). The failing lanes' column is last: lanes, passing and
 // failing lanes are dependent, so the solve gives it no pivot and 0 unless the passing lanes'
@@ -111,9 +107,9 @@ std::array<double, Terms> fit_nonnegative(const std::vector<std::array<double, T
         std::vector<std::vector<double>> ata(m, std::vector<double>(m, 0.0));
         std::vector<double> atb(m, 0.0);
         for (size_t s = 0; s < rows.size(); ++s) {
-            // Relative error; below k_resolution cycles the clock's steps dominate a sample.
-            const double w =
-                1.0 / std::max(relative_to ? (*relative_to)[s] : cycles[s], k_resolution);
+            // Relative error; below k_fit_resolution_cycles the clock's steps dominate a sample.
+            const double w = 1.0 / std::max(relative_to ? (*relative_to)[s] : cycles[s],
+                                            k_fit_resolution_cycles);
             for (size_t i = 0; i < m; ++i) {
                 atb[i] += rows[s][cols[i]] * w * cycles[s] * w;
                 for (size_t j = 0; j < m; ++j)
@@ -250,7 +246,7 @@ std::pair<double, double> short_stream_fit_error(const ShortStreamCosts& costs,
     std::vector<double> e;
     for (const OneLaneSample& s : samples)
         e.push_back(std::abs(short_stream_cycles(costs, s) - s.cycles) /
-                    std::max(s.cycles, k_resolution));
+                    std::max(s.cycles, k_fit_resolution_cycles));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};
@@ -326,7 +322,7 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
         e.push_back(std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1,
                                                 s.beyond_l2, s.failed_candidates) -
                              s.cycles) /
-                    std::max(s.cycles, k_resolution));
+                    std::max(s.cycles, k_fit_resolution_cycles));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};

@@ -14,6 +14,10 @@
 
 namespace sfx {
 
+// Cycles under which a microbenchmark sample is mostly the time-stamp counter's granularity
+// (it steps by tens of ticks on some machines) and counts as this many in relative errors.
+constexpr double k_fit_resolution_cycles = 100.0;
+
 // An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
 // `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_cache_share, and
 // `beyond_l2` for slots outside the L2 as well;

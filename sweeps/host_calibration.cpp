@@ -372,7 +372,8 @@ std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t w
             const OpCostSample& s = samples[i];
             const double priced = measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1,
                                                      s.beyond_l2, s.failed_candidates);
-            errors.push_back(priced / std::max(s.cycles, 1.0) - 1.0);
+            // A measurement under the clock's steps counts as those, as in fit_error.
+            errors.push_back((priced - s.cycles) / std::max(s.cycles, k_fit_resolution_cycles));
         }
         medians.push_back(errors.empty() ? std::nan("") : median(errors));
     }
@@ -422,14 +423,17 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches);
         const OpCostSample sample{s.lanes,  s.passed, beyond.l1, s.cycles, s.failed_candidates,
                                   beyond.l2};
-        (s.thin_lens            ? lens_camera
-         : s.sphere_light       ? sphere_light
-         : s.failing_candidates ? failing_candidates
-         : s.sphere_hits        ? sphere_hits
-                                : by_kind[s.kind])
-            .push_back(sample);
-        if (!s.thin_lens && !s.sphere_light && !s.failing_candidates && !s.sphere_hits)
-            slots_of[s.kind].push_back(s.slots);
+        std::vector<OpCostSample>* variant = s.thin_lens            ? &lens_camera
+                                             : s.sphere_light       ? &sphere_light
+                                             : s.failing_candidates ? &failing_candidates
+                                             : s.sphere_hits        ? &sphere_hits
+                                                                    : nullptr;
+        if (variant) {
+            variant->push_back(sample);
+            continue;
+        }
+        by_kind[s.kind].push_back(sample);
+        slots_of[s.kind].push_back(s.slots);
     }
     size_t points = 0;
     for (const auto& [kind, samples] : by_kind) {

@@ -224,7 +224,8 @@ struct FewRayFrom {
 FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, Isa isa);
 
 // An op kind's fitted `cost` on its `samples` (the i-th at a buffer of `slots[i]`): per buffer
-// of `buffers`, the median of priced / measured - 1 (NaN where none is at that buffer).
+// of `buffers`, the median of (priced - measured) / measured, a measurement under
+// k_fit_resolution_cycles counting as that (NaN where none is at that buffer).
 std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t width,
                                             const std::vector<OpCostSample>& samples,
                                             const std::vector<uint32_t>& slots,
