@@ -543,13 +543,13 @@ void add_calibrate_command(CLI::App& app) {
                     b.measured.converged_batches, b.measured.batches,
                     (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
                     (unsigned long long)b.modelled.displaced);
+            const std::string share_source =
+                cal.node_read_fit.given ? " (as " + o->few_ray_from + " gives it)" : "";
             std::printf(
                 "node reads of the one-ray and few-ray loops: exposed share %.3f of "
-                "the model's latency beyond an L1D hit%s%s%s, fit error median %.1f%%, worst "
+                "the model's latency beyond an L1D hit%s, fit error median %.1f%%, worst "
                 "%.1f%%",
-                cal.node_read_fit.share, cal.node_read_fit.given ? " (as " : "",
-                cal.node_read_fit.given ? o->few_ray_from.c_str() : "",
-                cal.node_read_fit.given ? " gives it)" : "", 100 * cal.node_read_fit.error.first,
+                cal.node_read_fit.share, share_source.c_str(), 100 * cal.node_read_fit.error.first,
                 100 * cal.node_read_fit.error.second);
             if (cal.node_read_fit.given)
                 std::printf("; these batches alone fit %.3f", cal.node_read_fit.own_share);
