@@ -45,6 +45,10 @@ uint32_t stream_slot_bytes();
 // lists and the mask are indexed by stream position, which ascends: RayBufferConfig::
 // slot_arrays).
 uint32_t stream_slot_arrays();
+// Bytes per slot of the arrays a microbenchmark repetition over a buffer of `slots` slots asks
+// the caches to hold (its timed calls, their made rays' set-up and the touch before them): the
+// fit prices its points as if they were stream_slot_bytes.
+double microbench_timed_slot_bytes(uint32_t slots);
 
 struct MicrobenchSample {
     OpKind kind = OpKind::box_test;
