@@ -232,9 +232,9 @@ void touch_slots(Buffers& b, const std::vector<uint32_t>& order) {
 // next generation's traversal in a loop of their own after the op, as the tracer's load_rays
 // does (stream_tracer.cpp): a frame never sets a ray up in the loop that made it. Into the
 // pass's own arrays, as load_rays does (the next deal restores them): arrays of their own added
-// 39 % to what a repetition asks the caches to hold, which put a 4096-slot buffer beyond the
-// 2 MiB L2 of an Intel Xeon VM (2026-12-06: the camera's sparse lanes there 215 cycles each
-// against 97 at 1024 slots; 105 with the set-up in the pass's arrays).
+// 43 % (141 bytes a slot) to what a repetition asks the caches to hold, which put a 4096-slot
+// buffer beyond the 2 MiB L2 of an Intel Xeon VM (2026-12-06: the AVX2 camera's lanes, 8 of
+// 4096 slots, 225 cycles each against 99 at 1024 slots; 103 with the set-up in the pass's arrays).
 void set_up_made(Buffers& b, const uint32_t* ids, uint32_t n, bool shadow) {
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t id = ids[i];
