@@ -661,21 +661,32 @@ void add_calibrate_command(CLI::App& app) {
         // traversals the per-op costs come from (at scene index scenes.size(), measured only).
         // The model also times the batches from empty caches and after themselves
         // (model_batch_memory), against their evicted and primed states.
+        // Counted apart from the workloads: a scene's check took about a minute on each back end
+        // of an Intel Xeon VM (2026-12-06), while the workloads' count showed its last ETA, of
+        // seconds, through all of them.
         std::map<std::pair<size_t, Isa>, std::vector<PredictorCheck>> predictor;
         std::map<std::pair<size_t, Isa>, std::vector<BatchMemoryCycles>> batch_memory;
+        progress.clear();
+        Progress checks("calibrate --check", host_isas.size() * (scenes.size() + 1),
+                        "branch-predictor checks (a scene on a back end)");
         for (size_t k = 0; k < host_isas.size(); ++k) {
             const Isa isa = host_isas[k];
             for (size_t sc = 0; sc < scenes.size(); ++sc) {
-                progress.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
+                checks.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
                 predictor[{sc, isa}] = check_predictor(*loaded[sc], *bvhs[sc], isa, bench_rule);
                 for (PredictorCheck& c : predictor[{sc, isa}]) {
                     batch_memory[{sc, isa}].push_back(model_batch_memory(hosts[k], c));
                     c.batches.clear();  // their memory, no longer needed
                 }
+                checks.advance();
             }
+            checks.set_label(std::string("the synthetic scene's branch predictor, ") +
+                             isa_name(isa));
             for (const PredictorSample& p : run_predictor_microbenchmarks(isa, bench_rule))
                 predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}, {}, {}});
+            checks.advance();
         }
+        checks.finish();
         const Microarchitecture uarch = read_microarchitecture();
         uint32_t workloads = 0, converged = 0;
         std::string sources;
