@@ -123,14 +123,28 @@ struct Buffers {
     std::vector<uint32_t> ids, scratch, scratch2, positions;
     std::vector<uint32_t> op_tally;  // TraversalJob::op_tally
 
+    // Calls f(element, bytes) for slot `id`'s element of each per-slot array of the pass (the
+    // arrays of stream_slot_bytes besides the id lists and the mask).
+    template <class F>
+    void for_each_slot_element(uint32_t id, F&& f) {
+        f(&path[id], sizeof(PathState));
+        f(&ray[id], sizeof(Ray));
+        f(&next[id], sizeof(Ray));
+        f(&pre[id], sizeof(RayPrecomp));
+        f(&hit[id], sizeof(Hit));
+        f(&any_hit[id], sizeof(uint8_t));
+        f(&surf[id], sizeof(SurfaceHit));
+        f(trav.data() + size_t(id) * traversal_field::record,
+          traversal_field::record * sizeof(float));
+    }
     // The bytes of the arrays a repetition's timed calls and their set-up touch: all but the
     // saved rays, which only the deal reads.
-    double timed_bytes() const {
+    double timed_bytes() {
+        double slot_bytes = 0.0;
+        if (!ray.empty()) for_each_slot_element(0, [&](const void*, size_t n) { slot_bytes += n; });
         const auto bytes = [](const auto& v) { return double(v.size()) * sizeof(v[0]); };
-        return bytes(path) + bytes(ray) + bytes(next) +
-               double(ray.size()) * traversal_field::record * sizeof(float) + bytes(pre) +
-               bytes(hit) + bytes(any_hit) + bytes(mask) + bytes(surf) + bytes(ids) +
-               bytes(scratch) + bytes(scratch2) + bytes(positions);
+        return slot_bytes * double(ray.size()) + bytes(mask) + bytes(ids) + bytes(scratch) +
+               bytes(scratch2) + bytes(positions);
     }
 };
 
@@ -213,18 +227,12 @@ uint64_t touch_lines(const void* p, size_t bytes) {
     return sum + c[bytes - 1];
 }
 
-// Reads every line of every array of the pass (stream_slot_bytes) at each slot of `order`, so
-// that the caches hold what a pass over the buffer leaves in them.
+// Reads every line of each per-slot array of the pass (Buffers::for_each_slot_element) at each
+// slot of `order`, so that the caches hold what a pass over the buffer leaves in them.
 void touch_slots(Buffers& b, const std::vector<uint32_t>& order) {
     uint64_t touched = 0;
-    const size_t record_bytes = traversal_field::record * sizeof(float);
     for (uint32_t id : order)
-        touched += touch_lines(&b.path[id], sizeof(PathState)) +
-                   touch_lines(&b.ray[id], sizeof(Ray)) + touch_lines(&b.next[id], sizeof(Ray)) +
-                   touch_lines(&b.pre[id], sizeof(RayPrecomp)) +
-                   touch_lines(&b.hit[id], sizeof(Hit)) + b.any_hit[id] +
-                   touch_lines(&b.surf[id], sizeof(SurfaceHit)) +
-                   touch_lines(b.trav.data() + size_t(id) * traversal_field::record, record_bytes);
+        b.for_each_slot_element(id, [&](const void* p, size_t n) { touched += touch_lines(p, n); });
     if (touched == 1) b.mask[0] = 1;  // keeps the reads
 }
 

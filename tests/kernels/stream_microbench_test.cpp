@@ -236,9 +236,10 @@ TEST_CASE("Microbenchmarks time every op kind of the native tracer", "[stream][h
 
 TEST_CASE("A microbenchmark repetition asks the caches to hold the tracer's arrays of a pass",
           "[stream][host]") {
-    // The fit prices a point's lanes beyond the L1D and the L2 by stream_slot_bytes; arrays of
-    // the microbenchmark's own (a made ray's set-up apart from the pass's arrays: +43 %) put
-    // its largest buffer beyond an L2 that holds a tile's rays.
+    // The fit prices a point's lanes beyond the L1D and the L2 by stream_slot_bytes: the arrays
+    // the touch before the timed calls reads (Buffers::for_each_slot_element) and the id lists
+    // must be those. (Arrays of the microbenchmark's own, a made ray's set-up apart from the
+    // pass's, +43 %, put its largest buffer beyond an L2 that holds a tile's rays.)
     for (const uint32_t slots : {64u, 4096u})
         CHECK(microbench_timed_slot_bytes(slots) ==
               Approx(double(stream_slot_bytes())).epsilon(0.05));
