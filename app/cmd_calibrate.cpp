@@ -82,6 +82,7 @@ void add_calibrate_command(CLI::App& app) {
         std::string output = "host.hw.yaml";
         std::string memory_from;
         std::string few_ray_from;
+        std::string branch_model = "unseen_ops";
         std::string check;
         std::string isa = "auto";
         uint32_t repeats = 41;
@@ -114,6 +115,13 @@ void add_calibrate_command(CLI::App& app) {
                   "few-ray loops' exposed share of a node read from this host file of another "
                   "such back end of the same machine instead of fitting them: those loops run "
                   "the same code at every such width");
+    c->add_option("--branch-model", o->branch_model,
+                  "--describe-host: how the model prices a traversal's branches, fitted on the "
+                  "branch microbenchmark: tage (L-TAGE's TAGE run over the traversal's branches, "
+                  "a cost per misprediction) or unseen_ops (a cost per op of a traversal not just "
+                  "run, by loop; hw_model/branch_predictor.h)")
+        ->check(CLI::IsMember({"tage", "unseen_ops"}))
+        ->capture_default_str();
     c->add_option("--check", o->check,
                   "HOST.hw.yaml[,MORE.hw.yaml]: predict and measure the native tracer's cycles "
                   "per workload, each file on the back end of its SIMD width");
@@ -203,6 +211,11 @@ void add_calibrate_command(CLI::App& app) {
                 } catch (const std::invalid_argument& e) {
                     throw InputError(o->few_ray_from, 0, "--few-ray-from", e.what());
                 }
+                if (few_ray_from->branch_model != o->branch_model)
+                    throw InputError(o->few_ray_from, 0, "--few-ray-from",
+                                     "its branch_predictor kind is " + few_ray_from->branch_model +
+                                         ", not the --branch-model " + o->branch_model +
+                                         " fitted here");
             }
             OutputFiles outputs;
             const std::string temp = outputs.add(o->output, "--output");
@@ -213,7 +226,7 @@ void add_calibrate_command(CLI::App& app) {
                     progress.set_total(total);
                     progress.set_done(done);
                 },
-                memory_from.get(), o->memory_from, few_ray_from.get());
+                memory_from.get(), o->memory_from, few_ray_from.get(), o->branch_model);
             progress.finish();
             std::ofstream(temp) << cal.yaml;
             parse_hw_config(cal.yaml, o->output);  // what was written reads back
@@ -683,7 +696,8 @@ void add_calibrate_command(CLI::App& app) {
             checks.set_label(std::string("the synthetic scene's branch predictor, ") +
                              isa_name(isa));
             for (const PredictorSample& p : run_predictor_microbenchmarks(isa, bench_rule))
-                predictor[{scenes.size(), isa}].push_back({p, PredictorStates{}, {}, {}});
+                predictor[{scenes.size(), isa}].push_back(
+                    {p, PredictorStates{}, PredictorStates{}, {}, {}});
             checks.advance();
         }
         checks.finish();
@@ -827,25 +841,26 @@ void add_calibrate_command(CLI::App& app) {
                     const std::string key = "measured.predictor." + kind;
                     if (index == scene_index) {
                         const BranchPredictorConfig& b = variants[i].host->branch_predictor;
+                        const PredictorStates& states = modelled_states(c, b.kind);
                         const std::string model = "predicted.predictor." + kind;
-                        row[model + "branches"] = c.modelled.branches;
+                        row[model + "branches"] = states.branches;
                         row[model + "mispredict_cycles"] =
                             b.kind == "none" ? 0.0 : b.mispredict_cycles;
-                        row[model + "primed_mispredictions"] = c.modelled.primed;
-                        row[model + "displaced_mispredictions"] = c.modelled.displaced;
+                        row[model + "primed_mispredictions"] = states.primed;
+                        row[model + "displaced_mispredictions"] = states.displaced;
                         // Priced as the model prices them: a box test's by its loop, the rest
                         // (the leaf tests') at the pooled cost.
                         std::array<double, 3> box_added{};
                         for (size_t l = 0; l < 3; ++l) {
-                            box_added[l] = double(c.modelled.displaced_by_loop[l]) -
-                                           double(c.modelled.primed_by_loop[l]);
+                            box_added[l] = double(states.displaced_by_loop[l]) -
+                                           double(states.primed_by_loop[l]);
                             row[model + "loop_mispredict_cycles." + loops[l]] =
                                 b.kind == "none" ? 0.0 : b.mispredict_cycles_in(l);
                         }
                         row[model + "extra_cycles"] =
                             b.kind == "none"
                                 ? 0.0
-                                : b.price(double(c.modelled.displaced) - double(c.modelled.primed),
+                                : b.price(double(states.displaced) - double(states.primed),
                                           box_added);
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
                         row[model + "cold_cycles"] = memory.cold;
@@ -853,9 +868,9 @@ void add_calibrate_command(CLI::App& app) {
                         for (int l = 0; l < 3; ++l) {
                             const std::string loop = std::string(".") + loops[l];
                             row[model + "primed_loop_mispredictions" + loop] =
-                                c.modelled.primed_by_loop[size_t(l)];
+                                states.primed_by_loop[size_t(l)];
                             row[model + "displaced_loop_mispredictions" + loop] =
-                                c.modelled.displaced_by_loop[size_t(l)];
+                                states.displaced_by_loop[size_t(l)];
                             row[model + "cold_loop_cycles" + loop] = memory.cold_loop[size_t(l)];
                             row[model + "warm_loop_cycles" + loop] = memory.warm_loop[size_t(l)];
                         }

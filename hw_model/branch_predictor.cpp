@@ -334,6 +334,24 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
     return states;
 }
 
+bool is_traversal_op(OpKind kind) {
+    return kind == OpKind::box_test || stage_of(kind) == OpStage::intersection;
+}
+
+PredictorStates unseen_ops_states(const std::vector<const PassBuffer*>& batches, uint32_t width) {
+    PredictorStates states;
+    for (const PassBuffer* b : batches) {
+        const std::vector<TraversalLoop> loops = traversal_loops(*b, width);
+        for (uint32_t i = 0; i < b->size(); ++i) {
+            const OpKind kind = b->at(i).kind;
+            states.displaced += is_traversal_op(kind);
+            if (kind == OpKind::box_test) ++states.displaced_by_loop[size_t(loops[i])];
+        }
+    }
+    states.branches = states.displaced;
+    return states;
+}
+
 uint64_t simulate_displaced_batch(const PassBuffer& others, const PassBuffer& batch, uint32_t width,
                                   const std::vector<uint8_t>& node_leaf,
                                   std::array<uint64_t, 3>* box_by_loop) {

@@ -107,6 +107,19 @@ PredictorStates simulate_predictor_states(const std::vector<const PassBuffer*>& 
                                           uint32_t width, const std::vector<uint8_t>& node_leaf,
                                           uint32_t repetitions = 5);
 
+// The unseen-ops predictor (BranchPredictorConfig kind "unseen_ops"): one that learns a
+// traversal only from the same traversal just run, nothing from other rays' traversals, so
+// that each op of a traversal it has not just run (a box test, priced by its loop; a leaf test,
+// `is_traversal_op`) counts one misprediction. On the branch microbenchmark (an Intel Xeon VM,
+// 2026-12-06) what the core's displaced batches took beyond their cached state followed the
+// batches' box tests (residual 8.8 K cycles rms over 96 batches at 36-41 cycles a box test,
+// AVX2) and not the TAGE's added mispredictions (22.6 K rms at 110 cycles each): a TAGE whose
+// history holds the traversal's data-dependent branches alone learns random rays' traversals
+// from one another, the core's does not. Primed (the batch just run): none; displaced: every
+// traversal op, summed over `batches` as simulate_predictor_states sums its states.
+bool is_traversal_op(OpKind kind);
+PredictorStates unseen_ops_states(const std::vector<const PassBuffer*>& batches, uint32_t width);
+
 // The model's side of a short-stream microbenchmark sample (run_one_ray_microbenchmarks,
 // kernels/stream/stream_microbench.h): a fresh predictor over the other rays' traversals
 // (twice, the first warming it), then over the batch's; the batch's mispredictions (with

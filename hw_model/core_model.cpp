@@ -99,11 +99,12 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
                            m_loop[i] != TraversalLoop::stream;
     }
     m_mispredicted.assign(n, 0);
-    if (m_predictor) {
+    if (m_predictor)
         replay_traversal_branches(*pass, m_loop, width(), node_leaf(), *m_predictor,
                                   m_mispredicted);
-        for (const uint32_t m : m_mispredicted) m_timing.branch_mispredictions += m;
-    }
+    else if (m_config.branch_predictor.kind == "unseen_ops")  // a frame's traversals: unseen
+        for (uint32_t i = 0; i < n; ++i) m_mispredicted[i] = is_traversal_op(pass->at(i).kind);
+    for (const uint32_t m : m_mispredicted) m_timing.branch_mispredictions += m;
 }
 
 void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now) {

@@ -626,8 +626,13 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "                   # copies its leaf tests read (kernels/intersect.h)\n";
     if (h.branch_predictor.kind != "none")
         y << "branch_predictor:\n  kind: " << h.branch_predictor.kind
-          << "  # the model's (L-TAGE's TAGE, hw_model/branch_predictor.h) over the traversal's\n"
-          << "              # branches: the core's own predictor is not published\n"
+          << (h.branch_predictor.kind == "unseen_ops"
+                  ? "  # each op of a traversal not just run (a frame's: all) one misprediction\n"
+                    "                    # (hw_model/branch_predictor.h): the core's own "
+                    "predictor is not published\n"
+                  : "  # the model's (L-TAGE's TAGE, hw_model/branch_predictor.h) over the "
+                    "traversal's\n              # branches: the core's own predictor is not "
+                    "published\n")
           << "  mispredict_cycles: " << fmt(h.branch_predictor.mispredict_cycles, 1)
           << "  # fitted: " << h.branch_predictor_fit << "\n";
     if (h.branch_predictor.kind != "none") {

@@ -397,7 +397,9 @@ struct DatapathConfig {
 // branches (derived from the trace) and prices each misprediction it makes.
 struct BranchPredictorConfig {
     // Assumed for the paper's machine: G&R describe SIMD filters over streams and a partition
-    // unit, no branch predictor; its filters' outcomes become masks, not jumps.
+    // unit, no branch predictor; its filters' outcomes become masks, not jumps. With
+    // "unseen_ops" the model runs no predictor: every traversal op of a frame (whose traversals
+    // never repeat) is one misprediction, and the costs below are an op's (unseen_ops_states).
     std::string kind = "none";
     // What one misprediction of the model's predictor costs the core, fitted by
     // `sfx calibrate --describe-host` on the branch microbenchmark (a synthetic scene of random
@@ -434,9 +436,11 @@ struct BranchPredictorConfig {
 
     template <class V>
     void visit(V& v) {
-        v.choice("kind", kind, {"none", "tage"},
+        v.choice("kind", kind, {"none", "tage", "unseen_ops"},
                  "branch predictor (none: no branches priced; tage: L-TAGE's TAGE run over the "
-                 "traversal's branches, each misprediction priced)");
+                 "traversal's branches, each misprediction priced; unseen_ops: each op of a "
+                 "traversal not just run, a box test or a leaf test, priced as one "
+                 "misprediction, hw_model/branch_predictor.h)");
         v.param("mispredict_cycles", mispredict_cycles, "cycles",
                 "cost of one misprediction of the model's predictor (fitted on a "
                 "microbenchmark)",

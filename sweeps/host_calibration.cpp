@@ -225,6 +225,33 @@ std::array<double, 3> fit_loop_mispredict_cycles(const std::vector<PredictorChec
     return cost;
 }
 
+const PredictorStates& modelled_states(const PredictorCheck& check, const std::string& kind) {
+    return kind == "unseen_ops" ? check.unseen : check.modelled;
+}
+
+UnseenOpCosts fit_unseen_op_cycles(const std::vector<PredictorCheck>& samples) {
+    std::array<double, 3> cycles{}, ops{};
+    double leaf_cycles = 0.0, leaf_ops = 0.0;
+    for (const PredictorCheck& b : samples) {
+        double in_loops = 0.0, box_ops = 0.0;
+        for (size_t l = 0; l < 3; ++l) {
+            const double extra =
+                b.measured.displaced_loop_cycles[l] - b.measured.cached_loop_cycles[l];
+            cycles[l] += extra;
+            in_loops += extra;
+            ops[l] += double(b.unseen.displaced_by_loop[l]);
+            box_ops += double(b.unseen.displaced_by_loop[l]);
+        }
+        leaf_cycles += b.measured.displaced_cycles - b.measured.cached_cycles - in_loops;
+        leaf_ops += double(b.unseen.displaced) - box_ops;
+    }
+    UnseenOpCosts out;
+    for (size_t l = 0; l < 3; ++l)
+        if (ops[l] > 0) out.box_by_loop[l] = std::max(0.0, cycles[l] / ops[l]);
+    out.leaf = leaf_ops > 0 ? std::max(0.0, leaf_cycles / leaf_ops) : 0.0;
+    return out;
+}
+
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
                                             const ConvergenceRule& convergence, bool time_evicted) {
     std::vector<std::shared_ptr<PassBuffer>> batches[2];  // camera rays, bounces
@@ -245,6 +272,7 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
         PredictorCheck c{
             m,
             simulate_predictor_states(kind, isa_width(resolve_isa(isa)), *shape.node_leaf),
+            unseen_ops_states(kind, isa_width(resolve_isa(isa))),
             {},
             shape};
         c.batches.assign(batches[m.bounce].begin(), batches[m.bounce].end());
@@ -352,6 +380,7 @@ FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, I
             file.branch_predictor.kind != "none")
             return {{o.few_lane_cycles, o.few_ray_entry_cycles},
                     file.branch_predictor.mispredict_cycles_in(1),
+                    file.branch_predictor.kind,
                     o.node_read_exposed_share,
                     source};
     throw std::invalid_argument(
@@ -383,7 +412,7 @@ std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t w
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress,
                                const HwConfig* memory_from, const std::string& memory_source,
-                               const FewRayFrom* few_ray_from) {
+                               const FewRayFrom* few_ray_from, const std::string& branch_model) {
     HostCalibration c;
     const Isa resolved = resolve_isa(isa);
     c.host = describe_host(isa_width(resolved), describe_isa(resolved), memory_from == nullptr);
@@ -467,20 +496,29 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     }
     // The cost of a misprediction of the model's branch predictor: on a scene of random
     // triangles, what the displaced batches took beyond the cached ones, over the
-    // mispredictions the model adds from primed to displaced on the same batches.
+    // mispredictions the model adds from primed to displaced on the same batches (the TAGE's;
+    // the unseen-ops predictor's: each traversal op of a displaced batch, fit_unseen_op_cycles).
     const Scene branch_scene = branch_microbench_scene();
     c.branch_samples = check_predictor(branch_scene, Bvh(branch_scene), resolved, convergence);
     std::vector<double> extra_cycles, extra_mispredictions;
     for (const PredictorCheck& b : c.branch_samples) {
+        const PredictorStates& m = modelled_states(b, branch_model);
         extra_cycles.push_back(b.measured.displaced_cycles - b.measured.cached_cycles);
-        extra_mispredictions.push_back(double(b.modelled.displaced) - double(b.modelled.primed));
+        extra_mispredictions.push_back(double(m.displaced) - double(m.primed));
         c.converged_points += b.measured.converged_batches;
         c.points += b.measured.batches;
     }
-    c.host.branch_predictor.kind = "tage";
-    c.host.branch_predictor.mispredict_cycles =
-        fit_mispredict_cycles(extra_cycles, extra_mispredictions);
-    const std::array<double, 3> by_loop = fit_loop_mispredict_cycles(c.branch_samples);
+    c.host.branch_predictor.kind = branch_model;
+    std::array<double, 3> by_loop{};
+    if (branch_model == "unseen_ops") {
+        const UnseenOpCosts unseen = fit_unseen_op_cycles(c.branch_samples);
+        c.host.branch_predictor.mispredict_cycles = unseen.leaf;
+        by_loop = unseen.box_by_loop;
+    } else {
+        c.host.branch_predictor.mispredict_cycles =
+            fit_mispredict_cycles(extra_cycles, extra_mispredictions);
+        by_loop = fit_loop_mispredict_cycles(c.branch_samples);
+    }
     c.host.branch_predictor.one_ray_mispredict_cycles = by_loop[0];
     c.host.branch_predictor.few_ray_mispredict_cycles =
         few_ray_from ? few_ray_from->mispredict_cycles : by_loop[1];
@@ -493,8 +531,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         branch_note << (k ? ";" : "") << " "
                     << (c.branch_samples[k].measured.bounce ? "bounces" : "camera rays")
                     << " displaced over cached " << std::llround(extra_cycles[k]) << " cycles, "
-                    << std::llround(extra_mispredictions[k]) << " mispredictions added";
-    branch_note << " (the model's predictor, primed to displaced); no frame";
+                    << std::llround(extra_mispredictions[k])
+                    << (branch_model == "unseen_ops" ? " traversal ops" : " mispredictions added");
+    branch_note << (branch_model == "unseen_ops"
+                        ? " (a box test's cost by the loop that runs it, the stage clock's split; "
+                          "a leaf test's outside the loops)"
+                        : " (the model's predictor, primed to displaced)")
+                << "; no frame";
     c.host.branch_predictor_fit = branch_note.str();
     // What evicting costs the synthetic scene's batches, whose scene is a few lines: the code,
     // TLB and page tables a read of 256 MiB evicts besides the scene (fit_node_read_exposed_share).
@@ -528,7 +571,13 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.one_ray_samples = run_one_ray_microbenchmarks(
         resolved, convergence, 1,
         [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
-            return replay_short_stream_predictor(others, batch, c.host.simd_width, one_ray_leaves);
+            ModelledMispredictions m =
+                replay_short_stream_predictor(others, batch, c.host.simd_width, one_ray_leaves);
+            if (branch_model == "unseen_ops") {  // the batch was just run: nothing unseen
+                m.total = 0.0;
+                m.box_by_loop = {};
+            }
+            return m;
         });
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());

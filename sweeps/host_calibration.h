@@ -31,13 +31,14 @@ namespace sfx {
 // measured, and the model's predictor on the same batches (hw_model/branch_predictor.h).
 struct PredictorCheck {
     PredictorSample measured;
-    PredictorStates modelled;
+    PredictorStates modelled;  // the TAGE's (simulate_predictor_states)
+    PredictorStates unseen;    // the unseen-ops predictor's (unseen_ops_states)
     // The batches' traces and their scene's shape, for the model to time (model_batch_memory).
     std::vector<std::shared_ptr<const PassBuffer>> batches;
     WorkloadShape shape;
 };
 // run_predictor_microbenchmarks on `scene` (its BVH `bvh`) with `isa` (`time_evicted` as
-// there), and the model's predictor replaying each batch's trace at that back end's width.
+// there), and the model's predictors on each batch's trace at that back end's width.
 std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, Isa isa,
                                             const ConvergenceRule& convergence,
                                             bool time_evicted = true);
@@ -48,6 +49,18 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
 // from primed to displaced, pooled over the samples; -1 (the pooled cost) for a loop holding
 // under k_loop_mispredict_min_share of the box tests' added mispredictions.
 std::array<double, 3> fit_loop_mispredict_cycles(const std::vector<PredictorCheck>& samples);
+// The states of `check` the predictor of kind `kind` (BranchPredictorConfig) models.
+const PredictorStates& modelled_states(const PredictorCheck& check, const std::string& kind);
+// BranchPredictorConfig's costs for kind "unseen_ops" from the branch microbenchmark's samples:
+// by loop, what the displaced batches took beyond the cached ones in that loop (the stage
+// clock's split) over the box tests the loop ran, pooled over the samples (-1 where a loop ran
+// none); and `leaf` (mispredict_cycles, which prices the leaf tests): what they took beyond the
+// cached ones outside the loops over the leaf tests.
+struct UnseenOpCosts {
+    std::array<double, 3> box_by_loop{-1.0, -1.0, -1.0};
+    double leaf = 0.0;
+};
+UnseenOpCosts fit_unseen_op_cycles(const std::vector<PredictorCheck>& samples);
 constexpr double k_loop_mispredict_min_share = 0.1;
 
 // The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
@@ -206,6 +219,8 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 
 // Describes the host, runs the microbenchmarks (each point repeated by `convergence`) and
 // fits. `isa`: the back end measured (auto: the widest). `progress(done, total)` per op kind.
+// `branch_model`: the BranchPredictorConfig kind fitted on the branch microbenchmark
+// ("unseen_ops" or "tage"; sfx calibrate --branch-model).
 // `memory_from` (a host file of this machine, read as `memory_source` names it), where given:
 // its scene memory instead of measuring one (HostDescription::memory).
 // The few-ray loop's costs as another wide back end's host file of the machine gives them
@@ -216,6 +231,7 @@ void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfi
 struct FewRayFrom {
     GivenFewRayCosts costs;
     double mispredict_cycles = 0.0;
+    std::string branch_model;  // the file's BranchPredictorConfig::kind, which prices it
     double node_read_exposed_share = 1.0;
     std::string source;  // the file
 };
@@ -235,7 +251,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {},
                                const HwConfig* memory_from = nullptr,
                                const std::string& memory_source = "",
-                               const FewRayFrom* few_ray_from = nullptr);
+                               const FewRayFrom* few_ray_from = nullptr,
+                               const std::string& branch_model = "unseen_ops");
 
 // Pins the calling thread (and threads it starts) to the CPU it runs on; false if refused.
 bool pin_to_current_cpu();

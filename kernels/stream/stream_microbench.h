@@ -304,6 +304,9 @@ struct PredictorSample {
         evicted_loop_cycles{};
     uint32_t converged_batches = 0;  // in every state timed (base/convergence.h)
 };
+// Untimed repetitions of a batch's state before its timed ones: the state before it outlasts
+// one preparation (two: a displaced repetition after one was still the fastest in some batches).
+constexpr uint32_t k_predictor_warm_repetitions = 2;
 std::vector<PredictorSample> run_predictor_microbenchmarks(
     const Scene& scene, const Bvh& bvh, Isa isa, const ConvergenceRule& convergence,
     uint64_t seed = 3, const PredictorBatchSink& batch_sink = {}, bool time_evicted = true);

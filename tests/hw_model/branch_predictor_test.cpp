@@ -157,3 +157,31 @@ TEST_CASE("A batch mispredicts less after itself than after others", "[branch]")
     CHECK(fit_mispredict_cycles({100}, {0}) == 0.0);
     CHECK(fit_mispredict_cycles({-100}, {2}) == 0.0);
 }
+
+TEST_CASE("The unseen-ops predictor mispredicts each traversal op of a batch not just run",
+          "[branch]") {
+    // One batch: three one-ray box tests, a stream's box test of 16 lanes, a triangle test and
+    // a sphere test.
+    PassBuffer batch;
+    TilePass tile;
+    tile.slot_count = 16;
+    batch.begin_pass(tile);
+    std::vector<uint32_t> stream(16);
+    for (uint32_t i = 0; i < 16; ++i) stream[i] = i;
+    add_op(batch, OpKind::box_test, 0, stream, 16);
+    for (int i = 0; i < 3; ++i) add_op(batch, OpKind::box_test, 1 + i, {0}, 1);
+    add_op(batch, OpKind::triangle_test, 7, {0}, 1);
+    add_op(batch, OpKind::sphere_test, 8, {0}, 0);
+    batch.end_pass(tile);
+    const PredictorStates s = unseen_ops_states({&batch, &batch}, 8);
+    CHECK(s.primed == 0);  // just run: nothing unseen
+    CHECK(s.displaced == 2 * 6);
+    CHECK(s.displaced_by_loop[size_t(TraversalLoop::stream)] == 2 * 1);
+    CHECK(s.displaced_by_loop[size_t(TraversalLoop::one_ray)] == 2 * 3);
+    CHECK(s.displaced_by_loop[size_t(TraversalLoop::few_ray)] == 0);
+    CHECK(is_traversal_op(OpKind::box_test));
+    CHECK(is_traversal_op(OpKind::triangle_test));
+    CHECK(is_traversal_op(OpKind::sphere_test));
+    CHECK_FALSE(is_traversal_op(OpKind::camera));
+    CHECK_FALSE(is_traversal_op(OpKind::lambertian_direct));
+}

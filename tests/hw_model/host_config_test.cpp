@@ -801,6 +801,14 @@ TEST_CASE("A host pays its fitted cost for each misprediction of its predictor",
     host.branch_predictor.one_ray_mispredict_cycles = 0;  // a fitted 0 is a cost
     CHECK(time_random(host).branch_cycles == 0);
     CHECK(HwConfig().branch_predictor.kind == "none");  // the paper's machine: no branches
+    // The unseen-ops predictor: each of the frame's 400 box tests once, whatever its outcome,
+    // at its loop's cost.
+    host.branch_predictor.kind = "unseen_ops";
+    host.branch_predictor.one_ray_mispredict_cycles = 30;
+    const FrameTiming unseen = time_random(host);
+    CHECK(unseen.branch_mispredictions == 400);
+    CHECK(unseen.branch_cycles == 30 * 400);
+    CHECK(busy(unseen) == busy(none) + 30 * 400);
 }
 
 TEST_CASE("The machine model times a host: measured costs, scene data beyond the L1D",

@@ -692,6 +692,37 @@ TEST_CASE("A misprediction's cost is fitted per loop where the model mispredicts
     CHECK(fit_loop_mispredict_cycles({}) == std::array<double, 3>{-1.0, -1.0, -1.0});
 }
 
+TEST_CASE("An unseen traversal op's cost is fitted per loop, a leaf test's outside them",
+          "[host]") {
+    // Two samples: the one-ray loop's displaced batches took 3000 + 1000 cycles more than the
+    // cached over 40 + 10 box tests (80 each); the stream loop's 500 over 50 (10 each), the
+    // few-ray loop ran none; outside the loops 600 + 0 cycles more over 20 + 10 leaf tests.
+    PredictorCheck a, b;
+    a.measured.displaced_loop_cycles = {13000, 0, 20500};
+    a.measured.cached_loop_cycles = {10000, 0, 20000};
+    a.measured.displaced_cycles = 40000 + 3000 + 500 + 600;
+    a.measured.cached_cycles = 40000;
+    a.unseen.displaced_by_loop = {40, 0, 50};
+    a.unseen.displaced = 40 + 50 + 20;
+    b.measured.displaced_loop_cycles = {2000, 0, 0};
+    b.measured.cached_loop_cycles = {1000, 0, 0};
+    b.measured.displaced_cycles = 5000 + 1000;
+    b.measured.cached_cycles = 5000;
+    b.unseen.displaced_by_loop = {10, 0, 0};
+    b.unseen.displaced = 10 + 10;
+    const UnseenOpCosts cost = fit_unseen_op_cycles({a, b});
+    CHECK(cost.box_by_loop[0] == Approx(80.0));
+    CHECK(cost.box_by_loop[1] == -1.0);  // no box test there: not fitted
+    CHECK(cost.box_by_loop[2] == Approx(10.0));
+    CHECK(cost.leaf == Approx(20.0));
+    // Displaced faster than cached somewhere: a cost of 0, not negative.
+    a.measured.displaced_loop_cycles[2] = 19000;
+    CHECK(fit_unseen_op_cycles({a, b}).box_by_loop[2] == 0.0);
+    // The states each kind prices.
+    CHECK(&modelled_states(a, "unseen_ops") == &a.unseen);
+    CHECK(&modelled_states(a, "tage") == &a.modelled);
+}
+
 TEST_CASE("A calibration whose sweeps ran slower than its probes moved", "[host]") {
     auto sample = [](OpKind kind, uint32_t slots, uint32_t lanes, double cycles) {
         MicrobenchSample s;
