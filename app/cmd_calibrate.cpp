@@ -366,7 +366,8 @@ void add_calibrate_command(CLI::App& app) {
                 j["loop_mispredict_cycles"] = {cal.host.branch_predictor.one_ray_mispredict_cycles,
                                                cal.host.branch_predictor.few_ray_mispredict_cycles,
                                                cal.host.branch_predictor.stream_mispredict_cycles};
-                for (const PredictorCheck& b : cal.branch_samples)
+                for (const PredictorCheck& b : cal.branch_samples) {
+                    const PredictorStates& m = modelled_states(b, cal.host.branch_predictor.kind);
                     j["branch_samples"].push_back(
                         {{"bounce", b.measured.bounce},
                          {"batches", b.measured.batches},
@@ -374,9 +375,10 @@ void add_calibrate_command(CLI::App& app) {
                          {"primed_cycles", b.measured.primed_cycles},
                          {"cached_cycles", b.measured.cached_cycles},
                          {"displaced_cycles", b.measured.displaced_cycles},
-                         {"branches", b.modelled.branches},
-                         {"primed_mispredictions", b.modelled.primed},
-                         {"displaced_mispredictions", b.modelled.displaced}});
+                         {"branches", m.branches},
+                         {"primed_mispredictions", m.primed},
+                         {"displaced_mispredictions", m.displaced}});
+                }
                 j["node_read_exposed_share"] = cal.node_read_fit.share;
                 j["node_read_share_given"] = cal.node_read_fit.given;
                 j["node_read_own_share"] = cal.node_read_fit.own_share;
@@ -540,13 +542,15 @@ void add_calibrate_command(CLI::App& app) {
                                 cal.filter_costs[i].per_op_cycles);
             const BranchPredictorConfig& bp = cal.host.branch_predictor;
             std::printf(
-                "branch mispredictions (the model's predictor): %.1f cycles each; a box "
+                "branch mispredictions (the model's predictor, %s): %.1f cycles each; a box "
                 "test's by loop %s / %s / %s (one-ray / few-ray / stream; -: the pooled), from "
                 "the branch microbenchmark:\n",
-                bp.mispredict_cycles, loop_cost_text(bp.one_ray_mispredict_cycles).c_str(),
+                bp.kind.c_str(), bp.mispredict_cycles,
+                loop_cost_text(bp.one_ray_mispredict_cycles).c_str(),
                 loop_cost_text(bp.few_ray_mispredict_cycles).c_str(),
                 loop_cost_text(bp.stream_mispredict_cycles).c_str());
-            for (const PredictorCheck& b : cal.branch_samples)
+            for (const PredictorCheck& b : cal.branch_samples) {
+                const PredictorStates& m = modelled_states(b, bp.kind);
                 std::printf(
                     "  %-7s cycles primed %.0f, cached %.0f, displaced %.0f (%u of %u "
                     "batches converged); model: %llu branches, mispredicted %llu "
@@ -554,8 +558,9 @@ void add_calibrate_command(CLI::App& app) {
                     b.measured.bounce ? "bounces" : "camera", b.measured.primed_cycles,
                     b.measured.cached_cycles, b.measured.displaced_cycles,
                     b.measured.converged_batches, b.measured.batches,
-                    (unsigned long long)b.modelled.branches, (unsigned long long)b.modelled.primed,
-                    (unsigned long long)b.modelled.displaced);
+                    (unsigned long long)m.branches, (unsigned long long)m.primed,
+                    (unsigned long long)m.displaced);
+            }
             const std::string share_source =
                 cal.node_read_fit.given ? " (as " + o->few_ray_from + " gives it)" : "";
             std::printf(
