@@ -173,15 +173,21 @@ ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
 
 ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,
                                                      const TraversalRecorder& batch, uint32_t width,
-                                                     const std::vector<uint8_t>& node_leaf) {
-    PassBuffer others_trace, batch_trace;
-    others(others_trace);
+                                                     const std::vector<uint8_t>& node_leaf,
+                                                     const std::string& predictor_kind) {
+    PassBuffer batch_trace;
     batch(batch_trace);
-    std::array<uint64_t, 3> by_loop{};
     ModelledMispredictions m;
-    m.total =
-        double(simulate_displaced_batch(others_trace, batch_trace, width, node_leaf, &by_loop));
-    for (size_t l = 0; l < 3; ++l) m.box_by_loop[l] = double(by_loop[l]);
+    // The unseen-ops predictor mispredicts none: the batch was just run (the others' recording
+    // ends with it).
+    if (predictor_kind != "unseen_ops") {
+        PassBuffer others_trace;
+        others(others_trace);
+        std::array<uint64_t, 3> by_loop{};
+        m.total =
+            double(simulate_displaced_batch(others_trace, batch_trace, width, node_leaf, &by_loop));
+        for (size_t l = 0; l < 3; ++l) m.box_by_loop[l] = double(by_loop[l]);
+    }
     const std::vector<TraversalLoop> loops = traversal_loops(batch_trace, width);
     for (uint32_t i = 0; i < batch_trace.size(); ++i)
         m.few_ray_one_lane_box_ops += batch_trace.at(i).kind == OpKind::box_test &&
@@ -571,13 +577,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     c.one_ray_samples = run_one_ray_microbenchmarks(
         resolved, convergence, 1,
         [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
-            ModelledMispredictions m =
-                replay_short_stream_predictor(others, batch, c.host.simd_width, one_ray_leaves);
-            if (branch_model == "unseen_ops") {  // the batch was just run: nothing unseen
-                m.total = 0.0;
-                m.box_by_loop = {};
-            }
-            return m;
+            return replay_short_stream_predictor(others, batch, c.host.simd_width, one_ray_leaves,
+                                                 branch_model);
         });
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());

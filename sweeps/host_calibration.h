@@ -208,11 +208,13 @@ ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
                                     const BranchPredictorConfig& predictor);
 
 // run_one_ray_microbenchmarks' PredictorReplay: the sample's traces recorded and run through
-// the model's predictor as the microbenchmark times them (simulate_displaced_batch, for a back
-// end of `width` lanes in the scene whose tree has leaves `node_leaf`).
+// the model's predictor of kind `predictor_kind` (BranchPredictorConfig) as the microbenchmark
+// times them (the TAGE: simulate_displaced_batch, for a back end of `width` lanes in the scene
+// whose tree has leaves `node_leaf`; the unseen-ops predictor: none, the batch just run).
 ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,
                                                      const TraversalRecorder& batch, uint32_t width,
-                                                     const std::vector<uint8_t>& node_leaf);
+                                                     const std::vector<uint8_t>& node_leaf,
+                                                     const std::string& predictor_kind = "tage");
 // The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
 // cost where the traversals measured it (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);
