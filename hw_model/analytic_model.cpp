@@ -276,16 +276,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                 ? slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()),
                                      op_stage, c.scene_memory.caches[1].kib)
                 : 0.0;
-        // A CPU core's data-TLB misses on the op's ray pages (the cycle model's LRU of pages,
-        // here as expected of a tile's buffer used in random order), at the TLB's miss cost.
-        const uint32_t slot_bytes = slot_bytes_of(c.ray_buffer, layout.bytes());
-        const double dtlb_cycles =
-            c.ray_buffer.storage == "l1d" && c.scene_memory.dtlb_entries > 0
-                ? expected_dtlb_misses(length, std::max(1u, shape.slots()), slot_bytes,
-                                       lane_ray_bytes(op_stage, slot_bytes),
-                                       c.scene_memory.dtlb_entries) *
-                      c.scene_memory.dtlb_miss_ns * c.clock.core_mhz / 1000.0
-                : 0.0;
         const double opening_share =
             beyond_l1 > 0
                 ? expected_lanes_opening_pages(
@@ -314,8 +304,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                                beyond_l2 * opening_share, double(bucket.failed_candidates) / ops) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
-                (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0) +
-                (g == 0 ? dtlb_cycles : 0.0);
+                (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

@@ -296,9 +296,7 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
       m_dram_latency(ns_to_cycles(dram_latency_ns_at(config, span_bytes), core_mhz)),
       m_core_mhz(core_mhz),
       m_span_bytes(span_bytes),
-      m_pages(config.dram_latency_by_span.empty() && config.dtlb_entries == 0
-                  ? 0
-                  : std::max(1u, cores)),
+      m_pages(config.dram_latency_by_span.empty() ? 0 : std::max(1u, cores)),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
       m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz),
       m_fills(k_fills) {
@@ -310,7 +308,6 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
         m_latency.push_back(ns_to_cycles(level.hit_latency_ns, core_mhz));
     }
     m_line_bytes = dram_line_bytes(config);
-    m_dtlb_miss_cycles = config.dtlb_entries > 0 ? config.dtlb_miss_ns * core_mhz / 1000.0 : 0.0;
 }
 
 SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
@@ -336,18 +333,14 @@ uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
 }
 
 uint32_t SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t bytes,
-                                       uint64_t now, uint32_t* dtlb_misses) {
-    if (dtlb_misses) *dtlb_misses = 0;
+                                       uint64_t now) {
     if (bytes == 0) return 0;
     const uint32_t levels = level_count();
     uint32_t farthest = 0;
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line) {
         const uint64_t at = line * m_line_bytes;
-        // The page again right after itself is 0 pages away (PageRecency::use): a TLB hit.
-        const uint64_t pages_between = use_page(core, at);
-        if (dtlb_misses && m_config.dtlb_entries > 0 && pages_between >= m_config.dtlb_entries)
-            ++*dtlb_misses;
+        use_page(core, at);
         const uint32_t level = m_shared ? m_shared->level_of(m_reader, at)
                                         : first_holding(levels, at, now - std::min(now, m_paused),
                                                         [&](uint32_t l) -> SetAssociativeCache& {
@@ -387,7 +380,7 @@ uint64_t SceneMemoryModel::read(uint32_t core, uint64_t address, uint32_t bytes,
         } else {
             ++m_dram_reads;
             const uint64_t dram_latency =
-                m_config.dram_latency_by_span.empty()
+                m_pages.empty()
                     ? m_dram_latency
                     : ns_to_cycles(dram_latency_ns_after(m_config, pages_between, m_span_bytes),
                                    m_core_mhz);

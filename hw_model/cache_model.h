@@ -177,12 +177,8 @@ class SceneMemoryModel {
     // caches (a CPU core's ray buffers, storage l1d): they take their place in every level as a
     // read's do, and evict scene lines; not counted among the scene's hits and misses, untimed.
     // Returns the farthest level any of them came from (0: every line was in the first level;
-    // level_count(): DRAM). `dtlb_misses` (if given): how many of the lines' page uses missed
-    // the core's first-level data TLB (SceneMemoryConfig::dtlb_entries; 0 without one).
-    uint32_t touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now,
-                         uint32_t* dtlb_misses = nullptr);
-    // What a ray line whose page the data TLB missed costs more (SceneMemoryConfig::dtlb_miss_ns).
-    double dtlb_miss_cycles() const { return m_dtlb_miss_cycles; }
+    // level_count(): DRAM).
+    uint32_t touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now);
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
 
@@ -201,7 +197,7 @@ class SceneMemoryModel {
   private:
     SetAssociativeCache& instance(uint32_t level, uint32_t core);
     // Records the use of `address`'s page by `core`; returns PageRecency::use's distance (0
-    // when neither DRAM's latency nor a data TLB depends on it).
+    // when DRAM's latency does not depend on it).
     uint64_t use_page(uint32_t core, uint64_t address);
     // The nearest level holding `line` for `core` at cycle `now` (level_count(): DRAM), counted.
     uint32_t look_up(uint32_t core, uint64_t line, uint64_t now);
@@ -228,11 +224,7 @@ class SceneMemoryModel {
     uint64_t m_dram_latency;                 // cycles, at the span (where no table: every read's)
     double m_core_mhz;
     uint64_t m_span_bytes;
-    // Per core; none without dram_latency_by_span or a data TLB. A page's distance is its
-    // place in the core's least-recently-used order of pages: the TLB holds it while that is
-    // under dtlb_entries.
-    std::vector<PageRecency> m_pages;
-    double m_dtlb_miss_cycles = 0.0;
+    std::vector<PageRecency> m_pages;  // per core; none without dram_latency_by_span
     uint32_t m_line_bytes;
     RateServer m_dram;  // bytes per cycle
     uint64_t m_dram_reads = 0, m_requests = 0;

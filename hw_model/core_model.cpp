@@ -121,9 +121,6 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     const uint64_t bytes =
         lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));
     const uint32_t page_bytes = lane_page_bytes_of(m_config.ray_buffer, m_record_bytes, op.stage);
-    // A line whose 4 KiB page the core's data TLB does not hold costs its second level's
-    // latency (SceneMemoryConfig::dtlb_entries; the ray and the scene pages share it): a tile of
-    // 64 x 64 spans some 330 pages of rays, a 16 x 16 tile 21.
     // A lane pays for its ray data beyond the L1D (beyond_l1_per_lane_cycles) where the caches
     // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays, and
     // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
@@ -143,13 +140,11 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
             record ? record_address(op.slots[i]) : k_slots + op.slots[i] * bytes;
         const uint64_t first_line = address / k_line, last_line = (address + bytes - 1) / k_line;
         const uint64_t from = first_line == last ? first_line + 1 : first_line;
-        uint32_t dtlb_misses = 0;
         const uint32_t level =
-            from <= last_line ? m_scene_memory->touch_other(
-                                    m_core, from * k_line,
-                                    uint32_t((last_line - from + 1) * k_line), now, &dtlb_misses)
-                              : 0;
-        m_group_beyond_lanes.back().dtlb_misses += dtlb_misses;
+            from <= last_line
+                ? m_scene_memory->touch_other(m_core, from * k_line,
+                                              uint32_t((last_line - from + 1) * k_line), now)
+                : 0;
         if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) {
             ++m_group_beyond_lanes.back().l1;
             m_group_beyond_lanes.back().l2 += level > 1;
@@ -418,9 +413,6 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
                               passed, t.first == 0, beyond.l1 / group_lanes,
                               beyond.l2 / group_lanes, op.failed_candidates)) +
-        // Its ray lines' pages the data TLB missed, at the second-level TLB's latency.
-        (beyond.dtlb_misses ? double(beyond.dtlb_misses) * m_scene_memory->dtlb_miss_cycles()
-                            : 0.0) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
         // A call cold: a shading filter's (the material sort's once, on its first filter) and a

@@ -135,10 +135,9 @@ class CoreModel {
     std::vector<uint64_t> m_group_lane_stall;
     // Per op whose ray lines a CPU core reads (touch_ray_lines): where its groups' entries start
     // in m_group_beyond_lanes (k_none otherwise); per such group, its lanes that pay for ray data
-    // beyond the L1D, and of them those beyond the L2 too; and its ray lines whose page the
-    // data TLB missed (SceneMemoryConfig::dtlb_entries).
+    // beyond the L1D, and of them those beyond the L2 too.
     struct BeyondLanes {
-        uint32_t l1 = 0, l2 = 0, dtlb_misses = 0;
+        uint32_t l1 = 0, l2 = 0;
     };
     std::vector<size_t> m_group_beyond_offset;
     std::vector<BeyondLanes> m_group_beyond_lanes;

@@ -138,14 +138,6 @@ double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, u
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
-double expected_dtlb_misses(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                            uint32_t lane_bytes, uint32_t entries) {
-    if (entries == 0 || lanes == 0) return 0.0;
-    const uint32_t reach_kib = uint32_t(uint64_t(entries) * k_prefetch_page_bytes / 1024);
-    return beyond_cache_fraction(slots, slot_bytes, reach_kib) *
-           expected_lanes_opening_pages(lanes, slots, lane_bytes);
-}
-
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {
     return buffer.slot_bytes ? buffer.slot_bytes : record_bytes;
 }

@@ -169,14 +169,6 @@ uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_array
 // frames came out 7-15 % over the measured.
 double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                           uint32_t cache_kib);
-
-// The data-TLB misses expected of a stream of `lanes` random slots, in increasing order, of a
-// buffer of `slots` slots of `slot_bytes` whose every page was used in random order just before
-// (a microbenchmark's repetition): of the pages its lanes open (lane_bytes each, laid slot after
-// slot, as the cycle model lays a lane's ray data: lane_ray_bytes), those outside the TLB's
-// reach of `entries` 4 KiB pages (SceneMemoryConfig::dtlb_entries; 0: none).
-double expected_dtlb_misses(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                            uint32_t lane_bytes, uint32_t entries);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);

@@ -940,63 +940,6 @@ TEST_CASE("A lane beyond the L2 as well pays for both levels where it opens a pa
     CHECK(passes(128) == 2 * 256 + 16 * (8 + 5) + 16 * 8);
 }
 
-TEST_CASE("A ray line whose page the data TLB does not hold costs the TLB's miss",
-          "[host][systemc]") {
-    // The box tests above (1024 records, 64 KiB in 16 pages, and node 3's page) at 1 GHz: a
-    // miss of 3 ns is 3 cycles; the lanes after a page's first find it in the TLB.
-    auto passes = [](uint32_t entries) {
-        HwConfig host = host_with({cost("box_test", 0, 4, 0, 0, 0)});
-        host.scene_memory.dtlb_entries = entries;
-        host.scene_memory.dtlb_miss_ns = 3.0;
-        return time_boxes(host, 2, 1024, 1024).stages[0][size_t(OpStage::traversal)].busy_cycles;
-    };
-    const uint64_t none = passes(0);
-    CHECK(none == 2 * 256);
-    // 8 entries hold half the pages: each pass misses on all 16 (least recently used out).
-    CHECK(passes(8) == none + 2 * 16 * 3);
-    // 32 hold them all: only the first pass misses, on pages never used before.
-    CHECK(passes(32) == none + 16 * 3);
-}
-
-TEST_CASE("A microbenchmark's data-TLB misses are its stream's pages beyond the TLB's reach",
-          "[host]") {
-    // 1024 slots of 64 bytes (16 pages) within 96 entries' reach: none.
-    CHECK(expected_dtlb_misses(1024, 1024, 64, 64, 96) == 0.0);
-    // 4096 slots of 330 bytes (330 pages, used in random order just before): of the 64 pages
-    // a dense box test's records open, those beyond the 96 the TLB holds.
-    const double opened = expected_lanes_opening_pages(4096, 4096, 64);
-    CHECK(opened == Approx(64.0));
-    CHECK(expected_dtlb_misses(4096, 4096, 330, 64, 96) ==
-          Approx(opened * (1.0 - 96.0 * 4096 / (4096.0 * 330))));
-    CHECK(
-        expected_dtlb_misses(16, 4096, 330, 266, 96) ==
-        Approx(expected_lanes_opening_pages(16, 4096, 266) * (1.0 - 96.0 * 4096 / (4096.0 * 330))));
-    CHECK(expected_dtlb_misses(4096, 4096, 330, 64, 0) == 0.0);  // no TLB modelled
-    CHECK(expected_dtlb_misses(0, 4096, 330, 64, 96) == 0.0);
-}
-
-TEST_CASE("The data TLB's reach and miss cost come from the page chases' step", "[host]") {
-    // The Intel Xeon VM's (2026-12-06): 1.22 ns to 96 pages, 2.9 ns beyond.
-    std::vector<std::pair<uint32_t, double>> chases = {{16, 1.22},  {64, 1.22},  {96, 1.23},
-                                                       {112, 2.85}, {128, 2.93}, {384, 2.93}};
-    SeenDataTlb seen = data_tlb_seen(chases);
-    CHECK(seen.entries == 96);
-    CHECK(seen.miss_ns == Approx(1.71));
-    // A chase over 96 pages already a third of the way up: the TLB holds 64 for sure.
-    chases[2].second = 1.80;
-    CHECK(data_tlb_seen(chases).entries == 64);
-    // No step (huge pages, or a TLB past the chases): none.
-    for (auto& c : chases) c.second = 1.22;
-    seen = data_tlb_seen(chases);
-    CHECK(seen.entries == 0);
-    CHECK(seen.miss_ns == 0.0);
-    CHECK(data_tlb_seen({}).entries == 0);
-    // The chase itself: one line a page, every line in the L1D, a load of a few ns at most.
-    const double ns = measure_page_chase_ns(16, measure_tsc_mhz(0.05));
-    CHECK(ns > 0.0);
-    CHECK(ns < 50.0);
-}
-
 TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
           "[host][systemc]") {
     // A shading op over slots 0-1023, then a box test over them (their records: 16 pages of
@@ -1069,7 +1012,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
     host.dram_span_latencies = {{2, 78.5}, {16, 155.5}, {256, 294.2}};
     host.pair_fill = {21.5, 148.0};  // the odd lines came from the L3: pairs
-    host.page_chases = {{16, 1.2}, {96, 1.25}, {128, 2.9}, {384, 2.95}};
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
     host.branch_predictor.one_ray_mispredict_cycles = 72.5;
@@ -1110,10 +1052,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.scene_memory.dram_latency_by_span[1].span_mib == Approx(16));
     CHECK(c.scene_memory.dram_latency_by_span[1].latency_ns == Approx(155.5));
     CHECK(yaml.find("first pass of a random chase") != std::string::npos);
-    CHECK(c.scene_memory.dtlb_entries == 96);
-    CHECK(c.scene_memory.dtlb_miss_ns == Approx(1.75));
-    CHECK(yaml.find("chases of one line a 4 KiB page (data_tlb_seen): 16 1.20, 96 1.25, 128 "
-                    "2.90, 384 2.95 ns") != std::string::npos);
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].beyond_l2_per_lane_cycles == Approx(6.5));
