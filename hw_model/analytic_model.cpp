@@ -255,9 +255,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
     const double units = double(std::max(1u, c.simd.units));
     const double agu_rate = double(c.agu.count) * c.agu.addresses_per_cycle;
     const double occupancy = c.ray_buffer.pipelined ? 1.0 : c.ray_buffer.access_latency_cycles;
-    std::array<std::vector<LaneRayArray>, k_op_kind_count> lane_arrays;
-    for (size_t k = 0; k < k_op_kind_count; ++k)
-        lane_arrays[k] = parse_lane_ray_arrays(costs[OpKind(k)].cost.ray_arrays);
     for (const auto& [key, bucket] : profile.buckets()) {
         const auto& [secondary, kind, length] = key;
         if (length == 0) continue;
@@ -278,16 +275,6 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             c.scene_memory.caches.size() > 1
                 ? slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()),
                                      op_stage, c.scene_memory.caches[1].kib)
-                : 0.0;
-        // A CPU core's data-TLB misses on the pages of the op's ray arrays (the cycle model's
-        // order of pages, here as expected of a tile's buffer used in random order), at the
-        // TLB's miss cost.
-        const double dtlb_cycles =
-            c.ray_buffer.storage == "l1d" && c.scene_memory.dtlb_entries > 0
-                ? expected_dtlb_misses(length, std::max(1u, shape.slots()),
-                                       slot_bytes_of(c.ray_buffer, layout.bytes()),
-                                       lane_arrays[size_t(kind)], c.scene_memory.dtlb_entries) *
-                      c.scene_memory.dtlb_miss_ns * c.clock.core_mhz / 1000.0
                 : 0.0;
         const double opening_share =
             beyond_l1 > 0
@@ -317,8 +304,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                                beyond_l2 * opening_share, double(bucket.failed_candidates) / ops) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
-                (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0) +
-                (g == 0 ? dtlb_cycles : 0.0);
+                (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);
             busy_sum += busy;
             if (l1d) {
                 // A CPU core: nothing besides the measured cost; the groups run back to back.

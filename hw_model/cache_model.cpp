@@ -297,8 +297,6 @@ SceneMemoryModel::SceneMemoryModel(const SceneMemoryConfig& config, double core_
       m_core_mhz(core_mhz),
       m_span_bytes(span_bytes),
       m_pages(config.dram_latency_by_span.empty() ? 0 : std::max(1u, cores)),
-      m_tlb_pages(config.dtlb_entries == 0 ? 0 : std::max(1u, cores)),
-      m_dtlb_miss_cycles(config.dtlb_entries == 0 ? 0.0 : config.dtlb_miss_ns * core_mhz / 1000.0),
       // GB/s at core_mhz cycles per microsecond: bytes per cycle = GB/s * 1000 / MHz.
       m_dram(config.dram_bandwidth_gbps * 1000.0 / core_mhz),
       m_fills(k_fills) {
@@ -317,15 +315,8 @@ SetAssociativeCache& SceneMemoryModel::instance(uint32_t level, uint32_t core) {
     return v[v.size() == 1 ? 0 : core % v.size()];
 }
 
-uint64_t SceneMemoryModel::use_page(uint32_t core, uint64_t address, bool through_tlb) {
-    if (through_tlb && !m_tlb_pages.empty()) m_tlb_pages[core % m_tlb_pages.size()].use(address);
+uint64_t SceneMemoryModel::use_page(uint32_t core, uint64_t address) {
     return m_pages.empty() ? 0 : m_pages[core % m_pages.size()].use(address);
-}
-
-bool SceneMemoryModel::dtlb_misses(uint32_t core, uint64_t address) {
-    // The page again right after itself is 0 pages away (PageRecency::use): a hit.
-    return !m_tlb_pages.empty() &&
-           m_tlb_pages[core % m_tlb_pages.size()].use(address) >= m_config.dtlb_entries;
 }
 
 uint32_t SceneMemoryModel::look_up(uint32_t core, uint64_t line, uint64_t now) {
@@ -349,7 +340,7 @@ uint32_t SceneMemoryModel::touch_other(uint32_t core, uint64_t address, uint32_t
     for (uint64_t line = address / m_line_bytes; line <= (address + bytes - 1) / m_line_bytes;
          ++line) {
         const uint64_t at = line * m_line_bytes;
-        use_page(core, at, false);  // the TLB sees the ray arrays' pages instead (dtlb_misses)
+        use_page(core, at);
         const uint32_t level = m_shared ? m_shared->level_of(m_reader, at)
                                         : first_holding(levels, at, now - std::min(now, m_paused),
                                                         [&](uint32_t l) -> SetAssociativeCache& {

@@ -179,13 +179,6 @@ class SceneMemoryModel {
     // Returns the farthest level any of them came from (0: every line was in the first level;
     // level_count(): DRAM).
     uint32_t touch_other(uint32_t core, uint64_t address, uint32_t bytes, uint64_t now);
-    // A CPU core's first-level data TLB (SceneMemoryConfig::dtlb_entries): whether `core`'s use
-    // of the 4 KiB page of `address` (a ray-buffer array's, as the tracer lays them out) misses
-    // it. Its pages are the core's last used, least recently used out: these and the scene's
-    // reads' (read, warm), not touch_other's lines (the ray data's lines as the caches see it).
-    bool dtlb_misses(uint32_t core, uint64_t address);
-    // What such a miss costs (SceneMemoryConfig::dtlb_miss_ns), in core cycles.
-    double dtlb_miss_cycles() const { return m_dtlb_miss_cycles; }
     // The same read issued at cycle 0 (for code that keeps no time).
     uint64_t read(uint64_t address, uint32_t bytes) { return read(0, address, bytes, 0); }
 
@@ -203,10 +196,9 @@ class SceneMemoryModel {
 
   private:
     SetAssociativeCache& instance(uint32_t level, uint32_t core);
-    // Records the use of `address`'s page by `core` (in the data TLB's order too, where
-    // `through_tlb`); returns PageRecency::use's distance (0 when DRAM's latency does not
-    // depend on it).
-    uint64_t use_page(uint32_t core, uint64_t address, bool through_tlb = true);
+    // Records the use of `address`'s page by `core`; returns PageRecency::use's distance (0
+    // when DRAM's latency does not depend on it).
+    uint64_t use_page(uint32_t core, uint64_t address);
     // The nearest level holding `line` for `core` at cycle `now` (level_count(): DRAM), counted.
     uint32_t look_up(uint32_t core, uint64_t line, uint64_t now);
 
@@ -233,8 +225,6 @@ class SceneMemoryModel {
     double m_core_mhz;
     uint64_t m_span_bytes;
     std::vector<PageRecency> m_pages;  // per core; none without dram_latency_by_span
-    std::vector<PageRecency> m_tlb_pages;  // per core, the data TLB's order; none without one
-    double m_dtlb_miss_cycles = 0.0;
     uint32_t m_line_bytes;
     RateServer m_dram;  // bytes per cycle
     uint64_t m_dram_reads = 0, m_requests = 0;

@@ -49,19 +49,6 @@ CoreModel::CoreModel(const HwConfig& config, const OpCostTable& costs, const Sce
       m_unit_carry(config.simd.units, 0.0),
       m_unit_stage(config.simd.units, 0) {
     if (config.branch_predictor.kind == "tage") m_predictor = std::make_unique<TagePredictor>();
-    // Each kind's ray arrays, numbered by name across kinds (the arrays two ops share are one
-    // array's pages); "ray" and "next_ray" trade places each generation (k_ray_arrays).
-    std::vector<std::string> names;
-    for (size_t k = 0; m_l1d && config.scene_memory.dtlb_entries > 0 && k < k_op_kind_count; ++k)
-        for (const LaneRayArray& a : parse_lane_ray_arrays(m_costs[OpKind(k)].cost.ray_arrays)) {
-            uint32_t id = a.name == "ray" ? k_current_rays : a.name == "next_ray" ? k_next_rays : 0;
-            if (id == 0) {
-                const auto at = std::find(names.begin(), names.end(), a.name);
-                id = 2 + uint32_t(at - names.begin());
-                if (at == names.end()) names.push_back(a.name);
-            }
-            m_lane_arrays[k].push_back({id, a.bytes});
-        }
 }
 
 const std::vector<uint8_t>& CoreModel::node_leaf() const {
@@ -129,17 +116,11 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // touched again. A tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5
     // core's L2.
     constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
-    constexpr uint64_t k_arrays = uint64_t(1) << 46;
     constexpr uint64_t k_line = 64;
     const bool record = op.stage != OpStage::shading;
     const uint64_t bytes =
         lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));
     const uint32_t page_bytes = lane_page_bytes_of(m_config.ray_buffer, m_record_bytes, op.stage);
-    // A lane's page of each ray array its op reads or writes (OpCostConfig::ray_arrays, the
-    // tracer's structure of arrays, each in a range of its own: k_arrays) that the core's data
-    // TLB does not hold costs the TLB's miss (SceneMemoryConfig::dtlb_entries; the scene's pages
-    // share it): a 64 x 64 tile's Lambertian lanes (path, surface, next ray and its set-up:
-    // 305 bytes a slot) span some 300 pages, a 32 x 32 tile's 76.
     // A lane pays for its ray data beyond the L1D (beyond_l1_per_lane_cycles) where the caches
     // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays, and
     // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
@@ -164,15 +145,6 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
                 ? m_scene_memory->touch_other(m_core, from * k_line,
                                               uint32_t((last_line - from + 1) * k_line), now)
                 : 0;
-        for (const LaneArray& a : m_lane_arrays[size_t(op.kind)]) {
-            // Generation g's rays are array g mod 2 (the tracer's ray[cur]), its next ones the
-            // other.
-            const uint32_t id = a.id == k_current_rays ? op.generation % 2
-                                : a.id == k_next_rays  ? (op.generation + 1) % 2
-                                                       : a.id;
-            m_group_beyond_lanes.back().dtlb_misses += m_scene_memory->dtlb_misses(
-                m_core, k_arrays + (uint64_t(id) << 36) + uint64_t(op.slots[i]) * a.bytes);
-        }
         if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) {
             ++m_group_beyond_lanes.back().l1;
             m_group_beyond_lanes.back().l2 += level > 1;
@@ -441,9 +413,6 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
                               passed, t.first == 0, beyond.l1 / group_lanes,
                               beyond.l2 / group_lanes, op.failed_candidates)) +
-        // Its ray lines' pages the data TLB missed, at the second-level TLB's latency.
-        (beyond.dtlb_misses ? double(beyond.dtlb_misses) * m_scene_memory->dtlb_miss_cycles()
-                            : 0.0) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
         // A call cold: a shading filter's (the material sort's once, on its first filter) and a

@@ -7,7 +7,6 @@
 // prices a step at the cycle a process asks, so the order of requests in flight decides the
 // conflicts. Tests drive it directly, without a kernel.
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -136,20 +135,12 @@ class CoreModel {
     std::vector<uint64_t> m_group_lane_stall;
     // Per op whose ray lines a CPU core reads (touch_ray_lines): where its groups' entries start
     // in m_group_beyond_lanes (k_none otherwise); per such group, its lanes that pay for ray data
-    // beyond the L1D, and of them those beyond the L2 too; and its lanes' ray-array pages the
-    // data TLB missed (SceneMemoryConfig::dtlb_entries).
+    // beyond the L1D, and of them those beyond the L2 too.
     struct BeyondLanes {
-        uint32_t l1 = 0, l2 = 0, dtlb_misses = 0;
+        uint32_t l1 = 0, l2 = 0;
     };
     std::vector<size_t> m_group_beyond_offset;
     std::vector<BeyondLanes> m_group_beyond_lanes;
-    // Per op kind, the ray arrays its lanes use (OpCostConfig::ray_arrays): a number per array
-    // name, the generation's rays and the next ones' apart; none without a data TLB.
-    struct LaneArray {
-        uint32_t id = 0, bytes = 0;
-    };
-    static constexpr uint32_t k_current_rays = ~0u, k_next_rays = ~0u - 1;
-    std::array<std::vector<LaneArray>, k_op_kind_count> m_lane_arrays;
     static constexpr size_t k_none = ~size_t(0);
     // When the scene data a group waits for (its op's, its lanes') has arrived.
     uint64_t scene_ready(const GroupToken& t) const;

@@ -251,8 +251,7 @@ Chase random_chase(uint64_t bytes) {
 }
 
 // Nanoseconds a load over `loads` loads along `chase` from the word `at` (left where they end).
-template <class Words>
-double chase_pass_ns(const Words& chase, size_t& at, size_t loads, double tsc_mhz) {
+double chase_pass_ns(const Chase& chase, size_t& at, size_t loads, double tsc_mhz) {
     const uint64_t c0 = __rdtsc();
     for (size_t i = 0; i < loads; ++i) at = chase[at];
     const uint64_t c1 = __rdtsc();
@@ -292,24 +291,6 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
     if (at == size_t(-1)) std::printf(" ");  // keeps the chase
     if (step_ns) *step_ns = best / tsc_mhz * 1000.0;
     return std::max(0.0, best - spin_best) / tsc_mhz * 1000.0;
-}
-
-double measure_page_chase_ns(uint32_t pages, double tsc_mhz) {
-    // 4 KiB pages, as the ray buffers' (std::vector, never advised for huge pages); page p's line
-    // at line (7 p mod 64) of it, so that the lines spread over the L1D's sets.
-    constexpr size_t k_page_words = 4096 / sizeof(size_t);
-    std::vector<size_t> chase(size_t(pages) * k_page_words);
-    std::vector<size_t> order(pages);
-    for (size_t p = 0; p < pages; ++p) order[p] = p * k_page_words + (p * 7 % 64) * k_chase_stride;
-    std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(12345));
-    for (size_t p = 0; p < pages; ++p) chase[order[p]] = order[(p + 1) % pages];
-    size_t at = 0;
-    for (size_t i = 0; i < 4 * size_t(pages); ++i) at = chase[at];  // warm
-    constexpr size_t k_loads = 1u << 12;
-    double best = 1e30;
-    for (int rep = 0; rep < 64; ++rep)
-        best = std::min(best, chase_pass_ns(chase, at, k_loads, tsc_mhz));
-    return best;
 }
 
 void evict_caches() {
@@ -432,17 +413,6 @@ SeenLevel last_level_seen(const HostDescription& h) {
     return seen;
 }
 
-SeenDataTlb data_tlb_seen(const std::vector<std::pair<uint32_t, double>>& page_chases) {
-    SeenDataTlb seen;
-    if (page_chases.size() < 2) return seen;
-    const double hit = page_chases.front().second, far = page_chases.back().second;
-    if (far - hit < 0.2) return seen;
-    for (const auto& [pages, ns] : page_chases)
-        if (ns <= hit + 0.25 * (far - hit)) seen.entries = std::max(seen.entries, pages);
-    seen.miss_ns = far - hit;
-    return seen;
-}
-
 void chase_last_level(HostDescription& h) {
     h.last_level_chases.clear();
     h.last_level_idle_chases.clear();
@@ -486,8 +456,6 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
         h.latency_ns.push_back(measure_load_latency_ns(uint64_t(c.kib) * 1024 / 2, h.tsc_mhz));
     }
     h.pair_fill = measure_pair_fill(h.tsc_mhz);
-    for (const uint32_t pages : k_page_chase_pages)
-        h.page_chases.emplace_back(pages, measure_page_chase_ns(pages, h.tsc_mhz));
     // DRAM: in huge pages, as the BVH's nodes and leaf primitives are.
     h.latency_ns.push_back(measure_load_latency_ns(k_beyond_last_level_bytes, h.tsc_mhz));
     // And by span, from a few MiB (a small scene's data) to 256 MiB.
@@ -535,9 +503,6 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     if (h.latency_ns.size() > h.caches.size()) c.scene_memory.dram_latency_ns = h.latency_ns.back();
     for (const auto& [mib, ns] : h.dram_span_latencies)
         c.scene_memory.dram_latency_by_span.push_back({mib, ns});
-    const SeenDataTlb tlb = data_tlb_seen(h.page_chases);
-    c.scene_memory.dtlb_entries = tlb.entries;
-    c.scene_memory.dtlb_miss_ns = tlb.miss_ns;
     // Caches and DRAM from another file of this machine; the prefetch and hit reads below are
     // this tracer's whoever measured them.
     if (!h.memory_source.empty()) c.scene_memory = h.memory;
@@ -651,21 +616,6 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
             y << "    - {span_mib: " << fmt(s.span_mib, s.span_mib < 1 ? 3 : 0)
               << ", latency_ns: " << fmt(s.latency_ns, 1) << "}\n";
     }
-    if (c.scene_memory.dtlb_entries > 0 || !h.memory_source.empty()) {
-        y << "  dtlb_entries: " << c.scene_memory.dtlb_entries << "  # ";
-        if (h.memory_source.empty()) {
-            y << "measured: chases of one line a 4 KiB page (data_tlb_seen):";
-            for (const auto& [pages, ns] : h.page_chases)
-                y << " " << pages << " " << fmt(ns, 2)
-                  << (pages == h.page_chases.back().first ? " ns" : ",");
-        } else {
-            y << "as " << h.memory_source << " describes it";
-        }
-        y << "\n  dtlb_miss_ns: " << fmt(c.scene_memory.dtlb_miss_ns, 2) << "  # "
-          << (h.memory_source.empty() ? "measured: the same chases' step, most pages' over fewest"
-                                      : "as " + h.memory_source + " describes it")
-          << " (a ray line's page the data TLB misses)\n";
-    }
     y << "  dram_bandwidth_gbps: " << fmt(c.scene_memory.dram_bandwidth_gbps, 1)
       << "  # assumed: not measured; DRAM lines queue for it\n"
       << "  prefetch_depth: 0  # the native tracer prefetches no op by its place in the order\n"
@@ -757,7 +707,6 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
                       : std::string())
               << (o.cold_call_cycles > 0 ? ", cold_call_cycles: " + fmt(o.cold_call_cycles, 2)
                                          : std::string())
-              << (o.ray_arrays.empty() ? std::string() : ", ray_arrays: \"" + o.ray_arrays + "\"")
               << "}\n";
     }
     return y.str();

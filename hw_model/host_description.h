@@ -93,9 +93,6 @@ struct HostDescription {
     // (measure_dram_first_pass_ns): SceneMemoryConfig::dram_latency_by_span.
     std::vector<std::pair<double, double>> dram_span_latencies;
     PairFillReading pair_fill;  // the last level's CacheLevelConfig::pair_fill (0: not measured)
-    // Chases of one line a 4 KiB page (pages, ns a load), fewest pages first, the lines held
-    // by the L1D throughout: data_tlb_seen reads the first-level data TLB from these.
-    std::vector<std::pair<uint32_t, double>> page_chases;
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     uint32_t slot_arrays = 1;        // the arrays it lies in beyond its traversal record
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
@@ -142,15 +139,6 @@ double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs 
 PairFillReading measure_pair_fill(double tsc_mhz, uint64_t pair_bytes = uint64_t(1) << 20,
                                   int runs = 5);
 
-// A random cyclic chase of one line a 4 KiB page over `pages` pages (ns a load, the fastest of
-// many short runs): the lines stay in the L1D (at most 384 pages: 24 KiB of lines), so what
-// grows with the pages is the data TLB's misses. On the Intel Xeon VM (2026-12-06) 1.22 ns to
-// 96 pages, 2.9 ns from 128 to 768.
-double measure_page_chase_ns(uint32_t pages, double tsc_mhz);
-// The page chases describe_host runs (HostDescription::page_chases).
-constexpr uint32_t k_page_chase_pages[] = {16, 24, 32,  40,  48,  56,  64,  72,  80,
-                                           88, 96, 104, 112, 128, 160, 192, 256, 384};
-
 // Runs the last level's chases (HostDescription::last_level_chases and
 // last_level_idle_chases) from `h.caches` at `h.tsc_mhz`; none with fewer than two levels.
 // describe_host runs it, and the silicon check again around its renders: the L3 a core of a
@@ -174,17 +162,6 @@ struct SeenLevel {
     bool cut = false;                  // ends short of what cpuid reports
 };
 SeenLevel last_level_seen(const HostDescription& host);
-
-// The first-level data TLB as page_chases see it (SceneMemoryConfig::dtlb_entries and
-// dtlb_miss_ns): `entries` the most pages whose chase took at most a quarter of the way from
-// the fewest pages' latency to the most pages' (a chase is a cycle: a least-recently-used TLB
-// of fewer entries than its pages misses on every load), `miss_ns` that whole way. None (0
-// entries) where the way is under 0.2 ns (no step: huge pages, or a TLB beyond the chases).
-struct SeenDataTlb {
-    uint32_t entries = 0;
-    double miss_ns = 0.0;
-};
-SeenDataTlb data_tlb_seen(const std::vector<std::pair<uint32_t, double>>& page_chases);
 
 // Measures what describe_host needs (the ISA comes from the caller: kernels/simd/isa.h);
 // without `measure_memory`, no load latencies or chases (the caller sets memory_source).

@@ -1,26 +1,26 @@
 #include "hw_model/hw_config.h"
 
+#include "base/strict_yaml.h"
+
 #include <yaml-cpp/yaml.h>
 
-#include <algorithm>
 #include <cerrno>
+#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <string_view>
+#include <sstream>
 
+#include "kernels/trace.h"
+#include "hw_model/tech_table.h"
 #include "base/input_error.h"
 #include "base/shipped_files.h"
-#include "base/strict_number.h"
-#include "base/strict_yaml.h"
 #include "base/user_files.h"
-#include "hw_model/ray_buffer_model.h"
-#include "hw_model/tech_table.h"
-#include "kernels/trace.h"
+#include "base/strict_number.h"
 
 #ifndef SFX_PRESET_DIR
 #define SFX_PRESET_DIR "hw_model/presets"
@@ -283,11 +283,6 @@ void check_hw_config(const HwConfig& c, const std::string& file, const HwLineMap
         const std::string key = "op_costs[" + std::to_string(i) + "].op";
         if (op_kind_named(op) == OpKind::count)
             fail(key, "'" + op + "' is not an op kind (kernels/trace.h)");
-        try {
-            parse_lane_ray_arrays(c.op_costs[i].ray_arrays);
-        } catch (const std::invalid_argument& e) {
-            fail("op_costs[" + std::to_string(i) + "].ray_arrays", e.what());
-        }
         if (!ops.insert(op).second) fail(key, "'" + op + "' has two cost entries");
     }
     const std::string unknown = unknown_tech_reason(c.tech.node);

@@ -305,14 +305,6 @@ struct SceneMemoryConfig {
     // tracer's surface_at reads the mesh's own arrays (a 16-byte triangle record indexed by
     // primitive, then its vertices), not the copies its leaf tests read in BVH order.
     std::string hit_reads = "primitives";
-    // A CPU core's first-level data TLB over the ray buffers' pages (storage l1d): a ray line
-    // whose 4 KiB page is not among the `dtlb_entries` pages its core used last (ray and scene
-    // pages alike, least recently used out) costs `dtlb_miss_ns` more, the latency a chase of
-    // one line a page adds past the TLB's reach (the second-level TLB's hit). 0 entries (the
-    // default, G&R's machine): no TLB. Where the scene's reads miss it, their latencies are the
-    // chases' that measured them.
-    uint32_t dtlb_entries = 0;
-    double dtlb_miss_ns = 0.0;
 
     template <class V>
     void visit(V& v) {
@@ -335,12 +327,6 @@ struct SceneMemoryConfig {
                  "where a lane's hit primitive is read when its surface is computed: "
                  "primitives (the record its intersection test fetched) or mesh (separate "
                  "triangle and vertex arrays, as the native tracer's surface_at reads)");
-        v.param("dtlb_entries", dtlb_entries, "pages",
-                "a CPU core's first-level data TLB: the 4 KiB pages it holds (least recently "
-                "used out; 0: none)",
-                0u, 1u << 16);
-        v.param("dtlb_miss_ns", dtlb_miss_ns, "ns",
-                "what a ray line whose page the first-level data TLB misses costs more", 0.0, 1e3);
     }
 };
 
@@ -680,11 +666,6 @@ struct OpCostConfig {
     // 12.6 % to 11.5 / 10.4 / 9.8 %, and every cornell cell's tiles ranked right.
     // 0: not measured.
     double cold_call_cycles = 0.0;
-    // The ray-buffer arrays a lane of this op reads or writes, its made rays' set-up included
-    // ("name:bytes" a slot, space-separated: parse_lane_ray_arrays in ray_buffer_model.h): the
-    // pages the core's data TLB holds for it (SceneMemoryConfig::dtlb_entries). Written by `sfx
-    // calibrate` from the native tracer's filters (kernels/stream); empty: none counted.
-    std::string ray_arrays;
 
     template <class V>
     void visit(V& v) {
@@ -775,9 +756,6 @@ struct OpCostConfig {
                 "call right after another, on its first group: a shading op's every call, the "
                 "box test's where it starts a traversal (0: not measured)",
                 0.0, 1e9);
-        v.param("ray_arrays", ray_arrays, "",
-                "the ray-buffer arrays a lane reads or writes, name:bytes a slot, "
-                "space-separated (its data-TLB pages; empty: none)");
     }
 };
 

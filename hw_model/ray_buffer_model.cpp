@@ -1,7 +1,6 @@
 #include "hw_model/ray_buffer_model.h"
 
 #include <algorithm>
-#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -137,39 +136,6 @@ double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, u
     if (lanes == 0) return 0.0;
     return beyond_cache_fraction(slots, slot_bytes, cache_kib) *
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
-}
-
-std::vector<LaneRayArray> parse_lane_ray_arrays(const std::string& text) {
-    std::vector<LaneRayArray> arrays;
-    std::istringstream in(text);
-    std::string item;
-    while (in >> item) {
-        const size_t colon = item.find(':');
-        LaneRayArray a;
-        a.name = item.substr(0, colon);
-        const std::string bytes = colon == std::string::npos ? "" : item.substr(colon + 1);
-        if (a.name.empty() || bytes.empty() ||
-            bytes.find_first_not_of("0123456789") != std::string::npos || bytes.size() > 6)
-            throw std::invalid_argument("'" + item + "' is not name:bytes");
-        a.bytes = uint32_t(std::stoul(bytes));
-        if (a.bytes == 0) throw std::invalid_argument("'" + item + "': an array of 0 bytes");
-        for (const LaneRayArray& b : arrays)
-            if (b.name == a.name) throw std::invalid_argument("'" + a.name + "' twice");
-        arrays.push_back(a);
-    }
-    return arrays;
-}
-
-double expected_dtlb_misses(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                            const std::vector<LaneRayArray>& arrays, uint32_t entries) {
-    if (entries == 0 || lanes == 0) return 0.0;
-    const uint32_t reach_kib = uint32_t(uint64_t(entries) * k_prefetch_page_bytes / 1024);
-    const double beyond = beyond_cache_fraction(slots, slot_bytes, reach_kib);
-    if (beyond <= 0.0) return 0.0;
-    double pages = 0.0;
-    for (const LaneRayArray& a : arrays)
-        pages += expected_lanes_opening_pages(lanes, slots, a.bytes);
-    return beyond * pages;
 }
 
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {

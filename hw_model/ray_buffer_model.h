@@ -10,7 +10,6 @@
 // access_latency cycles each when not), plus the pipeline fill once per chain.
 
 #include <cstdint>
-#include <string>
 #include <vector>
 
 #include "hw_model/hw_config.h"
@@ -170,24 +169,6 @@ uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_array
 // frames came out 7-15 % over the measured.
 double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                           uint32_t cache_kib);
-
-// The ray-buffer arrays a lane of an op reads or writes on a CPU core (OpCostConfig::ray_arrays:
-// "name:bytes" a slot each, space-separated, the native tracer's structure of arrays; its made
-// rays' set-up included). "ray" and "next_ray" name the current and the next generation's rays,
-// two arrays that trade places every generation. Throws std::invalid_argument where the text is
-// not such a list.
-struct LaneRayArray {
-    std::string name;
-    uint32_t bytes = 0;
-};
-std::vector<LaneRayArray> parse_lane_ray_arrays(const std::string& text);
-
-// The data-TLB misses expected of a stream of `lanes` random slots, in increasing order, of a
-// buffer of `slots` slots of `slot_bytes` whose every page was used in random order just before
-// (a microbenchmark's repetition): of the pages its lanes open in each of their `arrays`, those
-// outside the TLB's reach of `entries` 4 KiB pages (SceneMemoryConfig::dtlb_entries; 0: none).
-double expected_dtlb_misses(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                            const std::vector<LaneRayArray>& arrays, uint32_t entries);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);

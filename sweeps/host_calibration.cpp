@@ -448,25 +448,15 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::vector<OpCostSample> failing_candidates;    // the triangle test's
     std::vector<OpCostSample> sphere_hits;           // the emission filter's on sphere hits
     std::map<OpKind, std::vector<double>> cold_calls;  // a shading op's, one a length
-    // The data TLB the host file carries: the model adds its misses to every op's cost, so the
-    // points' expected misses come off before the fit, as the model's mispredictions do.
-    const HwConfig described = host_hw_config(c.host, {});
-    const double dtlb_miss_cycles =
-        described.scene_memory.dtlb_miss_ns * described.clock.core_mhz / 1000.0;
     for (const MicrobenchSample& s : c.samples) {
         if (s.cold_call_timed) cold_calls[s.kind].push_back(s.cold_call_cycles);
-        const double cycles =
-            s.cycles - dtlb_miss_cycles *
-                           expected_dtlb_misses(s.lanes, s.slots, slot_bytes,
-                                                parse_lane_ray_arrays(stream_op_ray_arrays(s.kind)),
-                                                described.scene_memory.dtlb_entries);
         if (s.lanes == 1 && one_lane_from_filters(s.kind)) {
-            one_lane[s.kind].push_back({1, s.passed, 0.0, cycles, s.failed_candidates});
+            one_lane[s.kind].push_back({1, s.passed, 0.0, s.cycles, s.failed_candidates});
             continue;
         }
         const LanesBeyondCaches beyond =
             lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches);
-        const OpCostSample sample{s.lanes,  s.passed, beyond.l1, cycles, s.failed_candidates,
+        const OpCostSample sample{s.lanes,  s.passed, beyond.l1, s.cycles, s.failed_candidates,
                                   beyond.l2};
         std::vector<OpCostSample>* variant = s.thin_lens            ? &lens_camera
                                              : s.sphere_light       ? &sphere_light
@@ -505,7 +495,6 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             points += sphere_hits.size();
         }
         c.op_costs.back().cold_call_cycles = fit_cold_call_cycles(cold_calls[kind]);
-        c.op_costs.back().ray_arrays = stream_op_ray_arrays(kind);
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
         c.residuals_by_buffer.push_back(fit_residuals_by_buffer(
             c.op_costs.back(), c.host.simd_width, samples, slots_of[kind], options.buffer_slots));

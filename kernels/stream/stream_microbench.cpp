@@ -46,50 +46,6 @@ uint32_t stream_slot_arrays() {
     return uint32_t(std::size(k_slot_array_bytes));
 }
 
-std::string stream_op_ray_arrays(OpKind kind) {
-    auto array = [](const char* name, size_t bytes) {
-        return std::string(name) + ":" + std::to_string(bytes);
-    };
-    const std::string record = array("record", traversal_field::record * sizeof(float)),
-                      path = array("path", sizeof(PathState)), ray = array("ray", sizeof(Ray)),
-                      next = array("next_ray", sizeof(Ray)), pre = array("pre", sizeof(RayPrecomp)),
-                      hit = array("hit", sizeof(Hit)), any_hit = array("any_hit", 1),
-                      surf = array("surf", sizeof(SurfaceHit));
-    // load_rays over the rays made: each ray into its traversal record and constants, its hit
-    // and any-hit flag reset.
-    const std::string set_up = record + " " + pre + " " + hit + " " + any_hit;
-    switch (kind) {
-        case OpKind::camera:  // the tile's rays and paths, then their set-up
-            return path + " " + ray + " " + set_up;
-        case OpKind::box_test:
-            return record;
-        case OpKind::triangle_test:
-        case OpKind::sphere_test:  // a candidate's full test, and its hit when closer
-            return record + " " + pre + " " + hit;
-        case OpKind::shadow_filter:
-            return any_hit + " " + hit + " " + path;
-        case OpKind::miss_filter:
-            return hit + " " + path;
-        case OpKind::emission_filter:  // compute_surfaces first: ray, hit, surface
-            return ray + " " + hit + " " + surf + " " + path;
-        case OpKind::depth_filter:
-        case OpKind::ambient:
-            return path + " " + surf;
-        case OpKind::material_filter:
-            return surf;
-        case OpKind::lambertian_choice:
-            return path;
-        case OpKind::lambertian_direct:
-        case OpKind::lambertian_indirect:
-            return path + " " + surf + " " + next + " " + set_up;
-        case OpKind::dielectric:
-        case OpKind::glossy:
-            return path + " " + surf + " " + ray + " " + next + " " + set_up;
-        default:  // the seed options' traversal ops: the traversal record
-            return record;
-    }
-}
-
 namespace {
 
 // A floor (Lambertian), a glossy panel, a glass sphere and a light over them. `dense`: the

@@ -26,7 +26,6 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <string>
 #include <vector>
 
 #include "base/convergence.h"
@@ -46,11 +45,6 @@ uint32_t stream_slot_bytes();
 // lists and the mask are indexed by stream position, which ascends: RayBufferConfig::
 // slot_arrays).
 uint32_t stream_slot_arrays();
-// The ray-buffer arrays a lane of `kind` reads or writes in the stream tracer, as
-// OpCostConfig::ray_arrays lists them ("name:bytes" a slot; "ray" the generation's rays,
-// "next_ray" the next one's): a filter's own, and where it makes rays their set-up's (load_rays:
-// the traversal record, the full tests' constants, hit and any-hit flag).
-std::string stream_op_ray_arrays(OpKind kind);
 // Bytes per slot of the arrays a microbenchmark repetition over a buffer of `slots` slots asks
 // the caches to hold (its timed calls, their made rays' set-up and the touch before them): the
 // fit prices its points as if they were stream_slot_bytes.

@@ -15,7 +15,6 @@
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
-#include "kernels/stream/stream_microbench.h"
 #include "tests/hw_model/test_hosts.h"
 #include "workloads/scene_loader.h"
 
@@ -941,97 +940,6 @@ TEST_CASE("A lane beyond the L2 as well pays for both levels where it opens a pa
     CHECK(passes(128) == 2 * 256 + 16 * (8 + 5) + 16 * 8);
 }
 
-TEST_CASE("A lane's ray-array page the data TLB does not hold costs the TLB's miss",
-          "[host][systemc]") {
-    // The box tests above (their traversal records: 1024 of 64 bytes, 16 pages; node 3's page
-    // besides) at 1 GHz: a miss of 3 ns is 3 cycles; the lanes after a page's first find it.
-    auto passes = [](uint32_t entries) {
-        OpCostConfig box = cost("box_test", 0, 4, 0, 0, 0);
-        box.ray_arrays = "record:64";
-        HwConfig host = host_with({box});
-        host.scene_memory.dtlb_entries = entries;
-        host.scene_memory.dtlb_miss_ns = 3.0;
-        return time_boxes(host, 2, 1024, 1024).stages[0][size_t(OpStage::traversal)].busy_cycles;
-    };
-    const uint64_t none = passes(0);
-    CHECK(none == 2 * 256);
-    // 8 entries hold half the pages: each pass misses on all 16 (least recently used out).
-    CHECK(passes(8) == none + 2 * 16 * 3);
-    // 32 hold them all: only the first pass misses, on pages never used before.
-    CHECK(passes(32) == none + 16 * 3);
-}
-
-TEST_CASE("A microbenchmark's data-TLB misses are its stream's pages beyond the TLB's reach",
-          "[host]") {
-    const std::vector<LaneRayArray> record = parse_lane_ray_arrays("record:64");
-    // 1024 slots of 64 bytes (16 pages) within 96 entries' reach: none.
-    CHECK(expected_dtlb_misses(1024, 1024, 64, record, 96) == 0.0);
-    // 4096 slots of 330 bytes (330 pages, used in random order just before): of the 64 pages
-    // a dense box test's records open, those beyond the 96 the TLB holds.
-    const double beyond = 1.0 - 96.0 * 4096 / (4096.0 * 330);
-    CHECK(expected_dtlb_misses(4096, 4096, 330, record, 96) == Approx(64 * beyond).epsilon(0.01));
-    // A Lambertian lane's path and surface: the pages 16 random lanes open in each array.
-    const std::vector<LaneRayArray> two = parse_lane_ray_arrays("path:64 surf:44");
-    CHECK(expected_dtlb_misses(16, 4096, 330, two, 96) ==
-          Approx((expected_lanes_opening_pages(16, 4096, 64) +
-                  expected_lanes_opening_pages(16, 4096, 44)) *
-                 beyond));
-    CHECK(expected_dtlb_misses(4096, 4096, 330, record, 0) == 0.0);  // no TLB modelled
-    CHECK(expected_dtlb_misses(0, 4096, 330, record, 96) == 0.0);
-    CHECK(expected_dtlb_misses(4096, 4096, 330, {}, 96) == 0.0);  // no arrays named
-}
-
-TEST_CASE("An op's ray arrays are name:bytes a slot, as the stream tracer's filters use them",
-          "[host]") {
-    const std::vector<LaneRayArray> a = parse_lane_ray_arrays("path:64  surf:44 next_ray:28");
-    REQUIRE(a.size() == 3);
-    CHECK(a[1].name == "surf");
-    CHECK(a[1].bytes == 44);
-    CHECK(parse_lane_ray_arrays("").empty());
-    for (const char* bad : {"path", "path:", ":64", "path:0", "path:6x", "path:64 path:64"})
-        CHECK_THROWS_AS(parse_lane_ray_arrays(bad), std::invalid_argument);
-    // A host file that lists them wrong names the file, line and key.
-    try {
-        parse_hw_config("version: 1\nop_costs:\n  - {op: camera, ray_arrays: \"path\"}\n",
-                        "bad.hw.yaml");
-        FAIL("no error for an array without its bytes");
-    } catch (const InputError& e) {
-        CHECK_THAT(e.what(), Catch::Contains("bad.hw.yaml") &&
-                                 Catch::Contains("op_costs[0].ray_arrays") &&
-                                 Catch::Contains("'path' is not name:bytes"));
-    }
-    // The tracer's: every kind's parse; a Lambertian lane its path, surface and next ray and
-    // that ray's set-up; the choice its path alone; a box test its traversal record.
-    for (uint32_t k = 0; k < k_op_kind_count; ++k)
-        CHECK_NOTHROW(parse_lane_ray_arrays(stream_op_ray_arrays(OpKind(k))));
-    CHECK(stream_op_ray_arrays(OpKind::lambertian_choice) == "path:64");
-    CHECK(stream_op_ray_arrays(OpKind::box_test) == "record:64");
-    CHECK(stream_op_ray_arrays(OpKind::lambertian_direct) ==
-          "path:64 surf:44 next_ray:28 record:64 pre:60 hit:16 any_hit:1");
-}
-
-TEST_CASE("The data TLB's reach and miss cost come from the page chases' step", "[host]") {
-    // The Intel Xeon VM's (2026-12-06): 1.22 ns to 96 pages, 2.9 ns beyond.
-    std::vector<std::pair<uint32_t, double>> chases = {{16, 1.22},  {64, 1.22},  {96, 1.23},
-                                                       {112, 2.85}, {128, 2.93}, {384, 2.93}};
-    SeenDataTlb seen = data_tlb_seen(chases);
-    CHECK(seen.entries == 96);
-    CHECK(seen.miss_ns == Approx(1.71));
-    // A chase over 96 pages already a third of the way up: the TLB holds 64 for sure.
-    chases[2].second = 1.80;
-    CHECK(data_tlb_seen(chases).entries == 64);
-    // No step (huge pages, or a TLB past the chases): none.
-    for (auto& c : chases) c.second = 1.22;
-    seen = data_tlb_seen(chases);
-    CHECK(seen.entries == 0);
-    CHECK(seen.miss_ns == 0.0);
-    CHECK(data_tlb_seen({}).entries == 0);
-    // The chase itself: one line a page, every line in the L1D, a load of a few ns at most.
-    const double ns = measure_page_chase_ns(16, measure_tsc_mhz(0.05));
-    CHECK(ns > 0.0);
-    CHECK(ns < 50.0);
-}
-
 TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
           "[host][systemc]") {
     // A shading op over slots 0-1023, then a box test over them (their records: 16 pages of
@@ -1104,7 +1012,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     host.last_level_idle_chases = {{100.0, 15.5}, {1000.0, 140.0}};
     host.dram_span_latencies = {{2, 78.5}, {16, 155.5}, {256, 294.2}};
     host.pair_fill = {21.5, 148.0};  // the odd lines came from the L3: pairs
-    host.page_chases = {{16, 1.2}, {96, 1.25}, {128, 2.9}, {384, 2.95}};
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 61.5;
     host.branch_predictor.one_ray_mispredict_cycles = 72.5;
@@ -1145,10 +1052,6 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.scene_memory.dram_latency_by_span[1].span_mib == Approx(16));
     CHECK(c.scene_memory.dram_latency_by_span[1].latency_ns == Approx(155.5));
     CHECK(yaml.find("first pass of a random chase") != std::string::npos);
-    CHECK(c.scene_memory.dtlb_entries == 96);
-    CHECK(c.scene_memory.dtlb_miss_ns == Approx(1.75));
-    CHECK(yaml.find("chases of one line a 4 KiB page (data_tlb_seen): 16 1.20, 96 1.25, 128 "
-                    "2.90, 384 2.95 ns") != std::string::npos);
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].beyond_l2_per_lane_cycles == Approx(6.5));
