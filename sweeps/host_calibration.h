@@ -214,7 +214,7 @@ ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
 ModelledMispredictions replay_short_stream_predictor(const TraversalRecorder& others,
                                                      const TraversalRecorder& batch, uint32_t width,
                                                      const std::vector<uint8_t>& node_leaf,
-                                                     const std::string& predictor_kind = "tage");
+                                                     const std::string& predictor_kind);
 // The fitted one- and few-lane costs into each kind's OpCostConfig, and the box test's per-op
 // cost where the traversals measured it (its stream loop's, in a traversal).
 void set_short_stream_costs(const ShortStreamCosts& fit, std::vector<OpCostConfig>& costs);

@@ -51,10 +51,10 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     const std::vector<OneRaySample> one_ray = run_one_ray_microbenchmarks(
         isa, microbench_rule(3), 1,
         [&](const TraversalRecorder& others, const TraversalRecorder& batch) {
-            fresh_mispredictions +=
-                replay_short_stream_predictor([](TraceSink&) {}, batch, isa_width(isa), leaves)
-                    .total;
-            return replay_short_stream_predictor(others, batch, isa_width(isa), leaves);
+            fresh_mispredictions += replay_short_stream_predictor([](TraceSink&) {}, batch,
+                                                                  isa_width(isa), leaves, "tage")
+                                        .total;
+            return replay_short_stream_predictor(others, batch, isa_width(isa), leaves, "tage");
         });
     double primed_mispredictions = 0.0;
     for (const OneRaySample& s : one_ray) {
