@@ -433,6 +433,11 @@ void chase_last_level(HostDescription& h) {
     }
 }
 
+uint32_t latency_chase_kib(const std::vector<HostCacheLevel>& caches, size_t level) {
+    const uint32_t half = std::max(1u, caches[level].kib / 2);
+    return level == 0 ? half : std::min(half, 2 * caches[level - 1].kib);
+}
+
 HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool measure_memory) {
     HostDescription h;
     h.microarchitecture = read_microarchitecture();
@@ -444,7 +449,6 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
     h.caches = read_host_caches();
     if (!measure_memory) return h;
     for (size_t i = 0; i < h.caches.size(); ++i) {
-        const HostCacheLevel& c = h.caches[i];
         if (i > 0 && i + 1 == h.caches.size()) {
             chase_last_level(h);
             if (!h.last_level_chases.empty()) {
@@ -452,8 +456,8 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
                 continue;
             }
         }
-        // Half the level: it fits there, and not in the level before (which is smaller).
-        h.latency_ns.push_back(measure_load_latency_ns(uint64_t(c.kib) * 1024 / 2, h.tsc_mhz));
+        h.latency_ns.push_back(
+            measure_load_latency_ns(uint64_t(latency_chase_kib(h.caches, i)) << 10, h.tsc_mhz));
     }
     h.pair_fill = measure_pair_fill(h.tsc_mhz);
     // DRAM: in huge pages, as the BVH's nodes and leaf primitives are.
@@ -570,7 +574,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
         y << h.caches[i].source << "; latency measured (pointer chase over ";
         const bool chased = i + 1 == c.scene_memory.caches.size() && !h.last_level_chases.empty();
         if (!chased) {
-            y << h.caches[i].kib / 2 << " KiB)\n";
+            y << latency_chase_kib(h.caches, i) << " KiB)\n";
             continue;
         }
         const SeenLevel seen = last_level_seen(h);

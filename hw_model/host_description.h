@@ -39,6 +39,15 @@ double measure_tsc_mhz(double seconds = 0.2);
 double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin = 0,
                                double* step_ns = nullptr);
 
+// The KiB a chase spans to read cache level `level`'s latency (0: the nearest of `caches`):
+// half the first level; a level behind another twice that one's size (mostly beyond it, as
+// the last level's first chase is, last_level_chase_kib), at most half its own. Not half the
+// level: an L2 loses lines well below its size (a chase over half the 1 MiB L2 of an AMD Zen 5
+// VM read 5.4 ns, over 96 to 288 KiB 4.0-4.1 ns, over 576 KiB 4.7-4.9 and over 960 KiB 8.0-11.3,
+// 2026-12-06; on an Intel Xeon VM's 2 MiB L2 the chase over half of it read 5.1 and 7.0 ns in
+// two runs of one day).
+uint32_t latency_chase_kib(const std::vector<HostCacheLevel>& caches, size_t level);
+
 // Beyond the L3 a core sees on any current CPU (no larger: the machine may be shared): the
 // DRAM chase's size, and what the silicon check reads to leave a core's caches cold.
 constexpr uint64_t k_beyond_last_level_bytes = 256ull << 20;

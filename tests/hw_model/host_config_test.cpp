@@ -1168,6 +1168,22 @@ TEST_CASE("The last level's size and others' fills come from this core's chases"
     CHECK(seen.foreign_fill_per_us == 0.0);
 }
 
+TEST_CASE("A level's latency is chased over twice the level before it, not half its own",
+          "[host]") {
+    auto level = [](uint32_t kib) {
+        HostCacheLevel l;
+        l.kib = kib;
+        return l;
+    };
+    // An AMD Zen 5 core: 48 KiB L1D, 1 MiB L2 (which loses lines well below its size), L3.
+    const std::vector<HostCacheLevel> zen5 = {level(48), level(1024), level(32768)};
+    CHECK(latency_chase_kib(zen5, 0) == 24);
+    CHECK(latency_chase_kib(zen5, 1) == 96);
+    CHECK(latency_chase_kib(zen5, 2) == 2048);  // as the last level's first chase
+    // A level behind one more than a quarter its size: at most half its own.
+    CHECK(latency_chase_kib({level(64), level(192)}, 1) == 96);
+}
+
 TEST_CASE("The host's caches and clock are read from the CPU", "[host]") {
     const std::vector<HostCacheLevel> caches = read_host_caches();
     REQUIRE(!caches.empty());  // sysfs or cpuid: every x86-64 CPU sfx runs on says something
