@@ -336,6 +336,11 @@ PairFillReading measure_pair_fill(double tsc_mhz, uint64_t pair_bytes, int runs)
 
 namespace {
 
+// A chase meant to read a level behind another spans this many times that one's size: mostly
+// beyond it, and far below where the level itself starts to lose lines (latency_chase_kib, and
+// the last level's first chase).
+constexpr uint32_t k_chase_over_level_before = 2;
+
 // The last level's chases: from twice the level before it (mostly beyond that level) in steps
 // of a quarter to a half, up to the level's size and at most 64 MiB (a quarter of DRAM's).
 std::vector<uint32_t> last_level_chase_kib(uint32_t before_kib, uint32_t last_kib) {
@@ -343,7 +348,7 @@ std::vector<uint32_t> last_level_chase_kib(uint32_t before_kib, uint32_t last_ki
     const uint64_t most = std::min<uint64_t>(last_kib, (k_beyond_last_level_bytes / 4) >> 10);
     std::vector<uint32_t> kib;
     for (double step : k_steps) {
-        const uint64_t k = uint64_t(step * 2.0 * before_kib);
+        const uint64_t k = uint64_t(step * k_chase_over_level_before * before_kib);
         if (k > most) break;
         kib.push_back(uint32_t(k));
     }
@@ -435,7 +440,7 @@ void chase_last_level(HostDescription& h) {
 
 uint32_t latency_chase_kib(const std::vector<HostCacheLevel>& caches, size_t level) {
     const uint32_t half = std::max(1u, caches[level].kib / 2);
-    return level == 0 ? half : std::min(half, 2 * caches[level - 1].kib);
+    return level == 0 ? half : std::min(half, k_chase_over_level_before * caches[level - 1].kib);
 }
 
 HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool measure_memory) {
