@@ -197,13 +197,21 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
     if (samples.empty()) throw std::invalid_argument("no short-stream traversal samples");
     constexpr size_t few_box = k_op_kind_count + size_t(OpKind::box_test);
     constexpr size_t few_entry = k_entry_terms + 1;
+    constexpr size_t one_box = size_t(OpKind::box_test);
     std::array<bool, k_short_terms> active{};
     std::vector<std::array<double, k_short_terms>> rows;
     std::vector<double> loops, whole;
-    for (const OneLaneSample& s : samples) {
-        const std::array<double, k_short_terms> row = short_stream_row(s);
+    auto add_row = [&](const std::array<double, k_short_terms>& row, double cycles,
+                       const OneLaneSample& s) {
         for (size_t k = 0; k < k_short_terms; ++k) active[k] = active[k] || row[k] > 0;
         rows.push_back(row);
+        loops.push_back(cycles - (given ? row[few_box] * given->few_lane_cycles +
+                                              row[few_entry] * given->entry_cycles
+                                        : 0.0));
+        whole.push_back(s.cycles);
+    };
+    for (const OneLaneSample& s : samples) {
+        const std::array<double, k_short_terms> row = short_stream_row(s);
         // What the one-ray and few-ray loops' ops took (the rest is priced by the formula),
         // its error relative to the whole sample's cycles, as short_stream_fit_error judges it.
         // The leaf tests' cycles by the stage clock where it split them off: priced by the
@@ -212,12 +220,34 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         // stream loop's per-op box cost (0-4 cycles at AVX2 and 7-10 at AVX-512, against 35-38
         // and 20-25 in the filters' independent calls; the stream loop priced 28 % under its
         // clocked share at AVX2).
-        loops.push_back(
+        const double beyond_priced =
             s.cycles - s.stream_op_cycles +
-            (s.leaf_cycles_clocked >= 0 ? s.leaf_op_cycles - s.leaf_cycles_clocked : 0.0) -
-            (given ? row[few_box] * given->few_lane_cycles + row[few_entry] * given->entry_cycles
-                   : 0.0));
-        whole.push_back(s.cycles);
+            (s.leaf_cycles_clocked >= 0 ? s.leaf_op_cycles - s.leaf_cycles_clocked : 0.0);
+        if (s.leaf_cycles_clocked < 0 || s.loop_cycles_clocked[0] < 0 ||
+            s.loop_cycles_clocked[1] < 0) {
+            add_row(row, beyond_priced, s);
+            continue;
+        }
+        // By loop: each loop's columns against its clocked cycles less its priced
+        // mispredictions; the stream loop's against the rest (the three sum to beyond_priced).
+        const double nested =
+            double(std::min<uint64_t>(s.few_ray_one_lane_box_ops, s.ops[one_box]));
+        std::array<double, k_short_terms> one_ray{}, few_ray{}, stream{};
+        for (size_t k = 0; k < k_op_kind_count; ++k) {
+            one_ray[k] = row[k];
+            few_ray[k_op_kind_count + k] = row[k_op_kind_count + k];
+            stream[2 * k_op_kind_count + k] = row[2 * k_op_kind_count + k];
+        }
+        one_ray[one_box] -= nested;
+        few_ray[one_box] = nested;
+        one_ray[k_entry_terms] = row[k_entry_terms];
+        few_ray[few_entry] = row[few_entry];
+        stream[k_traversal_term] = row[k_traversal_term];
+        const double one_ray_cycles = s.loop_cycles_clocked[0] - s.loop_mispredicted_cycles[0],
+                     few_ray_cycles = s.loop_cycles_clocked[1] - s.loop_mispredicted_cycles[1];
+        add_row(one_ray, one_ray_cycles, s);
+        add_row(few_ray, few_ray_cycles, s);
+        add_row(stream, beyond_priced - one_ray_cycles - few_ray_cycles, s);
     }
     const bool few_measured = active[few_box];
     if (given) active[few_box] = active[few_entry] = false;

@@ -95,6 +95,13 @@ struct OneLaneSample {
     // The leaf tests' part of `cycles` by the stage clock (OneRaySample::leaf_share), which the
     // fit takes instead of leaf_op_cycles; negative where none was clocked.
     double leaf_cycles_clocked = -1.0;
+    // The one-ray and few-ray loops' part of `cycles` less their leaves by the same clock
+    // (OneRaySample::short_loop_share), negative where not clocked; of `ops`' one-lane box
+    // tests, those the few-ray loop runs (OneRaySample::few_ray_one_lane_box_ops); and of
+    // stream_op_cycles, the box tests' mispredictions priced in the one-ray and few-ray loops.
+    std::array<double, 2> loop_cycles_clocked{-1.0, -1.0};
+    uint64_t few_ray_one_lane_box_ops = 0;
+    std::array<double, 2> loop_mispredicted_cycles{};
 };
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
@@ -105,8 +112,15 @@ struct OneLaneSample {
 // Least squares on relative error of the cycles beyond the stream-priced groups and lanes and
 // beyond the leaf tests as the stage clock splits them off (leaf_cycles_clocked, where clocked:
 // the leaf tests' costs are the filter microbenchmarks', and what those miss in a traversal is
-// not the traversal's to absorb), non-negative as in fit_op_cost. Throws std::invalid_argument
-// on no samples.
+// not the traversal's to absorb), non-negative as in fit_op_cost. Where the clock split the
+// loops too (loop_cycles_clocked), each loop is a row of its own: the one-ray loop's ops and
+// entries against its clocked cycles, the few-ray loop's likewise, the stream loop's per-op
+// costs and traversal starts against the rest; the rows sum to the whole sample's, and each
+// loop's cost is told from the others' by where the time went, not only by how the batches
+// mix them (fitted on the whole, the few-ray loop's box cost and the stream loop's traded: an
+// AMD Zen 5 VM's AVX2 batches' few-ray loop and rest priced 4.6 % over and 10.5 % under their
+// clocked parts on 2026-12-06, -1.3 % and +0.2 % by loop on 2026-12-07).
+// Errors stay relative to the whole sample's cycles. Throws std::invalid_argument on no samples.
 struct ShortStreamCosts {
     std::array<double, k_op_kind_count> one_lane{}, few_lane{}, stream_per_op{};
     std::array<bool, k_op_kind_count> stream_measured{};  // the samples' stream loops made it

@@ -127,6 +127,12 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
         }
         sample.stream_op_cycles += sample.leaf_op_cycles;
         sample.leaf_cycles_clocked = s.leaf_share * s.cycles;
+        for (size_t l = 0; l < 2; ++l) {
+            sample.loop_cycles_clocked[l] = s.short_loop_share[l] * s.cycles;
+            sample.loop_mispredicted_cycles[l] =
+                s.modelled_box_loop_mispredictions[l] * predictor.mispredict_cycles_in(l);
+        }
+        sample.few_ray_one_lane_box_ops = s.few_ray_one_lane_box_ops;
         out.push_back(sample);
     }
     return out;

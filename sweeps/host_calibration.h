@@ -193,9 +193,10 @@ bool microbenchmarks_reach_beyond_l2(const std::vector<uint32_t>& buffer_slots,
 // short_loop_share, leaf_share: the one-ray and few-ray loops less their leaves, the leaf tests,
 // the rest) and as the fitted costs price them: `costs` on the fit's samples (`fitted`, from
 // short_stream_fit_samples on the same `samples`), the box tests' mispredictions in each loop
-// at `predictor`'s price there. Reported beside the fit, which fits the batches' whole cycles:
-// the clock's reads in a short loop's interval (rdtsc is not ordered with the work around it)
-// make the split a check of where the fit puts the cost, not a target.
+// at `predictor`'s price there. Reported beside the fit, which takes the same split as its rows
+// (fit_short_stream_cycles) and is judged on the batches' whole cycles: the clock's reads in a
+// short loop's interval (rdtsc is not ordered with the work around it) blur the split as they
+// blur a frame's, which the check splits with the same clock.
 struct ShortStreamPart {
     double measured = 0.0, priced = 0.0;
 };

@@ -646,6 +646,55 @@ TEST_CASE("The short-stream fit recovers each kind's one- and few-lane cost and 
     CHECK(short_stream_fit_error(no_start, started).second > 0.05);
 }
 
+TEST_CASE(
+    "Where the stage clock splits the loops, the short-stream fit takes each loop's costs "
+    "from its own cycles, not from how the batches mix the loops",
+    "[host]") {
+    // Batches whose few-ray box tests are always twice their stream-loop ones: on the whole
+    // cycles a few-ray box at 55 and a stream box at 140 fit as well as 45 and 160. The clock
+    // says which: each loop's cycles (less its priced mispredictions; a few-ray stream's
+    // one-lane subtrees are its own) against its own ops.
+    auto sample = [](uint64_t boxes, uint64_t nested, uint64_t stream_boxes, double few_cost,
+                     double stream_cost) {
+        OneLaneSample s;
+        const uint64_t few_boxes = 2 * stream_boxes;
+        const double mispredicted_one = 3.0 * double(boxes),
+                     mispredicted_few = 7.0 * double(nested);
+        s.ops[size_t(OpKind::box_test)] = boxes;
+        s.few_ops[size_t(OpKind::box_test)] = few_boxes;
+        s.stream_ops[size_t(OpKind::box_test)] = stream_boxes;
+        s.few_ray_one_lane_box_ops = nested;
+        s.loop_mispredicted_cycles = {mispredicted_one, mispredicted_few};
+        s.stream_op_cycles = 900.0 + mispredicted_one + mispredicted_few;
+        s.leaf_cycles_clocked = 0.0;
+        s.loop_cycles_clocked = {
+            30.0 * double(boxes - nested) + mispredicted_one,
+            few_cost * double(few_boxes) + 30.0 * double(nested) + mispredicted_few};
+        s.cycles = s.loop_cycles_clocked[0] + s.loop_cycles_clocked[1] +
+                   stream_cost * double(stream_boxes) + 900.0;
+        return s;
+    };
+    constexpr size_t box = size_t(OpKind::box_test);
+    for (const auto& [few_cost, stream_cost] : {std::pair{55.0, 140.0}, std::pair{45.0, 160.0}}) {
+        std::vector<OneLaneSample> samples;
+        for (uint64_t b : {7u, 23u, 130u})
+            for (uint64_t n : {0u, 3u})
+                for (uint64_t w : {1u, 4u, 19u})
+                    samples.push_back(sample(b, n, w, few_cost, stream_cost));
+        const ShortStreamCosts fit = fit_short_stream_cycles(samples);
+        CHECK(fit.one_lane[box] == Approx(30).epsilon(1e-6));
+        CHECK(fit.few_lane[box] == Approx(few_cost).epsilon(1e-6));
+        CHECK(fit.stream_per_op[box] == Approx(stream_cost).epsilon(1e-6));
+        CHECK(short_stream_fit_error(fit, samples).second < 1e-9);
+        // Given the few-ray loop's cost (another back end's), the stream loop still takes its
+        // own from the rest.
+        const GivenFewRayCosts given_few{few_cost, 0.0};
+        const ShortStreamCosts given = fit_short_stream_cycles(samples, &given_few);
+        CHECK(given.stream_per_op[box] == Approx(stream_cost).epsilon(1e-6));
+        CHECK(given.one_lane[box] == Approx(30).epsilon(1e-6));
+    }
+}
+
 TEST_CASE("The box test that enters a short loop from the stream loop carries its entry cost",
           "[host]") {
     OpProfile p;
