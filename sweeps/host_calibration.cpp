@@ -684,8 +684,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                           : std::string())
          << " (8-32 streams of one ray and 4-32 of 2 to " << k_few_ray_lanes
          << " rays from the root, 8 and 32 entering 3 and 6 levels down, 1 and 4 of 8 to 128) "
-         << "of the same scene, other rays' traversals between repetitions, less their leaf "
-         << "tests by the stage clock's split and the model's "
+         << "of the same scene, other rays' traversals between repetitions, each loop against "
+         << "its part by the stage clock's split (their leaf tests taken off by it), less the "
+            "model's "
          << "mispredictions on them at mispredict_cycles (the model adds its own to every "
          << "traversal); the hit reads' "
          << "exposed "
