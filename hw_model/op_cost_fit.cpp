@@ -230,8 +230,7 @@ ShortStreamCosts fit_short_stream_cycles(const std::vector<OneLaneSample>& sampl
         }
         // By loop: each loop's columns against its clocked cycles less its priced
         // mispredictions; the stream loop's against the rest (the three sum to beyond_priced).
-        const double nested =
-            double(std::min<uint64_t>(s.few_ray_one_lane_box_ops, s.ops[one_box]));
+        const double nested = few_ray_one_lane_box_tests(s);
         std::array<double, k_short_terms> one_ray{}, few_ray{}, stream{};
         for (size_t k = 0; k < k_op_kind_count; ++k) {
             one_ray[k] = row[k];

@@ -3,6 +3,7 @@
 // (kernels/stream/stream_microbench.h), never on frames. The costs are priced where every op is
 // priced, OpProfile::issue_cycles (hw_model/op_costs.h); the fit's error is measured through it.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -103,6 +104,11 @@ struct OneLaneSample {
     uint64_t few_ray_one_lane_box_ops = 0;
     std::array<double, 2> loop_mispredicted_cycles{};
 };
+// Of a sample's one-lane box tests, those the few-ray loop runs (below a stream of 2 to
+// k_few_ray_lanes rays: the stage clock counts them there), priced at the one-lane cost.
+inline double few_ray_one_lane_box_tests(const OneLaneSample& s) {
+    return double(std::min<uint64_t>(s.few_ray_one_lane_box_ops, s.ops[size_t(OpKind::box_test)]));
+}
 
 // The one-lane and few-lane costs of every kind the samples make (OpCostConfig::
 // one_lane_cycles, few_lane_cycles; not measured, negative, for the rest) and the per-op cost in a

@@ -153,7 +153,7 @@ ShortStreamSplit short_stream_split(const ShortStreamCosts& costs,
         // priced at the one-lane cost either way). Until 2026-12-05 the split put them in the
         // one-ray loop: on an AMD Zen 5 VM (AVX2) it read the one-ray loop priced 3.9 times
         // over and the few-ray loop 22 % under, where the two together were priced right.
-        const double nested = double(std::min<uint64_t>(s.few_ray_one_lane_box_ops, f.ops[box]));
+        const double nested = few_ray_one_lane_box_tests(f);
         const double one_ray =
             (double(f.ops[box]) - nested) * costs.one_lane[box] +
             double(f.entries[0]) * costs.entry[0] +

@@ -773,6 +773,7 @@ TEST_CASE("The short-stream batches split by the stage clock beside the fit's pr
     fitted.few_ops[box] = 5;
     fitted.stream_ops[box] = 3;
     fitted.entries = {1, 1};
+    fitted.few_ray_one_lane_box_ops = raw.few_ray_one_lane_box_ops;  // as the fit's samples copy it
     fitted.leaf_op_cycles = 150.0;
     fitted.stream_op_cycles = 150.0 + 2 * 50.0 + 1 * 40.0 + 4 * 30.0 + 60.0;
     ShortStreamCosts costs;
