@@ -817,6 +817,10 @@ void add_calibrate_command(CLI::App& app) {
                     double(m.prediction.timing.traversal_loop_branch_cycles[l]);
                 row[std::string("predicted.traversal_") + loops[l] + "_loop_memory_cycles"] =
                     double(m.prediction.timing.traversal_loop_memory_cycles[l]);
+                row[std::string("predicted.intersection_") + loops[l] + "_loop_cycles"] =
+                    m.predicted_leaf_loop[size_t(l)];
+                row[std::string("measured.intersection_") + loops[l] + "_loop_cycles"] =
+                    m.measured_leaf_loop[size_t(l)];
             }
             // The shading stage by op kind, and the ray set-up (measured only).
             for (uint32_t k = 0; k < k_op_kind_count; ++k)

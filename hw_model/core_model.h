@@ -155,6 +155,9 @@ class CoreModel {
     // and whether it enters that loop from the stream loop (a short loop's first op).
     std::vector<TraversalLoop> m_loop;
     std::vector<uint8_t> m_enters_loop;
+    // Per op: the loop whose leaf code runs it, an intersection op's being its leaf's box test's
+    // (its producer), so that the intersection stage splits as the tracer's clock splits it.
+    std::vector<TraversalLoop> m_leaf_loop;
     // A CPU core's branch predictor (null: none), and per op of the pass its mispredictions.
     std::unique_ptr<TagePredictor> m_predictor;
     std::vector<uint32_t> m_mispredicted;

@@ -202,6 +202,12 @@ std::vector<Stat> Prediction::stats() const {
             add(std::string("traversal_loop_memory_cycles.") + loops[l],
                 double(timing.traversal_loop_memory_cycles[l]) * unit_scale, "cycles",
                 std::string("of those, their wait for scene data"));
+        for (int l = 0; l < 3; ++l)
+            add(std::string("intersection_loop_cycles.") + loops[l],
+                double(timing.intersection_loop_cycles[l]) * unit_scale, "cycles",
+                std::string("intersection ops' unit-cycles in the leaf code of the native "
+                            "tracer's ") +
+                    loops[l] + " loop");
         // And its shading stage by op kind, which the tracer's stage clock also splits.
         for (uint32_t k = 0; k < k_op_kind_count; ++k)
             if (stage_of(OpKind(k)) == OpStage::shading && timing.op_cycles[k] > 0)

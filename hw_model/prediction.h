@@ -144,6 +144,10 @@ struct FrameTiming {
     // prediction is made of, beside its ops' own costs.
     uint64_t traversal_loop_branch_cycles[3] = {0, 0, 0};
     uint64_t traversal_loop_memory_cycles[3] = {0, 0, 0};
+    // The intersection ops' unit-cycles by the loop whose leaf code runs them (that of the box
+    // test of their leaf): what the tracer's stage clock splits the intersection stage into
+    // (RenderStats::short_loop_leaf_tsc). Cycle-level models only.
+    uint64_t intersection_loop_cycles[3] = {0, 0, 0};
     // Each op kind's unit-cycles (busy and stalled), what the tracer's stage clock splits the
     // shading stage into (RenderStats::shading_op_tsc). Cycle-level models only.
     uint64_t op_cycles[k_op_kind_count] = {};
@@ -219,6 +223,12 @@ void FrameTiming::visit(A& a, B& b, F&& f) {
         f(CounterInfo(loops[l], "cycles", "of those, the box tests' wait for scene data")
               .under("traversal_loop_memory_cycles"),
           a.traversal_loop_memory_cycles[l], b.traversal_loop_memory_cycles[l]);
+    for (int l = 0; l < 3; ++l)
+        f(CounterInfo(loops[l], "cycles",
+                      "intersection ops' unit-cycles in the leaf code of the tracer's loop of "
+                      "that name")
+              .under("intersection_loop_cycles"),
+          a.intersection_loop_cycles[l], b.intersection_loop_cycles[l]);
     for (uint32_t k = 0; k < k_op_kind_count; ++k)
         f(CounterInfo(k_op_kinds[k].name, "cycles", "the op kind's unit-cycles, busy and stalled")
               .under("op_cycles"),

@@ -29,6 +29,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
     nonfinite_paths += o.nonfinite_paths;
     for (int i = 0; i < 3; ++i) stage_tsc[i] += o.stage_tsc[i];
     for (int i = 0; i < 2; ++i) short_loop_tsc[i] += o.short_loop_tsc[i];
+    for (int i = 0; i < 2; ++i) short_loop_leaf_tsc[i] += o.short_loop_leaf_tsc[i];
     for (uint32_t k = 0; k < k_op_kind_count; ++k) shading_op_tsc[k] += o.shading_op_tsc[k];
     ray_setup_tsc += o.ray_setup_tsc;
     shading_rest_tsc += o.shading_rest_tsc;

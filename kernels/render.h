@@ -77,6 +77,9 @@ struct RenderStats {
     // of the few-ray loop ([1]) run from the stream loop (kernels/stream), their leaves' not
     // included: where a traversal's short streams go (kernels/trace.h).
     uint64_t short_loop_tsc[2] = {0, 0};
+    // Of stage_tsc[1]: the ticks of the leaves the one-ray ([0]) and few-ray ([1]) loops reach
+    // (the stream loop's leaves are the rest).
+    uint64_t short_loop_leaf_tsc[2] = {0, 0};
     // Of stage_tsc[2] (stream tracer, stage clock): the ticks of each shading op kind as the
     // timing models price it (camera: the camera loop; emission_filter: with the hits'
     // surfaces, compute_surfaces; material_filter: the sort by material), of the ray set-up

@@ -269,6 +269,10 @@ struct SiliconMeasurement {
     // few-ray, stream loop), predicted and measured (the stage clock's short-loop ticks,
     // RenderStats::short_loop_tsc, split as the stages are; the stream loop the rest).
     std::array<double, 3> predicted_loop{}, measured_loop{};
+    // The intersection stage by the loop whose leaf code runs its tests (the loop of the box test
+    // that reached the leaf), predicted (FrameTiming::intersection_loop_cycles) and measured
+    // (RenderStats::short_loop_leaf_tsc, split as the stages are; the stream loop's the rest).
+    std::array<double, 3> predicted_leaf_loop{}, measured_leaf_loop{};
     // The shading stage by op kind (shading kinds only), predicted (FrameTiming::op_cycles) and
     // measured (the stage clock's RenderStats::shading_op_tsc, the fewest ticks of each, split
     // as the stages are); and the tracer's ray set-up (load_rays), measured only: the model

@@ -591,6 +591,27 @@ def loops_text(df):
     return "\n".join(lines)
 
 
+def leaf_loops_text(df):
+    """Per back end and scene, the intersection stage by the loop whose leaf code runs its tests
+    (the stage clock's ticks in the leaves each short loop reaches; rows written before it carry
+    none)."""
+    if "measured.intersection_stream_loop_cycles" not in df:
+        return "These rows carry no intersection split by loop."
+    lines = ["| back end | scene | loop | predicted Mcyc (sum) | measured Mcyc (sum) | "
+             "error of sum | share of measured intersection |", "|---|---|---|---|---|---|---|"]
+    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
+        intersection = g["measured.intersection_cycles"].sum()
+        for key, name in LOOPS:
+            p = g[f"predicted.intersection_{key}_loop_cycles"].sum()
+            m = g[f"measured.intersection_{key}_loop_cycles"].sum()
+            if max(p, m) < 0.01 * intersection:  # a loop the scene barely runs: noise
+                continue
+            lines.append(f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
+                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | "
+                         f"{m / max(intersection, 1):.0%} |")
+    return "\n".join(lines)
+
+
 def shading_ops_text(df):
     """Per back end and scene, the shading stage by op kind (the stage clock's ticks of each
     kind's filter), and the ray set-up the tracer runs apart, which the model prices in the ops
@@ -949,6 +970,12 @@ def write_page(df, page, plot_name, header):
         "(the tables above), each state's fastest cycles split by the shares of 5 clocked "
         "repetitions: what the predictor and a scene read from DRAM cost each loop, measured, "
         "beside the model's parts of the same loop.\n\n" + predictor_loops_text(df),
+        "## The intersection stage by loop\n\nThe leaf tests by the loop whose leaf code runs "
+        "them: the one-ray loop's (one lane), the few-ray loop's (a leaf that one to four of its "
+        "rays reach, in the wide back end's code), and the stream loop's. Measured: the stage "
+        "clock's ticks in the leaves each short loop reaches, split as the stages are; the "
+        "stream loop's are the rest of the intersection. Predicted: the model's cycles of the "
+        "intersection ops below a box test of each loop.\n\n" + leaf_loops_text(df),
         "## The shading stage by op\n\nMeasured: the stage clock's ticks of each shading "
         "op kind's filter (the camera's loop; the emission filter with the hits' surfaces, as "
         "the model prices it; the material filters as the sort by material the tracer runs "

@@ -127,11 +127,12 @@ struct TraversalStackEntry {
 // A depth-first walk of a binary tree keeps at most one entry per level, plus the one popped.
 constexpr uint32_t k_traversal_stack_size = Bvh::k_max_depth + 2;
 
-// The one-ray loop's ([0]) and the few-ray loop's ([1]) entries from the stream loop, and their
-// TSC ticks with their leaves' (TraversalJob::leaf_tsc) left out.
+// The one-ray loop's ([0]) and the few-ray loop's ([1]) entries from the stream loop, their
+// TSC ticks with their leaves' (TraversalJob::leaf_tsc) left out, and their leaves' ticks.
 struct ShortLoopClock {
     uint64_t ticks[2] = {0, 0};
     uint64_t entries[2] = {0, 0};
+    uint64_t leaf_ticks[2] = {0, 0};
 };
 
 // What one traversal (Fig. 3) of a stream works on. Plain pointers, so the wide translation

@@ -536,8 +536,8 @@ SFX_LANES_INLINE void timed_leaf(const TraversalJob& job, const BvhNode& node, u
     if (job.leaf_tsc) *job.leaf_tsc += __rdtsc() - start;
 }
 
-// `loop` (the one-ray loop 0, the few-ray loop 1), counted and its TSC ticks less its leaves'
-// added to job.short_loops when the caller asks for them.
+// `loop` (the one-ray loop 0, the few-ray loop 1), counted and its TSC ticks less its leaves',
+// and its leaves', added to job.short_loops when the caller asks for them.
 template <class Loop>
 SFX_LANES_INLINE void timed_short_loop(const TraversalJob& job, int loop, Loop&& run) {
     if (!job.short_loops) return run();
@@ -545,6 +545,7 @@ SFX_LANES_INLINE void timed_short_loop(const TraversalJob& job, int loop, Loop&&
     run();
     const uint64_t in_leaves = job.leaf_tsc ? *job.leaf_tsc - leaf : 0;
     job.short_loops->ticks[loop] += __rdtsc() - start - in_leaves;
+    job.short_loops->leaf_ticks[loop] += in_leaves;
     ++job.short_loops->entries[loop];
 }
 

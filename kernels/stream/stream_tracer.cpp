@@ -572,7 +572,10 @@ void StreamTracer::Impl::run(const TileRect& rect, uint32_t tile_index, uint32_t
             lap(spent);
             stats.stage_tsc[0] += spent - ticks.leaf;
             stats.stage_tsc[1] += ticks.leaf;
-            for (int l = 0; l < 2; ++l) stats.short_loop_tsc[l] += ticks.short_loops.ticks[l];
+            for (int l = 0; l < 2; ++l) {
+                stats.short_loop_tsc[l] += ticks.short_loops.ticks[l];
+                stats.short_loop_leaf_tsc[l] += ticks.short_loops.leaf_ticks[l];
+            }
             traverse_tsc += spent;
         } else {
             traverse_generation(traversal_rays, generation, entry, stats, trace, nullptr);

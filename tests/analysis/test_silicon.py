@@ -409,6 +409,30 @@ def test_traversal_by_loop(tmp_path):
     assert "mispredictions | scene data |" in parts
 
 
+def test_intersection_by_loop(tmp_path):
+    # Two workloads of one scene: each loop's sums, error and share of the measured
+    # intersection (each row's is 100e6 * 2 / 6); a loop under 1 % of it on both sides is left
+    # out.
+    rows = [row("a", 16, 100e6, 100e6), row("a", 32, 100e6, 100e6)]
+    for r, (one, few) in zip(rows, [(1e6, 6e6), (1e6, 4e6)]):
+        r.update({"predicted.intersection_one_ray_loop_cycles": one,
+                  "measured.intersection_one_ray_loop_cycles": one,
+                  "predicted.intersection_few_ray_loop_cycles": few * 2 / 3,
+                  "measured.intersection_few_ray_loop_cycles": few,
+                  "predicted.intersection_stream_loop_cycles": 0.1e6,
+                  "measured.intersection_stream_loop_cycles": 0.0})
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    text = silicon.leaf_loops_text(df)
+    assert "| avx512 | a | one-ray loop | 2.00 | 2.00 | +0.0 % | 3% |" in text
+    assert "| avx512 | a | few-ray loop | 6.67 | 10.00 | -33.3 % | 15% |" in text
+    assert "stream loop" not in text
+    older = df.drop(columns=[c for c in df.columns if c.startswith(
+        ("measured.intersection_", "predicted.intersection_")) and "_loop_" in c])
+    assert "no intersection split" in silicon.leaf_loops_text(older)
+
+
 def test_shading_by_op(tmp_path):
     # Two workloads of one scene (each row's measured shading is 50e6): each kind's sums
     # and error, its share of the measured shading; a kind under 1 % of it on both sides is

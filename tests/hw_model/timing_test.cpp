@@ -477,6 +477,46 @@ TEST_CASE("A chain of dependent ops has nothing for the window or the other unit
     CHECK(double(a.stalls.pipeline_fill) >= 0.85 * double(a.cycles));
 }
 
+TEST_CASE("An intersection op's cycles go to the loop of the box test that reached its leaf",
+          "[hw_model][systemc]") {
+    // A 16-lane box test (stream loop) passes 3 rays; their 3-lane box test (few-ray loop) passes
+    // one, whose leaf's triangle test is the few-ray loop's leaf code even at one lane; a 16-lane
+    // box test that passes 8 reaches a leaf in the stream loop; a 1-lane stream from another
+    // 16-lane box test (one-ray loop) reaches one there.
+    std::vector<uint8_t> three(16, 0), eight(16, 0), one(16, 0);
+    three[0] = three[1] = three[2] = 1;
+    for (uint32_t i = 0; i < 8; ++i) eight[i] = 1;
+    one[0] = 1;
+    const std::vector<CraftedOp> ops = {
+        {OpKind::box_test, consecutive(16), three, 1},
+        {OpKind::box_test, consecutive(3), {1, 0, 0}, 2},
+        {OpKind::triangle_test, consecutive(1), {1}, 0},
+        {OpKind::box_test, consecutive(16, 1, 16), eight, 3},
+        {OpKind::triangle_test, consecutive(8, 1, 16), std::vector<uint8_t>(8, 0), 1},
+        {OpKind::triangle_test, consecutive(8, 1, 16), std::vector<uint8_t>(8, 1), 2},
+        {OpKind::box_test, consecutive(16, 1, 32), one, 4},
+        {OpKind::box_test, consecutive(1, 1, 32), {1}, 5},
+        {OpKind::triangle_test, consecutive(1, 1, 32), {0}, 3}};
+    const auto leaves = [](const FrameTiming& t) {
+        return std::array<uint64_t, 3>{t.intersection_loop_cycles[0], t.intersection_loop_cycles[1],
+                                       t.intersection_loop_cycles[2]};
+    };
+    const FrameTiming wide = time_passes(with_width(16), {ops});
+    for (const uint64_t c : leaves(wide)) CHECK(c > 0);
+    // Without the few-ray loop (four lanes) the 3-lane stream is the stream loop's, and so is
+    // its leaf; the leaf below the 1-lane stream stays the one-ray loop's.
+    const FrameTiming narrow = time_passes(with_width(4), {ops});
+    CHECK(leaves(narrow)[size_t(TraversalLoop::few_ray)] == 0);
+    CHECK(leaves(narrow)[size_t(TraversalLoop::one_ray)] > 0);
+    CHECK(leaves(narrow)[size_t(TraversalLoop::stream)] > 0);
+    for (const FrameTiming* t : {&wide, &narrow}) {
+        const StageTiming& intersection = t->stages[1][size_t(OpStage::intersection)];
+        CHECK(t->intersection_loop_cycles[0] + t->intersection_loop_cycles[1] +
+                  t->intersection_loop_cycles[2] <=
+              intersection.busy_cycles + intersection.stall_cycles);
+    }
+}
+
 TEST_CASE("A box test's cycles go to the tracer loop its stream entered", "[hw_model][systemc]") {
     // A 16-lane op (stream loop) passes 3 rays: their stream (3 lanes) and the 1-lane stream
     // below it run in the few-ray loop on a back end of k_few_ray_min_width lanes or more; a
@@ -509,6 +549,8 @@ TEST_CASE("A box test's cycles go to the tracer loop its stream entered", "[hw_m
                   t->traversal_loop_cycles[2] <=
               traversal.busy_cycles + traversal.stall_cycles);
     }
+    // No intersection op: no leaf code's cycles.
+    for (const uint64_t c : wide.intersection_loop_cycles) CHECK(c == 0);
     CHECK(traversal_loop(1, 16, TraversalLoop::stream) == TraversalLoop::one_ray);
     CHECK(traversal_loop(k_few_ray_lanes, 16, TraversalLoop::stream) == TraversalLoop::few_ray);
     CHECK(traversal_loop(k_few_ray_lanes + 1, 16, TraversalLoop::stream) ==

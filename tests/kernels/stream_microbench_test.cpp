@@ -73,8 +73,9 @@ TEST_CASE("The part clock never changes a bit and times each generation of each 
     CHECK(render_stream(scene, bvh, s).stats.part_tsc.size() == timed.stats.part_tsc.size());
 }
 
-TEST_CASE("The stage clock splits the traversal by the loop that runs its short streams",
-          "[stream][host]") {
+TEST_CASE(
+    "The stage clock splits the traversal and its leaves by the loop that runs its short streams",
+    "[stream][host]") {
     // Atrium's 64-ray streams narrow to one ray (the one-ray loop) on every back end, and to
     // two to four (the few-ray loop) where the back end has k_few_ray_min_width lanes or more.
     const Scene scene = load_scene("atrium");
@@ -97,6 +98,13 @@ TEST_CASE("The stage clock splits the traversal by the loop that runs its short 
         CHECK((clocked.stats.short_loop_tsc[1] > 0) == (isa_width(isa) >= k_few_ray_min_width));
         CHECK(clocked.stats.short_loop_tsc[0] + clocked.stats.short_loop_tsc[1] <
               clocked.stats.stage_tsc[0]);
+        // The leaves the short loops reach: in the intersection stage, the stream loop's the rest.
+        CHECK(plain.stats.short_loop_leaf_tsc[0] + plain.stats.short_loop_leaf_tsc[1] == 0);
+        CHECK(clocked.stats.short_loop_leaf_tsc[0] > 0);
+        CHECK((clocked.stats.short_loop_leaf_tsc[1] > 0) ==
+              (isa_width(isa) >= k_few_ray_min_width));
+        CHECK(clocked.stats.short_loop_leaf_tsc[0] + clocked.stats.short_loop_leaf_tsc[1] <
+              clocked.stats.stage_tsc[1]);
     }
 }
 

@@ -339,6 +339,12 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
           Approx(m.measured_stage[0]));
     CHECK(m.predicted_loop[2] > 0);
     CHECK(m.predicted_loop[0] + m.predicted_loop[1] + m.predicted_loop[2] <= m.predicted_stage[0]);
+    // The intersection by the loop whose leaf code runs it, likewise.
+    CHECK(m.measured_leaf_loop[0] + m.measured_leaf_loop[1] + m.measured_leaf_loop[2] ==
+          Approx(m.measured_stage[1]));
+    CHECK(m.predicted_leaf_loop[2] > 0);
+    CHECK(m.predicted_leaf_loop[0] + m.predicted_leaf_loop[1] + m.predicted_leaf_loop[2] <=
+          m.predicted_stage[1]);
     // The shading stage by op kind: the measured parts (each its fewest ticks) and the ray
     // set-up lie within the measured stage and make most of it; the predicted kinds are the
     // predicted stage's ops (the stage also holds a pass's tail); no traversal kind is among them.
