@@ -562,6 +562,25 @@ def predictor_loops_text(df):
     return "\n".join(lines)
 
 
+def stage_loop_rows(df, stage):
+    """Per back end and scene, `stage` (traversal or intersection) by the tracer's loop: each
+    loop's (isa, scene, key, name, predicted, measured, share of the measured stage) over the
+    scored rows, a loop under 1 % of the stage on both sides left out (noise)."""
+    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
+        total = g[f"measured.{stage}_cycles"].sum()
+        for key, name in LOOPS:
+            p = g[f"predicted.{stage}_{key}_loop_cycles"].sum()
+            m = g[f"measured.{stage}_{key}_loop_cycles"].sum()
+            if max(p, m) < 0.01 * total:
+                continue
+            yield g, isa, scene, key, name, p, m, m / max(total, 1)
+
+
+def loop_row(isa, scene, name, p, m, share):
+    return (f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
+            f"{pct(p / m - 1) if m > 0 else 'n/a'} | {share:.0%} |")
+
+
 def loops_text(df):
     """Per back end and scene, the traversal by the tracer's loop that runs its box tests (the
     stage clock's short-loop ticks; rows written before it carry none)."""
@@ -574,20 +593,13 @@ def loops_text(df):
              "error of sum | share of measured traversal |"
              + (" of the prediction: mispredictions | scene data |" if parts else ""),
              "|---|---|---|---|---|---|---|" + ("---|---|" if parts else "")]
-    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
-        traversal = g["measured.traversal_cycles"].sum()
-        for key, name in LOOPS:
-            p = g[f"predicted.traversal_{key}_loop_cycles"].sum()
-            m = g[f"measured.traversal_{key}_loop_cycles"].sum()
-            if max(p, m) < 0.01 * traversal:  # a loop the scene barely runs: noise
-                continue
-            line = (f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
-                    f"{pct(p / m - 1) if m > 0 else 'n/a'} | {m / max(traversal, 1):.0%} |")
-            if parts:
-                for part in ("branch", "memory"):
-                    c = g[f"predicted.traversal_{key}_loop_{part}_cycles"].sum()
-                    line += f" {c / max(p, 1):.0%} |"
-            lines.append(line)
+    for g, isa, scene, key, name, p, m, share in stage_loop_rows(df, "traversal"):
+        line = loop_row(isa, scene, name, p, m, share)
+        if parts:
+            for part in ("branch", "memory"):
+                c = g[f"predicted.traversal_{key}_loop_{part}_cycles"].sum()
+                line += f" {c / max(p, 1):.0%} |"
+        lines.append(line)
     return "\n".join(lines)
 
 
@@ -599,16 +611,8 @@ def leaf_loops_text(df):
         return "These rows carry no intersection split by loop."
     lines = ["| back end | scene | loop | predicted Mcyc (sum) | measured Mcyc (sum) | "
              "error of sum | share of measured intersection |", "|---|---|---|---|---|---|---|"]
-    for (isa, scene), g in scored(df).groupby(["isa", "scene"], sort=False):
-        intersection = g["measured.intersection_cycles"].sum()
-        for key, name in LOOPS:
-            p = g[f"predicted.intersection_{key}_loop_cycles"].sum()
-            m = g[f"measured.intersection_{key}_loop_cycles"].sum()
-            if max(p, m) < 0.01 * intersection:  # a loop the scene barely runs: noise
-                continue
-            lines.append(f"| {isa} | {scene} | {name} | {p / 1e6:.2f} | {m / 1e6:.2f} | "
-                         f"{pct(p / m - 1) if m > 0 else 'n/a'} | "
-                         f"{m / max(intersection, 1):.0%} |")
+    lines += [loop_row(isa, scene, name, p, m, share)
+              for _, isa, scene, _, name, p, m, share in stage_loop_rows(df, "intersection")]
     return "\n".join(lines)
 
 
