@@ -145,10 +145,12 @@ std::vector<TraversalLoop> traversal_loops(const PassBuffer& pass, uint32_t widt
     std::vector<TraversalLoop> loop(pass.size(), TraversalLoop::stream);
     for (uint32_t i = 0; i < pass.size(); ++i) {
         const StreamOp op = pass.at(i);
-        if (op.kind != OpKind::box_test) continue;
         const int32_t producer = pass.producer(i);
         const TraversalLoop from = producer < 0 ? TraversalLoop::stream : loop[size_t(producer)];
-        loop[i] = traversal_loop(op.length, width, from);
+        if (op.kind == OpKind::box_test)
+            loop[i] = traversal_loop(op.length, width, from);
+        else if (op.stage == OpStage::intersection)
+            loop[i] = from;  // its leaf's box test's: the tracer runs the leaf in that loop
     }
     return loop;
 }

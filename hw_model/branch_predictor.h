@@ -75,7 +75,9 @@ class TagePredictor {
 
 // The box tests of a pass by the native tracer's loop that runs them (TraversalLoop): the
 // stream loop's child streams of one ray run in the one-ray loop and of 2 to k_few_ray_lanes in
-// the few-ray loop (wide back ends), and every op below stays in that loop. Other ops: stream.
+// the few-ray loop (wide back ends), and every op below stays in that loop; an intersection op
+// by the loop of the box test that reached its leaf (its producer), whose leaf code runs it.
+// Other ops: stream.
 std::vector<TraversalLoop> traversal_loops(const PassBuffer& pass, uint32_t width);
 
 // The traversal's data-dependent conditional branches, op by op in the trace's order (the

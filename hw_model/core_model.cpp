@@ -98,12 +98,6 @@ void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
         m_enters_loop[i] = pass->at(i).kind == OpKind::box_test && from == TraversalLoop::stream &&
                            m_loop[i] != TraversalLoop::stream;
     }
-    m_leaf_loop.assign(n, TraversalLoop::stream);
-    for (uint32_t i = 0; i < n; ++i) {
-        const int32_t producer = pass->producer(i);
-        if (pass->at(i).stage == OpStage::intersection && producer >= 0)
-            m_leaf_loop[i] = m_loop[size_t(producer)];
-    }
     m_mispredicted.assign(n, 0);
     if (m_predictor)
         replay_traversal_branches(*pass, m_loop, width(), node_leaf(), *m_predictor,
@@ -454,7 +448,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
             stage.scene_memory_cycles - scene_memory_before;
     }
     if (op.stage == OpStage::intersection)
-        m_timing.intersection_loop_cycles[size_t(m_leaf_loop[t.op])] += group_cycles;
+        m_timing.intersection_loop_cycles[size_t(m_loop[t.op])] += group_cycles;
     m_unit_free[unit] = e.issue_end;
     // ACTIONS: the group's instructions and lanes; its mask word through the scratchpad.
     ActionCounts& act = m_timing.actions;

@@ -151,13 +151,11 @@ class CoreModel {
     std::vector<uint64_t> m_unit_free;      // per SIMD unit
     std::vector<double> m_unit_carry;       // per SIMD unit: fractional issue cycles owed
     std::vector<uint8_t> m_unit_stage;  // per SIMD unit: [secondary * 3 + stage] of its last group
-    // Per op: the native tracer's loop that runs it (TraversalLoop; a box test's, else stream),
-    // and whether it enters that loop from the stream loop (a short loop's first op).
+    // Per op: the native tracer's loop that runs it (traversal_loops: a box test's or an
+    // intersection op's, else stream), and whether it enters that loop from the stream loop (a
+    // short loop's first op).
     std::vector<TraversalLoop> m_loop;
     std::vector<uint8_t> m_enters_loop;
-    // Per op: the loop whose leaf code runs it, an intersection op's being its leaf's box test's
-    // (its producer), so that the intersection stage splits as the tracer's clock splits it.
-    std::vector<TraversalLoop> m_leaf_loop;
     // A CPU core's branch predictor (null: none), and per op of the pass its mispredictions.
     std::unique_ptr<TagePredictor> m_predictor;
     std::vector<uint32_t> m_mispredicted;

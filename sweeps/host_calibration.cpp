@@ -1181,19 +1181,18 @@ std::vector<SiliconMeasurement> predict_and_measure(
         for (int s = 0; s < 3; ++s)
             m.measured_stage[size_t(s)] =
                 stages > 0 ? stage_min[v][size_t(s)] / stages * m.measured_frame : 0.0;
-        m.measured_loop[2] = m.measured_stage[0];
-        for (int l = 0; l < 2; ++l) {
-            m.measured_loop[size_t(l)] =
-                stages > 0 ? short_loop_min[v][size_t(l)] / stages * m.measured_frame : 0.0;
-            m.measured_loop[2] = std::max(0.0, m.measured_loop[2] - m.measured_loop[size_t(l)]);
-        }
-        m.measured_leaf_loop[2] = m.measured_stage[1];
-        for (int l = 0; l < 2; ++l) {
-            m.measured_leaf_loop[size_t(l)] =
-                stages > 0 ? short_loop_leaf_min[v][size_t(l)] / stages * m.measured_frame : 0.0;
-            m.measured_leaf_loop[2] =
-                std::max(0.0, m.measured_leaf_loop[2] - m.measured_leaf_loop[size_t(l)]);
-        }
+        // A stage by loop: the short loops' fewest ticks split as the stages are, the stream
+        // loop the rest of the stage.
+        const auto by_loop = [&](double stage, const std::array<double, 2>& short_loops) {
+            std::array<double, 3> loops{0.0, 0.0, stage};
+            for (size_t l = 0; l < 2; ++l) {
+                loops[l] = stages > 0 ? short_loops[l] / stages * m.measured_frame : 0.0;
+                loops[2] = std::max(0.0, loops[2] - loops[l]);
+            }
+            return loops;
+        };
+        m.measured_loop = by_loop(m.measured_stage[0], short_loop_min[v]);
+        m.measured_leaf_loop = by_loop(m.measured_stage[1], short_loop_leaf_min[v]);
         const double tick_cycles = stages > 0 ? m.measured_frame / stages : 0.0;
         // The stage clock times shading kinds only: the others stay 0.
         for (uint32_t k = 0; k < k_op_kind_count; ++k)
