@@ -372,9 +372,9 @@ void add_calibrate_command(CLI::App& app) {
                         {{"bounce", b.measured.bounce},
                          {"batches", b.measured.batches},
                          {"converged_batches", b.measured.converged_batches},
-                         {"primed_cycles", b.measured.primed_cycles},
-                         {"cached_cycles", b.measured.cached_cycles},
-                         {"displaced_cycles", b.measured.displaced_cycles},
+                         {"primed_cycles", b.measured.primed.cycles},
+                         {"cached_cycles", b.measured.cached.cycles},
+                         {"displaced_cycles", b.measured.displaced.cycles},
                          {"branches", m.branches},
                          {"primed_mispredictions", m.primed},
                          {"displaced_mispredictions", m.displaced}});
@@ -388,17 +388,16 @@ void add_calibrate_command(CLI::App& app) {
                     const PredictorSample& m = cal.branch_samples[i].measured;
                     j["node_read_samples"].push_back(
                         {{"bounce", m.bounce},
-                         {"evicted_loop_cycles", m.evicted_loop_cycles},
-                         {"primed_loop_cycles", m.primed_loop_cycles},
+                         {"evicted_loop_cycles", m.evicted.loops},
+                         {"primed_loop_cycles", m.primed.loops},
                          {"measured_extra_cycles", cal.node_read_fit.measured[i]},
                          {"modeled_whole_extra_cycles", cal.node_read_fit.modeled_whole[i]},
                          {"modeled_extra_cycles", cal.node_read_fit.modeled[i]}});
                 }
                 for (const PredictorSample& b : cal.eviction_baseline)
-                    j["eviction_baseline"].push_back(
-                        {{"bounce", b.bounce},
-                         {"evicted_loop_cycles", b.evicted_loop_cycles},
-                         {"primed_loop_cycles", b.primed_loop_cycles}});
+                    j["eviction_baseline"].push_back({{"bounce", b.bounce},
+                                                      {"evicted_loop_cycles", b.evicted.loops},
+                                                      {"primed_loop_cycles", b.primed.loops}});
                 for (const KernelRate& r : cal.rates)
                     j["rates"].push_back({{"what", r.what},
                                           {"slots", r.slots},
@@ -555,8 +554,8 @@ void add_calibrate_command(CLI::App& app) {
                     "  %-7s cycles primed %.0f, cached %.0f, displaced %.0f (%u of %u "
                     "batches converged); model: %llu branches, mispredicted %llu "
                     "primed, %llu displaced\n",
-                    b.measured.bounce ? "bounces" : "camera", b.measured.primed_cycles,
-                    b.measured.cached_cycles, b.measured.displaced_cycles,
+                    b.measured.bounce ? "bounces" : "camera", b.measured.primed.cycles,
+                    b.measured.cached.cycles, b.measured.displaced.cycles,
                     b.measured.converged_batches, b.measured.batches,
                     (unsigned long long)m.branches, (unsigned long long)m.primed,
                     (unsigned long long)m.displaced);
@@ -882,20 +881,28 @@ void add_calibrate_command(CLI::App& app) {
                                 states.displaced_by_loop[size_t(l)];
                             row[model + "cold_loop_cycles" + loop] = memory.cold_loop[size_t(l)];
                             row[model + "warm_loop_cycles" + loop] = memory.warm_loop[size_t(l)];
+                            row[model + "cold_leaf_loop_cycles" + loop] =
+                                memory.cold_leaf_loop[size_t(l)];
+                            row[model + "warm_leaf_loop_cycles" + loop] =
+                                memory.warm_leaf_loop[size_t(l)];
                         }
                     }
                     for (int l = 0; l < 3; ++l) {
                         const std::string loop = std::string(".") + loops[l];
-                        row[key + "primed_loop_cycles" + loop] = p.primed_loop_cycles[size_t(l)];
-                        row[key + "cached_loop_cycles" + loop] = p.cached_loop_cycles[size_t(l)];
-                        row[key + "displaced_loop_cycles" + loop] =
-                            p.displaced_loop_cycles[size_t(l)];
-                        row[key + "evicted_loop_cycles" + loop] = p.evicted_loop_cycles[size_t(l)];
+                        row[key + "primed_loop_cycles" + loop] = p.primed.loops[size_t(l)];
+                        row[key + "cached_loop_cycles" + loop] = p.cached.loops[size_t(l)];
+                        row[key + "displaced_loop_cycles" + loop] = p.displaced.loops[size_t(l)];
+                        row[key + "evicted_loop_cycles" + loop] = p.evicted.loops[size_t(l)];
+                        row[key + "primed_leaf_loop_cycles" + loop] = p.primed.leaves[size_t(l)];
+                        row[key + "cached_leaf_loop_cycles" + loop] = p.cached.leaves[size_t(l)];
+                        row[key + "displaced_leaf_loop_cycles" + loop] =
+                            p.displaced.leaves[size_t(l)];
+                        row[key + "evicted_leaf_loop_cycles" + loop] = p.evicted.leaves[size_t(l)];
                     }
-                    row[key + "primed_cycles"] = p.primed_cycles;
-                    row[key + "evicted_cycles"] = p.evicted_cycles;
-                    row[key + "cached_cycles"] = p.cached_cycles;
-                    row[key + "displaced_cycles"] = p.displaced_cycles;
+                    row[key + "primed_cycles"] = p.primed.cycles;
+                    row[key + "evicted_cycles"] = p.evicted.cycles;
+                    row[key + "cached_cycles"] = p.cached.cycles;
+                    row[key + "displaced_cycles"] = p.displaced.cycles;
                     row[key + "box_tests"] = p.box_tests;
                     row[key + "lines"] = p.lines;
                     row[key + "batches"] = p.batches;

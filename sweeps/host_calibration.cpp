@@ -225,7 +225,7 @@ std::array<double, 3> fit_loop_mispredict_cycles(const std::vector<PredictorChec
     double all = 0.0;
     for (const PredictorCheck& b : samples)
         for (size_t l = 0; l < 3; ++l) {
-            cycles[l] += b.measured.displaced_loop_cycles[l] - b.measured.cached_loop_cycles[l];
+            cycles[l] += b.measured.displaced.loops[l] - b.measured.cached.loops[l];
             mispredictions[l] +=
                 double(b.modelled.displaced_by_loop[l]) - double(b.modelled.primed_by_loop[l]);
         }
@@ -247,14 +247,13 @@ UnseenOpCosts fit_unseen_op_cycles(const std::vector<PredictorCheck>& samples) {
     for (const PredictorCheck& b : samples) {
         double in_loops = 0.0, box_ops = 0.0;
         for (size_t l = 0; l < 3; ++l) {
-            const double extra =
-                b.measured.displaced_loop_cycles[l] - b.measured.cached_loop_cycles[l];
+            const double extra = b.measured.displaced.loops[l] - b.measured.cached.loops[l];
             cycles[l] += extra;
             in_loops += extra;
             ops[l] += double(b.unseen.displaced_by_loop[l]);
             box_ops += double(b.unseen.displaced_by_loop[l]);
         }
-        leaf_cycles += b.measured.displaced_cycles - b.measured.cached_cycles - in_loops;
+        leaf_cycles += b.measured.displaced.cycles - b.measured.cached.cycles - in_loops;
         leaf_ops += double(b.unseen.displaced) - box_ops;
     }
     UnseenOpCosts out;
@@ -300,7 +299,7 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     for (const auto& batch : sample.batches) {
         SystemcTiming timing({config}, sample.shape);
         uint64_t before = 0;
-        std::array<uint64_t, 3> loops_before{};
+        std::array<uint64_t, 3> loops_before{}, leaves_before{};
         for (int run = 0; run < 2; ++run) {
             timing.begin_pass(batch->pass());
             for (size_t i = 0; i < batch->size(); ++i) timing.op(batch->at(i));
@@ -312,6 +311,9 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
                 (run == 0 ? out.cold_loop : out.warm_loop)[l] +=
                     double(t.traversal_loop_cycles[l] - loops_before[l]);
                 loops_before[l] = t.traversal_loop_cycles[l];
+                (run == 0 ? out.cold_leaf_loop : out.warm_leaf_loop)[l] +=
+                    double(t.intersection_loop_cycles[l] - leaves_before[l]);
+                leaves_before[l] = t.intersection_loop_cycles[l];
             }
         }
     }
@@ -340,10 +342,10 @@ NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
     NodeReadFit fit;
     for (const PredictorCheck& check : samples) {
         const PredictorSample& s = check.measured;
-        double extra = short_loops(s.evicted_loop_cycles) - short_loops(s.primed_loop_cycles);
+        double extra = short_loops(s.evicted.loops) - short_loops(s.primed.loops);
         for (const PredictorSample& b : baseline)
             if (b.bounce == s.bounce)
-                extra -= short_loops(b.evicted_loop_cycles) - short_loops(b.primed_loop_cycles);
+                extra -= short_loops(b.evicted.loops) - short_loops(b.primed.loops);
         fit.measured.push_back(extra);
     }
     // The model's extra is not proportional to the share (a shorter wait for a node can leave
@@ -515,7 +517,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     std::vector<double> extra_cycles, extra_mispredictions;
     for (const PredictorCheck& b : c.branch_samples) {
         const PredictorStates& m = modelled_states(b, branch_model);
-        extra_cycles.push_back(b.measured.displaced_cycles - b.measured.cached_cycles);
+        extra_cycles.push_back(b.measured.displaced.cycles - b.measured.cached.cycles);
         extra_mispredictions.push_back(double(m.displaced) - double(m.primed));
         c.converged_points += b.measured.converged_batches;
         c.points += b.measured.batches;

@@ -69,8 +69,10 @@ constexpr double k_loop_mispredict_min_share = 0.1;
 // prices scene data from DRAM, held out against the evicted batches.
 struct BatchMemoryCycles {
     double cold = 0.0, warm = 0.0;
-    // Of those, the box tests' by the loop that runs them (FrameTiming::traversal_loop_cycles).
-    std::array<double, 3> cold_loop{}, warm_loop{};
+    // Of those, the box tests' by the loop that runs them (FrameTiming::traversal_loop_cycles),
+    // and the leaves' tests' by the loop whose leaf code runs them
+    // (FrameTiming::intersection_loop_cycles).
+    std::array<double, 3> cold_loop{}, warm_loop{}, cold_leaf_loop{}, warm_leaf_loop{};
 };
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
 

@@ -616,6 +616,49 @@ def leaf_loops_text(df):
     return "\n".join(lines)
 
 
+def batch_loops_text(df):
+    """Per back end, scene and loop, the branch predictor's batches (camera rays and bounces
+    summed) as microbenchmarks of the scene's own traversals: each loop's box tests and leaf
+    tests right after themselves (primed) against the model's same ops right after themselves
+    (warm; its predictor off), and their scene read from DRAM (evicted - primed, less the
+    synthetic scene's batches' same part) against the model's (cold - warm); a part under 1 % of the batches' primed cycles on both sides left
+    out (rows written before the leaves' split carry none)."""
+    if ("measured.predictor.camera.primed_leaf_loop_cycles.stream" not in df
+            or "predicted.predictor.camera.warm_leaf_loop_cycles.stream" not in df):
+        return "These rows carry no batches split into box tests and leaves by loop."
+    lines = ["| back end | scene | tests | loop | model warm, Mcyc | measured primed, Mcyc | "
+             "error | model (cold - warm), Mcyc | measured (evicted - primed) beyond the "
+             "synthetic scene's, Mcyc | model / measured |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for isa in isas(df):
+        for scene, h in df[df["isa"] == isa].groupby("scene", sort=False):
+            r = h.iloc[0]
+
+            def total(side, state, part, key, which=""):
+                return sum(r[f"{side}.predictor.{which}{rays}.{state}_{part}_cycles.{key}"]
+                           for rays in ("camera", "bounce"))
+
+            primed_all = sum(r[f"measured.predictor.{rays}.primed_cycles"]
+                             for rays in ("camera", "bounce"))
+            for part, tests in (("loop", "box"), ("leaf_loop", "leaf")):
+                for key, name in LOOPS:
+                    warm = total("predicted", "warm", part, key)
+                    primed = total("measured", "primed", part, key)
+                    if max(warm, primed) < 0.01 * primed_all:
+                        continue
+                    cold = total("predicted", "cold", part, key) - warm
+                    # Less the synthetic scene's part (the code, TLB and page tables the read
+                    # evicts too: dram_text).
+                    evicted = (total("measured", "evicted", part, key) - primed
+                               - total("measured", "evicted", part, key, "synthetic.")
+                               + total("measured", "primed", part, key, "synthetic."))
+                    lines.append(
+                        f"| {isa} | {scene} | {tests} | {name} | {warm / 1e6:.2f} | "
+                        f"{primed / 1e6:.2f} | {pct(warm / primed - 1) if primed > 0 else 'n/a'} | "
+                        f"{cold / 1e6:.2f} | {evicted / 1e6:.2f} | "
+                        f"{f'{cold / evicted:.2f}' if evicted > 0 else 'n/a'} |")
+    return "\n".join(lines)
+
+
 def shading_ops_text(df):
     """Per back end and scene, the shading stage by op kind (the stage clock's ticks of each
     kind's filter), and the ray set-up the tracer runs apart, which the model prices in the ops
@@ -979,7 +1022,18 @@ def write_page(df, page, plot_name, header):
         "rays reach, in the wide back end's code), and the stream loop's. Measured: the stage "
         "clock's ticks in the leaves each short loop reaches, split as the stages are; the "
         "stream loop's are the rest of the intersection. Predicted: the model's cycles of the "
-        "intersection ops below a box test of each loop.\n\n" + leaf_loops_text(df),
+        "intersection ops below a box test of each loop.\n\n" + leaf_loops_text(df)
+        + "\n\nThe same split on the branch predictor's batches (the tables above; camera "
+        "rays and bounces summed), each a microbenchmark of the scene's own traversals: each "
+        "loop's box tests and leaf tests right after themselves (primed: caches and predictor "
+        "warm), against the model's timing of the same ops right after themselves (warm, its "
+        "predictor off), and what reading the scene from DRAM adds to each (evicted - primed, "
+        "measured, less the same of the synthetic scene's batches, as above) against the "
+        "model's cold - warm. The per-op costs are fitted on the "
+        "synthetic scenes' microbenchmarks, never on these batches: held out. Where a loop's "
+        "leaves are priced right here and not in the frames above, the frame's state (its "
+        "caches, its predictor, the work between its traversals) costs them what the batches "
+        "do not.\n\n" + batch_loops_text(df),
         "## The shading stage by op\n\nMeasured: the stage clock's ticks of each shading "
         "op kind's filter (the camera's loop; the emission filter with the hits' surfaces, as "
         "the model prices it; the material filters as the sort by material the tracer runs "

@@ -1025,13 +1025,22 @@ class OpLengthTally : public TraceSink {
 namespace {
 
 // The stage clock's split of a traversal (`traverse`, each repetition after `prepare`): the
-// shares of its time in the one-ray loop, the few-ray loop (their leaves left out) and the
-// leaves (TraversalJob::leaf_tsc, ShortLoopClock), each the median of 5 clocked repetitions
-// (the clock's reads are in them).
+// shares of its time in the one-ray loop and the few-ray loop (their leaves left out), and in
+// the leaves by the loop whose leaf code ran them (TraversalJob::leaf_tsc, ShortLoopClock; the
+// stream loop's are the rest of the leaves), each the median of 5 clocked repetitions (the
+// clock's reads are in them).
+struct ClockedShares {
+    std::array<double, 2> short_loops{};
+    std::array<double, 3> leaves{};
+    double all_leaves() const { return leaves[0] + leaves[1] + leaves[2]; }
+    // The stream loop's share less its leaves: the rest.
+    double stream_loop() const {
+        return std::max(0.0, 1.0 - short_loops[0] - short_loops[1] - all_leaves());
+    }
+};
 template <class Prepare, class Traverse>
-std::array<double, 3> clocked_loop_shares(TraversalJob& job, Prepare&& prepare,
-                                          Traverse&& traverse) {
-    std::vector<double> shares[3];
+ClockedShares clocked_loop_shares(TraversalJob& job, Prepare&& prepare, Traverse&& traverse) {
+    std::vector<double> shares[5];
     for (uint32_t rep = 0; rep < 5; ++rep) {
         prepare();
         uint64_t leaf_ticks = 0;
@@ -1043,10 +1052,17 @@ std::array<double, 3> clocked_loop_shares(TraversalJob& job, Prepare&& prepare,
         const double spent = double(std::max<uint64_t>(1, __rdtsc() - start));
         job.leaf_tsc = nullptr;
         job.short_loops = nullptr;
-        for (int l = 0; l < 2; ++l) shares[l].push_back(double(clock.ticks[l]) / spent);
-        shares[2].push_back(double(leaf_ticks) / spent);
+        const uint64_t short_leaves = clock.leaf_ticks[0] + clock.leaf_ticks[1];
+        for (int l = 0; l < 2; ++l) {
+            shares[l].push_back(double(clock.ticks[l]) / spent);
+            shares[2 + l].push_back(double(clock.leaf_ticks[l]) / spent);
+        }
+        shares[4].push_back(double(leaf_ticks - std::min(leaf_ticks, short_leaves)) / spent);
     }
-    return {median(shares[0]), median(shares[1]), median(shares[2])};
+    ClockedShares out;
+    for (int l = 0; l < 2; ++l) out.short_loops[size_t(l)] = median(shares[l]);
+    for (int l = 0; l < 3; ++l) out.leaves[size_t(l)] = median(shares[2 + l]);
+    return out;
 }
 
 // The node `depth` levels below the root on a ray's way down (the left child if the ray enters
@@ -1249,15 +1265,15 @@ std::vector<OneRaySample> run_one_ray_microbenchmarks(Isa isa, const Convergence
             sample.cycles = c.fastest / ticks_per_cycle;
             sample.converged = c.converged;
             sample.repetitions = c.samples;
-            const std::array<double, 3> shares = clocked_loop_shares(
+            const ClockedShares shares = clocked_loop_shares(
                 job,
                 [&] {
                     displace_then_prime(TraceDetail::none);
                     reset();
                 },
                 [&] { run(TraceDetail::none); });
-            sample.short_loop_share = {shares[0], shares[1]};
-            sample.leaf_share = shares[2];
+            sample.short_loop_share = shares.short_loops;
+            sample.leaf_share = shares.all_leaves();
             out.push_back(sample);
             if (shape.bundle)
                 for (uint32_t i = 0; i < batch_rays; ++i) {
@@ -1588,10 +1604,10 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                     }
                 }
             };
-            // The batch's fastest cycles in a state, and their split by the loop that ran them
-            // (clocked_loop_shares, each repetition prepared as the timed ones are; the leaves
-            // in no loop).
-            auto timed = [&](Before before, std::array<double, 3>& loops) {
+            // The batch's fastest cycles in a state, and their split by the loop that ran them,
+            // box tests and leaves apart (clocked_loop_shares, each repetition prepared as the
+            // timed ones are).
+            auto timed = [&](Before before, BatchStateCycles& state) {
                 // Untimed first: the state before (the batch run many times, primed or cached)
                 // lasts beyond one preparation; on the branch microbenchmark the first displaced
                 // repetition was over 3 % faster than the rest's median in 23 % of the batches
@@ -1612,21 +1628,19 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                 }
                 const Convergence c = judge_convergence(times, convergence);
                 converged = converged && c.converged;
-                const std::array<double, 3> shares = clocked_loop_shares(
+                const ClockedShares shares = clocked_loop_shares(
                     job, [&] { prepare(before); }, [&] { traverse(t, TraceDetail::none); });
                 const double cycles = c.fastest / ticks_per_cycle;
-                loops[0] += cycles * shares[0];
-                loops[1] += cycles * shares[1];
-                loops[2] += cycles * std::max(0.0, 1.0 - shares[0] - shares[1] - shares[2]);
-                return cycles;
+                state.cycles += cycles;
+                state.loops[0] += cycles * shares.short_loops[0];
+                state.loops[1] += cycles * shares.short_loops[1];
+                state.loops[2] += cycles * shares.stream_loop();
+                for (size_t l = 0; l < 3; ++l) state.leaves[l] += cycles * shares.leaves[l];
             };
-            sample.primed_cycles += timed(Before::itself, sample.primed_loop_cycles);
-            sample.cached_cycles +=
-                timed(Before::itself_and_others_lines, sample.cached_loop_cycles);
-            sample.displaced_cycles +=
-                timed(Before::others_traversals, sample.displaced_loop_cycles);
-            if (time_evicted)
-                sample.evicted_cycles += timed(Before::itself_evicted, sample.evicted_loop_cycles);
+            timed(Before::itself, sample.primed);
+            timed(Before::itself_and_others_lines, sample.cached);
+            timed(Before::others_traversals, sample.displaced);
+            if (time_evicted) timed(Before::itself_evicted, sample.evicted);
             sample.converged_batches += converged;
         }
         if (touched == 1) out.clear();  // keeps the reads of the others' lines

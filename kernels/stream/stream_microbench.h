@@ -290,18 +290,21 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 // by running its own predictor over the same batches (hw_model/branch_predictor.h).
 // `batch_sink`, where given, receives each batch's trace (TraceDetail::lanes: one TilePass of
 // 2 x 64 x 64 slots per batch, camera batches first) for the model to replay. Without
-// `time_evicted` the evicted state is not timed (evicted_cycles 0).
+// `time_evicted` the evicted state is not timed (its cycles 0).
 using PredictorBatchSink = std::function<TraceSink*(bool bounce, uint32_t batch)>;
+// A state's cycles, summed over the batches, and their split as the stage clock splits a
+// frame's traversal and intersection: the box tests by the loop that ran them (one-ray, few-ray,
+// stream), and the leaves' tests by the loop whose leaf code ran them (that of their leaf's box
+// test).
+struct BatchStateCycles {
+    double cycles = 0.0;
+    std::array<double, 3> loops{}, leaves{};
+};
 struct PredictorSample {
     bool bounce = false;                // camera rays, or a bounce of each
     uint32_t batches = 0;               // tiles
     uint64_t box_tests = 0, lines = 0;  // summed over the batches (lines: each one's distinct)
-    double primed_cycles = 0.0, cached_cycles = 0.0, displaced_cycles = 0.0;  // summed
-    double evicted_cycles = 0.0;
-    // Each state's cycles by the loop that ran them (one-ray, few-ray, stream; leaves in none),
-    // as the stage clock splits a frame's traversal.
-    std::array<double, 3> primed_loop_cycles{}, cached_loop_cycles{}, displaced_loop_cycles{},
-        evicted_loop_cycles{};
+    BatchStateCycles primed, cached, displaced, evicted;
     uint32_t converged_batches = 0;  // in every state timed (base/convergence.h)
 };
 // Untimed repetitions of a batch's state before its timed ones: the state before it outlasts

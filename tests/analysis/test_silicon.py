@@ -433,6 +433,42 @@ def test_intersection_by_loop(tmp_path):
     assert "no intersection split" in silicon.leaf_loops_text(older)
 
 
+def test_batches_by_loop(tmp_path):
+    # One scene's batches, camera rays and bounces alike (so each sum is twice one kind's):
+    # the model's warm box tests and leaves by loop against the measured primed ones, and the
+    # DRAM parts less the synthetic scene's; a part under 1 % of the batches' primed cycles
+    # (10e6 a kind) on both sides is left out.
+    r = row("a", 16, 100e6, 100e6)
+    for rays in ("camera", "bounce"):
+        m, p = f"measured.predictor.{rays}.", f"predicted.predictor.{rays}."
+        s = f"measured.predictor.synthetic.{rays}."
+        r[m + "primed_cycles"] = 10e6
+        for key, (box, leaf) in {"one_ray": (1e6, 0.5e6), "few_ray": (4e6, 2e6),
+                                 "stream": (0.01e6, 0.02e6)}.items():
+            r.update({f"{p}warm_loop_cycles.{key}": box * 1.5,
+                      f"{m}primed_loop_cycles.{key}": box,
+                      f"{p}cold_loop_cycles.{key}": box * 1.5 + 1e6,
+                      f"{m}evicted_loop_cycles.{key}": box + 2.2e6,
+                      f"{p}warm_leaf_loop_cycles.{key}": leaf * 0.75,
+                      f"{m}primed_leaf_loop_cycles.{key}": leaf,
+                      f"{p}cold_leaf_loop_cycles.{key}": leaf * 0.75 + 0.1e6,
+                      f"{m}evicted_leaf_loop_cycles.{key}": leaf + 0.5e6,
+                      f"{s}primed_loop_cycles.{key}": 1e6,
+                      f"{s}evicted_loop_cycles.{key}": 1.2e6,
+                      f"{s}primed_leaf_loop_cycles.{key}": 1e6,
+                      f"{s}evicted_leaf_loop_cycles.{key}": 1.1e6})
+    path = tmp_path / "rows.json"
+    path.write_text(json.dumps([r]))
+    df = silicon.load_rows(path)
+    text = silicon.batch_loops_text(df)
+    assert "| avx512 | a | box | one-ray loop | 3.00 | 2.00 | +50.0 % | 2.00 | 4.00 | 0.50 |" in text
+    assert "| avx512 | a | leaf | few-ray loop | 3.00 | 4.00 | -25.0 % | 0.20 | 0.80 | 0.25 |" in text
+    assert "stream loop" not in text
+    # Rows written before the leaves' split carry none, and say so.
+    older = df.drop(columns=[c for c in df.columns if "leaf_loop_cycles" in c])
+    assert "no batches split" in silicon.batch_loops_text(older)
+
+
 def test_shading_by_op(tmp_path):
     # Two workloads of one scene (each row's measured shading is 50e6): each kind's sums
     # and error, its share of the measured shading; a kind under 1 % of it on both sides is

@@ -542,6 +542,54 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(model_batch_memory(host, sample).cold > m.cold);
 }
 
+TEST_CASE("The model times a batch's leaf tests by the loop whose leaf code runs them",
+          "[host][systemc]") {
+    // 100 one-ray box tests, each on its own line and followed by its leaf's triangle test (a
+    // triangle a line further on): the one-ray loop's box tests and leaves, nothing else.
+    OpCostConfig box, triangle;
+    box.op = "box_test";
+    box.per_op_cycles = 10;
+    box.one_lane_cycles = 5;
+    triangle.op = "triangle_test";
+    triangle.per_op_cycles = 40;
+    triangle.one_lane_cycles = 30;
+    const HwConfig host = host_hw_config(small_host(), costs_for_every_kind({box, triangle}));
+    auto pass = std::make_shared<PassBuffer>();
+    TilePass tile;
+    tile.slot_count = 1;
+    pass->begin_pass(tile);
+    const uint32_t id = 0;
+    const uint8_t passed = 1, missed = 0;
+    for (uint32_t i = 0; i < 100; ++i)
+        for (const OpKind kind : {OpKind::box_test, OpKind::triangle_test}) {
+            StreamOp op;
+            op.kind = kind;
+            op.stage = stage_of(kind);
+            op.object = 2 * i;  // nodes a line apart, triangles 72 bytes apart
+            op.length = 1;
+            op.pass_count = kind == OpKind::box_test;
+            op.slots = &id;
+            op.passed = kind == OpKind::box_test ? &passed : &missed;
+            pass->op(op);
+        }
+    pass->end_pass(tile);
+    PredictorCheck sample;
+    sample.batches = {pass};
+    sample.shape = triangle_shape(8);
+    sample.shape.bvh_nodes = 400;
+    sample.shape.triangles = 400;
+    const BatchMemoryCycles m = model_batch_memory(host, sample);
+    const size_t one_ray = size_t(TraversalLoop::one_ray);
+    // Right after itself: each leaf test its one-lane cost, in the one-ray loop only.
+    CHECK(m.warm_leaf_loop[one_ray] == Approx(100 * 30).margin(4));
+    CHECK(m.warm_leaf_loop[size_t(TraversalLoop::few_ray)] == 0.0);
+    CHECK(m.warm_leaf_loop[size_t(TraversalLoop::stream)] == 0.0);
+    CHECK(m.warm_loop[one_ray] == Approx(100 * 5).margin(4));
+    // From empty caches each triangle comes from DRAM: the leaves wait for it.
+    CHECK(m.cold_leaf_loop[one_ray] > m.warm_leaf_loop[one_ray] + 100 * 20);
+    CHECK(m.cold_leaf_loop[one_ray] + m.cold_loop[one_ray] <= m.cold);
+}
+
 TEST_CASE("The filter fit's error is reported by microbenchmark buffer", "[host]") {
     OpCostConfig cost;
     cost.op = "lambertian_indirect";
@@ -599,13 +647,13 @@ TEST_CASE("The short loops' exposed share of a node read is fitted through the m
     // synthetic scene's camera batches too; its bounces' eviction is another kind's.
     const BatchMemoryCycles at = model_batch_memory(with_node_share(host, 0.4), sample);
     const double extra = at.cold_loop[one_ray] - at.warm_loop[one_ray];
-    sample.measured.primed_loop_cycles[one_ray] = 5000;
-    sample.measured.evicted_loop_cycles[one_ray] = 5000 + extra + 200;
+    sample.measured.primed.loops[one_ray] = 5000;
+    sample.measured.evicted.loops[one_ray] = 5000 + extra + 200;
     PredictorSample camera, bounces;
-    camera.primed_loop_cycles[one_ray] = 100;
-    camera.evicted_loop_cycles[one_ray] = 300;
+    camera.primed.loops[one_ray] = 100;
+    camera.evicted.loops[one_ray] = 300;
     bounces.bounce = true;
-    bounces.evicted_loop_cycles[one_ray] = 1e6;
+    bounces.evicted.loops[one_ray] = 1e6;
     const NodeReadFit fit = fit_node_read_exposed_share(host, {sample}, {camera, bounces});
     CHECK(fit.share == Approx(0.4).margin(0.01));
     CHECK(fit.measured[0] == Approx(extra));
@@ -624,9 +672,9 @@ TEST_CASE("The short loops' exposed share of a node read is fitted through the m
     CHECK(taken.modeled[0] > 1.5 * extra);
     CHECK(taken.error.second > 0.5);
     // Beyond the whole latency the share stays 1; at no extra, 0.
-    sample.measured.evicted_loop_cycles[one_ray] = 5000 + 3 * fit.modeled_whole[0];
+    sample.measured.evicted.loops[one_ray] = 5000 + 3 * fit.modeled_whole[0];
     CHECK(fit_node_read_exposed_share(host, {sample}, {}).share == 1.0);
-    sample.measured.evicted_loop_cycles[one_ray] = 5000;
+    sample.measured.evicted.loops[one_ray] = 5000;
     CHECK(fit_node_read_exposed_share(host, {sample}, {}).share == 0.0);
     // A chase of nodes whose addresses come from their parents' data: each waits for its
     // parent's arrival, whatever the share.
@@ -681,19 +729,19 @@ TEST_CASE("A misprediction's cost is fitted per loop where the model mispredicts
     // loop's 500 over 50 (10 each); the few-ray loop's 30 over 2, under a tenth of the 102
     // added: not fitted (-1, the pooled cost).
     PredictorCheck a, b;
-    a.measured.displaced_loop_cycles = {13000, 1030, 20500};
-    a.measured.cached_loop_cycles = {10000, 1000, 20000};
+    a.measured.displaced.loops = {13000, 1030, 20500};
+    a.measured.cached.loops = {10000, 1000, 20000};
     a.modelled.displaced_by_loop = {45, 3, 60};
     a.modelled.primed_by_loop = {5, 1, 10};
-    b.measured.displaced_loop_cycles = {2000, 0, 0};
-    b.measured.cached_loop_cycles = {1000, 0, 0};
+    b.measured.displaced.loops = {2000, 0, 0};
+    b.measured.cached.loops = {1000, 0, 0};
     b.modelled.displaced_by_loop = {10, 0, 0};
     const std::array<double, 3> cost = fit_loop_mispredict_cycles({a, b});
     CHECK(cost[0] == Approx(80.0));
     CHECK(cost[1] == -1.0);
     CHECK(cost[2] == Approx(10.0));
     // A loop whose displaced batches ran faster than the cached: a cost of 0, not negative.
-    a.measured.displaced_loop_cycles[2] = 19000;
+    a.measured.displaced.loops[2] = 19000;
     CHECK(fit_loop_mispredict_cycles({a, b})[2] == 0.0);
     CHECK(fit_loop_mispredict_cycles({}) == std::array<double, 3>{-1.0, -1.0, -1.0});
 }
@@ -704,16 +752,16 @@ TEST_CASE("An unseen traversal op's cost is fitted per loop, a leaf test's outsi
     // cached over 40 + 10 box tests (80 each); the stream loop's 500 over 50 (10 each), the
     // few-ray loop ran none; outside the loops 600 + 0 cycles more over 20 + 10 leaf tests.
     PredictorCheck a, b;
-    a.measured.displaced_loop_cycles = {13000, 0, 20500};
-    a.measured.cached_loop_cycles = {10000, 0, 20000};
-    a.measured.displaced_cycles = 40000 + 3000 + 500 + 600;
-    a.measured.cached_cycles = 40000;
+    a.measured.displaced.loops = {13000, 0, 20500};
+    a.measured.cached.loops = {10000, 0, 20000};
+    a.measured.displaced.cycles = 40000 + 3000 + 500 + 600;
+    a.measured.cached.cycles = 40000;
     a.unseen.displaced_by_loop = {40, 0, 50};
     a.unseen.displaced = 40 + 50 + 20;
-    b.measured.displaced_loop_cycles = {2000, 0, 0};
-    b.measured.cached_loop_cycles = {1000, 0, 0};
-    b.measured.displaced_cycles = 5000 + 1000;
-    b.measured.cached_cycles = 5000;
+    b.measured.displaced.loops = {2000, 0, 0};
+    b.measured.cached.loops = {1000, 0, 0};
+    b.measured.displaced.cycles = 5000 + 1000;
+    b.measured.cached.cycles = 5000;
     b.unseen.displaced_by_loop = {10, 0, 0};
     b.unseen.displaced = 10 + 10;
     const UnseenOpCosts cost = fit_unseen_op_cycles({a, b});
@@ -722,7 +770,7 @@ TEST_CASE("An unseen traversal op's cost is fitted per loop, a leaf test's outsi
     CHECK(cost.box_by_loop[2] == Approx(10.0));
     CHECK(cost.leaf == Approx(20.0));
     // Displaced faster than cached somewhere: a cost of 0, not negative.
-    a.measured.displaced_loop_cycles[2] = 19000;
+    a.measured.displaced.loops[2] = 19000;
     CHECK(fit_unseen_op_cycles({a, b}).box_by_loop[2] == 0.0);
     // The states each kind prices.
     CHECK(&modelled_states(a, "unseen_ops") == &a.unseen);
