@@ -692,7 +692,7 @@ void add_calibrate_command(CLI::App& app) {
                 checks.set_label(scenes[sc] + ": the branch predictor, " + isa_name(isa));
                 predictor[{sc, isa}] = check_predictor(*loaded[sc], *bvhs[sc], isa, bench_rule);
                 for (PredictorCheck& c : predictor[{sc, isa}]) {
-                    batch_memory[{sc, isa}].push_back(model_batch_memory(hosts[k], c));
+                    batch_memory[{sc, isa}].push_back(model_batch_memory(hosts[k], c, true));
                     c.batches.clear();  // their memory, no longer needed
                 }
                 checks.advance();
@@ -873,6 +873,7 @@ void add_calibrate_command(CLI::App& app) {
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
                         row[model + "cold_cycles"] = memory.cold;
                         row[model + "warm_cycles"] = memory.warm;
+                        row[model + "displaced_cycles"] = memory.displaced;
                         for (int l = 0; l < 3; ++l) {
                             const std::string loop = std::string(".") + loops[l];
                             row[model + "primed_loop_mispredictions" + loop] =
@@ -885,6 +886,10 @@ void add_calibrate_command(CLI::App& app) {
                                 memory.cold_leaf_loop[size_t(l)];
                             row[model + "warm_leaf_loop_cycles" + loop] =
                                 memory.warm_leaf_loop[size_t(l)];
+                            row[model + "displaced_loop_cycles" + loop] =
+                                memory.displaced_loop[size_t(l)];
+                            row[model + "displaced_leaf_loop_cycles" + loop] =
+                                memory.displaced_leaf_loop[size_t(l)];
                         }
                     }
                     for (int l = 0; l < 3; ++l) {

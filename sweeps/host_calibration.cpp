@@ -292,30 +292,40 @@ std::vector<PredictorCheck> check_predictor(const Scene& scene, const Bvh& bvh, 
     return out;
 }
 
-BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample) {
+BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample,
+                                     bool after_others) {
     HwConfig config = host;
     config.branch_predictor.kind = "none";
     BatchMemoryCycles out;
-    for (const auto& batch : sample.batches) {
-        SystemcTiming timing({config}, sample.shape);
-        uint64_t before = 0;
-        std::array<uint64_t, 3> loops_before{}, leaves_before{};
-        for (int run = 0; run < 2; ++run) {
-            timing.begin_pass(batch->pass());
-            for (size_t i = 0; i < batch->size(); ++i) timing.op(batch->at(i));
-            timing.end_pass(batch->pass());
-            const FrameTiming t = timing.timing(0);
-            (run == 0 ? out.cold : out.warm) += double(t.cycles - before);
-            before = t.cycles;
-            for (size_t l = 0; l < 3; ++l) {
-                (run == 0 ? out.cold_loop : out.warm_loop)[l] +=
-                    double(t.traversal_loop_cycles[l] - loops_before[l]);
-                loops_before[l] = t.traversal_loop_cycles[l];
-                (run == 0 ? out.cold_leaf_loop : out.warm_leaf_loop)[l] +=
-                    double(t.intersection_loop_cycles[l] - leaves_before[l]);
-                leaves_before[l] = t.intersection_loop_cycles[l];
-            }
+    // Times `batch` on `timing`, adding its cycles, and each loop's box tests and leaves, to
+    // the given sums.
+    const auto run = [](SystemcTiming& timing, const PassBuffer& batch, double& cycles,
+                        std::array<double, 3>& loops, std::array<double, 3>& leaves) {
+        const FrameTiming before = timing.timing(0);
+        timing.begin_pass(batch.pass());
+        for (size_t i = 0; i < batch.size(); ++i) timing.op(batch.at(i));
+        timing.end_pass(batch.pass());
+        const FrameTiming t = timing.timing(0);
+        cycles += double(t.cycles - before.cycles);
+        for (size_t l = 0; l < 3; ++l) {
+            loops[l] += double(t.traversal_loop_cycles[l] - before.traversal_loop_cycles[l]);
+            leaves[l] += double(t.intersection_loop_cycles[l] - before.intersection_loop_cycles[l]);
         }
+    };
+    for (const auto& batch : sample.batches) {
+        {
+            SystemcTiming timing({config}, sample.shape);
+            run(timing, *batch, out.cold, out.cold_loop, out.cold_leaf_loop);
+            run(timing, *batch, out.warm, out.warm_loop, out.warm_leaf_loop);
+        }  // one SystemcTiming at a time: SystemC has one simulation context
+        if (!after_others) continue;
+        SystemcTiming displaced({config}, sample.shape);
+        double ignored = 0.0;
+        std::array<double, 3> ignored_loops{}, ignored_leaves{};
+        run(displaced, *batch, ignored, ignored_loops, ignored_leaves);
+        for (const auto& other : sample.batches)
+            if (other != batch) run(displaced, *other, ignored, ignored_loops, ignored_leaves);
+        run(displaced, *batch, out.displaced, out.displaced_loop, out.displaced_leaf_loop);
     }
     return out;
 }

@@ -66,15 +66,20 @@ constexpr double k_loop_mispredict_min_share = 0.1;
 // The model's cycles for a predictor microbenchmark's batches on `host` (its branches not
 // priced: the states compared share the predictor's), each batch from empty caches (cold: the
 // microbenchmark's evicted state) and right after itself (warm: primed), summed: how the model
-// prices scene data from DRAM, held out against the evicted batches.
+// prices scene data from DRAM, held out against the evicted batches. With `after_others`, each
+// batch also right after itself and then the other batches of its kind (displaced: its own
+// lines aged by the others', the microbenchmark's displaced state as far as the caches go and
+// its cached state as far as the scene's lines go).
 struct BatchMemoryCycles {
-    double cold = 0.0, warm = 0.0;
+    double cold = 0.0, warm = 0.0, displaced = 0.0;
     // Of those, the box tests' by the loop that runs them (FrameTiming::traversal_loop_cycles),
     // and the leaves' tests' by the loop whose leaf code runs them
     // (FrameTiming::intersection_loop_cycles).
-    std::array<double, 3> cold_loop{}, warm_loop{}, cold_leaf_loop{}, warm_leaf_loop{};
+    std::array<double, 3> cold_loop{}, warm_loop{}, displaced_loop{};
+    std::array<double, 3> cold_leaf_loop{}, warm_leaf_loop{}, displaced_leaf_loop{};
 };
-BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample);
+BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample,
+                                     bool after_others = false);
 
 // OpCostConfig::node_read_exposed_share, the box test's: per sample (a predictor check of the
 // branch microbenchmark, its evicted state timed), what reading the scene from DRAM added to

@@ -620,15 +620,21 @@ def batch_loops_text(df):
     """Per back end, scene and loop, the branch predictor's batches (camera rays and bounces
     summed) as microbenchmarks of the scene's own traversals: each loop's box tests and leaf
     tests right after themselves (primed) against the model's same ops right after themselves
-    (warm; its predictor off), and their scene read from DRAM (evicted - primed, less the
+    (warm; its predictor off), their lines aged by the other batches' (cached over primed)
+    against the model's same ops after themselves and the other batches (over warm), and
+    their scene read from DRAM (evicted - primed, less the
     synthetic scene's batches' same part) against the model's (cold - warm); a part under 1 % of the batches' primed cycles on both sides left
     out (rows written before the leaves' split carry none)."""
     if ("measured.predictor.camera.primed_leaf_loop_cycles.stream" not in df
             or "predicted.predictor.camera.warm_leaf_loop_cycles.stream" not in df):
         return "These rows carry no batches split into box tests and leaves by loop."
     lines = ["| back end | scene | tests | loop | model warm, Mcyc | measured primed, Mcyc | "
-             "error | model (cold - warm), Mcyc | measured (evicted - primed) beyond the "
-             "synthetic scene's, Mcyc | model / measured |", "|---|---|---|---|---|---|---|---|---|---|"]
+             "error | lines aged: model (after the others / warm) | measured (cached / "
+             "primed) | model (cold - warm), Mcyc | measured (evicted - primed) beyond the "
+             "synthetic scene's, Mcyc | model / measured |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    # Rows written before the model's state after the other batches carry none.
+    aged = "predicted.predictor.camera.displaced_leaf_loop_cycles.stream" in df
     for isa in isas(df):
         for scene, h in df[df["isa"] == isa].groupby("scene", sort=False):
             r = h.iloc[0]
@@ -651,9 +657,13 @@ def batch_loops_text(df):
                     evicted = (total("measured", "evicted", part, key) - primed
                                - total("measured", "evicted", part, key, "synthetic.")
                                + total("measured", "primed", part, key, "synthetic."))
+                    cached = total("measured", "cached", part, key)
+                    after = (pct(total("predicted", "displaced", part, key) / warm - 1)
+                             if aged and warm > 0 else "-")
                     lines.append(
                         f"| {isa} | {scene} | {tests} | {name} | {warm / 1e6:.2f} | "
                         f"{primed / 1e6:.2f} | {pct(warm / primed - 1) if primed > 0 else 'n/a'} | "
+                        f"{after} | {pct(cached / primed - 1) if primed > 0 else 'n/a'} | "
                         f"{cold / 1e6:.2f} | {evicted / 1e6:.2f} | "
                         f"{f'{cold / evicted:.2f}' if evicted > 0 else 'n/a'} |")
     return "\n".join(lines)
@@ -1027,7 +1037,10 @@ def write_page(df, page, plot_name, header):
         "rays and bounces summed), each a microbenchmark of the scene's own traversals: each "
         "loop's box tests and leaf tests right after themselves (primed: caches and predictor "
         "warm), against the model's timing of the same ops right after themselves (warm, its "
-        "predictor off), and what reading the scene from DRAM adds to each (evicted - primed, "
+        "predictor off); what the other batches' lines cost each, aged in the caches "
+        "(cached over primed, measured; the model's same ops after themselves and then the "
+        "other batches, over warm); and what reading the scene from DRAM adds to each "
+        "(evicted - primed, "
         "measured, less the same of the synthetic scene's batches, as above) against the "
         "model's cold - warm. The per-op costs are fitted on the "
         "synthetic scenes' microbenchmarks, never on these batches: held out. Where a loop's "

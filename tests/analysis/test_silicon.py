@@ -443,6 +443,7 @@ def test_batches_by_loop(tmp_path):
         m, p = f"measured.predictor.{rays}.", f"predicted.predictor.{rays}."
         s = f"measured.predictor.synthetic.{rays}."
         r[m + "primed_cycles"] = 10e6
+        r[m + "cached_cycles"] = 11e6
         for key, (box, leaf) in {"one_ray": (1e6, 0.5e6), "few_ray": (4e6, 2e6),
                                  "stream": (0.01e6, 0.02e6)}.items():
             r.update({f"{p}warm_loop_cycles.{key}": box * 1.5,
@@ -453,6 +454,10 @@ def test_batches_by_loop(tmp_path):
                       f"{m}primed_leaf_loop_cycles.{key}": leaf,
                       f"{p}cold_leaf_loop_cycles.{key}": leaf * 0.75 + 0.1e6,
                       f"{m}evicted_leaf_loop_cycles.{key}": leaf + 0.5e6,
+                      f"{m}cached_loop_cycles.{key}": box * 1.1,
+                      f"{m}cached_leaf_loop_cycles.{key}": leaf * 1.2,
+                      f"{p}displaced_loop_cycles.{key}": box * 1.5,
+                      f"{p}displaced_leaf_loop_cycles.{key}": leaf * 0.75 * 1.05,
                       f"{s}primed_loop_cycles.{key}": 1e6,
                       f"{s}evicted_loop_cycles.{key}": 1.2e6,
                       f"{s}primed_leaf_loop_cycles.{key}": 1e6,
@@ -461,9 +466,16 @@ def test_batches_by_loop(tmp_path):
     path.write_text(json.dumps([r]))
     df = silicon.load_rows(path)
     text = silicon.batch_loops_text(df)
-    assert "| avx512 | a | box | one-ray loop | 3.00 | 2.00 | +50.0 % | 2.00 | 4.00 | 0.50 |" in text
-    assert "| avx512 | a | leaf | few-ray loop | 3.00 | 4.00 | -25.0 % | 0.20 | 0.80 | 0.25 |" in text
+    assert ("| avx512 | a | box | one-ray loop | 3.00 | 2.00 | +50.0 % | +0.0 % | +10.0 % | "
+            "2.00 | 4.00 | 0.50 |") in text
+    assert ("| avx512 | a | leaf | few-ray loop | 3.00 | 4.00 | -25.0 % | +5.0 % | +20.0 % | "
+            "0.20 | 0.80 | 0.25 |") in text
     assert "stream loop" not in text
+    # Rows written before the model's state after the other batches show none.
+    before = df.drop(columns=[c for c in df.columns if c.startswith("predicted.")
+                              and "displaced_" in c and "_loop_" in c])
+    assert ("| avx512 | a | box | one-ray loop | 3.00 | 2.00 | +50.0 % | - | +10.0 % | "
+            in silicon.batch_loops_text(before))
     # Rows written before the leaves' split carry none, and say so.
     older = df.drop(columns=[c for c in df.columns if "leaf_loop_cycles" in c])
     assert "no batches split" in silicon.batch_loops_text(older)

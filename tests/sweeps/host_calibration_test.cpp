@@ -542,6 +542,57 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     CHECK(model_batch_memory(host, sample).cold > m.cold);
 }
 
+TEST_CASE("The model times each batch after itself and the other batches of its kind",
+          "[host][systemc]") {
+    // Batches of one-ray box tests on nodes a line apart (32-byte nodes, 2 apart), from node
+    // `first` on: 200 of them fit the 32 KiB L1D; 5000 more lines (320 KiB) pass through the
+    // 256 KiB L2 and leave none of the first batch's lines in the caches.
+    const HwConfig host = one_lane_box_host();
+    const auto batch = [](uint32_t first, uint32_t count) {
+        auto pass = std::make_shared<PassBuffer>();
+        TilePass tile;
+        tile.slot_count = 1;
+        pass->begin_pass(tile);
+        const uint32_t id = 0;
+        const uint8_t passed = 1;
+        for (uint32_t i = 0; i < count; ++i) {
+            StreamOp op;
+            op.kind = OpKind::box_test;
+            op.object = first + 2 * i;
+            op.length = 1;
+            op.pass_count = 1;
+            op.slots = &id;
+            op.passed = &passed;
+            pass->op(op);
+        }
+        pass->end_pass(tile);
+        return pass;
+    };
+    PredictorCheck sample;
+    sample.shape = triangle_shape(8);
+    sample.shape.bvh_nodes = 20000;
+    const auto own = batch(0, 200);
+    const size_t one_ray = size_t(TraversalLoop::one_ray);
+    // The others few: the batch's lines stay; only its own time is summed (the others' too,
+    // each after the rest, as its own batch).
+    sample.batches = {own, batch(1000, 10)};
+    const BatchMemoryCycles kept = model_batch_memory(host, sample, true);
+    CHECK(kept.displaced == Approx(kept.warm).margin(8));
+    CHECK(kept.displaced_loop[one_ray] == Approx(kept.warm_loop[one_ray]).margin(8));
+    // The others many: the batch's lines come from DRAM again, as from empty caches.
+    sample.batches = {own, batch(1000, 5000)};
+    const BatchMemoryCycles aged = model_batch_memory(host, sample, true);
+    const BatchMemoryCycles own_only = [&] {
+        PredictorCheck alone = sample;
+        alone.batches = {own};
+        return model_batch_memory(host, alone, true);
+    }();
+    CHECK(own_only.displaced == Approx(own_only.warm).margin(4));
+    CHECK(aged.displaced - aged.warm > 0.9 * (own_only.cold - own_only.warm));
+    // Without it, the state is not timed.
+    CHECK(model_batch_memory(host, sample).displaced == 0.0);
+}
+
 TEST_CASE("The model times a batch's leaf tests by the loop whose leaf code runs them",
           "[host][systemc]") {
     // 100 one-ray box tests, each on its own line and followed by its leaf's triangle test (a
