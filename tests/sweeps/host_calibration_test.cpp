@@ -483,20 +483,20 @@ HwConfig one_lane_box_host() {
     return host_hw_config(small_host(), costs_for_every_kind({box}));
 }
 
-// Two batches of 200 one-ray box tests, camera rays: on nodes `step` apart (32-byte nodes, so
-// 2 is a line each), each the child of the one before (1: its left child, whose address the
-// core knows without its parent's data).
-PredictorCheck one_ray_batches(uint32_t step) {
+// A batch of `count` one-ray box tests, camera rays: on nodes `step` apart from node `first`
+// (32-byte nodes, so 2 is a line each), each the child of the one before (1: its left child,
+// whose address the core knows without its parent's data).
+std::shared_ptr<PassBuffer> one_ray_box_tests(uint32_t first, uint32_t count, uint32_t step) {
     auto pass = std::make_shared<PassBuffer>();
     TilePass tile;
     tile.slot_count = 1;
     pass->begin_pass(tile);
     const uint32_t id = 0;
     const uint8_t passed = 1;
-    for (uint32_t i = 0; i < 200; ++i) {
+    for (uint32_t i = 0; i < count; ++i) {
         StreamOp op;
         op.kind = OpKind::box_test;
-        op.object = step * i;
+        op.object = first + step * i;
         op.length = 1;
         op.pass_count = 1;
         op.slots = &id;
@@ -504,6 +504,12 @@ PredictorCheck one_ray_batches(uint32_t step) {
         pass->op(op);
     }
     pass->end_pass(tile);
+    return pass;
+}
+
+// Two batches of 200 such box tests from node 0.
+PredictorCheck one_ray_batches(uint32_t step) {
+    const auto pass = one_ray_box_tests(0, 200, step);
     PredictorCheck sample;
     sample.batches = {pass, pass};
     sample.shape = triangle_shape(8);
@@ -549,24 +555,7 @@ TEST_CASE("The model times each batch after itself and the other batches of its 
     // 256 KiB L2 and leave none of the first batch's lines in the caches.
     const HwConfig host = one_lane_box_host();
     const auto batch = [](uint32_t first, uint32_t count) {
-        auto pass = std::make_shared<PassBuffer>();
-        TilePass tile;
-        tile.slot_count = 1;
-        pass->begin_pass(tile);
-        const uint32_t id = 0;
-        const uint8_t passed = 1;
-        for (uint32_t i = 0; i < count; ++i) {
-            StreamOp op;
-            op.kind = OpKind::box_test;
-            op.object = first + 2 * i;
-            op.length = 1;
-            op.pass_count = 1;
-            op.slots = &id;
-            op.passed = &passed;
-            pass->op(op);
-        }
-        pass->end_pass(tile);
-        return pass;
+        return one_ray_box_tests(first, count, 2);
     };
     PredictorCheck sample;
     sample.shape = triangle_shape(8);
