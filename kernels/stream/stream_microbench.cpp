@@ -1027,8 +1027,9 @@ namespace {
 // The stage clock's split of a traversal (`traverse`, each repetition after `prepare`): the
 // shares of its time in the one-ray loop and the few-ray loop (their leaves left out), and in
 // the leaves by the loop whose leaf code ran them (TraversalJob::leaf_tsc, ShortLoopClock; the
-// stream loop's are the rest of the leaves), each the median of 5 clocked repetitions (the
-// clock's reads are in them).
+// stream loop's are the rest of the leaves), each the median of its own share over 5 clocked
+// repetitions (the clock's reads are in them), so that the parts add up (the leaves' whole is
+// the sum of the three loops' medians, not the median of their sum).
 struct ClockedShares {
     std::array<double, 2> short_loops{};
     std::array<double, 3> leaves{};
