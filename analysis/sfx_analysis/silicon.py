@@ -622,9 +622,9 @@ def batch_loops_text(df):
     tests right after themselves (primed) against the model's same ops right after themselves
     (warm; its predictor off), their lines aged by the other batches' (cached over primed)
     against the model's same ops after themselves and the other batches (over warm), and
-    their scene read from DRAM (evicted - primed, less the
-    synthetic scene's batches' same part) against the model's (cold - warm); a part under 1 % of the batches' primed cycles on both sides left
-    out (rows written before the leaves' split carry none)."""
+    their scene read from DRAM (evicted - primed, less the synthetic scene's batches' same
+    part) against the model's (cold - warm); a part under 1 % of the batches' primed cycles on
+    both sides left out (rows written before the leaves' split carry none)."""
     if ("measured.predictor.camera.primed_leaf_loop_cycles.stream" not in df
             or "predicted.predictor.camera.warm_leaf_loop_cycles.stream" not in df):
         return "These rows carry no batches split into box tests and leaves by loop."
@@ -1040,9 +1040,8 @@ def write_page(df, page, plot_name, header):
         "predictor off); what the other batches' lines cost each, aged in the caches "
         "(cached over primed, measured; the model's same ops after themselves and then the "
         "other batches, over warm); and what reading the scene from DRAM adds to each "
-        "(evicted - primed, "
-        "measured, less the same of the synthetic scene's batches, as above) against the "
-        "model's cold - warm. The per-op costs are fitted on the "
+        "(evicted - primed, measured, less the same of the synthetic scene's batches, as "
+        "above) against the model's cold - warm. The per-op costs are fitted on the "
         "synthetic scenes' microbenchmarks, never on these batches: held out. Where a loop's "
         "leaves are priced right here and not in the frames above, the frame's state (its "
         "caches, its predictor, the work between its traversals) costs them what the batches "
