@@ -840,6 +840,16 @@ void add_calibrate_command(CLI::App& app) {
             for (const Stat& stat : m.prediction.stats())
                 for (const char* prefix : {"stall_cycles.", "scene_cache.", "scene_memory."})
                     if (stat.name.rfind(prefix, 0) == 0) row["predicted." + stat.name] = stat.value;
+            // A batch state's cycles, and its box tests and leaves by loop, as `prefix` + state
+            // + "_cycles", "_loop_cycles.LOOP" and "_leaf_loop_cycles.LOOP".
+            const auto add_state = [&](const std::string& prefix, const char* state,
+                                       const BatchStateCycles& s) {
+                row[prefix + state + "_cycles"] = s.cycles;
+                for (size_t l = 0; l < 3; ++l) {
+                    row[prefix + state + "_loop_cycles." + loops[l]] = s.loops[l];
+                    row[prefix + state + "_leaf_loop_cycles." + loops[l]] = s.leaves[l];
+                }
+            };
             for (const auto& [which, index] :
                  {std::pair<std::string, size_t>{"", scene_index}, {"synthetic.", scenes.size()}})
                 for (size_t at = 0; at < predictor[{index, st.isa}].size(); ++at) {
@@ -871,43 +881,21 @@ void add_calibrate_command(CLI::App& app) {
                                 : b.price(double(states.displaced) - double(states.primed),
                                           box_added);
                         const BatchMemoryCycles& memory = batch_memory[{index, st.isa}][at];
-                        row[model + "cold_cycles"] = memory.cold;
-                        row[model + "warm_cycles"] = memory.warm;
-                        row[model + "displaced_cycles"] = memory.displaced;
+                        add_state(model, "cold", memory.cold);
+                        add_state(model, "warm", memory.warm);
+                        add_state(model, "displaced", memory.displaced);
                         for (int l = 0; l < 3; ++l) {
                             const std::string loop = std::string(".") + loops[l];
                             row[model + "primed_loop_mispredictions" + loop] =
                                 states.primed_by_loop[size_t(l)];
                             row[model + "displaced_loop_mispredictions" + loop] =
                                 states.displaced_by_loop[size_t(l)];
-                            row[model + "cold_loop_cycles" + loop] = memory.cold_loop[size_t(l)];
-                            row[model + "warm_loop_cycles" + loop] = memory.warm_loop[size_t(l)];
-                            row[model + "cold_leaf_loop_cycles" + loop] =
-                                memory.cold_leaf_loop[size_t(l)];
-                            row[model + "warm_leaf_loop_cycles" + loop] =
-                                memory.warm_leaf_loop[size_t(l)];
-                            row[model + "displaced_loop_cycles" + loop] =
-                                memory.displaced_loop[size_t(l)];
-                            row[model + "displaced_leaf_loop_cycles" + loop] =
-                                memory.displaced_leaf_loop[size_t(l)];
                         }
                     }
-                    for (int l = 0; l < 3; ++l) {
-                        const std::string loop = std::string(".") + loops[l];
-                        row[key + "primed_loop_cycles" + loop] = p.primed.loops[size_t(l)];
-                        row[key + "cached_loop_cycles" + loop] = p.cached.loops[size_t(l)];
-                        row[key + "displaced_loop_cycles" + loop] = p.displaced.loops[size_t(l)];
-                        row[key + "evicted_loop_cycles" + loop] = p.evicted.loops[size_t(l)];
-                        row[key + "primed_leaf_loop_cycles" + loop] = p.primed.leaves[size_t(l)];
-                        row[key + "cached_leaf_loop_cycles" + loop] = p.cached.leaves[size_t(l)];
-                        row[key + "displaced_leaf_loop_cycles" + loop] =
-                            p.displaced.leaves[size_t(l)];
-                        row[key + "evicted_leaf_loop_cycles" + loop] = p.evicted.leaves[size_t(l)];
-                    }
-                    row[key + "primed_cycles"] = p.primed.cycles;
-                    row[key + "evicted_cycles"] = p.evicted.cycles;
-                    row[key + "cached_cycles"] = p.cached.cycles;
-                    row[key + "displaced_cycles"] = p.displaced.cycles;
+                    add_state(key, "primed", p.primed);
+                    add_state(key, "cached", p.cached);
+                    add_state(key, "displaced", p.displaced);
+                    add_state(key, "evicted", p.evicted);
                     row[key + "box_tests"] = p.box_tests;
                     row[key + "lines"] = p.lines;
                     row[key + "batches"] = p.batches;

@@ -298,34 +298,33 @@ BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck&
     config.branch_predictor.kind = "none";
     BatchMemoryCycles out;
     // Times `batch` on `timing`, adding its cycles, and each loop's box tests and leaves, to
-    // the given sums.
-    const auto run = [](SystemcTiming& timing, const PassBuffer& batch, double& cycles,
-                        std::array<double, 3>& loops, std::array<double, 3>& leaves) {
+    // `sums`.
+    const auto run = [](SystemcTiming& timing, const PassBuffer& batch, BatchStateCycles& sums) {
         const FrameTiming before = timing.timing(0);
         timing.begin_pass(batch.pass());
         for (size_t i = 0; i < batch.size(); ++i) timing.op(batch.at(i));
         timing.end_pass(batch.pass());
         const FrameTiming t = timing.timing(0);
-        cycles += double(t.cycles - before.cycles);
+        sums.cycles += double(t.cycles - before.cycles);
         for (size_t l = 0; l < 3; ++l) {
-            loops[l] += double(t.traversal_loop_cycles[l] - before.traversal_loop_cycles[l]);
-            leaves[l] += double(t.intersection_loop_cycles[l] - before.intersection_loop_cycles[l]);
+            sums.loops[l] += double(t.traversal_loop_cycles[l] - before.traversal_loop_cycles[l]);
+            sums.leaves[l] +=
+                double(t.intersection_loop_cycles[l] - before.intersection_loop_cycles[l]);
         }
     };
     for (const auto& batch : sample.batches) {
         {
             SystemcTiming timing({config}, sample.shape);
-            run(timing, *batch, out.cold, out.cold_loop, out.cold_leaf_loop);
-            run(timing, *batch, out.warm, out.warm_loop, out.warm_leaf_loop);
+            run(timing, *batch, out.cold);
+            run(timing, *batch, out.warm);
         }  // one SystemcTiming at a time: SystemC has one simulation context
         if (!after_others) continue;
         SystemcTiming displaced({config}, sample.shape);
-        double ignored = 0.0;
-        std::array<double, 3> ignored_loops{}, ignored_leaves{};
-        run(displaced, *batch, ignored, ignored_loops, ignored_leaves);
+        BatchStateCycles before;  // the runs that set the state up, not summed
+        run(displaced, *batch, before);
         for (const auto& other : sample.batches)
-            if (other != batch) run(displaced, *other, ignored, ignored_loops, ignored_leaves);
-        run(displaced, *batch, out.displaced, out.displaced_loop, out.displaced_leaf_loop);
+            if (other != batch) run(displaced, *other, before);
+        run(displaced, *batch, out.displaced);
     }
     return out;
 }
@@ -345,7 +344,7 @@ NodeReadFit fit_node_read_exposed_share(const HwConfig& host,
         std::vector<double> out;
         for (const PredictorCheck& s : samples) {
             const BatchMemoryCycles m = model_batch_memory(config, s);
-            out.push_back(short_loops(m.cold_loop) - short_loops(m.warm_loop));
+            out.push_back(short_loops(m.cold.loops) - short_loops(m.warm.loops));
         }
         return out;
     };

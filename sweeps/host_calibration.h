@@ -70,13 +70,11 @@ constexpr double k_loop_mispredict_min_share = 0.1;
 // batch also right after itself and then the other batches of its kind (displaced: its own
 // lines aged by the others', the microbenchmark's displaced state as far as the caches go and
 // its cached state as far as the scene's lines go).
+// Each state split as the microbenchmark's are (BatchStateCycles): the box tests by the loop
+// that runs them (FrameTiming::traversal_loop_cycles), the leaves' tests by the loop whose leaf
+// code runs them (FrameTiming::intersection_loop_cycles).
 struct BatchMemoryCycles {
-    double cold = 0.0, warm = 0.0, displaced = 0.0;
-    // Of those, the box tests' by the loop that runs them (FrameTiming::traversal_loop_cycles),
-    // and the leaves' tests' by the loop whose leaf code runs them
-    // (FrameTiming::intersection_loop_cycles).
-    std::array<double, 3> cold_loop{}, warm_loop{}, displaced_loop{};
-    std::array<double, 3> cold_leaf_loop{}, warm_leaf_loop{}, displaced_leaf_loop{};
+    BatchStateCycles cold, warm, displaced;
 };
 BatchMemoryCycles model_batch_memory(const HwConfig& host, const PredictorCheck& sample,
                                      bool after_others = false);

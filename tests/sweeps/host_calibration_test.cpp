@@ -532,20 +532,21 @@ TEST_CASE("The model times a microbenchmark's batches from DRAM and right after 
     HwConfig host = one_lane_box_host();
     const PredictorCheck sample = one_ray_batches(2);
     const BatchMemoryCycles m = model_batch_memory(host, sample);
-    CHECK(m.warm == Approx(2 * 200 * 5).margin(4));
-    CHECK(m.cold > m.warm + 2 * 200 * 20);  // 81 ns DRAM at 1 GHz, less what prefetch hides
+    CHECK(m.warm.cycles == Approx(2 * 200 * 5).margin(4));
+    CHECK(m.cold.cycles >
+          m.warm.cycles + 2 * 200 * 20);  // 81 ns DRAM at 1 GHz, less what prefetch hides
     // Every box test is a one-ray stream's: the one-ray loop holds all of both states.
-    CHECK(m.warm_loop[size_t(TraversalLoop::one_ray)] == Approx(m.warm).margin(4));
-    CHECK(m.cold_loop[size_t(TraversalLoop::one_ray)] == Approx(m.cold).margin(4));
-    CHECK(m.cold_loop[size_t(TraversalLoop::stream)] == 0.0);
+    CHECK(m.warm.loops[size_t(TraversalLoop::one_ray)] == Approx(m.warm.cycles).margin(4));
+    CHECK(m.cold.loops[size_t(TraversalLoop::one_ray)] == Approx(m.cold.cycles).margin(4));
+    CHECK(m.cold.loops[size_t(TraversalLoop::stream)] == 0.0);
     // Each batch from its own empty caches; its branches never priced.
     host.branch_predictor.kind = "tage";
     host.branch_predictor.mispredict_cycles = 1000;
     const BatchMemoryCycles again = model_batch_memory(host, sample);
-    CHECK(again.cold == m.cold);
-    CHECK(again.warm == m.warm);
+    CHECK(again.cold.cycles == m.cold.cycles);
+    CHECK(again.warm.cycles == m.warm.cycles);
     host.scene_memory.dram_latency_ns = 200;
-    CHECK(model_batch_memory(host, sample).cold > m.cold);
+    CHECK(model_batch_memory(host, sample).cold.cycles > m.cold.cycles);
 }
 
 TEST_CASE("The model times each batch after itself and the other batches of its kind",
@@ -566,8 +567,8 @@ TEST_CASE("The model times each batch after itself and the other batches of its 
     // each after the rest, as its own batch).
     sample.batches = {own, batch(1000, 10)};
     const BatchMemoryCycles kept = model_batch_memory(host, sample, true);
-    CHECK(kept.displaced == Approx(kept.warm).margin(8));
-    CHECK(kept.displaced_loop[one_ray] == Approx(kept.warm_loop[one_ray]).margin(8));
+    CHECK(kept.displaced.cycles == Approx(kept.warm.cycles).margin(8));
+    CHECK(kept.displaced.loops[one_ray] == Approx(kept.warm.loops[one_ray]).margin(8));
     // The others many: the batch's lines come from DRAM again, as from empty caches.
     sample.batches = {own, batch(1000, 5000)};
     const BatchMemoryCycles aged = model_batch_memory(host, sample, true);
@@ -576,10 +577,11 @@ TEST_CASE("The model times each batch after itself and the other batches of its 
         alone.batches = {own};
         return model_batch_memory(host, alone, true);
     }();
-    CHECK(own_only.displaced == Approx(own_only.warm).margin(4));
-    CHECK(aged.displaced - aged.warm > 0.9 * (own_only.cold - own_only.warm));
+    CHECK(own_only.displaced.cycles == Approx(own_only.warm.cycles).margin(4));
+    CHECK(aged.displaced.cycles - aged.warm.cycles >
+          0.9 * (own_only.cold.cycles - own_only.warm.cycles));
     // Without it, the state is not timed.
-    CHECK(model_batch_memory(host, sample).displaced == 0.0);
+    CHECK(model_batch_memory(host, sample).displaced.cycles == 0.0);
 }
 
 TEST_CASE("The model times a batch's leaf tests by the loop whose leaf code runs them",
@@ -621,13 +623,13 @@ TEST_CASE("The model times a batch's leaf tests by the loop whose leaf code runs
     const BatchMemoryCycles m = model_batch_memory(host, sample);
     const size_t one_ray = size_t(TraversalLoop::one_ray);
     // Right after itself: each leaf test its one-lane cost, in the one-ray loop only.
-    CHECK(m.warm_leaf_loop[one_ray] == Approx(100 * 30).margin(4));
-    CHECK(m.warm_leaf_loop[size_t(TraversalLoop::few_ray)] == 0.0);
-    CHECK(m.warm_leaf_loop[size_t(TraversalLoop::stream)] == 0.0);
-    CHECK(m.warm_loop[one_ray] == Approx(100 * 5).margin(4));
+    CHECK(m.warm.leaves[one_ray] == Approx(100 * 30).margin(4));
+    CHECK(m.warm.leaves[size_t(TraversalLoop::few_ray)] == 0.0);
+    CHECK(m.warm.leaves[size_t(TraversalLoop::stream)] == 0.0);
+    CHECK(m.warm.loops[one_ray] == Approx(100 * 5).margin(4));
     // From empty caches each triangle comes from DRAM: the leaves wait for it.
-    CHECK(m.cold_leaf_loop[one_ray] > m.warm_leaf_loop[one_ray] + 100 * 20);
-    CHECK(m.cold_leaf_loop[one_ray] + m.cold_loop[one_ray] <= m.cold);
+    CHECK(m.cold.leaves[one_ray] > m.warm.leaves[one_ray] + 100 * 20);
+    CHECK(m.cold.leaves[one_ray] + m.cold.loops[one_ray] <= m.cold.cycles);
 }
 
 TEST_CASE("The filter fit's error is reported by microbenchmark buffer", "[host]") {
@@ -686,7 +688,7 @@ TEST_CASE("The short loops' exposed share of a node read is fitted through the m
     // Measured: what the model gives at a share of 0.4, plus 200 cycles that evicting costs the
     // synthetic scene's camera batches too; its bounces' eviction is another kind's.
     const BatchMemoryCycles at = model_batch_memory(with_node_share(host, 0.4), sample);
-    const double extra = at.cold_loop[one_ray] - at.warm_loop[one_ray];
+    const double extra = at.cold.loops[one_ray] - at.warm.loops[one_ray];
     sample.measured.primed.loops[one_ray] = 5000;
     sample.measured.evicted.loops[one_ray] = 5000 + extra + 200;
     PredictorSample camera, bounces;
@@ -721,7 +723,7 @@ TEST_CASE("The short loops' exposed share of a node read is fitted through the m
     const PredictorCheck chase = one_ray_batches(2);
     const auto chase_extra = [&](double share) {
         const BatchMemoryCycles m = model_batch_memory(with_node_share(host, share), chase);
-        return m.cold_loop[one_ray] - m.warm_loop[one_ray];
+        return m.cold.loops[one_ray] - m.warm.loops[one_ray];
     };
     CHECK(chase_extra(0.0) > 0.9 * chase_extra(1.0));
 }
