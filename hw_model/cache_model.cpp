@@ -2,16 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 namespace sfx {
+
+uint32_t whole_sets_kib(uint32_t kib, uint32_t ways, uint32_t line_bytes) {
+    const uint64_t set_bytes = uint64_t(std::max(1u, ways)) * line_bytes;
+    const uint64_t step = set_bytes / std::gcd(set_bytes, uint64_t(1024));  // KiB
+    return uint32_t(std::max<uint64_t>(step, (uint64_t(kib) + step / 2) / step * step));
+}
 
 SetAssociativeCache::SetAssociativeCache(const CacheLevelConfig& config, double core_mhz)
     : m_config(config) {
     const uint64_t lines = uint64_t(config.kib) * 1024 / config.line_bytes;
     if (config.ways == 0 || lines % config.ways != 0 ||
         (config.line_bytes & (config.line_bytes - 1)))
-        throw std::invalid_argument("cache " + config.name + ": bad geometry");
+        throw std::invalid_argument("cache " + config.name + ": " + std::to_string(config.kib) +
+                                    " KiB is not a whole number of sets of " +
+                                    std::to_string(config.ways) + " ways of " +
+                                    std::to_string(config.line_bytes) + "-byte lines");
     m_ways = config.ways;
     m_sets = uint32_t(lines / config.ways);
     m_line_shift = 0;

@@ -14,6 +14,11 @@
 
 namespace sfx {
 
+// The size nearest `kib` that is a whole number of sets of `ways` lines of `line_bytes`, in whole
+// KiB (at least one such step): a measured size becomes a cache's. A 20-way level of 64-byte
+// lines (the Intel Xeon VM's L3, family 6 model 0xCF) comes in steps of 5 KiB.
+uint32_t whole_sets_kib(uint32_t kib, uint32_t ways, uint32_t line_bytes);
+
 class SetAssociativeCache {
   public:
     // `core_mhz` times the level's foreign fills (CacheLevelConfig::foreign_fill_per_us).

@@ -21,6 +21,7 @@
 #include "base/host_clock.h"
 #include "base/huge_pages.h"
 #include "base/strict_number.h"
+#include "hw_model/cache_model.h"
 
 namespace sfx {
 
@@ -412,7 +413,9 @@ SeenLevel last_level_seen(const HostDescription& h) {
         return seen;
     }
     const uint64_t kib = uint64_t(std::llround(capacity * last.line_bytes / 1024.0));
-    seen.kib = uint32_t(std::clamp<uint64_t>(kib, 1, last.kib));
+    seen.kib = std::min(
+        whole_sets_kib(uint32_t(std::min<uint64_t>(kib, last.kib)), last.ways, last.line_bytes),
+        last.kib);
     seen.cut = seen.kib < last.kib;
     seen.foreign_fill_per_us = per_ns * 1000.0;
     return seen;

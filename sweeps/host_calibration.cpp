@@ -21,6 +21,7 @@
 #include "base/cpu_load.h"
 #include "base/cycle_source.h"
 #include "base/huge_pages.h"
+#include "hw_model/cache_model.h"
 #include "hw_model/op_costs.h"
 #include "hw_model/ray_buffer_model.h"
 #include "hw_model/systemc/systemc_timing.h"
@@ -876,8 +877,10 @@ HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen) {
     HwConfig c = host;
     if (seen.kib == 0 || c.scene_memory.caches.empty() || !c.scene_memory.caches.back().shared)
         return c;
-    c.scene_memory.caches.back().kib = seen.kib;
-    c.scene_memory.caches.back().foreign_fill_per_us = seen.foreign_fill_per_us;
+    CacheLevelConfig& last = c.scene_memory.caches.back();
+    // The run's median of two chases' sizes need not be whole sets.
+    last.kib = whole_sets_kib(seen.kib, last.ways, last.line_bytes);
+    last.foreign_fill_per_us = seen.foreign_fill_per_us;
     return c;
 }
 

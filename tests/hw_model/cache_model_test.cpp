@@ -18,6 +18,23 @@ TEST_CASE("A cache hits on a line it holds and misses on a new one", "[hw_model]
     CHECK(c.misses() == 2);
 }
 
+TEST_CASE("A measured size becomes a cache's in whole sets, whatever its ways",
+          "[hw_model][cache]") {
+    // 20 ways of 64-byte lines: sets of 1280 bytes, whole KiB every 5 KiB.
+    CHECK(whole_sets_kib(35330, 20, 64) == 35330);
+    CHECK(whole_sets_kib(35332, 20, 64) == 35330);
+    CHECK(whole_sets_kib(35333, 20, 64) == 35335);
+    CHECK(whole_sets_kib(1, 20, 64) == 5);
+    CHECK(whole_sets_kib(34567, 16, 64) == 34567);  // 16 ways: every KiB
+    CHECK(whole_sets_kib(34567, 12, 64) == 34566);  // 768-byte sets: every 3 KiB
+    SetAssociativeCache c({"l3", whole_sets_kib(34567, 20, 64), 64, 20, 40});
+    CHECK_FALSE(c.access(0));
+    CHECK(c.access(0));
+    CHECK_THROWS_WITH(SetAssociativeCache({"l3", 34567, 64, 20, 40}),
+                      "cache l3: 34567 KiB is not a whole number of sets of 20 ways of 64-byte "
+                      "lines");
+}
+
 TEST_CASE("Pseudo-LRU evicts the line not recently used", "[hw_model][cache]") {
     SetAssociativeCache c({"l1", 1, 64, 4, 4});                 // 16 lines: 4 sets of 4 ways
     const uint64_t set_stride = 4 * 64;                         // addresses mapping to set 0

@@ -1215,6 +1215,18 @@ TEST_CASE("The last level's size and others' fills come from this core's chases"
     CHECK(seen.kib == 520192);
     CHECK_FALSE(seen.cut);
     CHECK(seen.foreign_fill_per_us == 0.0);
+    // A 20-way level (the Intel Xeon VM's, family 6 model 0xCF): the size its chases cross at
+    // is rounded to whole sets, which the model's cache is built from.
+    host.caches.back() = {3, "unified", 266240, 64, 20, true, "test"};
+    host.last_level_chases = {
+        {2048, 16.0}, {4096, 16.0}, {6400, 16.0}, {7744, 144.0}, {16384, 144.0}};
+    host.last_level_idle_chases = {{100.0, 16.0}, {1000.0, 17.0}};
+    seen = last_level_seen(host);
+    CHECK(seen.kib == 7040);  // 5632 sets
+    host.last_level_chases = {
+        {2048, 16.0}, {4096, 16.0}, {6400, 16.0}, {7900, 144.0}, {16384, 144.0}};
+    CHECK(last_level_seen(host).kib % 5 == 0);
+    CHECK_NOTHROW(SetAssociativeCache(host_hw_config(host, {}).scene_memory.caches.back()));
 }
 
 TEST_CASE("A level's latency is chased over twice the level before it, not half its own",

@@ -11,6 +11,7 @@
 #include <map>
 
 #include "base/core_contention.h"
+#include "hw_model/cache_model.h"
 #include "hw_model/ray_buffer_model.h"
 #include "kernels/bvh.h"
 #include "kernels/simd/isa.h"
@@ -745,6 +746,14 @@ TEST_CASE("The check's L3 chased now replaces a host file's shared last level on
     CHECK(with_last_level(host, SeenLevel{}).scene_memory.caches.back().kib == 32768);
     host.scene_memory.caches.back().shared = false;
     CHECK(with_last_level(host, seen).scene_memory.caches.back().kib == 32768);
+    // A 20-way level (the Intel Xeon VM's, family 6 model 0xCF) takes the run's size in whole
+    // sets: a median of two rounds' need not be.
+    host.scene_memory.caches.back() = {"l3", 266240, 64, 20, 10.0};
+    host.scene_memory.caches.back().shared = true;
+    seen.kib = 7002;
+    const CacheLevelConfig twenty = with_last_level(host, seen).scene_memory.caches.back();
+    CHECK(twenty.kib == 7000);
+    CHECK_NOTHROW(SetAssociativeCache(twenty));
 }
 
 TEST_CASE("The run's L3 is the median of the chases, size and others' fills apart", "[host]") {
