@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "base/cache_eviction.h"
 #include "base/convergence.h"
 #include "base/core_clock.h"
 #include "base/host_clock.h"
@@ -292,14 +293,6 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
     if (at == size_t(-1)) std::printf(" ");  // keeps the chase
     if (step_ns) *step_ns = best / tsc_mhz * 1000.0;
     return std::max(0.0, best - spin_best) / tsc_mhz * 1000.0;
-}
-
-void evict_caches() {
-    static std::vector<uint64_t, HugePageAllocator<uint64_t>> other(k_beyond_last_level_bytes / 8,
-                                                                    1);
-    uint64_t sum = 0;
-    for (size_t i = 0; i < other.size(); i += 8) sum += other[i];  // one read a line
-    if (sum == 0) std::fprintf(stderr, " ");                       // keeps the reads
 }
 
 double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs) {
@@ -620,8 +613,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
     if (!c.scene_memory.dram_latency_by_span.empty()) {
         y << "  dram_latency_by_span:  # "
           << (h.memory_source.empty()
-                  ? "measured: the first pass of a random chase over the span after 256 MiB "
-                    "read elsewhere (measure_dram_first_pass_ns)"
+                  ? "measured: the first pass of a random chase over the span after other "
+                    "data read elsewhere (measure_dram_first_pass_ns, evict_caches)"
                   : "as " + h.memory_source + " describes it")
           << "\n";
         for (const DramSpanLatency& s : c.scene_memory.dram_latency_by_span)

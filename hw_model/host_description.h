@@ -129,10 +129,6 @@ struct HostDescription {
     std::string few_ray_source;
 };
 
-// Reads other data beyond the L3 a core keeps (k_beyond_last_level_bytes, a line at a time):
-// nothing read before it is left in this core's caches.
-void evict_caches();
-
 // The latency of a read from DRAM within `span_bytes`: the first pass of a random chase over
 // the span (at most 2^16 of its lines), right after evict_caches, so that every load of it
 // misses every cache; the fastest of `runs`. The span sets how many DRAM rows and pages the

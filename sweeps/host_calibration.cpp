@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "base/cache_eviction.h"
 #include "base/convergence.h"
 #include "base/core_contention.h"
 #include "base/cpu_load.h"

@@ -360,9 +360,9 @@ struct SiliconMeasurement {
     SeenLevel l3_before, l3_after, l3_render, l3_run;
     uint32_t l3_rounds_kib_min = ~0u, l3_rounds_kib_max = 0;  // over the rounds' chases
     double predicted_frame_described = 0.0, predicted_frame_round = 0.0;
-    // From cold caches (SiliconVariant::cold): the renders after reading 256 MiB of other data,
-    // which leaves none of the scene in this core's caches, under the same rule; the
-    // prediction from empty caches. 0 and no samples where not asked for.
+    // From cold caches (SiliconVariant::cold): the renders after evict_caches
+    // (base/cache_eviction.h), which leaves none of the scene in this core's caches, under the same
+    // rule; the prediction from empty caches. 0 and no samples where not asked for.
     double predicted_cold_frame = 0.0, measured_cold_frame = 0.0;
     Convergence cold_convergence;
     std::vector<double> cold_samples;

@@ -494,7 +494,7 @@ def predictor_text(df):
 
 def dram_text(df):
     """Per back end and scene: the predictor microbenchmark's batches right after themselves and
-    a read of 256 MiB of other data (every scene line in DRAM) over right after themselves,
+    a read of other data (every scene line in DRAM) over right after themselves,
     measured, beside the model's same batches from empty caches over right after themselves
     (rows written before either carry none)."""
     if ("measured.predictor.camera.evicted_cycles" not in df
@@ -962,7 +962,8 @@ def write_page(df, page, plot_name, header):
         "that loses lines by age between frames loses more of them in the longer frame and "
         "predicts a ratio above the measured one.\n\n" + scaling_text(df),
         "## Cold caches\n\nOne tile per scene, resolution and back end also rendered after "
-        "reading 256 MiB of other data, so that none of the scene is left in this core's "
+        "reading other data (three times the largest cache the CPU reports, at least 256 MiB), "
+        "so that none of the scene is left in this core's "
         "caches (the same convergence rule), and predicted from empty caches. The cost of cold "
         "caches is what the frame otherwise saves from the lines the render before left: on "
         "silicon, what those lines are worth after their ageing by the neighbours' fills; in "
@@ -1005,7 +1006,8 @@ def write_page(df, page, plot_name, header):
         "displaced cost, over the cached cycles), held out.\n\n"
         + predictor_text(df),
         "## Scene data from DRAM\n\nThe same batches right after themselves and a read of "
-        "256 MiB of other data (every scene line in DRAM, the predictor primed), over right "
+        "other data (three times the largest cache the CPU reports, at least 256 MiB: every "
+        "scene line in DRAM, the predictor primed), over right "
         "after themselves: what reading the scene from DRAM costs a traversal, measured, less "
         "what evicting costs the synthetic scene's batches, whose scene is a few lines (the "
         "code, TLB and page tables the read evicts too, which a frame keeps), beside the "

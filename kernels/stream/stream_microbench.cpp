@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "base/cache_eviction.h"
 #include "base/convergence.h"
 #include "base/core_clock.h"
 #include "base/core_contention.h"
@@ -1526,9 +1527,6 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
     const double overhead = tsc_overhead();
     const double ticks_per_cycle = tsc_ticks_per_core_cycle(3, isa_width(resolved));
     std::vector<PredictorSample> out;
-    // Other data, read a line at a time to evict the scene's lines (256 MiB: beyond any L3 a
-    // core keeps, as the scene memory's DRAM latency is measured).
-    std::vector<uint64_t> other_data(time_evicted ? (size_t(256) << 20) / sizeof(uint64_t) : 0, 1);
     for (const bool bounce : {false, true}) {
         // Each tile's batch: its slots in increasing order, as the tracer's streams are.
         std::vector<std::vector<uint32_t>> batches(k_tiles);
@@ -1588,7 +1586,7 @@ std::vector<PredictorSample> run_predictor_microbenchmarks(
                             if (o != t)
                                 for (const uint64_t* line : lines[o]) touched += *line;
                     if (before == Before::itself_evicted) {
-                        for (size_t i = 0; i < other_data.size(); i += 8) touched += other_data[i];
+                        evict_caches();  // the scene's lines, as a cold render's
                         // The batch's own data back in the caches, as primed: only the
                         // scene's lines stay in DRAM (traverse writes its rays' fields).
                         const size_t n = batches[t].size() + k_stream_padding;

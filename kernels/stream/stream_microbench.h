@@ -283,7 +283,7 @@ std::vector<uint32_t> surface_read_hits(const SurfaceReadSample& sample, uint32_
 // cached: what a frame's caches hold); and right after those batches' traversals (displaced:
 // a frame's traversals never repeat, so its predictor has seen other ones). Displaced over
 // lines cached is the predictor's part; lines cached over primed, the caches'. A fourth state,
-// right after itself and a read of 256 MiB of other data (evicted: every line in DRAM, the
+// right after itself and evict_caches (base/cache_eviction.h; evicted: every line in DRAM, the
 // predictor primed), over primed is what reading the scene from DRAM costs. The per-op costs
 // come from the synthetic scene's traversals (run_one_ray_microbenchmarks, displaced too); a
 // scene whose branches are harder to predict pays more than they say, which the model prices
