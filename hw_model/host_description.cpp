@@ -406,6 +406,7 @@ SeenLevel last_level_seen(const HostDescription& h) {
         return seen;
     }
     const uint64_t kib = uint64_t(std::llround(capacity * last.line_bytes / 1024.0));
+    // Whole sets (a 20-way level's come in steps of 5 KiB), within cpuid's size.
     seen.kib = std::min(
         whole_sets_kib(uint32_t(std::min<uint64_t>(kib, last.kib)), last.ways, last.line_bytes),
         last.kib);
