@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/cache_eviction.h"
 #include "hw_model/hw_config.h"
 
 namespace sfx {
@@ -48,9 +49,10 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin = 0
 // two runs of one day).
 uint32_t latency_chase_kib(const std::vector<HostCacheLevel>& caches, size_t level);
 
-// Beyond the L3 a core sees on any current CPU (no larger: the machine may be shared): the
-// DRAM chase's size, and what the silicon check reads to leave a core's caches cold.
-constexpr uint64_t k_beyond_last_level_bytes = 256ull << 20;
+// Beyond the L3 a core keeps of any current CPU (no larger: the machine may be shared): the
+// DRAM chase's size and the last of its spans. The caches are emptied by evict_caches
+// (base/cache_eviction.h), which reads at least this much and more where cpuid's L3 is larger.
+constexpr uint64_t k_beyond_last_level_bytes = k_min_eviction_bytes;
 
 // Reads the TSC (rdtsc): the clock the native tracer's cycles are counted in.
 uint64_t read_tsc();
