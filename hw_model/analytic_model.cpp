@@ -266,7 +266,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
         const double gathers = double(p.gather_words.size());
         // Of the lanes beyond the L1D, those opening a page of the array the op reads pay
-        // (lanes_opening_pages), here as expected of a stream of `length` random slots.
+        // (lanes_opening_pages), here as expected of a stream of `length` random slots; the
+        // rest pay as lanes in an open page.
         const OpStage op_stage = stage_of(kind);
         const double beyond_l1 =
             slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()), op_stage);
@@ -298,10 +299,10 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             // would pass all or none of the bucket).
             const double passing = length == 1 ? pass_rate : double(std::lround(pass_rate * lanes));
             const double busy =
-                p.issue_cycles(c.datapath, length,
-                               uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
-                               passing, g == 0, beyond_l1 * opening_share,
-                               beyond_l2 * opening_share, double(bucket.failed_candidates) / ops) +
+                p.issue_cycles(
+                    c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)),
+                    lanes, passing, g == 0, beyond_l1 * opening_share, beyond_l2 * opening_share,
+                    double(bucket.failed_candidates) / ops, beyond_l1 * (1.0 - opening_share)) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
                 (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);

@@ -11,7 +11,8 @@
 namespace sfx {
 
 double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
-                          double beyond_l1, double beyond_l2, double failed_candidates) {
+                          double beyond_l1, double beyond_l2, double failed_candidates,
+                          double beyond_l1_in_page) {
     OpProfile p;
     p.measured = true;
     p.cost = cost;
@@ -23,8 +24,9 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
         const uint32_t n = std::min(width, lanes - first);
         const uint32_t pass = std::min(n, left);
         left -= pass;
-        cycles += p.issue_cycles(datapath, lanes, minority_lanes(passed, lanes), n, pass,
-                                 first == 0, beyond_l1, beyond_l2, failed_candidates);
+        cycles +=
+            p.issue_cycles(datapath, lanes, minority_lanes(passed, lanes), n, pass, first == 0,
+                           beyond_l1, beyond_l2, failed_candidates, beyond_l1_in_page);
     }
     return cycles;
 }
@@ -32,12 +34,13 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
 namespace {
 
 // Columns of the cost formula for one sample (per op, group, lane, passing lane, minority
-// lane, beyond L1, beyond L2, failing lane). The failing lanes' column is last: lanes, passing and
+// lane, beyond L1, beyond L2, beyond L1 in an open page, failing lane). The failing lanes' column
+// is last: lanes, passing and
 // failing lanes are dependent, so the solve gives it no pivot and 0 unless the passing lanes'
 // cost would be negative and is dropped (a lane that passes costs less than one that fails:
 // the scalar box test on an Intel Xeon VM, 2026-11-29, 24-27 cycles a lane on streams that
 // mostly pass and 38-47 on streams that mostly fail; fitted without it, 17 % median error).
-constexpr int k_terms = 8;
+constexpr int k_terms = 9;
 std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
     return {1.0,
             double(lane_groups(s.lanes, width)),
@@ -46,6 +49,7 @@ std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
             double(minority_lanes(s.passed, s.lanes)),
             s.beyond_l1 * s.lanes,
             s.beyond_l2 * s.lanes,
+            s.beyond_l1_in_page * s.lanes,
             double(s.lanes - s.passed)};
 }
 
@@ -59,7 +63,8 @@ OpCostConfig from_coefficients(const std::string& op, const std::array<double, k
     c.per_minority_lane_cycles = x[4];
     c.beyond_l1_per_lane_cycles = x[5];
     c.beyond_l2_per_lane_cycles = x[6];
-    c.per_fail_cycles = x[7];
+    c.beyond_l1_in_page_per_lane_cycles = x[7];
+    c.per_fail_cycles = x[8];
     return c;
 }
 
@@ -169,13 +174,14 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     // column is told from the lane and pass columns only by streams of many lanes that all
     // pass and that none pass beside mixed ones (the shading filters' and leaf tests'
     // microbenchmarks).
-    bool any_beyond = false, any_beyond_l2 = false, any_passed = false, any_failed = false,
-         all_pass = false, none_pass = false, mixed = false;
+    bool any_beyond = false, any_beyond_l2 = false, any_in_page = false, any_passed = false,
+         any_failed = false, all_pass = false, none_pass = false, mixed = false;
     std::vector<std::array<double, k_terms>> rows;
     std::vector<double> cycles;
     for (const OpCostSample& s : samples) {
         any_beyond |= s.beyond_l1 > 0;
         any_beyond_l2 |= s.beyond_l2 > 0;
+        any_in_page |= s.beyond_l1_in_page > 0;
         any_passed |= s.passed > 0;
         any_failed |= s.passed < s.lanes;
         all_pass |= s.lanes >= 8 && s.passed == s.lanes;
@@ -186,9 +192,10 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     }
     active[5] = any_beyond;
     active[6] = any_beyond_l2;
+    active[7] = any_in_page;
     active[4] = all_pass && none_pass && mixed;
     active[3] = any_passed;
-    active[7] = any_passed && any_failed;
+    active[8] = any_passed && any_failed;
     return from_coefficients(op, fit_nonnegative(rows, cycles, active));
 }
 
@@ -292,7 +299,8 @@ double median_extra(const OpCostConfig& base, uint32_t width,
         if (const uint32_t units = units_of(s); units > 0)
             extra.push_back(
                 (s.cycles - measured_op_cycles(base, width, s.lanes, s.passed, s.beyond_l1,
-                                               s.beyond_l2, s.failed_candidates)) /
+                                               s.beyond_l2, s.failed_candidates,
+                                               s.beyond_l1_in_page)) /
                 units);
     return extra.empty() ? 0.0 : median(extra);
 }
@@ -348,10 +356,11 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
                                     const std::vector<OpCostSample>& samples) {
     std::vector<double> e;
     for (const OpCostSample& s : samples)
-        e.push_back(std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1,
-                                                s.beyond_l2, s.failed_candidates) -
-                             s.cycles) /
-                    std::max(s.cycles, k_fit_resolution_cycles));
+        e.push_back(
+            std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1, s.beyond_l2,
+                                        s.failed_candidates, s.beyond_l1_in_page) -
+                     s.cycles) /
+            std::max(s.cycles, k_fit_resolution_cycles));
     if (e.empty()) return {0.0, 0.0};
     std::sort(e.begin(), e.end());
     return {e[e.size() / 2], e.back()};

@@ -138,6 +138,14 @@ double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, u
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
+double beyond_cache_in_page_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
+                                  uint32_t lane_bytes, uint32_t cache_kib) {
+    if (lanes == 0) return 0.0;
+    return beyond_cache_fraction(slots, slot_bytes, cache_kib) *
+           (1.0 - expected_lanes_opening_pages(lanes, slots, lane_bytes) /
+                      double(std::min(lanes, slots)));
+}
+
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {
     return buffer.slot_bytes ? buffer.slot_bytes : record_bytes;
 }

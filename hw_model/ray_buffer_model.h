@@ -169,6 +169,10 @@ uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_array
 // frames came out 7-15 % over the measured.
 double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                           uint32_t cache_kib);
+// The same stream's share of lanes beyond the cache in a page the lane before opened (the rest
+// of beyond_cache_fraction's lanes: beyond_l1_in_page_per_lane_cycles).
+double beyond_cache_in_page_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
+                                  uint32_t lane_bytes, uint32_t cache_kib);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);
