@@ -283,6 +283,11 @@ void add_calibrate_command(CLI::App& app) {
                             j["op_costs"][k.op]["residual_by_buffer"]
                              [std::to_string(cal.residual_buffer_slots[b])] =
                                  cal.residuals_by_buffer[i][b];
+                    for (size_t l = 0; l < cal.residual_lengths.size(); ++l)
+                        if (!std::isnan(cal.residuals_by_length[i][l]))
+                            j["op_costs"][k.op]["residual_by_length"]
+                             [std::to_string(cal.residual_lengths[l])] =
+                                 cal.residuals_by_length[i][l];
                 }
                 for (const MicrobenchSample& m : cal.samples)
                     j["samples"].push_back(
@@ -462,6 +467,19 @@ void add_calibrate_command(CLI::App& app) {
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 std::printf("  %-20s", cal.op_costs[i].op.c_str());
                 for (const double r : cal.residuals_by_buffer[i])
+                    std::isnan(r) ? std::printf("        -") : std::printf(" %+7.1f%%", 100 * r);
+                std::printf("\n");
+            }
+            std::printf("fit error at %u slots by stream length:",
+                        cal.residual_buffer_slots.empty()
+                            ? 0u
+                            : *std::max_element(cal.residual_buffer_slots.begin(),
+                                                cal.residual_buffer_slots.end()));
+            for (const uint32_t lanes : cal.residual_lengths) std::printf(" %u", lanes);
+            std::printf(" lanes\n");
+            for (size_t i = 0; i < cal.op_costs.size(); ++i) {
+                std::printf("  %-20s", cal.op_costs[i].op.c_str());
+                for (const double r : cal.residuals_by_length[i])
                     std::isnan(r) ? std::printf("        -") : std::printf(" %+7.1f%%", 100 * r);
                 std::printf("\n");
             }

@@ -416,15 +416,15 @@ FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, I
         std::to_string(k_few_ray_min_width) + " lanes or more writes them)");
 }
 
-std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t width,
-                                            const std::vector<OpCostSample>& samples,
-                                            const std::vector<uint32_t>& slots,
-                                            const std::vector<uint32_t>& buffers) {
+std::vector<double> fit_residuals_by(const OpCostConfig& cost, uint32_t width,
+                                     const std::vector<OpCostSample>& samples,
+                                     const std::vector<uint32_t>& keys,
+                                     const std::vector<uint32_t>& wanted) {
     std::vector<double> medians;
-    for (const uint32_t buffer : buffers) {
+    for (const uint32_t key : wanted) {
         std::vector<double> errors;
         for (size_t i = 0; i < samples.size(); ++i) {
-            if (slots[i] != buffer) continue;
+            if (keys[i] != key) continue;
             const OpCostSample& s = samples[i];
             const double priced =
                 measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1, s.beyond_l2,
@@ -461,6 +461,7 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
     for (const MicrobenchSample& s : c.samples) c.converged_points += s.converged;
     c.points = uint32_t(c.samples.size());
     c.residual_buffer_slots = options.buffer_slots;
+    c.residual_lengths = options.lengths;
     const uint32_t slot_bytes = stream_slot_bytes();
     std::map<OpKind, std::vector<OpCostSample>> by_kind;
     std::map<OpKind, std::vector<uint32_t>> slots_of;      // by_kind's samples' buffers
@@ -519,8 +520,15 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         }
         c.op_costs.back().cold_call_cycles = fit_cold_call_cycles(cold_calls[kind]);
         c.fit_errors.push_back(fit_error(c.op_costs.back(), c.host.simd_width, samples));
-        c.residuals_by_buffer.push_back(fit_residuals_by_buffer(
+        c.residuals_by_buffer.push_back(fit_residuals_by(
             c.op_costs.back(), c.host.simd_width, samples, slots_of[kind], options.buffer_slots));
+        std::vector<uint32_t> lanes_at_largest;  // 0: at another buffer
+        const uint32_t largest =
+            *std::max_element(options.buffer_slots.begin(), options.buffer_slots.end());
+        for (size_t i = 0; i < samples.size(); ++i)
+            lanes_at_largest.push_back(slots_of[kind][i] == largest ? samples[i].lanes : 0);
+        c.residuals_by_length.push_back(fit_residuals_by(
+            c.op_costs.back(), c.host.simd_width, samples, lanes_at_largest, options.lengths));
         points += samples.size() + one_lane[kind].size();
     }
     // The cost of a misprediction of the model's branch predictor: on a scene of random

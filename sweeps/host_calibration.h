@@ -117,6 +117,11 @@ struct HostCalibration {
     // size that the form (ray data beyond the L1D, beyond the L2) does not price.
     std::vector<uint32_t> residual_buffer_slots;
     std::vector<std::vector<double>> residuals_by_buffer;
+    // The same on the largest buffer by stream length (`residual_lengths`, MicrobenchOptions::
+    // lengths): a trend along them, at one buffer, is a cost of a stream's density (its lanes'
+    // share of the buffer's pages) that the form does not price.
+    std::vector<uint32_t> residual_lengths;
+    std::vector<std::vector<double>> residuals_by_length;
     // Traversals, and the one- and few-lane costs' fit error on them (OpCostConfig::
     // one_lane_cycles of the box, triangle and sphere tests, few_lane_cycles of a wide back
     // end's box test, and the box test's per_op_cycles in the stream loop).
@@ -248,13 +253,13 @@ struct FewRayFrom {
 // where that back end has no few-ray loop or the file has no such costs.
 FewRayFrom few_ray_costs_from(const HwConfig& file, const std::string& source, Isa isa);
 
-// An op kind's fitted `cost` on its `samples` (the i-th at a buffer of `slots[i]`): per buffer
-// of `buffers`, the median of (priced - measured) / measured, a measurement under
-// k_fit_resolution_cycles counting as that (NaN where none is at that buffer).
-std::vector<double> fit_residuals_by_buffer(const OpCostConfig& cost, uint32_t width,
-                                            const std::vector<OpCostSample>& samples,
-                                            const std::vector<uint32_t>& slots,
-                                            const std::vector<uint32_t>& buffers);
+// An op kind's fitted `cost` on its `samples` (the i-th with key `keys[i]`: its buffer's slots,
+// or its stream's length): per key of `wanted`, the median of (priced - measured) / measured, a
+// measurement under k_fit_resolution_cycles counting as that (NaN where none has that key).
+std::vector<double> fit_residuals_by(const OpCostConfig& cost, uint32_t width,
+                                     const std::vector<OpCostSample>& samples,
+                                     const std::vector<uint32_t>& keys,
+                                     const std::vector<uint32_t>& wanted);
 
 HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
                                const std::function<void(uint32_t, uint32_t)>& progress = {},

@@ -645,7 +645,7 @@ TEST_CASE("The filter fit's error is reported by microbenchmark buffer", "[host]
     const std::vector<OpCostSample> samples = {at(priced), at(1.1 * priced), at(1.25 * priced),
                                                at(2.0 * priced)};
     const std::vector<uint32_t> slots = {256, 4096, 4096, 4096};
-    const std::vector<double> r = fit_residuals_by_buffer(cost, 8, samples, slots, {64, 256, 4096});
+    const std::vector<double> r = fit_residuals_by(cost, 8, samples, slots, {64, 256, 4096});
     REQUIRE(r.size() == 3);
     CHECK(std::isnan(r[0]));  // no sample at 64 slots
     CHECK(r[1] == Approx(0.0).margin(1e-12));
