@@ -261,7 +261,7 @@ void add_calibrate_command(CLI::App& app) {
                         {"per_minority_lane", k.per_minority_lane_cycles},
                         {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                         {"beyond_l2_per_lane", k.beyond_l2_per_lane_cycles},
-                        {"beyond_l1_in_page_per_lane", k.beyond_l1_in_page_per_lane_cycles},
+                        {"beyond_l1_skipping_per_lane", k.beyond_l1_skipping_per_lane_cycles},
                         {"one_lane", k.one_lane_cycles},
                         {"one_lane_pass", k.one_lane_pass_cycles},
                         {"one_lane_failed_candidate", k.one_lane_failed_candidate_cycles},
@@ -448,7 +448,7 @@ void add_calibrate_command(CLI::App& app) {
                     : "");
             std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind",
                         "per_op", "per_group", "per_lane", "per_pass", "per_fail", "minority",
-                        "beyondL1", "inPageL1", "beyondL2", "fit med", "fit max", "one_lane",
+                        "beyondL1", "skipL1", "beyondL2", "fit med", "fit max", "one_lane",
                         "few_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
@@ -457,7 +457,7 @@ void add_calibrate_command(CLI::App& app) {
                     "%9.1f %9.1f\n",
                     k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
                     k.per_pass_cycles, k.per_fail_cycles, k.per_minority_lane_cycles,
-                    k.beyond_l1_per_lane_cycles, k.beyond_l1_in_page_per_lane_cycles,
+                    k.beyond_l1_per_lane_cycles, k.beyond_l1_skipping_per_lane_cycles,
                     k.beyond_l2_per_lane_cycles, 100 * cal.fit_errors[i].first,
                     100 * cal.fit_errors[i].second, k.one_lane_cycles, k.few_lane_cycles);
             }

@@ -266,8 +266,8 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
         const double sparsity = std::max(0.0, 1.0 - double(length) / double(slots));
         const double gathers = double(p.gather_words.size());
         // Of the lanes beyond the L1D, those opening a page of the array the op reads pay
-        // (lanes_opening_pages), here as expected of a stream of `length` random slots; the
-        // rest pay as lanes in an open page.
+        // (lanes_opening_pages), here as expected of a stream of `length` random slots, and
+        // those skipping lines in an opened page (lanes_skipping_lines) pay their own.
         const OpStage op_stage = stage_of(kind);
         const double beyond_l1 =
             slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()), op_stage);
@@ -277,12 +277,15 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                 ? slots_beyond_cache(c.ray_buffer, layout.bytes(), std::max(1u, shape.slots()),
                                      op_stage, c.scene_memory.caches[1].kib)
                 : 0.0;
-        const double opening_share =
-            beyond_l1 > 0
-                ? expected_lanes_opening_pages(
-                      length, slots, lane_page_bytes_of(c.ray_buffer, layout.bytes(), op_stage)) /
-                      double(std::min(length, slots))
-                : 0.0;
+        const uint32_t page_bytes = lane_page_bytes_of(c.ray_buffer, layout.bytes(), op_stage);
+        const double opening_share = beyond_l1 > 0
+                                         ? expected_lanes_opening_pages(length, slots, page_bytes) /
+                                               double(std::min(length, slots))
+                                         : 0.0;
+        const double skipping_share =
+            beyond_l1 > 0 ? expected_lanes_skipping_lines(length, slots, page_bytes) /
+                                double(std::min(length, slots))
+                          : 0.0;
         // The cycle model's pipeline in closed form. Groups spread over the units; each round
         // of them costs the slowest of execution, the access side's issue, and the shared
         // address units and interconnect. An op that partitions holds the next op back: the
@@ -302,7 +305,7 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
                 p.issue_cycles(
                     c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)),
                     lanes, passing, g == 0, beyond_l1 * opening_share, beyond_l2 * opening_share,
-                    double(bucket.failed_candidates) / ops, beyond_l1 * (1.0 - opening_share)) +
+                    double(bucket.failed_candidates) / ops, beyond_l1 * skipping_share) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
                 (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);

@@ -125,11 +125,11 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // did not hold a line of it in the first level and it opens a 4 KiB page of its arrays, and
     // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
     // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes; a slot's
-    // arrays: lane_page_bytes), and beyond_l1_in_page_per_lane_cycles where the first level
-    // did not hold it in a page the lane before opened (what the lines brought so cost);
-    // counted per group. The fit expects the same of its microbenchmarks
-    // (beyond_cache_share). A slot's traversal record: what a box or leaf test reads, and a made
-    // ray's set-up writes.
+    // arrays: lane_page_bytes), and beyond_l1_skipping_per_lane_cycles where the first level
+    // did not hold it in a page the lane before opened and it skips lines past the lane
+    // before's (lane_skips_lines: a next-line prefetch does not bring them); counted per group. The
+    // fit expects the same of its microbenchmarks (beyond_cache_share). A slot's traversal record:
+    // what a box or leaf test reads, and a made ray's set-up writes.
     const auto record_address = [](uint32_t slot) {
         return k_records + uint64_t(slot) * k_traversal_record_bytes;
     };
@@ -150,8 +150,8 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
         if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) {
             ++m_group_beyond_lanes.back().l1;
             m_group_beyond_lanes.back().l2 += level > 1;
-        } else if (level > 0) {
-            ++m_group_beyond_lanes.back().l1_in_page;
+        } else if (level > 0 && lane_skips_lines(op.slots, i, page_bytes)) {
+            ++m_group_beyond_lanes.back().l1_skipping;
         }
         last = last_line;
     }
@@ -417,7 +417,7 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
                               passed, t.first == 0, beyond.l1 / group_lanes,
                               beyond.l2 / group_lanes, op.failed_candidates,
-                              beyond.l1_in_page / group_lanes)) +
+                              beyond.l1_skipping / group_lanes)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
         // A call cold: a shading filter's (the material sort's once, on its first filter) and a

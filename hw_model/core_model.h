@@ -135,10 +135,10 @@ class CoreModel {
     std::vector<uint64_t> m_group_lane_stall;
     // Per op whose ray lines a CPU core reads (touch_ray_lines): where its groups' entries start
     // in m_group_beyond_lanes (k_none otherwise); per such group, its lanes that pay for ray data
-    // beyond the L1D, and of them those beyond the L2 too, and those beyond the L1D in a page
-    // the lane before opened.
+    // beyond the L1D, and of them those beyond the L2 too, and those beyond the L1D that skip
+    // lines in a page the lane before opened.
     struct BeyondLanes {
-        uint32_t l1 = 0, l2 = 0, l1_in_page = 0;
+        uint32_t l1 = 0, l2 = 0, l1_skipping = 0;
     };
     std::vector<size_t> m_group_beyond_offset;
     std::vector<BeyondLanes> m_group_beyond_lanes;

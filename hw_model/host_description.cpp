@@ -674,8 +674,8 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", per_minority_lane_cycles: " << fmt(o.per_minority_lane_cycles, 2)
               << ", beyond_l1_per_lane_cycles: " << fmt(o.beyond_l1_per_lane_cycles, 2)
               << ", beyond_l2_per_lane_cycles: " << fmt(o.beyond_l2_per_lane_cycles, 2)
-              << ", beyond_l1_in_page_per_lane_cycles: "
-              << fmt(o.beyond_l1_in_page_per_lane_cycles, 2)
+              << ", beyond_l1_skipping_per_lane_cycles: "
+              << fmt(o.beyond_l1_skipping_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
               << (o.one_lane_pass_cycles > 0
                       ? ", one_lane_pass_cycles: " + fmt(o.one_lane_pass_cycles, 2)

@@ -468,12 +468,13 @@ struct BranchPredictorConfig {
 // another 4 KiB page of the array the op reads than the lane before it's: the prefetchers
 // cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
 // hw_model/ray_buffer_model.h beyond_cache_share), b2 of them beyond the L2 as well (the same
-// with the L2's size), b1 lanes beyond the L1D in a page the lane before already opened, and c
+// with the L2's size), b1 lanes beyond the L1D that skip lines in a page the lane before opened
+// (their slot's first line beyond the one after the lane before's last), and c
 // failing lanes that ran its full test (a triangle test's failed
 // candidates, StreamOp::failed_candidates), costs
 //   per_op + per_group * g + per_lane * n + per_pass * p + per_fail * (n - p)
 //   + per_minority_lane * m + beyond_l1_per_lane * b + beyond_l2_per_lane * b2
-//   + beyond_l1_in_page_per_lane * b1 + per_failed_candidate * c cycles
+//   + beyond_l1_skipping_per_lane * b1 + per_failed_candidate * c cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
 // predictor's misses, m = mispredicted_lanes in hw_model/op_costs.h: on outcomes in no order
 // the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
@@ -524,15 +525,18 @@ struct OpCostConfig {
     // K at tile 32), 2.1 M cycles more where the host ran 0.1-0.3 M more. 0: not measured.
     double beyond_l2_per_lane_cycles = 0.0;
     // What a lane beyond the L1D costs in a page of its array that the lane before it opened
-    // (a dense stream's lanes, whose lines the prefetchers bring): fitted with the rest on the
-    // microbenchmarks' streams, whose many lanes of one buffer share pages (200 of 1024 slots:
-    // about 20 lanes a page of a shading array). Since 2026-12-07: on the Intel Xeon VM of
-    // model 0xCF, without it, the fit priced the shading ops 1-4 % over at 64 slots and 1-3 %
-    // under at 4096 (scalar), and furnace's 64-pixel tiles at 64 x 64 came out 3 % cheaper
-    // than its 16-pixel ones where the host ran them alike (the lambertian bounce +5 %; the
-    // slot arrays' 4 KiB offsets staggered, the same), so that its tile ranking was upside
-    // down.
-    double beyond_l1_in_page_per_lane_cycles = 0.0;
+    // where it skips lines past the lane before's (lane_skips_lines: a next-line prefetch does
+    // not bring its line; a lane on the next line or the same one pays nothing more): fitted
+    // with the rest on the microbenchmarks' streams, whose many lanes of one buffer share pages
+    // (200 of 1024 slots: about 20 lanes a page of a shading array, most of them skipping).
+    // Since 2026-12-07: on the Intel Xeon VM of model 0xCF, without it, the fit priced the
+    // shading ops 1-4 % over at 64 slots and 1-3 % under at 4096 (scalar), and furnace's
+    // 64-pixel tiles at 64 x 64 came out 3 % cheaper than its 16-pixel ones where the host ran
+    // them alike (the lambertian bounce +5 %; the slot arrays' 4 KiB offsets staggered, the
+    // same); priced on every lane of an opened page (the same day's first form), the fit put
+    // the streams of every slot of 4096 5-12 % over and those of 96-512 lanes 2-10 % under,
+    // and cornell's and atrium's 64-pixel tiles 2-5 points dearer than the host ran them.
+    double beyond_l1_skipping_per_lane_cycles = 0.0;
     // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
     // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
     // microbenchmark's failing lanes are (its rays start from no hit: nearly every candidate
@@ -705,9 +709,9 @@ struct OpCostConfig {
                 "what a lane beyond the L1D adds where its ray data is beyond the L2 too (0: not "
                 "measured)",
                 0.0, 1e9);
-        v.param("beyond_l1_in_page_per_lane_cycles", beyond_l1_in_page_per_lane_cycles, "cycles",
-                "cost per lane beyond the L1D whose page of the array its op reads the lane "
-                "before opened (a dense stream's; fitted by sfx calibrate, 0: not measured)",
+        v.param("beyond_l1_skipping_per_lane_cycles", beyond_l1_skipping_per_lane_cycles, "cycles",
+                "cost per lane beyond the L1D that skips lines in a page of the array its op "
+                "reads the lane before opened (fitted by sfx calibrate, 0: not measured)",
                 0.0, 1e9);
         v.param("per_failed_candidate_cycles", per_failed_candidate_cycles, "cycles",
                 "the triangle test's: extra cost per failing lane that ran the full test (a "

@@ -138,12 +138,28 @@ double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, u
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
-double beyond_cache_in_page_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                                  uint32_t lane_bytes, uint32_t cache_kib) {
+double expected_lanes_skipping_lines(uint32_t lanes, uint32_t slots, uint32_t lane_bytes) {
+    lanes = std::min(lanes, slots);
+    if (lanes < 2 || lane_bytes == 0) return 0.0;
+    const double q = double(lanes - 1) / double(slots - 1);
+    double skipping = 0.0;  // over the slots, the chance that the lane before skips to it
+    for (uint32_t s = 1; s < slots; ++s) {
+        const uint64_t page = uint64_t(s) * lane_bytes / k_prefetch_page_bytes;
+        double gap = q;  // the lane before d slots back
+        for (uint32_t d = 1; d <= s && gap > 1e-9; ++d, gap *= 1.0 - q) {
+            const uint32_t pair[2] = {s - d, s};
+            if (uint64_t(pair[0]) * lane_bytes / k_prefetch_page_bytes != page) break;
+            if (lane_skips_lines(pair, 1, lane_bytes)) skipping += gap;
+        }
+    }
+    return skipping * double(lanes) / double(slots);
+}
+
+double beyond_cache_skipping_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
+                                   uint32_t lane_bytes, uint32_t cache_kib) {
     if (lanes == 0) return 0.0;
     return beyond_cache_fraction(slots, slot_bytes, cache_kib) *
-           (1.0 - expected_lanes_opening_pages(lanes, slots, lane_bytes) /
-                      double(std::min(lanes, slots)));
+           expected_lanes_skipping_lines(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes) {

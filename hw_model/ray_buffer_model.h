@@ -130,6 +130,16 @@ inline bool lane_opens_page(const uint32_t* slots, uint32_t i, uint32_t lane_byt
     auto page = [&](uint32_t j) { return uint64_t(slots[j]) * lane_bytes / k_prefetch_page_bytes; };
     return i == 0 || page(i) != page(i - 1);
 }
+// Whether lane i of such a stream, in a page the lane before opened, skips lines: its slot's
+// first line lies beyond the line after the lane before's last one, where a next-line prefetch
+// of the lane before's lines does not reach.
+inline bool lane_skips_lines(const uint32_t* slots, uint32_t i, uint32_t lane_bytes) {
+    constexpr uint64_t k_line = 64;
+    if (i == 0) return false;
+    const uint64_t first = uint64_t(slots[i]) * lane_bytes / k_line;
+    const uint64_t before_last = (uint64_t(slots[i - 1]) * lane_bytes + lane_bytes - 1) / k_line;
+    return first > before_last + 1;
+}
 // How many of the lanes [first, first + lanes) open one (lane_opens_page).
 uint32_t lanes_opening_pages(const uint32_t* slots, uint32_t first, uint32_t lanes,
                              uint32_t lane_bytes);
@@ -169,10 +179,15 @@ uint32_t lane_page_bytes(OpStage stage, uint32_t slot_bytes, uint32_t slot_array
 // frames came out 7-15 % over the measured.
 double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                           uint32_t cache_kib);
-// The same stream's share of lanes beyond the cache in a page the lane before opened (the rest
-// of beyond_cache_fraction's lanes: beyond_l1_in_page_per_lane_cycles).
-double beyond_cache_in_page_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
-                                  uint32_t lane_bytes, uint32_t cache_kib);
+// Of a stream of `lanes` slots drawn at random from `slots`, the lanes expected in a page the lane
+// before opened that skip lines (lane_skips_lines): each lane's slot the lane before's d slots on
+// with probability q (1 - q)^(d - 1), q = (lanes - 1) / (slots - 1). None of a stream of every
+// slot; of a sparse one, nearly all of its few lanes in an opened page.
+double expected_lanes_skipping_lines(uint32_t lanes, uint32_t slots, uint32_t lane_bytes);
+// The same stream's share of lanes beyond the cache that skip lines in a page the lane before
+// opened (beyond_cache_fraction's lanes: beyond_l1_skipping_per_lane_cycles).
+double beyond_cache_skipping_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
+                                   uint32_t lane_bytes, uint32_t cache_kib);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);

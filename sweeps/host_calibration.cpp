@@ -68,7 +68,7 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
     return {caches.empty() ? beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, 32)
                            : beyond(0),
             beyond(1),
-            beyond_cache_in_page_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib)};
+            beyond_cache_skipping_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib)};
 }
 
 bool microbenchmarks_reach_beyond_l2(const std::vector<uint32_t>& buffer_slots,
@@ -127,7 +127,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                 measured_op_cycles(
                     priced, width, o.lanes,
                     uint32_t(std::lround(double(o.passed) / double(o.count))), beyond.l1, beyond.l2,
-                    double(o.failed_candidates) / double(o.count), beyond.l1_in_page);
+                    double(o.failed_candidates) / double(o.count), beyond.l1_skipping);
         }
         sample.stream_op_cycles += sample.leaf_op_cycles;
         sample.leaf_cycles_clocked = s.leaf_share * s.cycles;
@@ -428,7 +428,7 @@ std::vector<double> fit_residuals_by(const OpCostConfig& cost, uint32_t width,
             const OpCostSample& s = samples[i];
             const double priced =
                 measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1, s.beyond_l2,
-                                   s.failed_candidates, s.beyond_l1_in_page);
+                                   s.failed_candidates, s.beyond_l1_skipping);
             // A measurement under the clock's steps counts as those, as in fit_error.
             errors.push_back((priced - s.cycles) / std::max(s.cycles, k_fit_resolution_cycles));
         }
@@ -480,8 +480,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         const LanesBeyondCaches beyond =
             lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches);
         const OpCostSample sample{
-            s.lanes,   s.passed,         beyond.l1, s.cycles, s.failed_candidates,
-            beyond.l2, beyond.l1_in_page};
+            s.lanes,   s.passed,          beyond.l1, s.cycles, s.failed_candidates,
+            beyond.l2, beyond.l1_skipping};
         std::vector<OpCostSample>* variant = s.thin_lens            ? &lens_camera
                                              : s.sphere_light       ? &sphere_light
                                              : s.failing_candidates ? &failing_candidates
@@ -676,7 +676,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
          << describe_isa(resolved) << "; stream lengths 1-4096, ids scattered over buffers of "
          << slash_joined(options.buffer_slots) << " slots of " << slot_bytes << " bytes"
          << " in increasing order, which tells a lane beyond the L1D that opens a page of its "
-            "array from one in a page the lane before opened";
+            "array from one that skips lines in a page the lane before opened, and from one on "
+            "the next line";
     if (c.host.caches.size() >= 2 &&
         !microbenchmarks_reach_beyond_l2(options.buffer_slots, c.host.caches))
         note << ", none of them beyond this host's L2 (" << c.host.caches[1].kib

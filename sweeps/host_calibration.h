@@ -185,7 +185,7 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
 // L2 where it has one level).
 struct LanesBeyondCaches {
     double l1 = 0.0, l2 = 0.0;
-    double l1_in_page = 0.0;  // beyond the L1D in a page the lane before opened
+    double l1_skipping = 0.0;  // beyond the L1D, skipping lines in a page the lane before opened
 };
 LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slots,
                                       const std::vector<HostCacheLevel>& caches);

@@ -471,27 +471,28 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK(level_fit.beyond_l2_per_lane_cycles == Approx(20).epsilon(1e-6));
     CHECK(fit_error(level_fit, 16, levels).second < 1e-9);
 
-    // Lanes beyond the L1D in a page the lane before opened (dense streams: many lanes of one
-    // buffer) tell their cost from a page-opening lane's (sparse streams: each lane a page).
-    OpCostConfig in_page = truth;
-    in_page.beyond_l1_in_page_per_lane_cycles = 1.5;
+    // Lanes beyond the L1D that skip lines in a page the lane before opened (streams of many
+    // lanes of one buffer) tell their cost from a page-opening lane's (sparse streams: each
+    // lane a page).
+    OpCostConfig skipping = truth;
+    skipping.beyond_l1_skipping_per_lane_cycles = 1.5;
     std::vector<OpCostSample> dense;
     for (uint32_t lanes : {1u, 7u, 16u, 33u, 100u, 512u, 4096u})
         for (const auto& [opening, inside] : {std::pair{0.0, 0.0}, {0.8, 0.05}, {0.05, 0.85}})
             for (uint32_t passed : {0u, lanes / 3}) {
                 OpCostSample s{
                     lanes, passed, opening,
-                    measured_op_cycles(in_page, 16, lanes, passed, opening, 0.0, 0.0, inside)};
-                s.beyond_l1_in_page = inside;
+                    measured_op_cycles(skipping, 16, lanes, passed, opening, 0.0, 0.0, inside)};
+                s.beyond_l1_skipping = inside;
                 dense.push_back(s);
             }
     const OpCostConfig dense_fit = fit_op_cost("triangle_test", 16, dense);
     CHECK(dense_fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
-    CHECK(dense_fit.beyond_l1_in_page_per_lane_cycles == Approx(1.5).epsilon(1e-6));
+    CHECK(dense_fit.beyond_l1_skipping_per_lane_cycles == Approx(1.5).epsilon(1e-6));
     CHECK(dense_fit.per_pass_cycles == Approx(40).epsilon(1e-6));
     CHECK(fit_error(dense_fit, 16, dense).second < 1e-9);
     // Without such lanes the term is not measured: 0.
-    CHECK(level_fit.beyond_l1_in_page_per_lane_cycles == 0.0);
+    CHECK(level_fit.beyond_l1_skipping_per_lane_cycles == 0.0);
 
     // A lane that passes costs less than one that fails (the scalar box test): the passing
     // lanes' cost would be negative, so the failing lanes' column takes it.
@@ -978,17 +979,22 @@ TEST_CASE(
     CHECK(passes(32, 2).busy_cycles == 2 * (256 + 128));
     // A 128 KiB L1D keeps them: only the first pass pays.
     CHECK(passes(128, 2).busy_cycles == 2 * 256 + 128);
-    // The other 1008 lanes of such a pass are in a page the lane before opened: at 0.5 cycles
-    // each they add 504 where the L1D does not hold their lines, nothing where it does.
-    auto in_page = [](uint32_t l1d_kib) {
+    // The other 1008 lanes of such a pass are in a page the lane before opened, each on the
+    // line after the lane before's: a lane that skips lines would pay 0.5 cycles more, these
+    // pay nothing. On every other slot (1024 lines over 128 KiB, 32 pages) 992 lanes skip a
+    // line each: 496 cycles more where the L1D does not hold their lines, nothing where it does.
+    auto skipping = [](uint32_t l1d_kib, uint32_t stride) {
         OpCostConfig box = cost("box_test", 0, 4, 0, 0, 8);
-        box.beyond_l1_in_page_per_lane_cycles = 0.5;
+        box.beyond_l1_skipping_per_lane_cycles = 0.5;
         HwConfig host = host_with({box});
         host.scene_memory.caches[0].kib = l1d_kib;
-        return time_boxes(host, 2, 1024, 1024).stages[0][size_t(OpStage::traversal)].busy_cycles;
+        return time_boxes(host, 2, 1024, 2048, 3, stride)
+            .stages[0][size_t(OpStage::traversal)]
+            .busy_cycles;
     };
-    CHECK(in_page(32) == 2 * (256 + 128 + 504));
-    CHECK(in_page(128) == 2 * 256 + 128 + 504);
+    CHECK(skipping(32, 1) == 2 * (256 + 128));
+    CHECK(skipping(32, 2) == 2 * (256 + 256 + 496));
+    CHECK(skipping(128, 2) == 2 * 256 + 256 + 496);
     // A shading op reads its slot but the traversal record: 16 slots of 64 bytes lie in one
     // page, of 400 bytes (336 read) in two, so one lane more pays; of 330 bytes (266 read) the
     // 16 lanes all start in the first page.
@@ -1078,7 +1084,7 @@ TEST_CASE("A host needs a measured cost for every kind its workload runs", "[hos
 TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
     box.beyond_l2_per_lane_cycles = 6.5;
-    box.beyond_l1_in_page_per_lane_cycles = 0.75;
+    box.beyond_l1_skipping_per_lane_cycles = 0.75;
     box.one_lane_cycles = 6;
     box.few_lane_cycles = 4.5;
     box.per_minority_lane_cycles = 7;
@@ -1138,7 +1144,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     REQUIRE(c.op_costs.size() == 1);
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].beyond_l2_per_lane_cycles == Approx(6.5));
-    CHECK(c.op_costs[0].beyond_l1_in_page_per_lane_cycles == Approx(0.75));
+    CHECK(c.op_costs[0].beyond_l1_skipping_per_lane_cycles == Approx(0.75));
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
     CHECK(c.op_costs[0].few_lane_cycles == Approx(4.5));
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
@@ -1410,18 +1416,34 @@ TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a 
     CHECK(lane_page_bytes(OpStage::shading, 330, 7) == 38);
     CHECK(beyond_cache_share(4096, 4096, 330, 38, 48) == Approx(f * 38 / 4096).epsilon(0.02));
     CHECK(beyond_cache_share(16, 4096, 330, 38, 48) == Approx(f * 13.2 / 16).epsilon(0.02));
-    // The rest of the lanes beyond the L1D are in a page the lane before opened: nearly all of
-    // a dense stream's, few of a sparse one's, none within the L1D.
-    CHECK(beyond_cache_in_page_share(4096, 4096, 330, 38, 48) ==
-          Approx(f * (1 - 38.0 / 4096)).epsilon(0.02));
-    CHECK(beyond_cache_in_page_share(16, 4096, 330, 38, 48) ==
-          Approx(f * (1 - 13.2 / 16)).epsilon(0.05));
-    CHECK(beyond_cache_in_page_share(64, 64, 330, 38, 48) == 0.0);
-    CHECK(beyond_cache_in_page_share(0, 64, 330, 38, 48) == 0.0);
+    // Of the rest, in a page the lane before opened, those that skip lines past the lane
+    // before's: none of a stream of every slot (38 bytes a slot: the next slot starts on the
+    // same line or the next), every lane on every third slot of 64-byte records, nearly all of
+    // a sparse stream's lanes in an opened page; none within the L1D.
+    const std::vector<uint32_t> thirds = {0, 3, 6, 9};
+    CHECK_FALSE(lane_skips_lines(thirds.data(), 0, 64));  // the first lane opens the page
+    CHECK(lane_skips_lines(thirds.data(), 1, 64));        // line 3 after line 0
+    CHECK_FALSE(lane_skips_lines(dense.data(), 1, 38));   // bytes 38-75 after 0-37
+    CHECK_FALSE(lane_skips_lines(dense.data(), 2, 64));   // line 2 after line 1
+    CHECK(expected_lanes_skipping_lines(4096, 4096, 38) == 0.0);
+    CHECK(expected_lanes_skipping_lines(1, 4096, 38) == 0.0);
+    CHECK(beyond_cache_skipping_share(4096, 4096, 330, 38, 48) == 0.0);
+    // 16 random lanes of 4096 slots: 16 - 13.2 in an opened page, their lane before about 270
+    // slots back: nearly all skip (some 7 % of them lie within two slots of it).
+    CHECK(beyond_cache_skipping_share(16, 4096, 330, 38, 48) ==
+          Approx(f * (16 - 13.2) / 16).epsilon(0.1));
+    // 1024 of 4096 (the lane before 1 to 3 slots back in 58 % of lanes, 38 to 114 bytes, the
+    // next line mostly): about 40 % skip, fewer than are in an opened page.
+    const double quarter = expected_lanes_skipping_lines(1024, 4096, 38) / 1024;
+    CHECK(quarter == Approx(0.405).epsilon(0.02));
+    CHECK(quarter < 1.0 - expected_lanes_opening_pages(1024, 4096, 38) / 1024);
+    CHECK(beyond_cache_skipping_share(64, 64, 330, 38, 48) == 0.0);
+    CHECK(beyond_cache_skipping_share(0, 64, 330, 38, 48) == 0.0);
+    // A stream's lanes beyond the L1D open a page, skip lines in an opened one, or neither.
     for (const uint32_t lanes : {1u, 16u, 200u, 1024u})
         CHECK(beyond_cache_share(lanes, 1024, 330, 38, 48) +
-                  beyond_cache_in_page_share(lanes, 1024, 330, 38, 48) ==
-              Approx(beyond_cache_fraction(1024, 330, 48)));
+                  beyond_cache_skipping_share(lanes, 1024, 330, 38, 48) <=
+              beyond_cache_fraction(1024, 330, 48) + 1e-12);
 }
 
 TEST_CASE("A filter's branch misses the rarer outcome's lanes, or one a change of outcome in runs",

@@ -957,24 +957,31 @@ TEST_CASE("The host file says where no microbenchmark buffer reaches beyond the 
     CHECK_FALSE(microbenchmarks_reach_beyond_l2(buffers, {caches_with_l2(1024)[0]}));
 }
 
-TEST_CASE("A microbenchmark's lanes beyond the L1D open a page or lie in an open one", "[host]") {
+TEST_CASE("A microbenchmark's lanes beyond the L1D open a page or skip lines in an opened one",
+          "[host]") {
     HostCacheLevel l1;
     l1.kib = 48;
     const std::vector<HostCacheLevel> caches = {l1};
     const double beyond = beyond_cache_fraction(4096, stream_slot_bytes(), 48);
     // A dense shading stream (every slot of 4096) opens a page of an array in about a hundred
-    // lanes; a sparse one (16 of 4096) nearly every lane; together they are the lanes beyond.
+    // lanes and skips no line; a sparse one (16 of 4096) opens a page at nearly every lane, and
+    // its lanes in an opened page skip lines.
     const LanesBeyondCaches dense =
         lanes_beyond_caches(OpKind::lambertian_indirect, 4096, 4096, caches);
     const LanesBeyondCaches sparse =
         lanes_beyond_caches(OpKind::lambertian_indirect, 16, 4096, caches);
-    CHECK(dense.l1 + dense.l1_in_page == Approx(beyond));
-    CHECK(sparse.l1 + sparse.l1_in_page == Approx(beyond));
-    CHECK(dense.l1_in_page > 0.9 * beyond);
-    CHECK(sparse.l1_in_page < 0.25 * beyond);
+    CHECK(dense.l1 < 0.02 * beyond);
+    CHECK(dense.l1_skipping == 0.0);
+    CHECK(sparse.l1 + sparse.l1_skipping == Approx(beyond).epsilon(0.02));
+    CHECK(sparse.l1_skipping < 0.25 * beyond);
+    // A lane every fourth slot: about 40 % of them skip lines.
+    const LanesBeyondCaches quarter =
+        lanes_beyond_caches(OpKind::lambertian_indirect, 1024, 4096, caches);
+    CHECK(quarter.l1_skipping > 0.3 * beyond);
+    CHECK(quarter.l1_skipping < 0.5 * beyond);
     // Within the L1D, none.
     const LanesBeyondCaches small =
         lanes_beyond_caches(OpKind::lambertian_indirect, 64, 64, caches);
     CHECK(small.l1 == 0.0);
-    CHECK(small.l1_in_page == 0.0);
+    CHECK(small.l1_skipping == 0.0);
 }
