@@ -461,28 +461,27 @@ void add_calibrate_command(CLI::App& app) {
                     k.beyond_l2_per_lane_cycles, 100 * cal.fit_errors[i].first,
                     100 * cal.fit_errors[i].second, k.one_lane_cycles, k.few_lane_cycles);
             }
+            // Each fitted kind's residuals, one column per key.
+            auto print_residuals = [&](const std::vector<uint32_t>& keys, const char* unit,
+                                       const std::vector<std::vector<double>>& residuals) {
+                for (const uint32_t key : keys) std::printf(" %u", key);
+                std::printf(" %s\n", unit);
+                for (size_t i = 0; i < cal.op_costs.size(); ++i) {
+                    std::printf("  %-20s", cal.op_costs[i].op.c_str());
+                    for (const double r : residuals[i])
+                        std::isnan(r) ? std::printf("        -")
+                                      : std::printf(" %+7.1f%%", 100 * r);
+                    std::printf("\n");
+                }
+            };
             std::printf("fit error by buffer (median of priced / measured - 1) at");
-            for (const uint32_t slots : cal.residual_buffer_slots) std::printf(" %u", slots);
-            std::printf(" slots\n");
-            for (size_t i = 0; i < cal.op_costs.size(); ++i) {
-                std::printf("  %-20s", cal.op_costs[i].op.c_str());
-                for (const double r : cal.residuals_by_buffer[i])
-                    std::isnan(r) ? std::printf("        -") : std::printf(" %+7.1f%%", 100 * r);
-                std::printf("\n");
-            }
+            print_residuals(cal.residual_buffer_slots, "slots", cal.residuals_by_buffer);
             std::printf("fit error at %u slots by stream length:",
                         cal.residual_buffer_slots.empty()
                             ? 0u
                             : *std::max_element(cal.residual_buffer_slots.begin(),
                                                 cal.residual_buffer_slots.end()));
-            for (const uint32_t lanes : cal.residual_lengths) std::printf(" %u", lanes);
-            std::printf(" lanes\n");
-            for (size_t i = 0; i < cal.op_costs.size(); ++i) {
-                std::printf("  %-20s", cal.op_costs[i].op.c_str());
-                for (const double r : cal.residuals_by_length[i])
-                    std::isnan(r) ? std::printf("        -") : std::printf(" %+7.1f%%", 100 * r);
-                std::printf("\n");
-            }
+            print_residuals(cal.residual_lengths, "lanes", cal.residuals_by_length);
             for (const OpCostConfig& k : cal.op_costs)
                 if (k.per_failed_candidate_cycles > 0)
                     std::printf(
