@@ -116,7 +116,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // touched again. A tile of 64 x 64 at 330 bytes a slot is 1.3 MiB, more than a Zen 5
     // core's L2.
     constexpr uint64_t k_records = uint64_t(1) << 44, k_slots = uint64_t(1) << 45;
-    constexpr uint64_t k_line = 64;
+    constexpr uint64_t k_line = k_ray_line_bytes;
     const bool record = op.stage != OpStage::shading;
     const uint64_t bytes =
         lane_ray_bytes(op.stage, slot_bytes_of(m_config.ray_buffer, m_record_bytes));

@@ -123,6 +123,9 @@ double beyond_cache_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t cache
 // whose slot starts in another page than the lane before it's (a stream's slots ascend) waits
 // for its line, and the lanes after it in that page find theirs prefetched.
 constexpr uint32_t k_prefetch_page_bytes = 4096;
+// The line the caches move a ray buffer's bytes in: 64 bytes on every host described so far
+// (sysfs cache/index*/coherency_line_size, the host files' line_bytes).
+constexpr uint64_t k_ray_line_bytes = 64;
 // Whether lane i of a stream of `slots` (ascending) opens a page of an array of `lane_bytes` a
 // slot: its slot starts in another page than the slot before it's (the stream's first lane
 // does).
@@ -134,10 +137,10 @@ inline bool lane_opens_page(const uint32_t* slots, uint32_t i, uint32_t lane_byt
 // first line lies beyond the line after the lane before's last one, where a next-line prefetch
 // of the lane before's lines does not reach.
 inline bool lane_skips_lines(const uint32_t* slots, uint32_t i, uint32_t lane_bytes) {
-    constexpr uint64_t k_line = 64;
     if (i == 0) return false;
-    const uint64_t first = uint64_t(slots[i]) * lane_bytes / k_line;
-    const uint64_t before_last = (uint64_t(slots[i - 1]) * lane_bytes + lane_bytes - 1) / k_line;
+    const uint64_t first = uint64_t(slots[i]) * lane_bytes / k_ray_line_bytes;
+    const uint64_t before_last =
+        (uint64_t(slots[i - 1]) * lane_bytes + lane_bytes - 1) / k_ray_line_bytes;
     return first > before_last + 1;
 }
 // How many of the lanes [first, first + lanes) open one (lane_opens_page).

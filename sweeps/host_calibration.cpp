@@ -59,15 +59,12 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
                                       const std::vector<HostCacheLevel>& caches) {
     const uint32_t lane_bytes =
         lane_page_bytes(stage_of(kind), stream_slot_bytes(), stream_slot_arrays());
-    auto beyond = [&](size_t level) {
-        return level < caches.size() ? beyond_cache_share(lanes, slots, stream_slot_bytes(),
-                                                          lane_bytes, caches[level].kib)
-                                     : 0.0;
-    };
+    // Without a described L1D, one of 32 KiB.
     const uint32_t l1_kib = caches.empty() ? 32 : caches[0].kib;
-    return {caches.empty() ? beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, 32)
-                           : beyond(0),
-            beyond(1),
+    return {beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib),
+            caches.size() > 1
+                ? beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, caches[1].kib)
+                : 0.0,
             beyond_cache_skipping_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib)};
 }
 
@@ -495,6 +492,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         slots_of[s.kind].push_back(s.slots);
     }
     size_t points = 0;
+    const uint32_t largest_buffer =
+        options.buffer_slots.empty()
+            ? 0
+            : *std::max_element(options.buffer_slots.begin(), options.buffer_slots.end());
     for (const auto& [kind, samples] : by_kind) {
         c.op_costs.push_back(fit_op_cost(to_string(kind), c.host.simd_width, samples));
         fit_one_lane_by_outcome(c.op_costs.back(), one_lane[kind]);
@@ -523,10 +524,8 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         c.residuals_by_buffer.push_back(fit_residuals_by(
             c.op_costs.back(), c.host.simd_width, samples, slots_of[kind], options.buffer_slots));
         std::vector<uint32_t> lanes_at_largest;  // 0: at another buffer
-        const uint32_t largest =
-            *std::max_element(options.buffer_slots.begin(), options.buffer_slots.end());
         for (size_t i = 0; i < samples.size(); ++i)
-            lanes_at_largest.push_back(slots_of[kind][i] == largest ? samples[i].lanes : 0);
+            lanes_at_largest.push_back(slots_of[kind][i] == largest_buffer ? samples[i].lanes : 0);
         c.residuals_by_length.push_back(fit_residuals_by(
             c.op_costs.back(), c.host.simd_width, samples, lanes_at_largest, options.lengths));
         points += samples.size() + one_lane[kind].size();
