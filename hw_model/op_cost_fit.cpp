@@ -334,6 +334,7 @@ double fit_extra_per_lane(const OpCostConfig& base, uint32_t width,
 }
 
 void fit_one_lane_by_outcome(OpCostConfig& cost, const std::vector<OpCostSample>& one_lane) {
+    if (one_lane.empty()) return;
     std::vector<double> failing, passing, failed_candidate, every;
     for (const OpCostSample& s : one_lane) {
         (s.passed > 0              ? passing

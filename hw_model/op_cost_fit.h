@@ -71,7 +71,12 @@ double fit_extra_per_failed_candidate(const OpCostConfig& base, uint32_t width,
 // is the median of those whose lane fails (of every sample where none fails),
 // one_lane_pass_cycles and one_lane_failed_candidate_cycles the medians of those whose lane
 // passes and of those whose lane is a failed candidate beyond it (0 where either side has no
-// sample; never negative). The rest of `cost` is kept.
+// sample; never negative). The rest of `cost` is kept, and all of it without samples: an op
+// with no one-lane samples (every op but the triangle and sphere tests) is priced on one lane by
+// the formula. Until 2026-12-07 it was priced at the median of none, 0, between its fit and the
+// short-stream costs that set it unmeasured again: its one-lane points' fit error read 100 %
+// and the extras fitted in between (thin lens, sphere light, sphere hits) took those points'
+// whole cost for their own.
 void fit_one_lane_by_outcome(OpCostConfig& cost, const std::vector<OpCostSample>& one_lane);
 
 // The fit's relative error on its own samples: (median, worst) of |predicted - measured| /

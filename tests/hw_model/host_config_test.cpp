@@ -335,6 +335,11 @@ TEST_CASE("A one-lane leaf test costs what its lane's outcome cost on one lane",
     fit_one_lane_by_outcome(sphere, {{1, 0, 0.0, 90.0, 0}, {1, 1, 0.0, 80.0, 0}});
     CHECK(sphere.one_lane_cycles == Approx(90));
     CHECK(sphere.one_lane_pass_cycles == 0.0);
+    // No one-lane samples (a shading op's): unmeasured, and one lane is priced by the formula.
+    OpCostConfig shader = cost("lambertian_indirect", 20, 6, 3, 40, 2);
+    fit_one_lane_by_outcome(shader, {});
+    CHECK(shader.one_lane_cycles < 0);
+    CHECK(measured_op_cycles(shader, 8, 1, 1, 0.0) == Approx(20 + 6 + 3 + 40));
 
     // The price: the failing lane's, plus the passing lane's or the failed candidate's extra;
     // the closed form's bucket of one-lane ops at its mean pass rate and failed candidates.
