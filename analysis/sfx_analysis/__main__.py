@@ -80,11 +80,17 @@ def _silicon(args) -> int:
         df = silicon.load_rows(args.rows)
     except (OSError, ValueError, KeyError) as e:
         raise StoreError(f"{args.rows}: cannot read the silicon-check rows ({e})") from None
+    repeats = []
+    for path in args.repeats:
+        try:
+            repeats.append(silicon.load_rows(path))
+        except (OSError, ValueError, KeyError) as e:
+            raise StoreError(f"{path}: cannot read the silicon-check rows ({e})") from None
     with open(args.header) as f:
         header = f.read()
     plot = os.path.join(os.path.dirname(os.path.abspath(args.output)), args.plot)
     silicon.scatter_plot(df, plot)
-    silicon.write_page(df, args.output, args.plot, header)
+    silicon.write_page(df, args.output, args.plot, header, repeats)
     print(silicon.table_text(df))
     print()
     print(silicon.stage_table_text(df))
@@ -93,7 +99,7 @@ def _silicon(args) -> int:
     print()
     print(silicon.width_ranking_text(df))
     print()
-    print(silicon.all_summaries_text(df))
+    print(silicon.all_summaries_text(df, repeats))
     print(f"silicon check: {os.path.abspath(args.output)}, {plot}")
     return 0
 
@@ -134,6 +140,9 @@ def main(argv=None) -> int:
     si.add_argument("-o", "--output", required=True, help="page to write (Markdown)")
     si.add_argument("--plot", default="silicon-check.png", help="plot file name, beside the page")
     si.add_argument("--header", required=True, help="Markdown put under the page's title")
+    si.add_argument("--repeats", nargs="*", default=[],
+                    help="`sfx calibrate --check --json` outputs of one of the rows' workloads, "
+                         "each measured in a process of its own: the reproducibility line")
     si.set_defaults(run=_silicon)
     sk = sub.add_parser("seed-kernels", help="the seed papers' options (docs/seed-kernels.md)")
     sk.add_argument("db")

@@ -105,6 +105,60 @@ def self_consistency(df):
                                        "predicted_ratio", "lo", "hi", "consistent"])
 
 
+def reproducibility(df, repeats):
+    """One workload of the check measured again in processes of their own (`repeats`: their
+    rows, as load_rows reads them): its fastest render in each process, the run's own first,
+    against the range each process's convergence rule vouched for. A placement fixed for a
+    whole process (code and stack under ASLR, the scene's arrays, the physical pages) moves a
+    workload's fastest render from one process to the next, and no range measured inside one
+    process sees it: the fastest renders of scalar furnace 64x64 tile 16 in four processes of
+    one Intel Xeon VM, 3812-3921 K cycles, their own ranges 0.2-1.9 % (2026-12-07). None where
+    no repeat matches a converged workload of `df`."""
+    keys = ["isa", "scene", "res", "tile"]
+    found = None
+    for r in repeats:
+        r = scored(r)
+        if r.empty:
+            continue
+        key = tuple(r.iloc[0][k] for k in keys)
+        main_rows = scored(df)
+        main_rows = main_rows[(main_rows[keys] == pd.Series(key, index=keys)).all(axis=1)]
+        if main_rows.empty:
+            continue
+        if found is None:
+            found = {"workload": key, "fastest": [main_rows["measured.frame_cycles"].iloc[0]],
+                     "ranges": [main_rows["measured.hi"].iloc[0] /
+                                main_rows["measured.lo"].iloc[0] - 1]}
+        if key != found["workload"]:
+            continue
+        found["fastest"].append(r["measured.frame_cycles"].iloc[0])
+        found["ranges"].append(r["measured.hi"].iloc[0] / r["measured.lo"].iloc[0] - 1)
+    if found is None or len(found["fastest"]) < 2:
+        return None
+    found["apart"] = max(found["fastest"]) / min(found["fastest"]) - 1
+    # The processes measured one thing: every two ranges overlap, as the rankings' rule would
+    # have them (the faster process's range reaches the slower one's fastest).
+    runs = sorted(zip(found["fastest"], found["ranges"]))
+    found["within_ranges"] = all(f * (1 + r) >= g for i, (f, r) in enumerate(runs)
+                                 for g, _ in runs[i + 1:])
+    return found
+
+
+def reproducibility_text(rep):
+    """One line (and its verdict) for the page's summary."""
+    if rep is None:
+        return "- reproducibility: no workload measured again in processes of its own"
+    isa, scene, res, tile = rep["workload"]
+    verdict = ("within the ranges" if rep["within_ranges"] else
+               "FLAGGED: a run's ranges understate its workloads' spread from run to run, and a "
+               "pair of workloads closer than this may order either way in another run")
+    return (f"- reproducibility: {isa} {scene} {res} tile {tile} measured in "
+            f"{len(rep['fastest'])} processes (the run's and {len(rep['fastest']) - 1} of their "
+            f"own): fastest {min(rep['fastest']) / 1e6:.2f}-{max(rep['fastest']) / 1e6:.2f} "
+            f"Mcyc, {100 * rep['apart']:.1f} % apart, against each process's own range of "
+            f"{100 * min(rep['ranges']):.1f}-{100 * max(rep['ranges']):.1f} %: {verdict}")
+
+
 def scaling_text(df):
     """Per back end and scene, the larger resolution's frame over the smaller one's, measured
     and predicted (the mean over the tiles converged at both). A check of the model that no
@@ -882,9 +936,10 @@ def l3_text(df):
             f"{held}{rounds}; the model predicted " + predicted_with)
 
 
-def all_summaries_text(df):
+def all_summaries_text(df, repeats=()):
     """How it was measured, the summary of every back end, the width ranking's, and the
-    self-consistency flags."""
+    self-consistency flags (with `repeats`, the rows of one workload measured again in
+    processes of their own: reproducibility)."""
     parts = []
     head = measurement_text(df)
     if head:
@@ -893,6 +948,8 @@ def all_summaries_text(df):
         parts.append(summary_text(summary(df[df["isa"] == isa]), isa))
     parts.append(width_summary_text(width_summary(df)))
     parts.append(consistency_text(df))
+    if repeats:
+        parts.append(reproducibility_text(reproducibility(df, repeats)))
     return "\n".join(parts)
 
 
@@ -936,12 +993,12 @@ def scatter_plot(df, path):
     plt.close(fig)
 
 
-def write_page(df, page, plot_name, header):
+def write_page(df, page, plot_name, header, repeats=()):
     """docs/silicon-check-*.md: how it was run, the summaries, the tables; the plot beside it."""
     text = "\n\n".join([
         "# The timing model on silicon: the host CPU predicting the native stream tracer",
         header.strip(),
-        "## Summary\n\n" + all_summaries_text(df),
+        "## Summary\n\n" + all_summaries_text(df, repeats),
         f"![predicted against measured]({plot_name})",
         "## Per workload\n\nError = predicted / measured - 1. Noise = (max - min) / median of the "
         "measured renders of that workload. Converged: whether its fastest renders agreed "

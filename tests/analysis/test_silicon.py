@@ -646,3 +646,45 @@ def test_a_workload_with_no_render_kept_shows_dashes(tmp_path):
     assert "inf" not in table and "nan" not in table
     assert "| avx512 | a | 64x64 | 32 | 0.00 | - | - | - | - | - | - | NO (0) |" in table
     assert silicon.summary(df)["converged"] == 1
+
+
+def test_reproducibility(tmp_path):
+    # One workload measured again in two processes of its own: its fastest 100 in the run, 101
+    # and 103 in the others, each with the rows' range (99 to 102: 3 % over the fastest).
+    rows = [row("a", 16, 100, 100), row("a", 32, 100, 120)]
+    p = tmp_path / "rows.json"
+    p.write_text(json.dumps(rows))
+    df = silicon.load_rows(p)
+    repeats = []
+    for i, measured in enumerate([101, 103]):
+        q = tmp_path / f"repeat-{i}.json"
+        q.write_text(json.dumps([row("a", 16, 100, measured)]))
+        repeats.append(silicon.load_rows(q))
+    rep = silicon.reproducibility(df, repeats)
+    assert rep["workload"] == ("avx512", "a", "64x64", 16)
+    assert rep["fastest"] == [100, 101, 103]
+    assert rep["apart"] == pytest.approx(0.03)
+    assert rep["within_ranges"]  # 100's range reaches 103, 101's 104
+    text = silicon.reproducibility_text(rep)
+    assert "measured in 3 processes" in text and "3.0 % apart" in text
+    assert "FLAGGED" not in text
+    # With the rule's ranges: 101 and 103 a range of 0.5 % each, the run's 100 of 1 %: 100's
+    # range reaches 101 only, and the host is flagged.
+    df["measured.hi"] = df["measured.lo"] * 1.01
+    for r in repeats:
+        r["measured.hi"] = r["measured.lo"] * 1.005
+    rep = silicon.reproducibility(df, repeats)
+    assert not rep["within_ranges"]
+    assert "FLAGGED" in silicon.reproducibility_text(rep)
+    # A repeat of another workload, or of none converged, is not compared; none left: no line.
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps([row("b", 16, 100, 100)]))
+    assert silicon.reproducibility(df, [silicon.load_rows(other)]) is None
+    assert "no workload measured again" in silicon.reproducibility_text(None)
+    # The page carries the line.
+    header = tmp_path / "h.md"
+    header.write_text("")
+    assert main(["silicon", str(p), "-o", str(tmp_path / "x.md"), "--header", str(header),
+                 "--repeats", str(tmp_path / "repeat-0.json"),
+                 str(tmp_path / "repeat-1.json")]) == 0
+    assert "measured in 3 processes" in (tmp_path / "x.md").read_text()
