@@ -115,26 +115,18 @@ def reproducibility(df, repeats):
     one Intel Xeon VM, 3812-3921 K cycles, their own ranges 0.2-1.9 % (2026-12-07). None where
     no repeat matches a converged workload of `df`."""
     keys = ["isa", "scene", "res", "tile"]
-    found = None
-    for r in repeats:
-        r = scored(r)
-        if r.empty:
-            continue
-        key = tuple(r.iloc[0][k] for k in keys)
-        main_rows = scored(df)
-        main_rows = main_rows[(main_rows[keys] == pd.Series(key, index=keys)).all(axis=1)]
-        if main_rows.empty:
-            continue
-        if found is None:
-            found = {"workload": key, "fastest": [main_rows["measured.frame_cycles"].iloc[0]],
-                     "ranges": [main_rows["measured.hi"].iloc[0] /
-                                main_rows["measured.lo"].iloc[0] - 1]}
-        if key != found["workload"]:
-            continue
-        found["fastest"].append(r["measured.frame_cycles"].iloc[0])
-        found["ranges"].append(r["measured.hi"].iloc[0] / r["measured.lo"].iloc[0] - 1)
-    if found is None or len(found["fastest"]) < 2:
+    main_rows = scored(df).set_index(keys)
+    repeats = [scored(r).set_index(keys) for r in repeats]
+    # The workload: the first repeat's that the run measured too (converged in both).
+    workload = next((r.index[0] for r in repeats if not r.empty and r.index[0] in main_rows.index),
+                    None)
+    if workload is None:
         return None
+    runs = [main_rows.loc[[workload]].iloc[0]] + [r.iloc[0] for r in repeats
+                                                   if not r.empty and r.index[0] == workload]
+    found = {"workload": workload,
+             "fastest": [r["measured.frame_cycles"] for r in runs],
+             "ranges": [r["measured.hi"] / r["measured.lo"] - 1 for r in runs]}
     found["apart"] = max(found["fastest"]) / min(found["fastest"]) - 1
     # The processes measured one thing: every two ranges overlap, as the rankings' rule would
     # have them (the faster process's range reaches the slower one's fastest).
