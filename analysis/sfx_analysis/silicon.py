@@ -106,49 +106,99 @@ def self_consistency(df):
 
 
 def reproducibility(df, repeats):
-    """One workload of the check measured again in processes of their own (`repeats`: their
-    rows, as load_rows reads them): its fastest render in each process, the run's own first,
-    against the range each process's convergence rule vouched for. A placement fixed for a
-    whole process (code and stack under ASLR, the scene's arrays, the physical pages) moves a
-    workload's fastest render from one process to the next, and no range measured inside one
-    process sees it: the fastest renders of scalar furnace 64x64 tile 16 in four processes of
-    one Intel Xeon VM, 3812-3921 K cycles, their own ranges 0.2-1.9 % (2026-12-07). None where
-    no repeat matches a converged workload of `df`."""
+    """Workloads of the check measured again in processes of their own (`repeats`: their rows,
+    as load_rows reads them; the script repeats one cell's tiles): each one's fastest render in
+    each process, the run's own first, against the range each process's convergence rule
+    vouched for, and each pair's difference (one tile's frame over another's) from process to
+    process. A placement fixed for a whole process (code and stack under ASLR, the scene's
+    arrays, the physical pages) moves a workload's fastest render from one process to the next,
+    and no range measured inside one process sees it: the fastest renders of scalar furnace
+    64x64 tile 16 in four processes of one Intel Xeon VM, 3812-3921 K cycles, their own ranges
+    0.2-1.9 %; and its tile 64 over tile 16, +1.1 % in one process and -0.1 % in the next, the
+    same frames (2026-12-07). None where no repeat matches a converged workload of `df`."""
     keys = ["isa", "scene", "res", "tile"]
     main_rows = scored(df).set_index(keys)
     repeats = [scored(r).set_index(keys) for r in repeats]
-    # The workload: the first repeat's that the run measured too (converged in both).
-    workload = next((r.index[0] for r in repeats if not r.empty and r.index[0] in main_rows.index),
-                    None)
-    if workload is None:
+    # The workloads: those of the repeats that the run measured too (converged in both), in
+    # the first repeat's order.
+    order = [w for r in repeats for w in r.index if w in main_rows.index]
+    order = list(dict.fromkeys(order))
+    if not order:
         return None
-    runs = [main_rows.loc[[workload]].iloc[0]] + [r.iloc[0] for r in repeats
-                                                   if not r.empty and r.index[0] == workload]
-    found = {"workload": workload,
-             "fastest": [r["measured.frame_cycles"] for r in runs],
-             "ranges": [r["measured.hi"] / r["measured.lo"] - 1 for r in runs]}
-    found["apart"] = max(found["fastest"]) / min(found["fastest"]) - 1
-    # The processes measured one thing: every two ranges overlap, as the rankings' rule would
-    # have them (the faster process's range reaches the slower one's fastest).
-    runs = sorted(zip(found["fastest"], found["ranges"]))
-    found["within_ranges"] = all(f * (1 + r) >= g for i, (f, r) in enumerate(runs)
-                                 for g, _ in runs[i + 1:])
-    return found
+    runs = [main_rows] + repeats
+    workloads = []
+    for w in order:
+        found = [r.loc[w] for r in runs if w in r.index]
+        fastest = [f["measured.frame_cycles"] for f in found]
+        ranges = [f["measured.hi"] / f["measured.lo"] - 1 for f in found]
+        # The processes measured one thing: every two ranges overlap, as the rankings' rule
+        # would have them (the faster process's range reaches the slower one's fastest).
+        by_speed = sorted(zip(fastest, ranges))
+        workloads.append({
+            "workload": w, "fastest": fastest, "ranges": ranges,
+            "apart": max(fastest) / min(fastest) - 1,
+            "within_ranges": all(f * (1 + r) >= g for i, (f, r) in enumerate(by_speed)
+                                 for g, _ in by_speed[i + 1:])})
+    # Each pair of one cell's workloads: its difference in every process that measured both.
+    pairs = []
+    for a, b in itertools.combinations(order, 2):
+        if a[:3] != b[:3]:
+            continue
+        diffs = [r.loc[b, "measured.frame_cycles"] / r.loc[a, "measured.frame_cycles"] - 1
+                 for r in runs if a in r.index and b in r.index]
+        if len(diffs) > 1:
+            pairs.append({"pair": (a, b), "differences": diffs,
+                          "spread": max(diffs) - min(diffs),
+                          "flipped": min(diffs) < 0 < max(diffs)})
+    return {"workloads": workloads, "processes": len(runs),
+            "apart": max(w["apart"] for w in workloads),
+            "within_ranges": all(w["within_ranges"] for w in workloads),
+            "pairs": pairs,
+            "pair_spread": max((p["spread"] for p in pairs), default=None)}
 
 
-def reproducibility_text(rep):
-    """One line (and its verdict) for the page's summary."""
+def wrong_pair_gaps(df):
+    """How far apart each judged pair ordered wrong was measured, tile and width rankings
+    alike (each frame over the other's, the measured slower first)."""
+    gaps = []
+    for isa in isas(df):
+        rank = ranking(df[df["isa"] == isa])
+        gaps += [w["measured"] for ws in rank["wrong"] for w in ws]
+    rank = width_ranking(df)
+    if not rank.empty:
+        gaps += [w["measured"] for ws in rank["wrong"] for w in ws]
+    return gaps
+
+
+def reproducibility_text(rep, df=None):
+    """The page summary's lines (and their verdict); with the run's rows `df`, how many of the
+    pairs the rankings ordered wrong were measured closer than a pair moved between processes."""
     if rep is None:
         return "- reproducibility: no workload measured again in processes of its own"
-    isa, scene, res, tile = rep["workload"]
     verdict = ("within the ranges" if rep["within_ranges"] else
                "FLAGGED: a run's ranges understate its workloads' spread from run to run, and a "
                "pair of workloads closer than this may order either way in another run")
-    return (f"- reproducibility: {isa} {scene} {res} tile {tile} measured in "
-            f"{len(rep['fastest'])} processes (the run's and {len(rep['fastest']) - 1} of their "
-            f"own): fastest {min(rep['fastest']) / 1e6:.2f}-{max(rep['fastest']) / 1e6:.2f} "
-            f"Mcyc, {100 * rep['apart']:.1f} % apart, against each process's own range of "
-            f"{100 * min(rep['ranges']):.1f}-{100 * max(rep['ranges']):.1f} %: {verdict}")
+    lines = [f"- reproducibility: {len(rep['workloads'])} workloads measured in "
+             f"{rep['processes']} processes (the run's and {rep['processes'] - 1} of their own), "
+             f"up to {100 * rep['apart']:.1f} % apart: {verdict}"]
+    for w in rep["workloads"]:
+        isa, scene, res, tile = w["workload"]
+        lines.append(f"  - {isa} {scene} {res} tile {tile}: fastest "
+                     f"{min(w['fastest']) / 1e6:.2f}-{max(w['fastest']) / 1e6:.2f} Mcyc, "
+                     f"{100 * w['apart']:.1f} % apart, against each process's own range of "
+                     f"{100 * min(w['ranges']):.1f}-{100 * max(w['ranges']):.1f} %")
+    for p in rep["pairs"]:
+        (_, _, _, a), (_, _, _, b) = p["pair"]
+        diffs = ", ".join(pct(d) for d in p["differences"])
+        lines.append(f"  - tile {b} over tile {a}: {diffs} by process"
+                     f"{' (the order flipped)' if p['flipped'] else ''}")
+    if rep["pair_spread"] is not None and df is not None:
+        gaps = wrong_pair_gaps(df)
+        closer = sum(g <= rep["pair_spread"] for g in gaps)
+        lines.append(f"  - a pair's difference moved by up to {100 * rep['pair_spread']:.1f} "
+                     f"points between processes; of the {len(gaps)} pairs the rankings ordered "
+                     f"wrong, {closer} were measured closer than that")
+    return "\n".join(lines)
 
 
 def scaling_text(df):
@@ -941,7 +991,7 @@ def all_summaries_text(df, repeats=()):
     parts.append(width_summary_text(width_summary(df)))
     parts.append(consistency_text(df))
     if repeats:
-        parts.append(reproducibility_text(reproducibility(df, repeats)))
+        parts.append(reproducibility_text(reproducibility(df, repeats), df))
     return "\n".join(parts)
 
 

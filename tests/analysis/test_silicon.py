@@ -661,13 +661,14 @@ def test_reproducibility(tmp_path):
         q.write_text(json.dumps([row("a", 16, 100, measured)]))
         repeats.append(silicon.load_rows(q))
     rep = silicon.reproducibility(df, repeats)
-    assert rep["workload"] == ("avx512", "a", "64x64", 16)
-    assert rep["fastest"] == [100, 101, 103]
+    assert [w["workload"] for w in rep["workloads"]] == [("avx512", "a", "64x64", 16)]
+    assert rep["workloads"][0]["fastest"] == [100, 101, 103]
     assert rep["apart"] == pytest.approx(0.03)
     assert rep["within_ranges"]  # 100's range reaches 103, 101's 104
-    text = silicon.reproducibility_text(rep)
-    assert "measured in 3 processes" in text and "3.0 % apart" in text
-    assert "FLAGGED" not in text
+    assert rep["pairs"] == [] and rep["pair_spread"] is None  # one workload: no pair
+    text = silicon.reproducibility_text(rep, df)
+    assert "1 workloads measured in 3 processes" in text and "3.0 % apart" in text
+    assert "FLAGGED" not in text and "points between processes" not in text
     # With the rule's ranges: 101 and 103 a range of 0.5 % each, the run's 100 of 1 %: 100's
     # range reaches 101 only, and the host is flagged.
     df["measured.hi"] = df["measured.lo"] * 1.01
@@ -676,6 +677,23 @@ def test_reproducibility(tmp_path):
     rep = silicon.reproducibility(df, repeats)
     assert not rep["within_ranges"]
     assert "FLAGGED" in silicon.reproducibility_text(rep)
+    # A cell's two tiles in each process: tile 32 over tile 16 +20 % in the run, +10 % and -5 %
+    # in the others: the pair moved by 25 points and flipped. The run's rankings ordered tile
+    # 32 over 16 (measured 20 % apart) wrong: closer than 25 points.
+    two = []
+    for i, (t16, t32) in enumerate([(101, 111.1), (103, 97.85)]):
+        q = tmp_path / f"pair-{i}.json"
+        q.write_text(json.dumps([row("a", 16, 100, t16), row("a", 32, 100, t32)]))
+        two.append(silicon.load_rows(q))
+    df = silicon.load_rows(p)
+    rep = silicon.reproducibility(df, two)
+    assert len(rep["workloads"]) == 2
+    (pair,) = rep["pairs"]
+    assert pair["differences"] == pytest.approx([0.2, 0.1, -0.05])
+    assert pair["flipped"] and rep["pair_spread"] == pytest.approx(0.25)
+    text = silicon.reproducibility_text(rep, df)
+    assert "tile 32 over tile 16: +20.0 %, +10.0 %, -5.0 % by process (the order flipped)" in text
+    assert "of the 1 pairs the rankings ordered wrong, 1 were measured closer than that" in text
     # A repeat of another workload, or of none converged, is not compared; none left: no line.
     other = tmp_path / "other.json"
     other.write_text(json.dumps([row("b", 16, 100, 100)]))
