@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -899,6 +900,36 @@ HwConfig with_last_level(const HwConfig& host, const SeenLevel& seen) {
     return c;
 }
 
+SiliconOrder silicon_order(const std::vector<SiliconVariant>& variants) {
+    const size_t n = variants.size();
+    SiliconOrder order;
+    order.frames.resize(n);
+    std::vector<uint32_t> place(n);           // among the workloads of its frames
+    std::vector<uint32_t> per_frames, first;  // per frame group: workloads, first variant
+    for (size_t v = 0; v < n; ++v) {
+        const RenderSettings& a = variants[v].settings;
+        uint32_t g = 0;
+        for (; g < first.size(); ++g) {
+            const SiliconVariant& f = variants[first[g]];
+            if (f.scene == variants[v].scene && f.settings.width == a.width &&
+                f.settings.height == a.height && f.settings.spp == a.spp &&
+                f.settings.max_depth == a.max_depth && f.settings.seed == a.seed)
+                break;
+        }
+        if (g == first.size()) {
+            first.push_back(uint32_t(v));
+            per_frames.push_back(0);
+        }
+        order.frames[v] = g;
+        place[v] = per_frames[g]++;
+    }
+    order.rounds.resize(n);
+    std::iota(order.rounds.begin(), order.rounds.end(), size_t(0));
+    std::stable_sort(order.rounds.begin(), order.rounds.end(),
+                     [&](size_t a, size_t b) { return place[a] < place[b]; });
+    return order;
+}
+
 void keep_freed_memory_in_heap() {
     mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest (HEAP_MAX_SIZE / 2 on 64 bits)
     mallopt(M_TRIM_THRESHOLD, 1 << 30);
@@ -914,10 +945,11 @@ std::vector<SiliconMeasurement> predict_and_measure(
     const double tsc_mhz = measure_tsc_mhz();
     if (progress) progress("chasing the L3", 0, n);
     const SeenLevel l3_before = chase_last_level_now(tsc_mhz);
+    const SiliconOrder order = silicon_order(variants);
     for (size_t v = 0; v < n; ++v) {
         settings[v] = variants[v].settings;
         settings[v].threads = 1;
-        settings[v].seed += k_frames_per_workload * v;
+        settings[v].seed += k_frames_per_workload * order.frames[v];
         out[v].seed = settings[v].seed;
         out[v].l3_before = l3_before;
     }
@@ -1040,7 +1072,7 @@ std::vector<SiliconMeasurement> predict_and_measure(
             round_l3.push_back(chase_last_level_now(tsc_mhz));
             warm_variant = n;  // the chases evicted the caches a render warmed
         }
-        for (size_t v = 0; v < n; ++v) {
+        for (const size_t v : order.rounds) {
             SiliconMeasurement& m = out[v];
             if (!needs_more(v)) continue;
             const Scene& scene = *variants[v].scene;

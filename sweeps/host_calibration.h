@@ -409,18 +409,34 @@ struct SiliconVariant {
     bool cold = false;
 };
 
+// The frames a check's workloads render and the order its rounds take them in. Workloads of one
+// scene, resolution, sample count, depth and seed render the same frames (`frames`: their group's
+// index; seeds k_frames_per_workload apart per group), so that a cell's tiles and back ends are
+// compared on the same work: with frames of each workload's own (until 2026-12-07), a pair's
+// predicted difference moved with the frames (scalar furnace 64x64, tile 64 over 16: -1.2, -2.0
+// and +1.0 % for three pairs of seeds, on an Intel Xeon VM) as far as the pairs the rankings
+// ordered wrong were measured apart (0.4-2.3 %). A round takes each group's first workload, then
+// each one's second, and so on (`rounds`), so that between two renders of one frame come the
+// other groups' renders: a render right after its own frame finds what the model's warm frames do
+// not hold (below).
+struct SiliconOrder {
+    std::vector<uint32_t> frames;  // per workload: its frame group
+    std::vector<size_t> rounds;    // the workloads in the order a round renders them
+};
+SiliconOrder silicon_order(const std::vector<SiliconVariant>& variants);
+
 // Which of a workload's other frames (other_frame in kernels/render.h) the check renders where
 // it does not time the workload's own: none of its timed renders follows a render of the same
 // frame, whose random outcomes the core's branch predictor would have learned (the model prices
 // them fresh). Its measured render follows the warm frame and the stage-clocked one (whose
 // stage shares stand for the measured frame's: another seed moves them by its noise only), as
 // the model's warm frames (sampling's: other_frame 2, then 1) precede its timed one; its cold
-// render, after the measured one, is a frame of its own, predicted as such. Each workload's frames
-// are its own (its seed k_frames_per_workload times its index past the variant's): with one seed
-// for all, the workloads rendered before it (the same scene at other tiles and back ends) left
-// the caches lines of its own frame, which the model's warm frames do not hold (atrium's and
-// conference's AVX2 frames measured 0-6 % slower after two other frames than after their own,
-// 2026-12-05, where the model warmed by those two put them 1-9 % dearer).
+// render, after the measured one, is a frame of its own, predicted as such. A frame group's
+// workloads are rendered apart (SiliconOrder): rendered one after another, the workloads before
+// it (the same scene at other tiles and back ends) left the caches lines of its own frame, which
+// the model's warm frames do not hold (atrium's and conference's AVX2 frames measured 0-6 %
+// slower after two other frames than after their own, 2026-12-05, where the model warmed by those
+// two put them 1-9 % dearer); a check of one scene and resolution has nothing to put between.
 constexpr uint64_t k_clocked_frame = 1, k_warm_frame = 2, k_cold_frame = 3;
 // Its own frame and its other frames 1 to k_cold_frame.
 constexpr uint64_t k_frames_per_workload = k_cold_frame + 1;

@@ -985,3 +985,29 @@ TEST_CASE("A microbenchmark's lanes beyond the L1D open a page or skip lines in 
     CHECK(small.l1 == 0.0);
     CHECK(small.l1_skipping == 0.0);
 }
+
+TEST_CASE("A check's tiles and back ends render the same frames, kept apart in a round", "[host]") {
+    // Two scenes (only their addresses matter), scene a at two resolutions, two tiles each.
+    const Scene a, b;
+    std::vector<SiliconVariant> variants;
+    auto add = [&](const Scene& scene, uint32_t res, uint32_t tile) {
+        SiliconVariant v;
+        v.scene = &scene;
+        v.settings.width = v.settings.height = res;
+        v.settings.tile = tile;
+        variants.push_back(v);
+    };
+    add(a, 64, 16);
+    add(a, 64, 32);
+    add(a, 128, 16);
+    add(a, 128, 32);
+    add(b, 64, 16);
+    add(b, 64, 32);
+    const SiliconOrder order = silicon_order(variants);
+    CHECK(order.frames == std::vector<uint32_t>{0, 0, 1, 1, 2, 2});
+    // Each group's first workload, then each one's second: a frame's two renders are apart.
+    CHECK(order.rounds == std::vector<size_t>{0, 2, 4, 1, 3, 5});
+    // Another seed is another frame.
+    variants[1].settings.seed = 9;
+    CHECK(silicon_order(variants).frames == std::vector<uint32_t>{0, 1, 2, 2, 3, 3});
+}
