@@ -270,9 +270,9 @@ TEST_CASE("A host configuration fitted on microbenchmarks predicts a tiny frame"
     CHECK(cell[0].predicted_cold_frame == 0.0);
     CHECK(cell[1].predicted_frame > 0);
     CHECK(cell[1].predicted_frame != cell[0].predicted_frame);
-    // Each workload renders frames of its own (seeds k_frames_per_workload apart), and its
-    // prediction is sfx simulate's of that frame after two other frames of it (--seed S
-    // --warm-frames 2).
+    // Each scene's workloads render frames of their own (seeds k_frames_per_workload apart by
+    // frame group, silicon_order), and a workload's prediction is sfx simulate's of that frame
+    // after two other frames of it (--seed S --warm-frames 2).
     CHECK(cell[0].seed == s.seed);
     CHECK(cell[1].seed == f.seed + k_frames_per_workload);
     RenderSettings own = f;
