@@ -158,16 +158,9 @@ def reproducibility(df, repeats):
 
 
 def wrong_pair_gaps(df):
-    """How far apart each judged pair ordered wrong was measured, tile and width rankings
-    alike (each frame over the other's, the measured slower first)."""
-    gaps = []
-    for isa in isas(df):
-        rank = ranking(df[df["isa"] == isa])
-        gaps += [w["measured"] for ws in rank["wrong"] for w in ws]
-    rank = width_ranking(df)
-    if not rank.empty:
-        gaps += [w["measured"] for ws in rank["wrong"] for w in ws]
-    return gaps
+    """wrong_gaps over every ranking of the rows: each back end's tiles, and the widths."""
+    gaps = [g for isa in isas(df) for g in wrong_gaps(ranking(df[df["isa"] == isa]))]
+    return gaps + wrong_gaps(width_ranking(df))
 
 
 def reproducibility_text(rep, df=None):
@@ -451,10 +444,16 @@ def wrong_pair_text(w):
             f"predicted {pct(w['predicted'])}")
 
 
+def wrong_gaps(rank):
+    """How far apart each pair ordered wrong was measured, over the rows of a ranking (each
+    frame over the other's, the measured slower first)."""
+    return [w["measured"] for ws in rank.get("wrong", []) for w in ws]
+
+
 def wrong_gaps_text(rank):
     """How far apart the pairs ordered wrong were measured, over the rows of a ranking: a miss
     of a pair 1 % apart asks of the model what a miss of one 10 % apart does not."""
-    gaps = [w["measured"] for ws in rank.get("wrong", []) for w in ws]
+    gaps = wrong_gaps(rank)
     if not gaps:
         return ""
     if len(gaps) == 1:
