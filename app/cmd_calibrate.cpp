@@ -262,6 +262,7 @@ void add_calibrate_command(CLI::App& app) {
                         {"beyond_l1_per_lane", k.beyond_l1_per_lane_cycles},
                         {"beyond_l2_per_lane", k.beyond_l2_per_lane_cycles},
                         {"beyond_l1_skipping_per_lane", k.beyond_l1_skipping_per_lane_cycles},
+                        {"beyond_tlb_per_lane", k.beyond_tlb_per_lane_cycles},
                         {"one_lane", k.one_lane_cycles},
                         {"one_lane_pass", k.one_lane_pass_cycles},
                         {"one_lane_failed_candidate", k.one_lane_failed_candidate_cycles},
@@ -419,6 +420,8 @@ void add_calibrate_command(CLI::App& app) {
                 describe(cal.host.microarchitecture).c_str(), cal.host.isa.c_str(),
                 cal.host.tsc_mhz, cal.host.core_mhz, clock_chain_name(cal.host.simd_width),
                 cal.host.caches.size(), pinned ? ", pinned" : ", NOT pinned");
+            std::printf("first-level DTLB: %u pages (%s)\n", cal.host.dtlb.pages,
+                        describe(cal.host.dtlb).c_str());
             std::printf(
                 "microbenchmarks: %u of %u points converged (%s in each of %u sweeps, "
                 "judged over all)\n",
@@ -446,20 +449,21 @@ void add_calibrate_command(CLI::App& app) {
                 std::abs(moved) > k_speed_probe_tolerance
                     ? ": the machine moved during calibration, calibrate again"
                     : "");
-            std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n", "op kind",
-                        "per_op", "per_group", "per_lane", "per_pass", "per_fail", "minority",
-                        "beyondL1", "skipL1", "beyondL2", "fit med", "fit max", "one_lane",
-                        "few_lane");
+            std::printf("%-20s %9s %9s %9s %9s %9s %9s %9s %9s %9s %9s %8s %8s %9s %9s\n",
+                        "op kind", "per_op", "per_group", "per_lane", "per_pass", "per_fail",
+                        "minority", "beyondL1", "skipL1", "beyondL2", "beyondTLB", "fit med",
+                        "fit max", "one_lane", "few_lane");
             for (size_t i = 0; i < cal.op_costs.size(); ++i) {
                 const OpCostConfig& k = cal.op_costs[i];
                 std::printf(
-                    "%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% %7.1f%% "
-                    "%9.1f %9.1f\n",
+                    "%-20s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %7.1f%% "
+                    "%7.1f%% %9.1f %9.1f\n",
                     k.op.c_str(), k.per_op_cycles, k.per_group_cycles, k.per_lane_cycles,
                     k.per_pass_cycles, k.per_fail_cycles, k.per_minority_lane_cycles,
                     k.beyond_l1_per_lane_cycles, k.beyond_l1_skipping_per_lane_cycles,
-                    k.beyond_l2_per_lane_cycles, 100 * cal.fit_errors[i].first,
-                    100 * cal.fit_errors[i].second, k.one_lane_cycles, k.few_lane_cycles);
+                    k.beyond_l2_per_lane_cycles, k.beyond_tlb_per_lane_cycles,
+                    100 * cal.fit_errors[i].first, 100 * cal.fit_errors[i].second,
+                    k.one_lane_cycles, k.few_lane_cycles);
             }
             // Each fitted kind's residuals, one column per key.
             auto print_residuals = [&](const std::vector<uint32_t>& keys, const char* unit,

@@ -286,6 +286,13 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             beyond_l1 > 0 ? expected_lanes_skipping_lines(length, slots, page_bytes) /
                                 double(std::min(length, slots))
                           : 0.0;
+        // Beyond the first-level DTLB's reach: every lane opening a page, in the L1D or not.
+        const double beyond_tlb =
+            c.ray_buffer.storage == "l1d"
+                ? beyond_tlb_share(length, std::max(1u, shape.slots()),
+                                   slot_bytes_of(c.ray_buffer, layout.bytes()), page_bytes,
+                                   c.ray_buffer.dtlb_pages)
+                : 0.0;
         // The cycle model's pipeline in closed form. Groups spread over the units; each round
         // of them costs the slowest of execution, the access side's issue, and the shared
         // address units and interconnect. An op that partitions holds the next op back: the
@@ -302,10 +309,11 @@ FrameTiming analytic_timing(const HwConfig& c, const WorkloadShape& shape,
             // would pass all or none of the bucket).
             const double passing = length == 1 ? pass_rate : double(std::lround(pass_rate * lanes));
             const double busy =
-                p.issue_cycles(
-                    c.datapath, length, uint32_t(std::lround(double(bucket.mispredicted) / ops)),
-                    lanes, passing, g == 0, beyond_l1 * opening_share, beyond_l2 * opening_share,
-                    double(bucket.failed_candidates) / ops, beyond_l1 * skipping_share) +
+                p.issue_cycles(c.datapath, length,
+                               uint32_t(std::lround(double(bucket.mispredicted) / ops)), lanes,
+                               passing, g == 0, beyond_l1 * opening_share,
+                               beyond_l2 * opening_share, double(bucket.failed_candidates) / ops,
+                               beyond_l1 * skipping_share, beyond_tlb) +
                 // A shading filter's call cold (a traversal's start is not priced here, as
                 // its other start costs are not: the cycle-level model's).
                 (g == 0 && op_stage == OpStage::shading ? p.cold_call_cycles() : 0.0);

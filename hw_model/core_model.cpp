@@ -70,6 +70,10 @@ const OpProfile& CoreModel::profile(uint32_t op) const {
 void CoreModel::begin_pass(const PassBuffer* pass, uint64_t now) {
     m_pass = pass;
     m_pass_start = now;
+    m_beyond_tlb = m_l1d ? beyond_tlb_fraction(pass->pass().slot_count,
+                                               slot_bytes_of(m_config.ray_buffer, m_record_bytes),
+                                               m_config.ray_buffer.dtlb_pages)
+                         : 0.0;
     const size_t n = pass->size();
     m_scene_ready.assign(n, 0);
     m_scene_arrival.assign(n, 0);
@@ -126,8 +130,9 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
     // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes; a slot's
     // arrays: lane_page_bytes), and beyond_l1_skipping_per_lane_cycles where the first level
-    // did not hold it in a page the lane before opened and it skips lines past the lane
-    // before's (lane_skips_lines: a next-line prefetch does not bring them); counted per group. The
+    // before's (lane_skips_lines: a next-line prefetch does not bring them); and, where it opens
+    // a page at all, beyond_tlb_per_lane_cycles for the pass's share of slots beyond the DTLB's
+    // reach (m_beyond_tlb, the fit's beyond_tlb_share); counted per group. The
     // fit expects the same of its microbenchmarks (beyond_cache_share). A slot's traversal record:
     // what a box or leaf test reads, and a made ray's set-up writes.
     const auto record_address = [](uint32_t slot) {
@@ -147,7 +152,9 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
                 ? m_scene_memory->touch_other(m_core, from * k_line,
                                               uint32_t((last_line - from + 1) * k_line), now)
                 : 0;
-        if (level > 0 && lane_opens_page(op.slots, i, page_bytes)) {
+        const bool opens_page = lane_opens_page(op.slots, i, page_bytes);
+        m_group_beyond_lanes.back().pages += opens_page;
+        if (level > 0 && opens_page) {
             ++m_group_beyond_lanes.back().l1;
             m_group_beyond_lanes.back().l2 += level > 1;
         } else if (level > 0 && lane_skips_lines(op.slots, i, page_bytes)) {
@@ -417,7 +424,8 @@ CoreModel::Executed CoreModel::execute(const GroupToken& t, uint32_t unit, uint6
              : p.issue_cycles(m_config.datapath, op.length, m_mispredicted_lanes[t.op], t.lanes,
                               passed, t.first == 0, beyond.l1 / group_lanes,
                               beyond.l2 / group_lanes, op.failed_candidates,
-                              beyond.l1_skipping / group_lanes)) +
+                              beyond.l1_skipping / group_lanes,
+                              m_beyond_tlb * beyond.pages / group_lanes)) +
         (t.first == 0 && m_enters_loop[t.op] ? p.loop_entry_cycles(m_loop[t.op]) : 0.0) +
         (t.first == 0 && op.starts_traversal ? p.traversal_start_cycles() : 0.0) +
         // A call cold: a shading filter's (the material sort's once, on its first filter) and a

@@ -139,7 +139,10 @@ class CoreModel {
     // lines in a page the lane before opened.
     struct BeyondLanes {
         uint32_t l1 = 0, l2 = 0, l1_skipping = 0;
+        uint32_t pages = 0;  // lanes that open a page of their array, in the L1D or not
     };
+    // The share of the pass's slots beyond the first-level DTLB's reach (beyond_tlb_fraction).
+    double m_beyond_tlb = 0.0;
     std::vector<size_t> m_group_beyond_offset;
     std::vector<BeyondLanes> m_group_beyond_lanes;
     static constexpr size_t k_none = ~size_t(0);

@@ -2,6 +2,7 @@
 
 #include <cpuid.h>
 #include <sched.h>
+#include <sys/mman.h>
 #include <x86intrin.h>
 
 #include <algorithm>
@@ -295,6 +296,72 @@ double measure_load_latency_ns(uint64_t bytes, double tsc_mhz, uint32_t spin, do
     return std::max(0.0, best - spin_best) / tsc_mhz * 1000.0;
 }
 
+DtlbReading measure_dtlb_pages(uint32_t max_pages) {
+    constexpr size_t k_page = 4096;
+    max_pages = std::min(max_pages, 512u);
+    const size_t bytes = size_t(max_pages) * k_page;
+    void* mapped = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    DtlbReading r;
+    if (mapped == MAP_FAILED) return r;
+    madvise(mapped, bytes, MADV_NOHUGEPAGE);
+    char* const base = static_cast<char*>(mapped);
+    // Page p's line: at line p mod 64 of its page, so that 512 lines fill the sets alike.
+    const auto line = [&](uint32_t p) {
+        return reinterpret_cast<uintptr_t*>(base + p * k_page + (p % 64) * 64);
+    };
+    uintptr_t at = 0;
+    for (uint32_t pages = 8; pages <= max_pages; pages += 8) {
+        std::vector<uint32_t> order(pages);
+        std::iota(order.begin(), order.end(), 0u);
+        std::shuffle(order.begin() + 1, order.end(), std::mt19937_64(pages));
+        for (uint32_t i = 0; i < pages; ++i)
+            *line(order[i]) = reinterpret_cast<uintptr_t>(line(order[(i + 1) % pages]));
+        at = reinterpret_cast<uintptr_t>(line(order[0]));
+        for (uint32_t i = 0; i < 4 * pages; ++i) at = *reinterpret_cast<uintptr_t*>(at);
+        constexpr size_t k_loads = 1u << 12;
+        double best = 1e30;
+        for (int run = 0; run < 32; ++run) {
+            const uint64_t c0 = __rdtsc();
+            for (size_t i = 0; i < k_loads; ++i) at = *reinterpret_cast<uintptr_t*>(at);
+            const uint64_t c1 = __rdtsc();
+            best = std::min(best, double(c1 - c0) / double(k_loads));
+        }
+        r.chases.emplace_back(pages, best);
+    }
+    if (at == 0) std::printf(" ");  // keeps the chase
+    munmap(mapped, bytes);
+    r.pages = dtlb_reach(r.chases);
+    return r;
+}
+
+uint32_t dtlb_reach(const std::vector<std::pair<uint32_t, double>>& chases) {
+    if (chases.empty()) return 0;
+    const double step = chases.front().second * 4 / 3;
+    for (size_t i = 1; i + 1 < chases.size(); ++i)
+        if (chases[i].second > step && chases[i + 1].second > step) return chases[i - 1].first;
+    return 0;
+}
+
+std::string describe(const DtlbReading& r) {
+    if (r.chases.empty()) return "not measured";
+    char buf[192];
+    if (r.pages == 0) {
+        std::snprintf(buf, sizeof buf,
+                      "no step in a chase of one line a page up to %u pages (%.1f TSC ticks a "
+                      "load at %u): not modelled",
+                      r.chases.back().first, r.chases.back().second, r.chases.back().first);
+        return buf;
+    }
+    const auto step = std::find_if(r.chases.begin(), r.chases.end(),
+                                   [&](const auto& c) { return c.first > r.pages; });
+    std::snprintf(buf, sizeof buf,
+                  "measured: a chase of one line a page, %.1f TSC ticks a load at %u pages, "
+                  "%.1f at %u, %.1f at %u",
+                  r.chases.front().second, r.chases.front().first, step[-1].second, step[-1].first,
+                  step->second, step->first);
+    return buf;
+}
+
 double measure_dram_first_pass_ns(uint64_t span_bytes, double tsc_mhz, int runs) {
     const Chase chase = random_chase(span_bytes);
     const size_t lines = chase.size() / k_chase_stride;
@@ -449,6 +516,7 @@ HostDescription describe_host(uint32_t simd_width, const std::string& isa, bool 
     h.tsc_mhz = measure_tsc_mhz();
     h.core_mhz = h.tsc_mhz / tsc_ticks_per_core_cycle(21, simd_width);
     h.caches = read_host_caches();
+    h.dtlb = measure_dtlb_pages();  // the ray buffers' pages: measured with or without the memory
     if (!measure_memory) return h;
     for (size_t i = 0; i < h.caches.size(); ++i) {
         if (i > 0 && i + 1 == h.caches.size()) {
@@ -485,6 +553,7 @@ HwConfig host_hw_config(const HostDescription& h, const std::vector<OpCostConfig
     c.ray_buffer.storage = "l1d";
     c.ray_buffer.slot_bytes = h.slot_bytes;
     c.ray_buffer.slot_arrays = std::max(1u, h.slot_arrays);
+    c.ray_buffer.dtlb_pages = h.dtlb.pages;
     c.ray_buffer.line_words = (h.caches.empty() ? 64 : h.caches.front().line_bytes) / 4;
     c.partition.kind = "compress";
     c.scene_memory.caches.clear();
@@ -559,6 +628,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
       << "  slot_bytes: " << h.slot_bytes << "  # the native tracer's ray slot (kernels/stream)\n"
       << "  slot_arrays: " << c.ray_buffer.slot_arrays
       << "  # the arrays a slot indexes beyond its traversal record (kernels/stream)\n"
+      << "  dtlb_pages: " << c.ray_buffer.dtlb_pages << "  # " << describe(h.dtlb) << "\n"
       << "partition:\n  kind: compress  # vpcompressd (AVX-512) or a permutation table (AVX2)\n"
       << "scene_memory:\n  caches:\n";
     for (size_t i = 0; i < c.scene_memory.caches.size(); ++i) {
@@ -676,6 +746,7 @@ std::string host_hw_yaml(const HostDescription& h, const std::vector<OpCostConfi
               << ", beyond_l2_per_lane_cycles: " << fmt(o.beyond_l2_per_lane_cycles, 2)
               << ", beyond_l1_skipping_per_lane_cycles: "
               << fmt(o.beyond_l1_skipping_per_lane_cycles, 2)
+              << ", beyond_tlb_per_lane_cycles: " << fmt(o.beyond_tlb_per_lane_cycles, 2)
               << ", one_lane_cycles: " << fmt(o.one_lane_cycles, 2)
               << (o.one_lane_pass_cycles > 0
                       ? ", one_lane_pass_cycles: " + fmt(o.one_lane_pass_cycles, 2)

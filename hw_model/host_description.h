@@ -76,6 +76,25 @@ std::string vendor_short_name(const std::string& vendor);
 // "AuthenticAMD family 0x17 model 0x31 stepping 0 (AMD EPYC 7B12)".
 std::string describe(const Microarchitecture& m);
 
+// A reading of measure_dtlb_pages (below): the chase's TSC ticks a load by pages, and the
+// pages the first-level DTLB maps (0: no step found).
+struct DtlbReading {
+    std::vector<std::pair<uint32_t, double>> chases;
+    uint32_t pages = 0;
+};
+// The 4 KiB pages a core's first-level data TLB maps (RayBufferConfig::dtlb_pages): a random
+// chase of one line a page over 8, 16, ... `max_pages` pages of 4 KiB (no huge pages), each
+// line at its own offset in its page so that the lines stay in the L1D (at most 512 of them);
+// the fastest of many short runs. The reach is the last count before the load's time steps up
+// by a third over the fewest pages' (the second-level TLB's hit) for two counts in a row: on
+// the Intel Xeon VM of model 0xCF (2026-12-08) 3.9 TSC ticks a load up to 96 pages, 7.4 at
+// 112 and 9.1 at 128, where cpuid's leaf 0x18 is empty.
+DtlbReading measure_dtlb_pages(uint32_t max_pages = 512);
+// That reach from the chases (pages, ticks a load), fewest pages first; 0: no step.
+uint32_t dtlb_reach(const std::vector<std::pair<uint32_t, double>>& chases);
+// Where a host file's dtlb_pages comes from, with the chase's loads on either side of the step.
+std::string describe(const DtlbReading& r);
+
 // A reading of measure_pair_fill (below).
 struct PairFillReading {
     double after_even_ns = 0.0, cold_ns = 0.0;
@@ -106,6 +125,7 @@ struct HostDescription {
     PairFillReading pair_fill;  // the last level's CacheLevelConfig::pair_fill (0: not measured)
     uint32_t slot_bytes = 0;         // one ray slot of the native tracer (0: unknown)
     uint32_t slot_arrays = 1;        // the arrays it lies in beyond its traversal record
+    DtlbReading dtlb;                // the first-level DTLB's reach (measured)
     double speed_probe_cycles = 0.0;  // HwConfig::speed_probe_cycles (0: not measured)
     // The CPU the description was measured on (sched_getcpu; -1: unknown). On a virtual machine
     // one CPU's L3 may not be another's (a neighbour's load on its physical core): the check

@@ -119,6 +119,12 @@ struct RayBufferConfig {
     // as of equal size, an assumption); 1: one array, as before it existed. A host file's 7 is
     // counted from the native tracer's code (stream_slot_arrays), not fitted.
     uint32_t slot_arrays = 1;
+    // l1d: the 4 KiB pages the core's first-level data TLB maps (measured: `sfx calibrate
+    // --describe-host` chases one line a page over more and more pages, measure_dtlb_pages in
+    // hw_model/host_description.h); 0: not modelled. A lane that opens a page of a pass whose
+    // slots span more pages than that pays beyond_tlb_per_lane_cycles (ray_buffer_model.h
+    // beyond_tlb_share), hit or miss in the L1D.
+    uint32_t dtlb_pages = 0;
 
     uint32_t bank_kib() const { return banks ? kib / banks : 0; }
 
@@ -146,6 +152,9 @@ struct RayBufferConfig {
                 "arrays a slot's bytes beyond its traversal record are spread over (l1d; sets "
                 "how often a dense stream's lane opens a page of one)",
                 1u, 64u);
+        v.param("dtlb_pages", dtlb_pages, "pages",
+                "4 KiB pages the core's first-level data TLB maps (l1d; 0: not modelled)", 0u,
+                1u << 20);
     }
 };
 
@@ -469,12 +478,14 @@ struct BranchPredictorConfig {
 // cover the rest; the cycle level asks its caches, the fit and the closed form expect it,
 // hw_model/ray_buffer_model.h beyond_cache_share), b2 of them beyond the L2 as well (the same
 // with the L2's size), b1 lanes beyond the L1D that skip lines in a page the lane before opened
-// (their slot's first line beyond the one after the lane before's last), and c
+// (their slot's first line beyond the one after the lane before's last), t lanes that open a
+// page beyond the first-level DTLB's reach (hit or miss in the L1D), and c
 // failing lanes that ran its full test (a triangle test's failed
 // candidates, StreamOp::failed_candidates), costs
 //   per_op + per_group * g + per_lane * n + per_pass * p + per_fail * (n - p)
 //   + per_minority_lane * m + beyond_l1_per_lane * b + beyond_l2_per_lane * b2
-//   + beyond_l1_skipping_per_lane * b1 + per_failed_candidate * c cycles
+//   + beyond_l1_skipping_per_lane * b1 + beyond_tlb_per_lane * t + per_failed_candidate * c
+//   cycles
 // (the minority term: a filter that branches on each lane's outcome pays the branch
 // predictor's misses, m = mispredicted_lanes in hw_model/op_costs.h: on outcomes in no order
 // the lanes of the rarer outcome, min(p, n - p), as in the microbenchmarks, which time
@@ -537,6 +548,19 @@ struct OpCostConfig {
     // the streams of every slot of 4096 5-12 % over and those of 96-512 lanes 2-10 % under,
     // and cornell's and atrium's 64-pixel tiles 2-5 points dearer than the host ran them.
     double beyond_l1_skipping_per_lane_cycles = 0.0;
+    // What a lane that opens a page of its array costs where the pass's slots span more pages
+    // than the first-level DTLB maps (RayBufferConfig::dtlb_pages; the share of the slots beyond
+    // its reach, beyond_tlb_share in hw_model/ray_buffer_model.h), whether or not the L1D holds
+    // its line: fitted with the rest on the microbenchmarks, whose 4096-slot buffers (1.4 MB,
+    // 340 pages) outrun a DTLB of 96 pages and whose smaller ones do not. Since 2026-12-08: on
+    // the Intel Xeon VM of model 0xCF a chase of one line a page took 5 core cycles a load up to
+    // 96 pages and 9-12 beyond (the second-level TLB's hit); without the term the scalar fit
+    // priced 12 of 15 kinds' 4096-slot points under the measured (medians -0.4 to -3.9 %), with
+    // it the medians lie within -1.3 to +1.1 % (the indirect bounce 10.7 cycles a lane, the
+    // camera 7.1). A frame's
+    // dense lanes open few pages: furnace 64 x 64 at tile 64 came out 0.07 points dearer
+    // against tile 16 than without it. 0: not measured.
+    double beyond_tlb_per_lane_cycles = 0.0;
     // The triangle test's: what a candidate that fails its full test (behind the ray's origin,
     // or beyond its hit so far) adds to a lane the float edge stage rejects, which the plain
     // microbenchmark's failing lanes are (its rays start from no hit: nearly every candidate
@@ -712,6 +736,11 @@ struct OpCostConfig {
         v.param("beyond_l1_skipping_per_lane_cycles", beyond_l1_skipping_per_lane_cycles, "cycles",
                 "cost per lane beyond the L1D that skips lines in a page of the array its op "
                 "reads the lane before opened (fitted by sfx calibrate, 0: not measured)",
+                0.0, 1e9);
+        v.param("beyond_tlb_per_lane_cycles", beyond_tlb_per_lane_cycles, "cycles",
+                "cost per lane that opens a page of its array where the pass's slots span more "
+                "pages than the first-level DTLB maps (ray_buffer.dtlb_pages; fitted by sfx "
+                "calibrate, 0: not measured)",
                 0.0, 1e9);
         v.param("per_failed_candidate_cycles", per_failed_candidate_cycles, "cycles",
                 "the triangle test's: extra cost per failing lane that ran the full test (a "

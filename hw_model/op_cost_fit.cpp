@@ -12,7 +12,7 @@ namespace sfx {
 
 double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
                           double beyond_l1, double beyond_l2, double failed_candidates,
-                          double beyond_l1_skipping) {
+                          double beyond_l1_skipping, double beyond_tlb) {
     OpProfile p;
     p.measured = true;
     p.cost = cost;
@@ -26,7 +26,7 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
         left -= pass;
         cycles +=
             p.issue_cycles(datapath, lanes, minority_lanes(passed, lanes), n, pass, first == 0,
-                           beyond_l1, beyond_l2, failed_candidates, beyond_l1_skipping);
+                           beyond_l1, beyond_l2, failed_candidates, beyond_l1_skipping, beyond_tlb);
     }
     return cycles;
 }
@@ -34,13 +34,14 @@ double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lan
 namespace {
 
 // Columns of the cost formula for one sample (per op, group, lane, passing lane, minority
-// lane, beyond L1, beyond L2, beyond L1 skipping lines in an opened page, failing lane). The
+// lane, beyond L1, beyond L2, beyond L1 skipping lines in an opened page, beyond the DTLB,
+// failing lane). The
 // failing lanes' column is last: lanes, passing and failing lanes are dependent, so the solve gives
 // it no pivot and 0 unless the passing lanes' cost would be negative and is dropped (a lane that
 // passes costs less than one that fails: the scalar box test on an Intel Xeon VM, 2026-11-29, 24-27
 // cycles a lane on streams that mostly pass and 38-47 on streams that mostly fail; fitted without
 // it, 17 % median error).
-constexpr int k_terms = 9;
+constexpr int k_terms = 10;
 std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
     return {1.0,
             double(lane_groups(s.lanes, width)),
@@ -50,6 +51,7 @@ std::array<double, k_terms> terms(const OpCostSample& s, uint32_t width) {
             s.beyond_l1 * s.lanes,
             s.beyond_l2 * s.lanes,
             s.beyond_l1_skipping * s.lanes,
+            s.beyond_tlb * s.lanes,
             double(s.lanes - s.passed)};
 }
 
@@ -64,7 +66,8 @@ OpCostConfig from_coefficients(const std::string& op, const std::array<double, k
     c.beyond_l1_per_lane_cycles = x[5];
     c.beyond_l2_per_lane_cycles = x[6];
     c.beyond_l1_skipping_per_lane_cycles = x[7];
-    c.per_fail_cycles = x[8];
+    c.beyond_tlb_per_lane_cycles = x[8];
+    c.per_fail_cycles = x[9];
     return c;
 }
 
@@ -174,14 +177,15 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     // column is told from the lane and pass columns only by streams of many lanes that all
     // pass and that none pass beside mixed ones (the shading filters' and leaf tests'
     // microbenchmarks).
-    bool any_beyond = false, any_beyond_l2 = false, any_skipping = false, any_passed = false,
-         any_failed = false, all_pass = false, none_pass = false, mixed = false;
+    bool any_beyond = false, any_beyond_l2 = false, any_skipping = false, any_tlb = false,
+         any_passed = false, any_failed = false, all_pass = false, none_pass = false, mixed = false;
     std::vector<std::array<double, k_terms>> rows;
     std::vector<double> cycles;
     for (const OpCostSample& s : samples) {
         any_beyond |= s.beyond_l1 > 0;
         any_beyond_l2 |= s.beyond_l2 > 0;
         any_skipping |= s.beyond_l1_skipping > 0;
+        any_tlb |= s.beyond_tlb > 0;
         any_passed |= s.passed > 0;
         any_failed |= s.passed < s.lanes;
         all_pass |= s.lanes >= 8 && s.passed == s.lanes;
@@ -193,9 +197,10 @@ OpCostConfig fit_op_cost(const std::string& op, uint32_t width,
     active[5] = any_beyond;
     active[6] = any_beyond_l2;
     active[7] = any_skipping;
+    active[8] = any_tlb;
     active[4] = all_pass && none_pass && mixed;
     active[3] = any_passed;
-    active[8] = any_passed && any_failed;
+    active[9] = any_passed && any_failed;
     return from_coefficients(op, fit_nonnegative(rows, cycles, active));
 }
 
@@ -300,7 +305,7 @@ double median_extra(const OpCostConfig& base, uint32_t width,
             extra.push_back(
                 (s.cycles - measured_op_cycles(base, width, s.lanes, s.passed, s.beyond_l1,
                                                s.beyond_l2, s.failed_candidates,
-                                               s.beyond_l1_skipping)) /
+                                               s.beyond_l1_skipping, s.beyond_tlb)) /
                 units);
     return extra.empty() ? 0.0 : median(extra);
 }
@@ -359,7 +364,7 @@ std::pair<double, double> fit_error(const OpCostConfig& cost, uint32_t width,
     for (const OpCostSample& s : samples)
         e.push_back(
             std::abs(measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1, s.beyond_l2,
-                                        s.failed_candidates, s.beyond_l1_skipping) -
+                                        s.failed_candidates, s.beyond_l1_skipping, s.beyond_tlb) -
                      s.cycles) /
             std::max(s.cycles, k_fit_resolution_cycles));
     if (e.empty()) return {0.0, 0.0};

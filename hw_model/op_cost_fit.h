@@ -22,12 +22,13 @@ constexpr double k_fit_resolution_cycles = 100.0;
 // An op's measured cost: OpProfile::issue_cycles over its groups (n lanes, p passing, a share
 // `beyond_l1` of the lanes paying for ray slots outside the L1D, beyond_cache_share, and
 // `beyond_l2` for slots outside the L2 as well, `beyond_l1_skipping` outside the L1D skipping lines
-// in a page the lane before opened, beyond_cache_skipping_share; `failed_candidates` of the failing
+// in a page the lane before opened, beyond_cache_skipping_share, `beyond_tlb` opening a page
+// beyond the first-level DTLB's reach, beyond_tlb_share; `failed_candidates` of the failing
 // lanes candidates that ran the full test (0: none; a mean where the ops of a traversal sample are
 // priced by their kind and length); one lane: one_lane_cycles when measured).
 double measured_op_cycles(const OpCostConfig& cost, uint32_t width, uint32_t lanes, uint32_t passed,
                           double beyond_l1, double beyond_l2 = 0.0, double failed_candidates = 0.0,
-                          double beyond_l1_skipping = 0.0);
+                          double beyond_l1_skipping = 0.0, double beyond_tlb = 0.0);
 
 // One microbenchmark run of an op kind: what the cost formula sees, and the cycles measured.
 struct OpCostSample {
@@ -37,6 +38,7 @@ struct OpCostSample {
     uint32_t failed_candidates = 0;  // StreamOp::failed_candidates
     double beyond_l2 = 0.0;          // of the lanes, those beyond the L2 as well
     double beyond_l1_skipping = 0.0;  // beyond the L1D, skipping lines in an opened page
+    double beyond_tlb = 0.0;          // opening a page beyond the first-level DTLB's reach
 };
 
 // Fits an op kind's cost profile to its samples: least squares on relative error, every

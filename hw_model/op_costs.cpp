@@ -268,7 +268,7 @@ ModuloSchedule modulo_schedule(const UnitClassCounts& body, const UnitClassCount
 double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_t op_mispredicted,
                                uint32_t lanes, double passed, bool first, double beyond_l1,
                                double beyond_l2, double op_failed_candidates,
-                               double beyond_l1_skipping) const {
+                               double beyond_l1_skipping, double beyond_tlb) const {
     if (!measured) {
         if (cluster(d)) return double(schedule.ii);
         return programmable(d) ? double(compute_instructions) : double(d.initiation_interval);
@@ -287,6 +287,7 @@ double OpProfile::issue_cycles(const DatapathConfig& d, uint32_t length, uint32_
            cost.beyond_l1_per_lane_cycles * beyond_l1 * lanes +
            cost.beyond_l2_per_lane_cycles * beyond_l2 * lanes +
            cost.beyond_l1_skipping_per_lane_cycles * beyond_l1_skipping * lanes +
+           cost.beyond_tlb_per_lane_cycles * beyond_tlb * lanes +
            cost.per_failed_candidate_cycles * op_failed_candidates * lanes / double(length);
 }
 

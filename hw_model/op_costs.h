@@ -127,7 +127,8 @@ struct OpProfile {
     // of the op's lanes failing candidates (StreamOp::failed_candidates; 0: none, or a mean
     // over ops where the closed form prices a bucket of them), and a share `beyond_l1_skipping`
     // beyond the L1D that skip lines in a page the lane before opened (beyond_cache_skipping_share,
-    // lane_skips_lines). A measured
+    // lane_skips_lines), and a share `beyond_tlb` that open a page beyond the first-level DTLB's
+    // reach (beyond_tlb_share). A measured
     // minority cost and failed candidates' cost are the op's, shared by its groups by lanes (the
     // trace does not say which lanes they are). Fractional for measured costs (the caller carries
     // the remainder); instruction-priced groups cost compute_instructions (programmable), the
@@ -135,7 +136,7 @@ struct OpProfile {
     double issue_cycles(const DatapathConfig& datapath, uint32_t length, uint32_t op_mispredicted,
                         uint32_t lanes, double passed, bool first, double beyond_l1,
                         double beyond_l2 = 0.0, double op_failed_candidates = 0.0,
-                        double beyond_l1_skipping = 0.0) const;
+                        double beyond_l1_skipping = 0.0, double beyond_tlb = 0.0) const;
     // Cycles an op adds on its first group when it enters the traversal's one-ray or few-ray
     // loop from the stream loop (TraversalLoop, kernels/trace.h): a measured box test's loop
     // entry cost; 0 for any other op or loop.

@@ -138,6 +138,17 @@ double beyond_cache_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, u
            expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
 }
 
+double beyond_tlb_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t dtlb_pages) {
+    return dtlb_pages == 0 ? 0.0 : beyond_cache_fraction(slots, slot_bytes, dtlb_pages * 4);
+}
+
+double beyond_tlb_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                        uint32_t dtlb_pages) {
+    if (lanes == 0) return 0.0;
+    return beyond_tlb_fraction(slots, slot_bytes, dtlb_pages) *
+           expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
+}
+
 double expected_lanes_skipping_lines(uint32_t lanes, uint32_t slots, uint32_t lane_bytes) {
     lanes = std::min(lanes, slots);
     if (lanes < 2 || lane_bytes == 0) return 0.0;

@@ -191,6 +191,17 @@ double expected_lanes_skipping_lines(uint32_t lanes, uint32_t slots, uint32_t la
 // opened (beyond_cache_fraction's lanes: beyond_l1_skipping_per_lane_cycles).
 double beyond_cache_skipping_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes,
                                    uint32_t lane_bytes, uint32_t cache_kib);
+// The share of a pass's `slots` slots (of `slot_bytes` each, every array of the buffer) beyond
+// the reach of a first-level DTLB of `dtlb_pages` 4 KiB pages, as beyond_cache_fraction prices a
+// cache of that size: a lane that opens a page of its array there misses the DTLB whether or
+// not the L1D holds its line (RayBufferConfig::dtlb_pages; 0: none beyond).
+double beyond_tlb_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t dtlb_pages);
+// A random stream's share of lanes that open a page beyond that reach, as the op costs' fit
+// prices its microbenchmarks (beyond_tlb_per_lane_cycles): the expected lanes opening a page
+// of an array of `lane_bytes` a slot (lane_page_bytes) times beyond_tlb_fraction. The cycle
+// level counts the lanes that open a page instead (CoreModel::touch_ray_lines).
+double beyond_tlb_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
+                        uint32_t dtlb_pages);
 // A slot's bytes in a configuration's buffer: ray_buffer.slot_bytes (the native tracer's, on
 // a host), else the scene's ray record (`record_bytes`).
 uint32_t slot_bytes_of(const RayBufferConfig& buffer, uint32_t record_bytes);

@@ -57,7 +57,8 @@ bool one_lane_from_filters(OpKind kind) {
 }  // namespace
 
 LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slots,
-                                      const std::vector<HostCacheLevel>& caches) {
+                                      const std::vector<HostCacheLevel>& caches,
+                                      uint32_t dtlb_pages) {
     const uint32_t lane_bytes =
         lane_page_bytes(stage_of(kind), stream_slot_bytes(), stream_slot_arrays());
     // Without a described L1D, one of 32 KiB.
@@ -66,7 +67,8 @@ LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slot
             caches.size() > 1
                 ? beyond_cache_share(lanes, slots, stream_slot_bytes(), lane_bytes, caches[1].kib)
                 : 0.0,
-            beyond_cache_skipping_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib)};
+            beyond_cache_skipping_share(lanes, slots, stream_slot_bytes(), lane_bytes, l1_kib),
+            beyond_tlb_share(lanes, slots, stream_slot_bytes(), lane_bytes, dtlb_pages)};
 }
 
 bool microbenchmarks_reach_beyond_l2(const std::vector<uint32_t>& buffer_slots,
@@ -81,7 +83,8 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                     const std::vector<OpCostConfig>& costs,
                                                     uint32_t width,
                                                     const std::vector<HostCacheLevel>& caches,
-                                                    const BranchPredictorConfig& predictor) {
+                                                    const BranchPredictorConfig& predictor,
+                                                    uint32_t dtlb_pages) {
     std::array<const OpCostConfig*, k_op_kind_count> cost_of{};
     for (const OpCostConfig& o : costs)
         if (const OpKind kind = op_kind_named(o.op); kind != OpKind::count)
@@ -119,13 +122,14 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                 priced.per_op_cycles = 0.0;
                 sample.stream_ops[size_t(o.kind)] += o.count;
             }
-            const LanesBeyondCaches beyond = lanes_beyond_caches(o.kind, o.lanes, s.slots, caches);
+            const LanesBeyondCaches beyond =
+                lanes_beyond_caches(o.kind, o.lanes, s.slots, caches, dtlb_pages);
             (o.kind == OpKind::box_test ? sample.stream_op_cycles : sample.leaf_op_cycles) +=
                 double(o.count) *
                 measured_op_cycles(
                     priced, width, o.lanes,
                     uint32_t(std::lround(double(o.passed) / double(o.count))), beyond.l1, beyond.l2,
-                    double(o.failed_candidates) / double(o.count), beyond.l1_skipping);
+                    double(o.failed_candidates) / double(o.count), beyond.l1_skipping, beyond.tlb);
         }
         sample.stream_op_cycles += sample.leaf_op_cycles;
         sample.leaf_cycles_clocked = s.leaf_share * s.cycles;
@@ -426,7 +430,7 @@ std::vector<double> fit_residuals_by(const OpCostConfig& cost, uint32_t width,
             const OpCostSample& s = samples[i];
             const double priced =
                 measured_op_cycles(cost, width, s.lanes, s.passed, s.beyond_l1, s.beyond_l2,
-                                   s.failed_candidates, s.beyond_l1_skipping);
+                                   s.failed_candidates, s.beyond_l1_skipping, s.beyond_tlb);
             // A measurement under the clock's steps counts as those, as in fit_error.
             errors.push_back((priced - s.cycles) / std::max(s.cycles, k_fit_resolution_cycles));
         }
@@ -476,10 +480,10 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
             continue;
         }
         const LanesBeyondCaches beyond =
-            lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches);
+            lanes_beyond_caches(s.kind, s.lanes, s.slots, c.host.caches, c.host.dtlb.pages);
         const OpCostSample sample{
-            s.lanes,   s.passed,          beyond.l1, s.cycles, s.failed_candidates,
-            beyond.l2, beyond.l1_skipping};
+            s.lanes,   s.passed,           beyond.l1, s.cycles, s.failed_candidates,
+            beyond.l2, beyond.l1_skipping, beyond.tlb};
         std::vector<OpCostSample>* variant = s.thin_lens            ? &lens_camera
                                              : s.sphere_light       ? &sphere_light
                                              : s.failing_candidates ? &failing_candidates
@@ -613,8 +617,9 @@ HostCalibration calibrate_host(Isa isa, const ConvergenceRule& convergence,
         });
     for (const OneRaySample& s : c.one_ray_samples) c.converged_points += s.converged;
     c.points += uint32_t(c.one_ray_samples.size());
-    c.short_stream_samples = short_stream_fit_samples(
-        c.one_ray_samples, c.op_costs, c.host.simd_width, c.host.caches, c.host.branch_predictor);
+    c.short_stream_samples =
+        short_stream_fit_samples(c.one_ray_samples, c.op_costs, c.host.simd_width, c.host.caches,
+                                 c.host.branch_predictor, c.host.dtlb.pages);
     c.short_stream_costs = fit_short_stream_cycles(c.short_stream_samples,
                                                    few_ray_from ? &few_ray_from->costs : nullptr);
     c.short_stream_fit_errors =

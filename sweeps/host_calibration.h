@@ -168,7 +168,8 @@ struct HostCalibration {
 // The traversal samples as the one- and few-lane fit sees them (fit_short_stream_cycles): each
 // sample's other ops (its leaves' tests, and its stream-loop box tests' lanes) priced by
 // `costs`, the stream formula of a back end of `width` lanes, over the sample's buffer (its
-// slots, the native slot size) beside the host's `caches` (its L1D and L2: lanes_beyond_caches);
+// slots, the native slot size) beside the host's `caches` (its L1D and L2) and DTLB of
+// `dtlb_pages` (lanes_beyond_caches);
 // and the model's mispredictions on
 // its batch (OneRaySample::modelled_mispredictions) as `predictor` prices them (a box test's
 // by its loop), which the model adds to every traversal it times, so that the fitted costs do
@@ -177,18 +178,22 @@ std::vector<OneLaneSample> short_stream_fit_samples(const std::vector<OneRaySamp
                                                     const std::vector<OpCostConfig>& costs,
                                                     uint32_t width,
                                                     const std::vector<HostCacheLevel>& caches,
-                                                    const BranchPredictorConfig& predictor = {});
+                                                    const BranchPredictorConfig& predictor = {},
+                                                    uint32_t dtlb_pages = 0);
 
 // The shares of a microbenchmark stream's `lanes` lanes of `kind` over `slots` slots of the native
 // tracer's buffers that pay for ray data beyond the L1D and beyond the L2 as well
 // (beyond_cache_share with the first and the second of the host's `caches`; none beyond the
-// L2 where it has one level).
+// L2 where it has one level), and that open a page beyond the reach of a first-level DTLB of
+// `dtlb_pages` pages (beyond_tlb_share; 0: none).
 struct LanesBeyondCaches {
     double l1 = 0.0, l2 = 0.0;
     double l1_skipping = 0.0;  // beyond the L1D, skipping lines in a page the lane before opened
+    double tlb = 0.0;          // opening a page beyond the DTLB's reach
 };
 LanesBeyondCaches lanes_beyond_caches(OpKind kind, uint32_t lanes, uint32_t slots,
-                                      const std::vector<HostCacheLevel>& caches);
+                                      const std::vector<HostCacheLevel>& caches,
+                                      uint32_t dtlb_pages = 0);
 
 // Whether any of the microbenchmarks' ray buffers of `buffer_slots` slots lies partly beyond
 // the L2 of `caches` (beyond_cache_fraction, whose share lanes_beyond_caches prices; false

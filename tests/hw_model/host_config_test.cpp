@@ -498,6 +498,26 @@ TEST_CASE("The fit recovers costs from exact samples and never goes negative", "
     CHECK(fit_error(dense_fit, 16, dense).second < 1e-9);
     // Without such lanes the term is not measured: 0.
     CHECK(level_fit.beyond_l1_skipping_per_lane_cycles == 0.0);
+    CHECK(level_fit.beyond_tlb_per_lane_cycles == 0.0);
+
+    // Lanes that open a page beyond the DTLB's reach (the biggest buffers' lanes, in the L1D or
+    // not) tell their cost from a lane beyond the L1D's.
+    OpCostConfig paged = truth;
+    paged.beyond_tlb_per_lane_cycles = 7;
+    std::vector<OpCostSample> pages;
+    for (uint32_t lanes : {1u, 7u, 16u, 33u, 100u, 512u, 4096u})
+        for (const auto& [l1, tlb] : {std::pair{0.0, 0.0}, {0.5, 0.0}, {0.9, 0.6}, {0.1, 0.3}})
+            for (uint32_t passed : {0u, lanes / 3}) {
+                OpCostSample s{
+                    lanes, passed, l1,
+                    measured_op_cycles(paged, 16, lanes, passed, l1, 0.0, 0.0, 0.0, tlb)};
+                s.beyond_tlb = tlb;
+                pages.push_back(s);
+            }
+    const OpCostConfig page_fit = fit_op_cost("triangle_test", 16, pages);
+    CHECK(page_fit.beyond_l1_per_lane_cycles == Approx(3).epsilon(1e-6));
+    CHECK(page_fit.beyond_tlb_per_lane_cycles == Approx(7).epsilon(1e-6));
+    CHECK(fit_error(page_fit, 16, pages).second < 1e-9);
 
     // A lane that passes costs less than one that fails (the scalar box test): the passing
     // lanes' cost would be negative, so the failing lanes' column takes it.
@@ -1033,6 +1053,36 @@ TEST_CASE("A lane beyond the L2 as well pays for both levels where it opens a pa
     CHECK(passes(128) == 2 * 256 + 16 * (8 + 5) + 16 * 8);
 }
 
+TEST_CASE("A lane that opens a page beyond the DTLB's reach pays for it, in the L1D or not",
+          "[host][systemc]") {
+    // The box tests above (1024 records in 16 pages, 4 cycles a group, 64 groups) in passes of
+    // 1024 slots of 330 bytes (330 KiB), 10 cycles a lane that opens a page beyond a DTLB of
+    // `dtlb_pages`: of 16 pages, 64 KiB of the 330 are in its reach, and 16 lanes open a page.
+    auto passes = [](uint32_t l1d_kib, uint32_t dtlb_pages) {
+        OpCostConfig box = cost("box_test", 0, 4, 0, 0, 8);
+        box.beyond_tlb_per_lane_cycles = 10;
+        HwConfig host = host_with({box});
+        host.scene_memory.caches[0].kib = l1d_kib;
+        host.ray_buffer.slot_bytes = 330;
+        host.ray_buffer.dtlb_pages = dtlb_pages;
+        return time_boxes(host, 2, 1024, 1024).stages[0][size_t(OpStage::traversal)].busy_cycles;
+    };
+    const double beyond = 1.0 - 64.0 / 330.0;
+    CHECK(beyond_tlb_fraction(1024, 330, 16) == Approx(beyond));
+    // Not modelled, or a reach over the pass's 330 KiB: the L1D's terms alone (128 KiB holds
+    // the records after the first pass).
+    CHECK(passes(128, 0) == 2 * 256 + 128);
+    CHECK(passes(128, 128) == 2 * 256 + 128);
+    // Beyond it, both passes pay for their 16 lanes, though the L1D holds the second's lines.
+    CHECK(double(passes(128, 16)) == Approx(2 * 256 + 128 + 2 * 16 * 10 * beyond).margin(1));
+    CHECK(double(passes(32, 16)) == Approx(2 * (256 + 128) + 2 * 16 * 10 * beyond).margin(1));
+    // The fit's share of a random stream: the lanes expected to open a page, times that share.
+    CHECK(beyond_tlb_share(100, 1024, 330, 48, 16) ==
+          Approx(beyond * expected_lanes_opening_pages(100, 1024, 48) / 100));
+    CHECK(beyond_tlb_share(100, 1024, 330, 48, 0) == 0.0);
+    CHECK(beyond_tlb_share(100, 256, 330, 48, 96) == 0.0);  // 83 KiB: within 96 pages
+}
+
 TEST_CASE("The set-up of the rays an op makes leaves their traversal records in the caches",
           "[host][systemc]") {
     // A shading op over slots 0-1023, then a box test over them (their records: 16 pages of
@@ -1090,6 +1140,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     OpCostConfig box = cost("box_test", 1, 2, 3, 4, 5);
     box.beyond_l2_per_lane_cycles = 6.5;
     box.beyond_l1_skipping_per_lane_cycles = 0.75;
+    box.beyond_tlb_per_lane_cycles = 2.25;
     box.one_lane_cycles = 6;
     box.few_lane_cycles = 4.5;
     box.per_minority_lane_cycles = 7;
@@ -1100,6 +1151,7 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     box.node_read_exposed_share = 0.375;
     HostDescription host = small_host();
     host.slot_arrays = 7;
+    host.dtlb = {{{8, 3.9}, {96, 3.9}, {104, 7.4}, {112, 9.1}}, 96};
     host.caches.push_back({3, "unified", 32768, 64, 16, true, "test"});
     host.latency_ns = {1.0, 5.0, 15.5, 81.0};
     host.last_level_chases = {{512, 15.5}, {1024, 16.0}, {2048, 98.4}, {4096, 130.5}};
@@ -1150,6 +1202,9 @@ TEST_CASE("host.hw.yaml reads back with its host knobs", "[host]") {
     CHECK(c.op_costs[0].beyond_l1_per_lane_cycles == Approx(5));
     CHECK(c.op_costs[0].beyond_l2_per_lane_cycles == Approx(6.5));
     CHECK(c.op_costs[0].beyond_l1_skipping_per_lane_cycles == Approx(0.75));
+    CHECK(c.op_costs[0].beyond_tlb_per_lane_cycles == Approx(2.25));
+    CHECK(c.ray_buffer.dtlb_pages == 96);
+    CHECK(yaml.find("3.9 TSC ticks a load at 8 pages, 3.9 at 96, 7.4 at 104") != std::string::npos);
     CHECK(c.op_costs[0].one_lane_cycles == Approx(6));
     CHECK(c.op_costs[0].few_lane_cycles == Approx(4.5));
     CHECK(c.op_costs[0].per_minority_lane_cycles == Approx(7));
@@ -1380,6 +1435,23 @@ TEST_CASE("DRAM's latency is measured by span, from the first pass after the cac
     const double ns = measure_dram_first_pass_ns(uint64_t(2) << 20, tsc_mhz, 1);
     CHECK(ns > 20.0);
     CHECK(ns < 5000.0);
+}
+
+TEST_CASE("The DTLB's reach is where a chase of one line a page steps up for good", "[host]") {
+    // A step at 104 pages; a lone slow count before it (a descheduled run) is not one.
+    CHECK(dtlb_reach(
+              {{8, 3.9}, {16, 3.9}, {24, 6.0}, {32, 3.9}, {96, 4.0}, {104, 7.4}, {112, 9.1}}) ==
+          96);
+    CHECK(dtlb_reach({{8, 3.9}, {16, 4.1}, {512, 4.2}}) == 0);  // no step
+    CHECK(dtlb_reach({}) == 0);
+    // On this host: 8 to 256 pages by 8, each a load's ticks; a reach, if any, among them.
+    const DtlbReading r = measure_dtlb_pages(256);
+    REQUIRE(r.chases.size() == 32);
+    CHECK(r.chases.front().first == 8);
+    CHECK(r.chases.back().first == 256);
+    for (const auto& [pages, ticks] : r.chases) CHECK(ticks > 0.0);
+    CHECK(r.pages == dtlb_reach(r.chases));
+    CHECK(r.pages < 256);
 }
 
 TEST_CASE("A stream's lanes pay for slots beyond the L1D only where they open a page", "[host]") {
