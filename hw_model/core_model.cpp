@@ -130,6 +130,7 @@ void CoreModel::touch_ray_lines(uint32_t index, const StreamOp& op, uint64_t now
     // beyond_l2_per_lane_cycles as well where the second level did not hold one either (the
     // prefetchers bring the rest of a page's ascending lines: k_prefetch_page_bytes; a slot's
     // arrays: lane_page_bytes), and beyond_l1_skipping_per_lane_cycles where the first level
+    // did not hold it in a page the lane before opened and it skips lines past the lane
     // before's (lane_skips_lines: a next-line prefetch does not bring them); and, where it opens
     // a page at all, beyond_tlb_per_lane_cycles for the pass's share of slots beyond the DTLB's
     // reach (m_beyond_tlb, the fit's beyond_tlb_share); counted per group. The
