@@ -144,9 +144,11 @@ double beyond_tlb_fraction(uint32_t slots, uint32_t slot_bytes, uint32_t dtlb_pa
 
 double beyond_tlb_share(uint32_t lanes, uint32_t slots, uint32_t slot_bytes, uint32_t lane_bytes,
                         uint32_t dtlb_pages) {
-    if (lanes == 0) return 0.0;
-    return beyond_tlb_fraction(slots, slot_bytes, dtlb_pages) *
-           expected_lanes_opening_pages(lanes, slots, lane_bytes) / double(std::min(lanes, slots));
+    // A cache of the reach's size would put the same lanes beyond it (0 pages: none, where a
+    // cache of 0 KiB would put them all).
+    return dtlb_pages == 0
+               ? 0.0
+               : beyond_cache_share(lanes, slots, slot_bytes, lane_bytes, dtlb_pages * 4);
 }
 
 double expected_lanes_skipping_lines(uint32_t lanes, uint32_t slots, uint32_t lane_bytes) {
